@@ -1,0 +1,26 @@
+#pragma once
+// The subcommands of the vitri CLI. Each takes the arguments after its name and returns the exit code.
+// A command throws vitri::Error (or std::exception) on bad input; main() prints it and returns 1.
+
+#include <string>
+#include <vector>
+
+namespace vitri::cli {
+
+using Args = std::vector<std::string>;
+
+/// One subcommand: its name, a one-line summary, its usage text and its entry point.
+struct Command {
+  const char* name;
+  const char* summary;
+  const char* usage;
+  int (*run)(const Args& args);
+};
+
+/// All subcommands, in the order `vitri --help` lists them (defined in main.cpp).
+const std::vector<Command>& commands();
+
+/// True when args holds -h or --help.
+bool wants_help(const Args& args);
+
+}  // namespace vitri::cli

@@ -1,0 +1,56 @@
+// vitri: command-line entry point. `vitri COMMAND [ARGS...]`; `vitri --help` lists the commands.
+#include "commands.hpp"
+#include "vitri/core/error.hpp"
+
+#include <cstdio>
+#include <exception>
+#include <iostream>
+#include <string>
+
+namespace vitri::cli {
+
+// Each subcommand lives in its own cmd_*.cpp; declare it here and add it to the table below.
+const std::vector<Command>& commands() {
+  static const std::vector<Command> table = {
+  };
+  return table;
+}
+
+}  // namespace vitri::cli
+
+namespace {
+
+void print_help() {
+  std::cout << "vitri: dynamic triangulation of variational implicit surfaces\n\n"
+               "usage: vitri COMMAND [ARGS...]\n       vitri COMMAND --help\n\ncommands:\n";
+  for (const auto& c : vitri::cli::commands()) std::cout << "  " << c.name << "\t" << c.summary << "\n";
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 2 || std::string(argv[1]) == "-h" || std::string(argv[1]) == "--help") {
+    print_help();
+    return argc < 2 ? 2 : 0;
+  }
+  const std::string name = argv[1];
+  vitri::cli::Args args(argv + 2, argv + argc);
+  for (const auto& c : vitri::cli::commands()) {
+    if (name != c.name) continue;
+    if (vitri::cli::wants_help(args)) {
+      std::cout << c.usage;
+      return 0;
+    }
+    try {
+      return c.run(args);
+    } catch (const vitri::Error& e) {
+      std::cerr << "vitri " << name << ": error: " << e.what() << "\n";
+      return 1;
+    } catch (const std::exception& e) {
+      std::cerr << "vitri " << name << ": internal error: " << e.what() << "\n";
+      return 3;
+    }
+  }
+  std::cerr << "vitri: unknown command '" << name << "' (try vitri --help)\n";
+  return 2;
+}

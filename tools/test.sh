@@ -1,0 +1,12 @@
+#!/usr/bin/env bash
+# Builds vitri with AddressSanitizer + UndefinedBehaviorSanitizer and runs the whole test suite.
+# Usage: bash tools/test.sh   (build tree: build-test/)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/deps.sh cmake make g++ libeigen3-dev catch2
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVITRI_SANITIZE=address,undefined \
+      -DVITRI_BUILD_BENCH=OFF -DVITRI_WERROR=ON
+cmake --build build-test -j"$jobs"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --test-dir build-test --output-on-failure -j"$jobs"

@@ -1,0 +1,355 @@
+// Tests of vitri/polygonize/mesh_metrics.hpp: exact counts on meshes built by hand whose topology is
+// known (tetrahedron, cube, torus, open box, bowtie, flipped faces, degenerate triangles).
+#include "vitri/polygonize/mesh_metrics.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace {
+
+using vitri::compute_mesh_metrics;
+using vitri::MeshMetrics;
+
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::MatrixXd rows(const std::vector<std::array<double, 3>>& v) {
+  Eigen::MatrixXd M(static_cast<Eigen::Index>(v.size()), 3);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    for (int c = 0; c < 3; ++c) M(static_cast<Eigen::Index>(i), c) = v[i][static_cast<std::size_t>(c)];
+  return M;
+}
+
+Eigen::MatrixXi tris(const std::vector<std::array<int, 3>>& f) {
+  Eigen::MatrixXi M(static_cast<Eigen::Index>(f.size()), 3);
+  for (std::size_t i = 0; i < f.size(); ++i)
+    for (int c = 0; c < 3; ++c) M(static_cast<Eigen::Index>(i), c) = f[i][static_cast<std::size_t>(c)];
+  return M;
+}
+
+// Positively oriented unit tetrahedron; faces counter-clockwise seen from outside.
+Eigen::MatrixXd tet_V() { return rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}}); }
+Eigen::MatrixXi tet_F() { return tris({{0, 2, 1}, {1, 2, 3}, {0, 3, 2}, {0, 1, 3}}); }
+
+// Cube [0, 2]^3, corner index x + 2y + 4z, each face split along its diagonal from the first corner.
+Eigen::MatrixXd cube_V() {
+  std::vector<std::array<double, 3>> v;
+  for (int c = 0; c < 8; ++c) v.push_back({2.0 * (c & 1), 2.0 * ((c >> 1) & 1), 2.0 * ((c >> 2) & 1)});
+  return rows(v);
+}
+std::vector<std::array<int, 3>> cube_faces() {
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4}, {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  std::vector<std::array<int, 3>> f;
+  for (const auto& q : quads) {
+    f.push_back({q[0], q[1], q[2]});
+    f.push_back({q[0], q[2], q[3]});
+  }
+  return f;
+}
+
+// Torus (R, r) sampled on an n x m parameter grid, each quad split in two, outward.
+void torus(int n, int m, double R, double r, Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+  V.resize(n * m, 3);
+  F.resize(2 * n * m, 3);
+  auto id = [&](int i, int j) { return ((i + n) % n) * m + (j + m) % m; };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < m; ++j) {
+      const double u = 2 * kPi * i / n, w = 2 * kPi * j / m;
+      V.row(id(i, j)) << (R + r * std::cos(w)) * std::cos(u), (R + r * std::cos(w)) * std::sin(u), r * std::sin(w);
+      // u goes around the z axis, w around the tube: (d/du x d/dw) points outward.
+      F.row(2 * id(i, j)) << id(i, j), id(i + 1, j), id(i + 1, j + 1);
+      F.row(2 * id(i, j) + 1) << id(i, j), id(i + 1, j + 1), id(i, j + 1);
+    }
+}
+
+}  // namespace
+
+TEST_CASE("mesh_metrics: tetrahedron", "[mesh_metrics]") {
+  const MeshMetrics m = compute_mesh_metrics(tet_V(), tet_F());
+  CHECK(m.vertices == 4);
+  CHECK(m.triangles == 4);
+  CHECK(m.edges == 6);
+  CHECK(m.boundary_edges == 0);
+  CHECK(m.non_manifold_edges == 0);
+  CHECK(m.inconsistent_edges == 0);
+  CHECK(m.non_manifold_vertices == 0);
+  CHECK(m.components == 1);
+  CHECK(m.euler_characteristic == 2);
+  CHECK(m.isolated_vertices == 0);
+  CHECK(m.duplicate_vertices == 0);
+  CHECK(m.zero_area_triangles == 0);
+  CHECK(m.watertight());
+  CHECK(m.consistently_oriented());
+  CHECK(m.manifold());
+  CHECK(m.closed_manifold());
+  CHECK(m.signed_volume == Approx(1.0 / 6.0).epsilon(1e-14));
+  CHECK(m.area == Approx(1.5 + std::sqrt(3.0) / 2.0).epsilon(1e-14));
+  // Three right isosceles faces (45, 45, 90) and one equilateral face (60).
+  CHECK(m.min_angle == Approx(45.0).epsilon(1e-12));
+  CHECK(m.max_angle == Approx(90.0).epsilon(1e-12));
+  CHECK(m.mean_min_angle == Approx((3 * 45.0 + 60.0) / 4.0).epsilon(1e-12));
+  CHECK(m.share_below_10 == 0.0);
+  CHECK(m.share_below_20 == 0.0);
+  REQUIRE(m.min_angle_histogram.size() == 12);  // 5-degree bins over [0, 60]
+  CHECK(m.min_angle_histogram[9] == 3);         // [45, 50)
+  CHECK(m.min_angle_histogram[11] == 1);        // [55, 60]
+  std::size_t total = 0;
+  for (const auto c : m.min_angle_histogram) total += c;
+  CHECK(total == 4);
+}
+
+TEST_CASE("mesh_metrics: cube", "[mesh_metrics]") {
+  const MeshMetrics m = compute_mesh_metrics(cube_V(), tris(cube_faces()));
+  CHECK(m.vertices == 8);
+  CHECK(m.triangles == 12);
+  CHECK(m.edges == 18);
+  CHECK(m.euler_characteristic == 2);
+  CHECK(m.components == 1);
+  CHECK(m.closed_manifold());
+  CHECK(m.signed_volume == Approx(8.0).epsilon(1e-14));
+  CHECK(m.area == Approx(24.0).epsilon(1e-14));
+  CHECK(m.min_angle == Approx(45.0).epsilon(1e-12));
+  CHECK(m.max_angle == Approx(90.0).epsilon(1e-12));
+
+  SECTION("translation changes neither volume nor topology") {
+    Eigen::MatrixXd V = cube_V();
+    V.rowwise() += Eigen::RowVector3d(1e3, -7.0, 0.5);
+    const MeshMetrics t = compute_mesh_metrics(V, tris(cube_faces()));
+    CHECK(t.signed_volume == Approx(8.0).epsilon(1e-12));
+    CHECK(t.closed_manifold());
+  }
+  SECTION("all faces reversed: consistent but inward") {
+    auto f = cube_faces();
+    for (auto& t : f) std::swap(t[1], t[2]);
+    const MeshMetrics r = compute_mesh_metrics(cube_V(), tris(f));
+    CHECK(r.consistently_oriented());
+    CHECK(r.watertight());
+    CHECK(r.signed_volume == Approx(-8.0).epsilon(1e-14));
+  }
+}
+
+TEST_CASE("mesh_metrics: torus has Euler characteristic 0", "[mesh_metrics]") {
+  for (const auto& [n, m] : {std::pair{3, 3}, std::pair{8, 6}, std::pair{40, 20}}) {
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    const double R = 2.0, r = 0.5;
+    torus(n, m, R, r, V, F);
+    const MeshMetrics mm = compute_mesh_metrics(V, F);
+    INFO("grid " << n << " x " << m);
+    CHECK(mm.vertices == static_cast<std::size_t>(n * m));
+    CHECK(mm.edges == static_cast<std::size_t>(3 * n * m));
+    CHECK(mm.triangles == static_cast<std::size_t>(2 * n * m));
+    CHECK(mm.euler_characteristic == 0);
+    CHECK(mm.components == 1);
+    CHECK(mm.closed_manifold());
+    // An inscribed polyhedron: positive, below the true volume 2 pi^2 R r^2.
+    const double exact = 2 * kPi * kPi * R * r * r;
+    CHECK(mm.signed_volume > 0.0);
+    CHECK(mm.signed_volume < exact);
+    if (n == 40) CHECK(mm.signed_volume > 0.97 * exact);
+  }
+}
+
+TEST_CASE("mesh_metrics: open box (one face removed)", "[mesh_metrics]") {
+  auto f = cube_faces();
+  f.erase(f.begin(), f.begin() + 2);  // the bottom face z = 0
+  const MeshMetrics m = compute_mesh_metrics(cube_V(), tris(f));
+  CHECK(m.edges == 17);
+  CHECK(m.boundary_edges == 4);
+  CHECK(m.non_manifold_edges == 0);
+  CHECK(m.non_manifold_vertices == 0);  // border vertices are half-discs: still manifold
+  CHECK(m.euler_characteristic == 1);   // a disc
+  CHECK_FALSE(m.watertight());
+  CHECK(m.manifold());
+  CHECK(m.consistently_oriented());
+  CHECK_FALSE(m.closed_manifold());
+
+  SECTION("single triangle") {
+    const MeshMetrics s = compute_mesh_metrics(tet_V(), tris({{0, 1, 2}}));
+    CHECK(s.boundary_edges == 3);
+    CHECK(s.isolated_vertices == 1);
+    CHECK(s.euler_characteristic == 1);
+    CHECK(s.components == 1);
+  }
+}
+
+TEST_CASE("mesh_metrics: non-manifold configurations", "[mesh_metrics]") {
+  SECTION("bowtie: two triangles sharing one vertex") {
+    const auto V = rows({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}});
+    const MeshMetrics m = compute_mesh_metrics(V, tris({{0, 1, 2}, {0, 3, 4}}));
+    CHECK(m.non_manifold_vertices == 1);
+    CHECK(m.non_manifold_edges == 0);
+    CHECK(m.boundary_edges == 6);
+    CHECK(m.components == 1);
+    CHECK(m.euler_characteristic == 1);
+    CHECK_FALSE(m.manifold());
+  }
+  SECTION("two tetrahedra touching at a vertex: closed but pinched") {
+    Eigen::MatrixXd V(7, 3);
+    V.topRows(4) = tet_V();
+    V.bottomRows(3) = -tet_V().bottomRows(3);  // mirror image through vertex 0
+    Eigen::MatrixXi F(8, 3);
+    F.topRows(4) = tet_F();
+    // The mirrored tetrahedron (0, 4, 5, 6) is negatively oriented: reverse the faces to stay outward.
+    F.bottomRows(4) << 0, 4, 5, 4, 6, 5, 0, 5, 6, 0, 6, 4;
+    const MeshMetrics m = compute_mesh_metrics(V, F);
+    CHECK(m.watertight());
+    CHECK(m.consistently_oriented());
+    CHECK(m.non_manifold_vertices == 1);
+    CHECK_FALSE(m.manifold());
+    CHECK_FALSE(m.closed_manifold());
+    CHECK(m.components == 1);
+    CHECK(m.euler_characteristic == 3);  // 7 - 12 + 8
+    CHECK(m.signed_volume == Approx(2.0 / 6.0).epsilon(1e-14));
+  }
+  SECTION("three triangles on one edge") {
+    const auto V = rows({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}});
+    const MeshMetrics m = compute_mesh_metrics(V, tris({{0, 1, 2}, {1, 0, 3}, {0, 1, 4}}));
+    CHECK(m.non_manifold_edges == 1);
+    CHECK(m.boundary_edges == 6);
+    CHECK(m.edges == 7);
+    CHECK_FALSE(m.manifold());
+    CHECK_FALSE(m.watertight());
+  }
+  SECTION("two separate tetrahedra: two components") {
+    Eigen::MatrixXd V(8, 3);
+    V.topRows(4) = tet_V();
+    V.bottomRows(4) = tet_V().rowwise() + Eigen::RowVector3d(5, 0, 0);
+    Eigen::MatrixXi F(8, 3);
+    F.topRows(4) = tet_F();
+    F.bottomRows(4) = tet_F().array() + 4;
+    const MeshMetrics m = compute_mesh_metrics(V, F);
+    CHECK(m.components == 2);
+    CHECK(m.euler_characteristic == 4);
+    CHECK(m.closed_manifold());
+  }
+}
+
+TEST_CASE("mesh_metrics: flipped triangles", "[mesh_metrics]") {
+  SECTION("one face of the tetrahedron flipped") {
+    Eigen::MatrixXi F = tet_F();
+    std::swap(F(1, 1), F(1, 2));
+    const MeshMetrics m = compute_mesh_metrics(tet_V(), F);
+    CHECK(m.watertight());
+    CHECK(m.inconsistent_edges == 3);  // the three edges of the flipped face
+    CHECK_FALSE(m.consistently_oriented());
+    CHECK_FALSE(m.closed_manifold());
+    CHECK(m.euler_characteristic == 2);
+  }
+  SECTION("two cube triangles flipped") {
+    auto f = cube_faces();
+    std::swap(f[0][1], f[0][2]);
+    std::swap(f[3][1], f[3][2]);  // a top triangle: no edge in common with triangle 0
+    const MeshMetrics m = compute_mesh_metrics(cube_V(), tris(f));
+    CHECK(m.inconsistent_edges == 6);
+    CHECK(m.watertight());
+  }
+}
+
+TEST_CASE("mesh_metrics: duplicates and zero-area triangles", "[mesh_metrics]") {
+  SECTION("exact duplicate vertex (unreferenced)") {
+    Eigen::MatrixXd V(5, 3);
+    V.topRows(4) = tet_V();
+    V.row(4) = V.row(2);
+    const MeshMetrics m = compute_mesh_metrics(V, tet_F());
+    CHECK(m.duplicate_vertices == 1);
+    CHECK(m.isolated_vertices == 1);
+    CHECK(m.euler_characteristic == 2);  // isolated vertices do not count
+    CHECK_FALSE(m.closed_manifold());
+  }
+  SECTION("near duplicate: only with a tolerance") {
+    Eigen::MatrixXd V(5, 3);
+    V.topRows(4) = tet_V();
+    V.row(4) = V.row(3) + Eigen::RowVector3d(1e-9, 0, -1e-9);
+    CHECK(compute_mesh_metrics(V, tet_F()).duplicate_vertices == 0);
+    vitri::MeshMetricsOptions o;
+    o.duplicate_tolerance = 1e-6;
+    CHECK(compute_mesh_metrics(V, tet_F(), o).duplicate_vertices == 1);
+    o.duplicate_tolerance = 1e-10;
+    CHECK(compute_mesh_metrics(V, tet_F(), o).duplicate_vertices == 0);
+  }
+  SECTION("collinear, coincident and index-degenerate triangles") {
+    const auto V = rows({{0, 0, 0}, {0.1, 0.2, 0.3}, {0.2, 0.4, 0.6}, {1, 1, 1}, {1, 1, 1}, {0.3, 0, 0}});
+    const MeshMetrics m = compute_mesh_metrics(V, tris({{0, 1, 2}, {3, 4, 5}, {0, 0, 5}, {0, 1, 5}}));
+    CHECK(m.degenerate_triangles == 1);    // {0, 0, 5}
+    CHECK(m.zero_area_triangles == 3);     // collinear, two equal positions, repeated index
+    CHECK(m.duplicate_vertices == 1);      // 3 and 4
+    CHECK(m.min_angle == 0.0);
+    CHECK(m.max_angle == 180.0);
+    CHECK(m.share_below_10 == Approx(0.75));
+    CHECK(m.min_angle_histogram[0] == 3);
+  }
+  SECTION("a sliver that is thin but not flat is not zero-area") {
+    const auto V = rows({{0, 0, 0}, {1, 0, 0}, {0.5, 1e-200, 0}});
+    const MeshMetrics m = compute_mesh_metrics(V, tris({{0, 1, 2}}));
+    CHECK(m.zero_area_triangles == 0);
+    CHECK(m.min_angle < 1e-100);
+    CHECK(m.min_angle >= 0.0);
+  }
+}
+
+TEST_CASE("mesh_metrics: triangle_min_angles", "[mesh_metrics]") {
+  const auto a = vitri::triangle_min_angles(tet_V(), tet_F());
+  REQUIRE(a.size() == 4);
+  CHECK(a[0] == Approx(45.0));
+  CHECK(a[1] == Approx(60.0));
+  CHECK(a[2] == Approx(45.0));
+  CHECK(a[3] == Approx(45.0));
+}
+
+TEST_CASE("mesh_metrics: empty mesh and bad input", "[mesh_metrics]") {
+  const MeshMetrics empty = compute_mesh_metrics(Eigen::MatrixXd(0, 3), Eigen::MatrixXi(0, 3));
+  CHECK(empty.components == 0);
+  CHECK(empty.euler_characteristic == 0);
+  CHECK_FALSE(empty.watertight());
+
+  CHECK_THROWS_AS(compute_mesh_metrics(tet_V(), tris({{0, 1, 4}})), vitri::InvalidArgument);
+  CHECK_THROWS_AS(compute_mesh_metrics(tet_V(), tris({{0, -1, 2}})), vitri::InvalidArgument);
+  CHECK_THROWS_AS(compute_mesh_metrics(Eigen::MatrixXd(4, 2), tet_F()), vitri::InvalidArgument);
+  CHECK_THROWS_AS(compute_mesh_metrics(tet_V(), Eigen::MatrixXi(1, 4)), vitri::InvalidArgument);
+  Eigen::MatrixXd V = tet_V();
+  V(2, 1) = std::numeric_limits<double>::quiet_NaN();
+  try {
+    compute_mesh_metrics(V, tet_F());
+    FAIL("expected InvalidPoint");
+  } catch (const vitri::InvalidPoint& e) {
+    CHECK(e.index() == 2);
+  }
+  vitri::MeshMetricsOptions o;
+  o.histogram_bin_degrees = 0.0;
+  CHECK_THROWS_AS(compute_mesh_metrics(tet_V(), tet_F(), o), vitri::InvalidArgument);
+}
+
+namespace {
+
+// f = |p|^2 - 1 (not a distance: |f| / |grad f| = |r^2 - 1| / (2 r)).
+struct SquaredSphere : vitri::ImplicitFunction {
+  double value(const vitri::Point3& p) const override { return squared_norm(p) - 1.0; }
+  double value_gradient(const vitri::Point3& p, vitri::Point3& g) const override {
+    g = 2.0 * p;
+    return value(p);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("mesh_metrics: surface_distance", "[mesh_metrics]") {
+  const SquaredSphere f;
+  const auto V = rows({{2, 0, 0}, {0, 0.5, 0}, {0, 0, 1}, {0, 0, 0}});
+  const vitri::SurfaceDistanceStats s = vitri::surface_distance(V, f);
+  CHECK(s.evaluations == 4);
+  CHECK(s.zero_gradient == 1);  // the origin
+  REQUIRE(s.vertices == 3);
+  const double d0 = 3.0 / 4.0, d1 = 0.75 / 1.0, d2 = 0.0;
+  CHECK(s.max == Approx(std::max({d0, d1, d2})));
+  CHECK(s.mean == Approx((d0 + d1 + d2) / 3.0));
+  CHECK(s.rms == Approx(std::sqrt((d0 * d0 + d1 * d1 + d2 * d2) / 3.0)));
+
+  Eigen::MatrixXd bad = V;
+  bad(1, 0) = std::numeric_limits<double>::infinity();
+  CHECK_THROWS_AS(vitri::surface_distance(bad, f), vitri::InvalidPoint);
+}

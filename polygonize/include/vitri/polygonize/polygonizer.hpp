@@ -1,0 +1,224 @@
+#pragma once
+/// @file polygonizer.hpp
+/// Refinement of transverse tetrahedra and marching tetrahedra (Crespin 2003, sections 3 and 5) over
+/// any ImplicitFunction.
+///
+/// A Polygonizer owns a Delaunay tetrahedralization of a domain box, the value of f at every Delaunay
+/// vertex (evaluated once, in batches), and the set of transverse tetrahedra (vertex signs differ) kept
+/// up to date from the Delaunay change sets. refine(precision) inserts circumcenters of transverse
+/// tetrahedra whose circumradius exceeds the precision; extract() turns the transverse tetrahedra into
+/// an indexed, watertight triangle mesh. Refining again with a smaller precision continues the same
+/// tetrahedralization (levels of detail); a mesh can be extracted at any moment.
+///
+/// Sign rule: a vertex value of exactly 0 counts as positive ("sign(0) = +"), so every vertex is
+/// strictly classified and marching tetrahedra is the standard two-case table. See docs/polygonize.md
+/// for how zero-valued vertices are placed on the mesh and for the termination argument.
+///
+/// @note The function is held by reference and must outlive the Polygonizer. When the function
+/// changes (dynamic editing), call function_changed().
+
+#include "vitri/core/box.hpp"
+#include "vitri/core/implicit.hpp"
+#include "vitri/core/point.hpp"
+#include "vitri/delaunay/triangulation.hpp"
+#include "vitri/polygonize/surface_mesh.hpp"
+
+#include <cstddef>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <optional>
+#include <queue>
+#include <utility>
+#include <vector>
+
+namespace vitri {
+
+/// Order in which transverse tetrahedra are refined.
+enum class QueueOrder {
+  Fifo,          ///< first in, first out, as in the paper (large tetrahedra tend to come first)
+  LargestFirst,  ///< largest circumradius first (priority queue; a cancelled run is more uniform)
+};
+
+/// How extract() places a mesh vertex on a crossed Delaunay edge.
+enum class VertexPlacement {
+  RootFinding,  ///< Illinois (safeguarded regula falsi) on the edge, to `root_tolerance`
+  Linear,       ///< linear interpolation of the two end values (no function evaluation)
+};
+
+/// Why a Delaunay vertex exists (kept per vertex; only Refinement vertices are garbage-collected).
+enum class VertexKind : std::uint8_t {
+  Corner,      ///< one of the 8 corners of the domain box
+  Seed,        ///< a user point (constraint point or seed): never removed by the polygonizer
+  Sampling,    ///< inserted by the initial sampling (component discovery)
+  Refinement,  ///< a circumcenter (or its fallback) inserted by refine()
+};
+
+/// Options of the Polygonizer. Lengths are absolute unless the name says "fraction".
+struct PolygonizerOptions {
+  /// Refinement order of transverse tetrahedra.
+  QueueOrder order = QueueOrder::Fifo;
+  /// Initial sampling (before any transverse refinement): every tetrahedron, transverse or not, is
+  /// refined until its circumradius is at most this fraction of the domain diagonal. It guarantees that
+  /// every component of {f < 0} or {f > 0} containing a ball of that radius is found, even without a
+  /// seed point in it. 0 disables it (then only sign changes between seeds and corners are followed).
+  double sampling_fraction = 0.1;
+  /// Proximity rejection: a refinement point closer than this fraction of the current precision to an
+  /// existing vertex is not inserted. Must be in (0, 1) (circumcenters then always pass; see docs).
+  double min_distance_fraction = 0.25;
+  /// Mesh vertex placement on crossed edges.
+  VertexPlacement placement = VertexPlacement::RootFinding;
+  /// Root finder stops when the bracket is shorter than this fraction of the edge length.
+  double root_tolerance = 1e-4;
+  /// Root finder iteration cap per edge (each iteration is one function evaluation, batched).
+  int max_root_iterations = 16;
+  /// Zero-valued vertices: collapse the mesh vertices of their crossed edges into the zero vertex
+  /// itself when the result stays a manifold (see docs/polygonize.md). When false, or when the collapse
+  /// would pinch or fold the mesh, those mesh vertices stay at `zero_offset` along their edges.
+  bool snap_zero_vertices = true;
+  /// Fraction of the edge length, from the zero vertex, at which a non-snapped crossing is placed.
+  double zero_offset = 0.05;
+  /// Threads for gradient (normal) evaluation in extract(); 0 = hardware concurrency.
+  unsigned threads = 0;
+};
+
+/// Counters and timings. Times in seconds; counters cumulative since construction unless stated.
+struct PolygonizerStats {
+  std::size_t vertices = 0;             ///< live Delaunay vertices (corners included)
+  std::size_t tetrahedra = 0;           ///< live Delaunay tetrahedra
+  std::size_t transverse = 0;           ///< live transverse tetrahedra
+  std::size_t function_evaluations = 0; ///< calls of f (value or gradient), all phases
+  std::size_t vertex_evaluations = 0;   ///< of which at Delaunay vertices
+  std::size_t root_evaluations = 0;     ///< of which by the root finder
+  std::size_t gradient_evaluations = 0; ///< of which for normals
+  std::size_t insertions = 0;           ///< Delaunay insertions by refinement and sampling
+  std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box replaced by a fallback point
+  std::size_t rejected = 0;             ///< refinement points rejected by proximity (tetrahedron dropped)
+  std::size_t removed_steiner = 0;      ///< refinement vertices removed by collect_garbage()
+  std::size_t zero_snapped = 0;         ///< last extract(): zero vertices used as mesh vertices
+  std::size_t zero_offset = 0;          ///< last extract(): zero vertices whose crossings stayed offset
+  double init_seconds = 0;              ///< construction: seeds, sampling, first classification
+  double refine_seconds = 0;            ///< last refine() call
+  double extract_seconds = 0;           ///< last extract() call
+  double update_seconds = 0;            ///< last function_changed() call
+};
+
+/// Progress of refine(), passed to the callback after each batch of insertions.
+struct RefineProgress {
+  std::size_t vertices = 0;  ///< live Delaunay vertices
+  std::size_t queued = 0;    ///< tetrahedra waiting in the queue
+  std::size_t inserted = 0;  ///< points inserted by this refine() call so far
+};
+
+/// Called during refine(); return false to cancel (the tetrahedralization stays valid and refine() can
+/// be called again to continue).
+using ProgressCallback = std::function<bool(const RefineProgress&)>;
+
+/// Stateful refinement + extraction over one implicit function. Not thread-safe.
+class Polygonizer {
+ public:
+  /// Tetrahedralizes the domain box and the seed points (inserted in a shuffled order), evaluates f at
+  /// every vertex in one batch (a seed with a given value in `seed_values` uses it instead: constraint
+  /// points pass their exact constraint value), runs the initial sampling and classifies tetrahedra.
+  /// @param f       the function; kept by reference.
+  /// @param domain  the box of the tetrahedralization; nothing outside it is meshed.
+  /// @param seeds   points inserted first (may be empty), strictly inside the domain; exact duplicates
+  ///                are skipped.
+  /// @param seed_values  empty, or one value per seed (NaN: evaluate f).
+  /// @throws InvalidArgument for an empty, flat or non-finite domain or bad options;
+  ///         InvalidPoint(i) when seed i is not finite or not strictly inside the domain.
+  Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds = {},
+              const std::vector<double>& seed_values = {}, const PolygonizerOptions& options = {});
+
+  /// The bounding box of `points` scaled by `factor` about its center (paper 3.2.2: factor 2). A flat or
+  /// single-point set is padded to a cube of side 1e-3 of its diagonal (or 1 when everything is one point).
+  /// @throws InvalidArgument when points is empty or factor <= 1; InvalidPoint(i) when point i is not finite.
+  static Box3 domain_for(const std::vector<Point3>& points, double factor = 2.0);
+
+  /// Refines until every transverse tetrahedron has circumradius <= precision (except the rare ones
+  /// whose refinement point was rejected, counted in stats().rejected). Continues the current
+  /// tetrahedralization: calling it with a smaller precision refines further (level of detail).
+  /// @return false when the callback cancelled. @throws InvalidArgument when precision <= 0 or NaN.
+  bool refine(double precision, const ProgressCallback& progress = {});
+
+  /// Marching tetrahedra over the transverse tetrahedra: one mesh vertex per crossed Delaunay edge
+  /// (shared, so the mesh is indexed and watertight), triangles counter-clockwise seen from f > 0,
+  /// unit normals from the gradient of f. Evaluates f (root finder, gradients), hence non-const.
+  SurfaceMesh extract();
+
+  // ---- Dynamic editing (used by vitri::Mesher) -----------------------------------------------------
+  /// Inserts p as a vertex of kind `kind` with a fixed value (kept by function_changed()) or, when
+  /// `value` is empty, f(p). An existing Sampling/Refinement vertex at exactly p is removed first; an
+  /// exact duplicate of a Seed returns kNoVertex. The new tetrahedra are classified and queued.
+  /// @throws InvalidPoint(0) when p is not finite or outside the domain.
+  VertexId insert_vertex(const Point3& p, std::optional<double> value = std::nullopt,
+                         VertexKind kind = VertexKind::Seed);
+  /// Removes a vertex (not a corner) and reclassifies the new tetrahedra.
+  void remove_vertex(VertexId v);
+  /// Moves a vertex to p (same policy as insert_vertex for a duplicate position); returns false and
+  /// leaves v in place when p duplicates a Seed vertex. `value`: new fixed value, or empty to keep the
+  /// fixed value v had (or evaluate f when it had none).
+  bool move_vertex(VertexId v, const Point3& p, std::optional<double> value = std::nullopt);
+  /// Sets a fixed value for v (used instead of f(v) from now on) and reclassifies its tetrahedra.
+  void set_vertex_value(VertexId v, double value);
+  /// The function changed: re-evaluates f at every vertex without a fixed value (one batch), and
+  /// reclassifies only the tetrahedra around vertices whose sign changed. Call refine() afterwards.
+  void function_changed();
+  /// Removes Refinement vertices that no transverse tetrahedron touches (they no longer serve the
+  /// surface). Removing such a vertex never creates a transverse tetrahedron. Returns how many.
+  std::size_t collect_garbage();
+
+  // ---- Queries ---------------------------------------------------------------------------------------
+  const Triangulation& triangulation() const { return tri_; }
+  const ImplicitFunction& function() const { return f_; }
+  /// The stored value at vertex v (f(v) or its fixed value).
+  double vertex_value(VertexId v) const { return values_[v]; }
+  VertexKind vertex_kind(VertexId v) const { return static_cast<VertexKind>(kind_[v]); }
+  /// Delaunay vertex of seed i (kNoVertex when seed i duplicated an earlier one).
+  const std::vector<VertexId>& seed_vertices() const { return seed_vertices_; }
+  /// Live transverse tetrahedra (unordered).
+  const std::vector<TetId>& transverse_tetrahedra() const { return tlist_; }
+  /// True when tetrahedron t is live and its vertex signs differ (sign(0) = +).
+  bool is_transverse(TetId t) const;
+  /// The precision of the last refine() call (infinity before the first).
+  double precision() const { return precision_; }
+  /// Counters and timings (vertices/tetrahedra/transverse are current).
+  PolygonizerStats stats() const;
+  const PolygonizerOptions& options() const { return options_; }
+
+ private:
+  bool is_negative_value(VertexId v) const { return values_[v] < 0.0; }  // sign(0) = +
+  void grow_vertex_arrays();
+  void grow_tet_arrays();
+  void evaluate_pending();
+  void on_killed(const ChangeSet& cs);
+  void classify(TetId t, bool requeue);
+  void set_transverse(TetId t, bool on);
+  void push(TetId t);
+  bool pop(TetId& t);
+  std::size_t queued() const;
+  void clear_queue();
+  void sample(double radius);
+  bool insert_refinement_point(TetId t, double min_distance, VertexKind kind, std::vector<TetId>& created);
+  void classify_created(std::vector<TetId>& created);
+
+  const ImplicitFunction& f_;
+  PolygonizerOptions options_;
+  Triangulation tri_;
+  double precision_;
+  std::vector<double> values_;          // per vertex id
+  std::vector<std::uint8_t> kind_;      // VertexKind per vertex id
+  std::vector<std::uint8_t> fixed_;     // 1 when values_ is a fixed value (constraint)
+  std::vector<std::uint32_t> tcount_;   // per vertex: incident transverse tetrahedra
+  std::vector<std::uint32_t> tpos_;     // per tet: index in tlist_, or kNotListed
+  std::vector<TetId> tlist_;            // live transverse tetrahedra
+  std::vector<double> radius_;          // per tet: circumradius, valid while listed
+  std::vector<VertexId> pending_;       // vertices waiting for their value (batch)
+  std::vector<VertexId> seed_vertices_;
+  std::deque<TetId> fifo_;
+  std::priority_queue<std::pair<double, TetId>> heap_;
+  ChangeSet changes_;
+  PolygonizerStats stats_;
+};
+
+}  // namespace vitri

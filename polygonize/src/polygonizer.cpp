@@ -1,0 +1,504 @@
+// Refinement of transverse tetrahedra (Crespin 2003, sections 3.2-3.4 and 5).
+//
+// A brief explanation. The Delaunay tetrahedralization starts from the 8 corners of the domain box and
+// the seed points. An initial *sampling* pass refines every tetrahedron (transverse or not) down to a
+// coarse circumradius, so that every component of the surface that is not tiny shows up as a sign
+// change between two vertices, whether or not a seed lies on it. From then on only *transverse*
+// tetrahedra (vertex signs differ; sign(0) = +) are refined: while the queue holds a transverse
+// tetrahedron whose circumradius exceeds the precision, its circumcenter is inserted with
+// insert_in_conflict() (the tetrahedron itself is in conflict, so no point location is needed).
+//
+// The transverse set is maintained from the Delaunay change sets: killed tetrahedra leave it, created
+// ones are classified once their vertices have values. Work is done in rounds: a round pops a batch of
+// queued tetrahedra, inserts their circumcenters, evaluates f at all new vertices in one batch call
+// (vectorized/threaded in the RBF), then classifies the created tetrahedra and queues the transverse
+// ones. The order stays FIFO (or largest-first) up to the batching.
+//
+// Termination (docs/polygonize.md): every inserted point is at least `d_min = min_distance_fraction *
+// precision` away from every existing vertex. A circumcenter of a Delaunay tetrahedron of radius
+// R > precision > d_min is at distance >= R from every vertex (empty sphere), so it always passes; the
+// fallback points used when the circumcenter leaves the box are checked explicitly. Points at mutual
+// distance >= d_min in a bounded box are finitely many (packing), each queue entry is either dropped or
+// causes an insertion, and entries are created only by insertions: the loop ends.
+#include "vitri/polygonize/polygonizer.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <sstream>
+#include <string>
+
+namespace vitri {
+
+namespace {
+
+constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
+constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// The sign rule of the whole module: exactly 0 counts as positive.
+inline bool is_negative(double v) { return v < 0.0; }
+
+/// The Delaunay tree accepts points strictly inside its box only (the corners alone are on the hull).
+bool strictly_inside(const Box3& b, const Point3& p) {
+  return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+}
+
+/// The point of the box shrunk by a relative margin 1e-9 that is nearest to p.
+Point3 clamp_inside(const Box3& b, const Point3& p) {
+  const Point3 m = 1e-9 * b.extent();
+  return {std::clamp(p.x, b.lo.x + m.x, b.hi.x - m.x), std::clamp(p.y, b.lo.y + m.y, b.hi.y - m.y),
+          std::clamp(p.z, b.lo.z + m.z, b.hi.z - m.z)};
+}
+
+std::string describe(const Point3& p) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+  return s.str();
+}
+
+}  // namespace
+
+Box3 Polygonizer::domain_for(const std::vector<Point3>& points, double factor) {
+  if (points.empty()) throw InvalidArgument("domain_for: no point");
+  if (!(factor > 1.0) || !std::isfinite(factor)) throw InvalidArgument("domain_for: factor must be > 1");
+  Box3 b;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!is_finite(points[i])) throw InvalidPoint(i, "coordinates are not finite");
+    b.extend(points[i]);
+  }
+  // Pad flat directions so the box has volume.
+  const double diag = b.diagonal();
+  const double pad = diag > 0.0 ? 1e-3 * diag : 1.0;
+  for (std::size_t k = 0; k < 3; ++k) {
+    if (b.hi[k] - b.lo[k] < pad) {
+      const double c = 0.5 * (b.lo[k] + b.hi[k]);
+      b.lo[k] = c - 0.5 * pad;
+      b.hi[k] = c + 0.5 * pad;
+    }
+  }
+  return b.scaled(factor);
+}
+
+Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
+                         const std::vector<double>& seed_values, const PolygonizerOptions& options)
+    : f_(f), options_(options), tri_(domain), precision_(std::numeric_limits<double>::infinity()) {
+  const auto t0 = Clock::now();
+  if (!(options_.sampling_fraction >= 0.0) || !std::isfinite(options_.sampling_fraction))
+    throw InvalidArgument("PolygonizerOptions::sampling_fraction must be >= 0");
+  if (!(options_.min_distance_fraction > 0.0 && options_.min_distance_fraction < 1.0))
+    throw InvalidArgument("PolygonizerOptions::min_distance_fraction must be in (0, 1)");
+  if (!(options_.root_tolerance > 0.0 && options_.root_tolerance < 1.0))
+    throw InvalidArgument("PolygonizerOptions::root_tolerance must be in (0, 1)");
+  if (!(options_.zero_offset > 0.0 && options_.zero_offset < 0.5))
+    throw InvalidArgument("PolygonizerOptions::zero_offset must be in (0, 0.5)");
+  if (options_.max_root_iterations < 1) throw InvalidArgument("PolygonizerOptions::max_root_iterations must be >= 1");
+  if (!seed_values.empty() && seed_values.size() != seeds.size())
+    throw InvalidArgument("Polygonizer: seed_values must be empty or have one value per seed");
+
+  grow_vertex_arrays();
+  for (VertexId v = 0; v < 8; ++v) {
+    kind_[v] = static_cast<std::uint8_t>(VertexKind::Corner);
+    pending_.push_back(v);
+  }
+  seed_vertices_.assign(seeds.size(), kNoVertex);
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed coordinates are not finite");
+    if (!strictly_inside(domain, seeds[i]))
+      throw InvalidPoint(i, "seed " + describe(seeds[i]) + " is not strictly inside the domain box");
+    if (!seed_values.empty() && std::isinf(seed_values[i])) throw InvalidPoint(i, "seed value is infinite");
+  }
+  // Batch insertion (randomized spatial order inside the Delaunay tree); exact duplicates are skipped.
+  const std::vector<InsertResult> inserted = tri_.insert_points(seeds, 0.0, nullptr);
+  grow_vertex_arrays();
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    if (inserted[i].status != InsertStatus::Inserted) continue;
+    const VertexId v = inserted[i].vertex;
+    kind_[v] = static_cast<std::uint8_t>(VertexKind::Seed);
+    seed_vertices_[i] = v;
+    if (!seed_values.empty() && !std::isnan(seed_values[i])) {
+      values_[v] = seed_values[i];
+      fixed_[v] = 1;
+    } else {
+      pending_.push_back(v);
+    }
+  }
+  if (options_.sampling_fraction > 0.0) sample(options_.sampling_fraction * domain.diagonal());
+  evaluate_pending();
+  grow_tet_arrays();
+  tri_.for_each_tetrahedron([this](TetId t) { classify(t, false); });
+  stats_.init_seconds = seconds_since(t0);
+}
+
+void Polygonizer::grow_vertex_arrays() {
+  const std::size_t n = tri_.vertex_capacity();
+  if (values_.size() >= n) return;
+  const std::size_t cap = std::max(n, values_.size() * 2);
+  values_.resize(cap, 0.0);
+  kind_.resize(cap, static_cast<std::uint8_t>(VertexKind::Refinement));
+  fixed_.resize(cap, 0);
+  tcount_.resize(cap, 0);
+}
+
+void Polygonizer::grow_tet_arrays() {
+  const std::size_t n = tri_.tet_capacity();
+  if (tpos_.size() >= n) return;
+  const std::size_t cap = std::max(n, tpos_.size() * 2);
+  tpos_.resize(cap, kNotListed);
+  radius_.resize(cap, 0.0);
+}
+
+void Polygonizer::evaluate_pending() {
+  if (pending_.empty()) return;
+  std::vector<Point3> pts;
+  std::vector<VertexId> ids;
+  pts.reserve(pending_.size());
+  for (const VertexId v : pending_) {
+    if (!tri_.is_vertex(v) || fixed_[v]) continue;
+    ids.push_back(v);
+    pts.push_back(tri_.point(v));
+  }
+  pending_.clear();
+  std::vector<double> out(pts.size());
+  f_.values(pts.data(), pts.size(), out.data());
+  stats_.function_evaluations += pts.size();
+  stats_.vertex_evaluations += pts.size();
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
+    values_[ids[i]] = out[i];
+  }
+}
+
+bool Polygonizer::is_transverse(TetId t) const {
+  if (!tri_.is_live(t)) return false;
+  const auto v = tri_.tet_vertices(t);
+  const bool n0 = is_negative(values_[v[0]]);
+  return is_negative(values_[v[1]]) != n0 || is_negative(values_[v[2]]) != n0 || is_negative(values_[v[3]]) != n0;
+}
+
+void Polygonizer::set_transverse(TetId t, bool on) {
+  const bool listed = tpos_[t] != kNotListed;
+  if (on == listed) return;
+  const auto v = tri_.tet_vertices(t);
+  if (on) {
+    tpos_[t] = static_cast<std::uint32_t>(tlist_.size());
+    tlist_.push_back(t);
+    for (const VertexId u : v) ++tcount_[u];
+  } else {
+    const std::uint32_t i = tpos_[t];
+    const TetId last = tlist_.back();
+    tlist_[i] = last;
+    tpos_[last] = i;
+    tlist_.pop_back();
+    tpos_[t] = kNotListed;
+    for (const VertexId u : v) --tcount_[u];
+  }
+}
+
+void Polygonizer::on_killed(const ChangeSet& cs) {
+  for (const TetId t : cs.killed)
+    if (t < tpos_.size() && tpos_[t] != kNotListed) set_transverse(t, false);
+}
+
+void Polygonizer::classify(TetId t, bool requeue) {
+  if (!tri_.is_live(t)) return;
+  const bool was = tpos_[t] != kNotListed;
+  const bool now = is_transverse(t);
+  if (now && (!was || requeue)) radius_[t] = tri_.circumradius(t);
+  set_transverse(t, now);
+  if (now && (!was || requeue) && radius_[t] > precision_) push(t);
+}
+
+void Polygonizer::classify_created(std::vector<TetId>& created) {
+  grow_tet_arrays();
+  for (const TetId t : created) classify(t, false);
+  created.clear();
+}
+
+void Polygonizer::push(TetId t) {
+  if (options_.order == QueueOrder::Fifo) {
+    fifo_.push_back(t);
+  } else {
+    heap_.emplace(radius_[t], t);
+  }
+}
+
+bool Polygonizer::pop(TetId& t) {
+  if (options_.order == QueueOrder::Fifo) {
+    if (fifo_.empty()) return false;
+    t = fifo_.front();
+    fifo_.pop_front();
+  } else {
+    if (heap_.empty()) return false;
+    t = heap_.top().second;
+    heap_.pop();
+  }
+  return true;
+}
+
+std::size_t Polygonizer::queued() const { return options_.order == QueueOrder::Fifo ? fifo_.size() : heap_.size(); }
+
+void Polygonizer::clear_queue() {
+  fifo_.clear();
+  heap_ = {};
+}
+
+bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKind kind,
+                                          std::vector<TetId>& created) {
+  const Box3& box = tri_.box();
+  const Point3 c = tri_.circumcenter(t);
+  changes_.clear();
+  InsertResult r;
+  if (is_finite(c) && strictly_inside(box, c)) {
+    r = tri_.insert_in_conflict(c, t, min_distance, &changes_);
+  } else {
+    // Fallback 1: the point of the (slightly shrunk) box nearest to the circumcenter. It lies in or
+    // very near the circumball (the tetrahedron is in the box), not necessarily in conflict with t:
+    // insert it with point location.
+    ++stats_.boundary_fallbacks;
+    const auto v = tri_.tet_vertices(t);
+    const Point3 q = is_finite(c) ? clamp_inside(box, c)
+                                  : 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
+    r = tri_.insert(q, min_distance, &changes_);
+    if (r.status != InsertStatus::Inserted) {
+      // Fallback 2: the midpoint of the longest edge, strictly inside the circumball, so in conflict.
+      double best = -1.0;
+      Point3 m;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
+          if (d > best) {
+            best = d;
+            m = 0.5 * (tri_.point(v[i]) + tri_.point(v[j]));
+          }
+        }
+      changes_.clear();
+      r = tri_.insert_in_conflict(m, t, min_distance, &changes_);
+    }
+  }
+  if (r.status != InsertStatus::Inserted) {
+    ++stats_.rejected;
+    return false;
+  }
+  grow_vertex_arrays();
+  grow_tet_arrays();
+  kind_[r.vertex] = static_cast<std::uint8_t>(kind);
+  fixed_[r.vertex] = 0;
+  tcount_[r.vertex] = 0;
+  pending_.push_back(r.vertex);
+  ++stats_.insertions;
+  on_killed(changes_);
+  created.insert(created.end(), changes_.created.begin(), changes_.created.end());
+  return true;
+}
+
+void Polygonizer::sample(double radius) {
+  // Values are not needed here: every tetrahedron larger than `radius` is split, whatever its signs.
+  std::deque<TetId> queue;
+  tri_.for_each_tetrahedron([&](TetId t) {
+    if (tri_.circumradius(t) > radius) queue.push_back(t);
+  });
+  std::vector<TetId> created;
+  const double dmin = options_.min_distance_fraction * radius;
+  while (!queue.empty()) {
+    const TetId t = queue.front();
+    queue.pop_front();
+    if (!tri_.is_live(t) || tri_.circumradius(t) <= radius) continue;
+    const bool inserted = insert_refinement_point(t, dmin, VertexKind::Sampling, created);
+    if (!inserted) continue;
+    for (const TetId c : created)
+      if (tri_.is_live(c) && tri_.circumradius(c) > radius) queue.push_back(c);
+    if (tri_.is_live(t)) queue.push_back(t);  // a fallback point did not kill it: try again
+    created.clear();
+  }
+}
+
+bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
+  if (!(precision > 0.0) || !std::isfinite(precision))
+    throw InvalidArgument("refine: precision must be positive and finite");
+  const auto t0 = Clock::now();
+  precision_ = precision;
+  const double dmin = options_.min_distance_fraction * precision;
+  clear_queue();
+  for (const TetId t : tlist_)
+    if (radius_[t] > precision) push(t);
+  std::vector<TetId> created, retry;
+  RefineProgress info;
+  bool completed = true;
+  while (queued() > 0) {
+    const std::size_t n = std::min(queued(), kRoundSize);
+    for (std::size_t i = 0; i < n; ++i) {
+      TetId t;
+      if (!pop(t)) break;
+      if (!tri_.is_live(t) || tpos_[t] == kNotListed || radius_[t] <= precision) continue;
+      if (insert_refinement_point(t, dmin, VertexKind::Refinement, created)) {
+        ++info.inserted;
+        if (tri_.is_live(t)) retry.push_back(t);
+      }
+    }
+    evaluate_pending();
+    classify_created(created);
+    for (const TetId t : retry)
+      if (tri_.is_live(t) && tpos_[t] != kNotListed) push(t);
+    retry.clear();
+    if (progress) {
+      info.vertices = tri_.num_vertices();
+      info.queued = queued();
+      if (!progress(info)) {
+        completed = false;
+        clear_queue();
+        break;
+      }
+    }
+  }
+  stats_.refine_seconds = seconds_since(t0);
+  return completed;
+}
+
+// ---- Dynamic editing ----------------------------------------------------------------------------------
+
+VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value, VertexKind kind) {
+  if (!is_finite(p)) throw InvalidPoint(0, "coordinates are not finite");
+  if (!strictly_inside(tri_.box(), p))
+    throw InvalidPoint(0, "point " + describe(p) + " is not strictly inside the domain box");
+  if (value && !std::isfinite(*value)) throw InvalidPoint(0, "value is not finite");
+  changes_.clear();
+  InsertResult r = tri_.insert(p, 0.0, &changes_);
+  if (r.status != InsertStatus::Inserted) {
+    const auto k = static_cast<VertexKind>(kind_[r.nearest]);
+    if (k != VertexKind::Sampling && k != VertexKind::Refinement) return kNoVertex;
+    remove_vertex(r.nearest);
+    changes_.clear();
+    r = tri_.insert(p, 0.0, &changes_);
+    if (r.status != InsertStatus::Inserted) return kNoVertex;
+  }
+  grow_vertex_arrays();
+  grow_tet_arrays();
+  const VertexId v = r.vertex;
+  kind_[v] = static_cast<std::uint8_t>(kind);
+  tcount_[v] = 0;
+  if (value) {
+    values_[v] = *value;
+    fixed_[v] = 1;
+  } else {
+    fixed_[v] = 0;
+    pending_.push_back(v);
+    evaluate_pending();
+  }
+  on_killed(changes_);
+  std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
+  classify_created(created);
+  return v;
+}
+
+void Polygonizer::remove_vertex(VertexId v) {
+  if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("remove_vertex: not a removable vertex");
+  changes_.clear();
+  tri_.remove(v, &changes_);
+  on_killed(changes_);
+  std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
+  classify_created(created);
+}
+
+bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double> value) {
+  if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("move_vertex: not a movable vertex");
+  if (!is_finite(p)) throw InvalidPoint(0, "coordinates are not finite");
+  if (!strictly_inside(tri_.box(), p))
+    throw InvalidPoint(0, "point " + describe(p) + " is not strictly inside the domain box");
+  changes_.clear();
+  InsertResult r = tri_.move(v, p, 0.0, &changes_);
+  if (r.status != InsertStatus::Inserted) {
+    const auto k = static_cast<VertexKind>(kind_[r.nearest]);
+    if (r.nearest == v) return true;  // moved onto itself
+    if (k != VertexKind::Sampling && k != VertexKind::Refinement) return false;
+    remove_vertex(r.nearest);
+    changes_.clear();
+    r = tri_.move(v, p, 0.0, &changes_);
+    if (r.status != InsertStatus::Inserted) return false;
+  }
+  grow_tet_arrays();
+  if (value) {
+    values_[v] = *value;
+    fixed_[v] = 1;
+  } else if (!fixed_[v]) {
+    pending_.push_back(v);
+    evaluate_pending();
+  }
+  on_killed(changes_);
+  std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
+  classify_created(created);
+  // Tetrahedra around v that the move kept alive changed shape: re-measure and re-queue them.
+  for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, true);
+  return true;
+}
+
+void Polygonizer::set_vertex_value(VertexId v, double value) {
+  if (!tri_.is_vertex(v)) throw InvalidArgument("set_vertex_value: not a vertex");
+  if (!std::isfinite(value)) throw InvalidArgument("set_vertex_value: value is not finite");
+  values_[v] = value;
+  fixed_[v] = 1;
+  for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, false);
+}
+
+void Polygonizer::function_changed() {
+  const auto t0 = Clock::now();
+  std::vector<VertexId> ids;
+  std::vector<Point3> pts;
+  const std::size_t cap = tri_.vertex_capacity();
+  for (VertexId v = 0; v < cap; ++v) {
+    if (fixed_[v] || !tri_.is_vertex(v)) continue;
+    ids.push_back(v);
+    pts.push_back(tri_.point(v));
+  }
+  std::vector<double> out(pts.size());
+  f_.values(pts.data(), pts.size(), out.data());
+  stats_.function_evaluations += pts.size();
+  stats_.vertex_evaluations += pts.size();
+  std::vector<TetId> touched;
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
+    const VertexId v = ids[i];
+    const bool flip = is_negative(out[i]) != is_negative(values_[v]);
+    values_[v] = out[i];
+    if (flip) {
+      const auto inc = tri_.incident_tetrahedra(v);
+      touched.insert(touched.end(), inc.begin(), inc.end());
+    }
+  }
+  std::sort(touched.begin(), touched.end());
+  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+  for (const TetId t : touched) classify(t, false);
+  stats_.update_seconds = seconds_since(t0);
+}
+
+std::size_t Polygonizer::collect_garbage() {
+  std::size_t removed = 0;
+  const std::size_t cap = tri_.vertex_capacity();
+  for (VertexId v = 8; v < cap; ++v) {
+    if (kind_[v] != static_cast<std::uint8_t>(VertexKind::Refinement) || tcount_[v] != 0 || !tri_.is_vertex(v))
+      continue;
+    remove_vertex(v);
+    ++removed;
+  }
+  stats_.removed_steiner += removed;
+  return removed;
+}
+
+PolygonizerStats Polygonizer::stats() const {
+  PolygonizerStats s = stats_;
+  s.vertices = tri_.num_vertices();
+  s.tetrahedra = tri_.num_tetrahedra();
+  s.transverse = tlist_.size();
+  return s;
+}
+
+}  // namespace vitri

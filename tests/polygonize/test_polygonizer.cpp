@@ -1,0 +1,331 @@
+// Tests of the Polygonizer: refinement of transverse tetrahedra and marching tetrahedra over analytic
+// functions whose surface, topology and distance are known exactly.
+#include <catch2/catch.hpp>
+
+#include "vitri/core/error.hpp"
+#include "vitri/polygonize/analytic.hpp"
+#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+#include "vitri/polygonize/surface_mesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+
+using namespace vitri;
+
+namespace {
+
+MeshMetrics metrics_of(const SurfaceMesh& m) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  to_eigen(m, V, F);
+  return compute_mesh_metrics(V, F);
+}
+
+/// Largest distance to the true surface over the vertices and the triangle centroids.
+template <class Fn>
+double max_distance(const SurfaceMesh& m, const Fn& dist, bool centroids) {
+  double d = 0.0;
+  for (const Point3& p : m.vertices) d = std::max(d, dist(p));
+  if (centroids)
+    for (const auto& t : m.triangles)
+      d = std::max(d, dist((m.vertices[t[0]] + m.vertices[t[1]] + m.vertices[t[2]]) / 3.0));
+  return d;
+}
+
+void require_closed(const SurfaceMesh& m, long long euler, std::size_t components) {
+  const MeshMetrics mm = metrics_of(m);
+  INFO("V " << mm.vertices << " F " << mm.triangles << " boundary " << mm.boundary_edges << " nonmanifold e/v "
+            << mm.non_manifold_edges << "/" << mm.non_manifold_vertices << " inconsistent " << mm.inconsistent_edges
+            << " degenerate " << mm.degenerate_triangles << " zero-area " << mm.zero_area_triangles
+            << " duplicates " << mm.duplicate_vertices << " euler " << mm.euler_characteristic << " components "
+            << mm.components);
+  REQUIRE(mm.closed_manifold());
+  REQUIRE(mm.isolated_vertices == 0);
+  REQUIRE(mm.euler_characteristic == euler);
+  REQUIRE(mm.components == components);
+  REQUIRE(mm.signed_volume > 0.0);
+  REQUIRE(m.normals.size() == m.vertices.size());
+}
+
+const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
+
+}  // namespace
+
+TEST_CASE("sphere: closed genus-0 manifold, on the surface, within the precision", "[polygonizer]") {
+  const SphereFunction f({0.1, 0.2, -0.05}, 1.0);
+  const double precision = GENERATE(0.25, 0.1);
+  Polygonizer poly(f, kCube);
+  REQUIRE(poly.refine(precision));
+  const SurfaceMesh m = poly.extract();
+  require_closed(m, 2, 1);
+  REQUIRE(poly.stats().rejected == 0);
+  // Every transverse tetrahedron is within the precision.
+  for (const TetId t : poly.transverse_tetrahedra()) REQUIRE(poly.triangulation().circumradius(t) <= precision);
+  // Vertices on the surface up to the root tolerance (f is a distance here; edges are < 2 precision).
+  const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
+  REQUIRE(max_distance(m, dist, false) <= 2e-4 * precision + 1e-12);
+  // Every triangle lies in a transverse tetrahedron of diameter <= 2 precision holding its vertices.
+  REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
+  // Volume converges to the ball's.
+  const double ball = 4.0 / 3.0 * 3.14159265358979323846;
+  REQUIRE(std::abs(metrics_of(m).signed_volume - ball) / ball < (precision > 0.2 ? 0.2 : 0.05));
+  // Normals: unit, outward (the gradient of a distance).
+  for (std::size_t i = 0; i < m.vertices.size(); ++i) {
+    Point3 g;
+    f.value_gradient(m.vertices[i], g);
+    REQUIRE(std::abs(norm(m.normals[i]) - 1.0) < 1e-12);
+    REQUIRE(dot(m.normals[i], g) > 0.999);
+  }
+}
+
+TEST_CASE("torus: closed genus-1 manifold (Euler characteristic 0)", "[polygonizer]") {
+  const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
+  Polygonizer poly(f, kCube);
+  const double precision = 0.08;
+  REQUIRE(poly.refine(precision));
+  const SurfaceMesh m = poly.extract();
+  require_closed(m, 0, 1);
+  const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
+  REQUIRE(max_distance(m, dist, false) <= 2e-4 * precision + 1e-12);
+  REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
+}
+
+TEST_CASE("blend of two spheres: one blob when close, two when far", "[polygonizer]") {
+  SECTION("close") {
+    const BlendFunction f({-0.4, 0.0, 0.0}, 0.7, {0.4, 0.1, 0.0}, 0.6);
+    Polygonizer poly(f, kCube);
+    REQUIRE(poly.refine(0.08));
+    require_closed(poly.extract(), 2, 1);
+  }
+  SECTION("far") {
+    const BlendFunction f({-1.0, 0.0, 0.0}, 0.5, {1.0, 0.1, 0.0}, 0.5);
+    Polygonizer poly(f, kCube);
+    REQUIRE(poly.refine(0.08));
+    require_closed(poly.extract(), 4, 2);
+  }
+}
+
+TEST_CASE("two disjoint spheres come out without seed points", "[polygonizer]") {
+  const SphereFunction a({-1.0, 0.1, 0.0}, 0.3), b({1.1, -0.2, 0.3}, 0.25);
+  const UnionFunction f(a, b);
+  const auto dist = [&](const Point3& p) { return std::min(a.distance_to_surface(p), b.distance_to_surface(p)); };
+  SECTION("no seed at all: the sampling finds both (radius 0.03 x diagonal < 0.25)") {
+    PolygonizerOptions o;
+    o.sampling_fraction = 0.03;
+    Polygonizer poly(f, kCube, {}, {}, o);
+    REQUIRE(poly.refine(0.06));
+    const SurfaceMesh m = poly.extract();
+    require_closed(m, 4, 2);
+    REQUIRE(max_distance(m, dist, true) <= 0.12);
+  }
+  SECTION("seeds on one sphere only") {
+    PolygonizerOptions o;
+    o.sampling_fraction = 0.03;
+    const std::vector<Point3> seeds = {{-1.0, 0.1, 0.0}, {-0.7, 0.1, 0.0}, {-1.0, 0.4, 0.0}};
+    Polygonizer poly(f, kCube, seeds, {}, o);
+    REQUIRE(poly.refine(0.06));
+    require_closed(poly.extract(), 4, 2);
+  }
+  SECTION("without sampling nor seeds nothing is found (the sampling is what finds them)") {
+    PolygonizerOptions o;
+    o.sampling_fraction = 0.0;
+    Polygonizer poly(f, kCube, {}, {}, o);
+    REQUIRE(poly.refine(0.06));
+    REQUIRE(poly.extract().triangles.empty());
+  }
+}
+
+TEST_CASE("levels of detail continue the same tetrahedralization", "[polygonizer]") {
+  const TorusFunction f({0.0, 0.0, 0.0}, 1.0, 0.4);
+  Polygonizer poly(f, kCube);
+  std::size_t last_mesh = 0, last_delaunay = 0;
+  for (const double p : {0.3, 0.15, 0.08}) {
+    REQUIRE(poly.refine(p));
+    const SurfaceMesh m = poly.extract();
+    require_closed(m, 0, 1);
+    REQUIRE(m.vertices.size() > last_mesh);
+    REQUIRE(poly.stats().vertices >= last_delaunay);
+    last_mesh = m.vertices.size();
+    last_delaunay = poly.stats().vertices;
+  }
+  // Refining again at the same precision does nothing.
+  const std::size_t before = poly.stats().vertices;
+  REQUIRE(poly.refine(0.08));
+  REQUIRE(poly.stats().vertices == before);
+}
+
+TEST_CASE("options: queue order and vertex placement", "[polygonizer]") {
+  const TorusFunction f({0.0, 0.0, 0.0}, 1.0, 0.4);
+  PolygonizerOptions o;
+  o.order = GENERATE(QueueOrder::Fifo, QueueOrder::LargestFirst);
+  o.placement = GENERATE(VertexPlacement::RootFinding, VertexPlacement::Linear);
+  Polygonizer poly(f, kCube, {}, {}, o);
+  REQUIRE(poly.refine(0.1));
+  const SurfaceMesh m = poly.extract();
+  require_closed(m, 0, 1);
+  const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
+  if (o.placement == VertexPlacement::Linear) {
+    REQUIRE(poly.stats().root_evaluations == 0);
+    REQUIRE(max_distance(m, dist, false) <= 0.2);
+  } else {
+    REQUIRE(max_distance(m, dist, false) <= 2e-5);
+  }
+}
+
+TEST_CASE("zero-valued vertices: sign(0) = +, no duplicate, no flat triangle, no pinch", "[polygonizer]") {
+  // |p|^2 - 25 is exact on integers: the 30 integer points of the radius-5 sphere have f == 0 exactly.
+  const QuadricSphereFunction f({0.0, 0.0, 0.0}, 5.0);
+  std::vector<Point3> lattice;
+  std::vector<Point3> zeros;
+  for (int x = -6; x <= 6; ++x)
+    for (int y = -6; y <= 6; ++y)
+      for (int z = -6; z <= 6; ++z) {
+        const Point3 p{double(x), double(y), double(z)};
+        lattice.push_back(p);
+        if (f.value(p) == 0.0) zeros.push_back(p);
+      }
+  REQUIRE(zeros.size() == 30);
+  const bool snap = GENERATE(true, false);
+  const double precision = GENERATE(1.5, 0.5);
+  PolygonizerOptions o;
+  o.snap_zero_vertices = snap;
+  Polygonizer poly(f, Polygonizer::domain_for(lattice), lattice, {}, o);
+  REQUIRE(poly.refine(precision));
+  const SurfaceMesh m = poly.extract();
+  require_closed(m, 2, 1);
+  const PolygonizerStats s = poly.stats();
+  REQUIRE(s.zero_snapped + s.zero_offset == 30);  // every zero point has a crossed edge here
+  if (!snap) {
+    REQUIRE(s.zero_snapped == 0);
+  } else {
+    REQUIRE(s.zero_snapped > 0);
+    // A snapped zero vertex is a mesh vertex exactly.
+    std::set<std::array<double, 3>> vs;
+    for (const Point3& p : m.vertices) vs.insert({p.x, p.y, p.z});
+    std::size_t found = 0;
+    for (const Point3& z : zeros) found += vs.count({z.x, z.y, z.z});
+    REQUIRE(found == s.zero_snapped);
+  }
+  // Distance: offset crossings are within zero_offset of an edge (< 2 precision) from the surface.
+  const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
+  REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
+}
+
+TEST_CASE("cancellation and progress", "[polygonizer]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 1.0);
+  Polygonizer poly(f, kCube);
+  std::size_t calls = 0;
+  REQUIRE_FALSE(poly.refine(0.03, [&](const RefineProgress& p) {
+    ++calls;
+    REQUIRE(p.vertices > 8);
+    return false;
+  }));
+  REQUIRE(calls == 1);
+  // The tetrahedralization is still valid and refinement resumes.
+  poly.triangulation().verify_topology();
+  REQUIRE(poly.refine(0.1));
+  require_closed(poly.extract(), 2, 1);
+}
+
+TEST_CASE("dynamic function: re-evaluation, local reclassification, garbage collection", "[polygonizer]") {
+  // A sphere whose radius and center the test changes in place.
+  struct Moving final : ImplicitFunction {
+    Point3 c{0.0, 0.0, 0.0};
+    double r = 1.0;
+    double value(const Point3& p) const override { return norm(p - c) - r; }
+    double value_gradient(const Point3& p, Point3& g) const override {
+      const Point3 d = p - c;
+      const double n = norm(d);
+      g = n > 0 ? d / n : Point3{0, 0, 1};
+      return n - r;
+    }
+  } f;
+  const double precision = 0.1;
+  Polygonizer poly(f, kCube);
+  REQUIRE(poly.refine(precision));
+  const std::size_t fresh0 = poly.stats().vertices;
+  for (int step = 0; step < 12; ++step) {
+    f.c = {0.3 * std::sin(step), 0.2 * std::cos(1.3 * step), 0.1 * step / 12.0};
+    f.r = 0.8 + 0.2 * ((step * 7) % 5) / 4.0;
+    poly.function_changed();
+    REQUIRE(poly.refine(precision));
+    poly.collect_garbage();
+    const SurfaceMesh m = poly.extract();
+    require_closed(m, 2, 1);
+    for (const TetId t : poly.transverse_tetrahedra())
+      REQUIRE(poly.triangulation().circumradius(t) <= precision);
+    const auto dist = [&](const Point3& p) { return std::abs(norm(p - f.c) - f.r); };
+    REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
+  }
+  // Compare with a fresh mesh of the final function.
+  Polygonizer fresh(f, kCube);
+  REQUIRE(fresh.refine(precision));
+  INFO("edited " << poly.stats().vertices << " fresh " << fresh.stats().vertices << " initial " << fresh0);
+  REQUIRE(static_cast<double>(poly.stats().vertices) <= 1.5 * static_cast<double>(fresh.stats().vertices));
+  REQUIRE(hausdorff_distance(poly.extract(), fresh.extract()) <= precision);
+  poly.triangulation().verify_topology();
+}
+
+TEST_CASE("bad input is rejected with a clear error", "[polygonizer]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 1.0);
+  SECTION("precision") {
+    Polygonizer poly(f, kCube);
+    REQUIRE_THROWS_AS(poly.refine(0.0), InvalidArgument);
+    REQUIRE_THROWS_AS(poly.refine(-1.0), InvalidArgument);
+    REQUIRE_THROWS_AS(poly.refine(std::numeric_limits<double>::quiet_NaN()), InvalidArgument);
+  }
+  SECTION("seed outside the domain names its index") {
+    const std::vector<Point3> seeds = {{0, 0, 0}, {0.5, 0, 0}, {3.0, 0, 0}};
+    try {
+      Polygonizer poly(f, kCube, seeds);
+      FAIL("no exception");
+    } catch (const InvalidPoint& e) {
+      REQUIRE(e.index() == 2);
+    }
+  }
+  SECTION("non-finite seed") {
+    const std::vector<Point3> seeds = {{0, std::numeric_limits<double>::quiet_NaN(), 0}};
+    REQUIRE_THROWS_AS(Polygonizer(f, kCube, seeds), InvalidPoint);
+  }
+  SECTION("NaN from the function") {
+    struct Nan final : ImplicitFunction {
+      double value(const Point3& p) const override { return p.x > 0.5 ? std::nan("") : p.x; }
+      double value_gradient(const Point3& p, Point3& g) const override {
+        g = {1, 0, 0};
+        return value(p);
+      }
+    } bad;
+    REQUIRE_THROWS_AS(Polygonizer(bad, kCube), NumericalError);
+  }
+  SECTION("options") {
+    PolygonizerOptions o;
+    o.min_distance_fraction = 1.0;
+    REQUIRE_THROWS_AS(Polygonizer(f, kCube, {}, {}, o), InvalidArgument);
+  }
+  SECTION("domain_for") {
+    REQUIRE_THROWS_AS(Polygonizer::domain_for({}), InvalidArgument);
+    const Box3 b = Polygonizer::domain_for({{0, 0, 0}, {1, 2, 0}});  // flat: padded
+    REQUIRE(b.hi.z > b.lo.z);
+    REQUIRE(b.lo.x == Approx(-0.5));
+    REQUIRE(b.hi.y == Approx(3.0));
+  }
+}
+
+TEST_CASE("MeshDistance matches brute force", "[surface_mesh]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 1.0);
+  Polygonizer poly(f, kCube);
+  REQUIRE(poly.refine(0.3));
+  const SurfaceMesh m = poly.extract();
+  const MeshDistance md(m);
+  for (const Point3& q : {Point3{0, 0, 0}, Point3{2, 0.1, -0.3}, Point3{0.5, 0.5, 0.5}, Point3{-3, 4, 1}}) {
+    double brute = std::numeric_limits<double>::infinity();
+    for (const auto& t : m.triangles)
+      brute = std::min(brute, point_triangle_distance(q, m.vertices[t[0]], m.vertices[t[1]], m.vertices[t[2]]));
+    REQUIRE(md.distance(q) == Approx(brute).epsilon(1e-12));
+  }
+  REQUIRE(point_triangle_distance({0, 0, 1}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}) == Approx(1.0));
+  REQUIRE(point_triangle_distance({2, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}) == Approx(1.0));
+}

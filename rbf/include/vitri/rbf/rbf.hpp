@@ -1,0 +1,196 @@
+#pragma once
+/// @file rbf.hpp
+/// The variational implicit function (Turk & O'Brien): an interpolant of constraints (c_i, h_i)
+///
+///   f(x) = sum_j w_j |x - c_j|^3 + p0 + p . x,   f(c_i) = h_i,   sum_j w_j = 0,   sum_j w_j c_j = 0,
+///
+/// fitted by a Cholesky factorization of the saddle-point system reduced to the null space of the
+/// polynomial block, evaluated one point or many at a time, and edited (add / remove / move a constraint,
+/// change a value) in O(N^2) by updating that factorization. See docs/rbf.md for the method.
+///
+/// Sign convention of the project: f < 0 inside, f > 0 outside. Coordinates are centered and scaled
+/// internally; every public quantity (points, gradients) is in the caller's units.
+
+#include "vitri/core/implicit.hpp"
+#include "vitri/core/point.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace vitri {
+
+/// A set of interpolation constraints: f(points[i]) = values[i]. The two vectors have the same length.
+struct Constraints {
+  std::vector<Point3> points;  ///< Constraint positions c_i, in the caller's units.
+  std::vector<double> values;  ///< Prescribed values h_i (f < 0 inside, f > 0 outside).
+
+  /// Number of constraints.
+  std::size_t size() const { return points.size(); }
+  /// Appends the constraint f(p) = value.
+  void add(const Point3& p, double value) {
+    points.push_back(p);
+    values.push_back(value);
+  }
+  /// Builds a set from an N x 3 position matrix and N values. Throws InvalidArgument on a size mismatch.
+  static Constraints from_matrix(const Eigen::Ref<const Eigen::MatrixXd>& positions,
+                                 const Eigen::Ref<const Eigen::VectorXd>& values);
+};
+
+/// How Rbf::fit solves the linear system.
+enum class RbfSolver {
+  /// Default: null-space reduction to an SPD system, Cholesky, one step of iterative refinement.
+  /// Supports the O(N^2) edits.
+  Cholesky,
+  /// Reference: plain dense partial-pivoting LU of the full (N + 4) saddle system. About 4x slower,
+  /// no incremental edits (an edit refits from scratch). For tests and benchmarks.
+  FullLu,
+};
+
+/// Options of Rbf::fit and of the edits.
+struct RbfOptions {
+  /// Solver of fit(); see RbfSolver.
+  RbfSolver solver = RbfSolver::Cholesky;
+  /// Two constraints closer than `duplicate_tolerance * diagonal` (diagonal of the bounding box of the
+  /// constraints) are rejected as near-duplicates with InvalidPoint naming both. 0 rejects exact
+  /// duplicates only. Near-duplicates make the system nearly singular (large weights, wild f).
+  double duplicate_tolerance = 1e-6;
+  /// Relative residual max_i |f(c_i) - h_i| / max_i |h_i| above which the fit is flagged unreliable
+  /// (FitReport::warning). The fit throws NumericalError when it is above `fail_residual`.
+  double warn_residual = 1e-9;
+  /// See warn_residual. Also the threshold of the drift check after edits (which refits first).
+  double fail_residual = 1e-5;
+  /// Condition-number estimate (1-norm, reduced system in scaled coordinates) above which the fit is
+  /// flagged unreliable (FitReport::warning). Never fails on its own.
+  double warn_condition = 1e13;
+  /// Threads used by the batch evaluation values() / values_gradients(): 0 = hardware concurrency,
+  /// 1 = the calling thread only. Small batches always run on the calling thread.
+  unsigned threads = 0;
+  /// Number of edits between two automatic drift checks (a residual computation, O(N^2) kernel
+  /// evaluations, about the cost of one edit). When the relative residual exceeds `warn_residual`, the
+  /// function is refitted from scratch. 0 disables the automatic check (check_drift() still works).
+  std::size_t drift_check_interval = 64;
+};
+
+/// What a fit (or the last drift check) measured.
+struct FitReport {
+  std::size_t constraints = 0;  ///< N.
+  /// max_i |f(c_i) - h_i| / max_i |h_i|, evaluated with the final weights (the same code path as value()).
+  double relative_residual = 0.0;
+  /// |sum w| + |sum w c| relative to sum |w| |c|-scale: how well the side conditions hold (scaled coords).
+  double side_condition_residual = 0.0;
+  /// Estimate of the 1-norm condition number of the reduced SPD system (scaled coordinates). 0 for the
+  /// FullLu solver. After edits: a cheap lower bound (max / min diagonal of the Cholesky factor)^2.
+  double condition_estimate = 0.0;
+  /// Iterative refinement steps applied by the last fit or drift check.
+  int refinement_steps = 0;
+  /// True when relative_residual > warn_residual or condition_estimate > warn_condition: the function
+  /// may not interpolate the data accurately (near-duplicate points, extreme scales).
+  bool warning = false;
+  /// Human-readable summary, empty when !warning.
+  std::string message;
+};
+
+/// The RBF interpolant. Typical use:
+///
+///   vitri::Rbf f;
+///   f.fit(constraints);                 // throws on bad input
+///   double v = f.value({0, 0, 0});
+///   f.add_constraint({1, 2, 3}, 0.0);   // O(N^2)
+///
+/// Constraint numbering: constraints are numbered 0..size()-1 in the order given to fit(), then
+/// add_constraint() appends (index size()), and remove_constraint(i) erases like std::vector::erase:
+/// constraints after i shift down by one. move_constraint and set_value keep every index.
+///
+/// Thread safety: the const members (evaluation) may run concurrently; edits need exclusive access.
+class Rbf : public ImplicitFunction {
+ public:
+  Rbf();
+  /// Shorthand for Rbf r; r.fit(constraints, options).
+  explicit Rbf(const Constraints& constraints, const RbfOptions& options = {});
+  ~Rbf() override;
+  Rbf(const Rbf&);
+  Rbf& operator=(const Rbf&);
+  Rbf(Rbf&&) noexcept;
+  Rbf& operator=(Rbf&&) noexcept;
+
+  /// Fits the interpolant to the constraints, replacing any previous state.
+  /// @throws InvalidPoint     non-finite coordinate or value (index of the constraint), exact or
+  ///                          near-duplicate positions (index of the later one; message names both).
+  /// @throws InvalidArgument  fewer than 4 constraints, or all values equal to zero (f would be 0).
+  /// @throws NumericalError   all constraints coplanar (the linear polynomial is undetermined), the
+  ///                          reduced system is not positive definite, or the relative residual is
+  ///                          above options.fail_residual.
+  /// @return the fit report (also available as report()).
+  const FitReport& fit(const Constraints& constraints, const RbfOptions& options = {});
+
+  /// True after a successful fit().
+  bool fitted() const;
+  /// Number of constraints N.
+  std::size_t size() const;
+  /// Current constraints, in the numbering described in the class comment.
+  const Constraints& constraints() const;
+  /// Options of the last fit().
+  const RbfOptions& options() const;
+  /// Report of the last fit(), refit or drift check.
+  const FitReport& report() const;
+
+  // ----- evaluation (ImplicitFunction) -----
+  double value(const Point3& p) const override;
+  double value_gradient(const Point3& p, Point3& gradient) const override;
+  /// out[i] = f(points[i]), i < n, threaded when large (options().threads).
+  void values(const Point3* points, std::size_t n, double* out) const override;
+  /// values[i] = f(points[i]) and gradients[i] = grad f(points[i]), i < n, threaded when large.
+  void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const;
+
+  // ----- coefficients, in the caller's units -----
+  /// RBF weights w_j of f (one per constraint, same numbering), for the caller's coordinates.
+  std::vector<double> weights() const;
+  /// Linear part: f(x) = sum_j w_j |x - c_j|^3 + constant + linear . x.
+  double polynomial_constant() const;
+  Point3 polynomial_linear() const;
+
+  // ----- edits: each O(N^2), keeping the Cholesky factor up to date -----
+  /// Appends the constraint f(p) = value; it gets index size() - 1.
+  /// @throws InvalidPoint (index size()) for non-finite data or a (near-)duplicate of an existing point.
+  void add_constraint(const Point3& p, double value);
+  /// Removes constraint i; the constraints after it shift down by one (std::vector::erase).
+  /// @throws InvalidPoint when i >= size(); InvalidArgument when fewer than 4 non-coplanar constraints
+  ///         or only zero values would remain (the function is then left unchanged).
+  void remove_constraint(std::size_t i);
+  /// Moves constraint i to p, keeping its value and index. Same errors as add_constraint (index i).
+  void move_constraint(std::size_t i, const Point3& p);
+  /// Sets the value of constraint i. @throws InvalidPoint for a non-finite value or i out of range;
+  /// InvalidArgument when every value would be zero.
+  void set_value(std::size_t i, double value);
+
+  /// Computes the residual of the current weights (O(N^2)); when it exceeds options().warn_residual,
+  /// applies iterative refinement and, if still inaccurate, refits from scratch. Updates report().
+  /// Called automatically every options().drift_check_interval edits.
+  /// @return true when a refit from scratch was needed.
+  bool check_drift();
+  /// Refits from scratch from the current constraints (O(N^3)).
+  void refit();
+  /// Number of edits since the last full factorization (fit or refit).
+  std::size_t edits_since_fit() const;
+  /// Number of full factorizations made by edits (anchor replacement, drift) since fit().
+  std::size_t refits_by_edits() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// The plain reference formulation, independent of Rbf: solves the full (N + 4) x (N + 4) saddle system
+/// [A P; P^T 0] [w; a] = [h; 0] by partial-pivoting LU in the caller's coordinates (no scaling, no
+/// checks). Returns w (N) followed by a (4: constant, x, y, z). For tests and benchmarks only.
+Eigen::VectorXd rbf_solve_dense_lu(const Constraints& constraints);
+
+/// Evaluates the function given by rbf_solve_dense_lu's coefficients at p (direct sum, for tests).
+double rbf_evaluate_coefficients(const Constraints& constraints, const Eigen::VectorXd& coefficients,
+                                 const Point3& p);
+
+}  // namespace vitri

@@ -1,0 +1,1 @@
+#include "vitri/rbf/constraints.hpp"

@@ -1,0 +1,153 @@
+// Incremental edits of vitri::Rbf: after any sequence of add / remove / move / set_value the function
+// equals a fresh fit of the resulting constraints (1e-8 relative on random probes).
+#include "vitri/core/error.hpp"
+#include "vitri/rbf/rbf.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+using vitri::Constraints;
+using vitri::Point3;
+using vitri::Rbf;
+
+namespace {
+
+// max |f - g| over random probes, relative to max |g|.
+double probe_difference(const Rbf& f, const Rbf& g, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  double d = 0, m = 0;
+  for (int k = 0; k < 200; ++k) {
+    const Point3 p{u(rng), u(rng), u(rng)};
+    const double a = f.value(p), b = g.value(p);
+    d = std::max(d, std::abs(a - b));
+    m = std::max(m, std::abs(b));
+  }
+  return d / m;
+}
+
+Constraints random_constraints(std::size_t n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Constraints c;
+  for (std::size_t i = 0; i < n; ++i) c.add({u(rng), u(rng), u(rng)}, u(rng));
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("rbf edits equal a fresh fit", "[rbf][edits]") {
+  const unsigned seed = GENERATE(1u, 2u, 3u);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Constraints c = random_constraints(120, rng);
+  vitri::RbfOptions opt;
+  opt.drift_check_interval = 0;  // no automatic refit: the updates alone must be accurate
+  Rbf f(c, opt);
+  for (int step = 0; step < 60; ++step) {
+    const int kind = static_cast<int>(rng() % 4);
+    const std::size_t i = rng() % c.size();
+    if (kind == 0) {
+      const Point3 p{u(rng), u(rng), u(rng)};
+      const double v = u(rng);
+      f.add_constraint(p, v);
+      c.add(p, v);
+    } else if (kind == 1) {
+      f.remove_constraint(i);
+      c.points.erase(c.points.begin() + static_cast<std::ptrdiff_t>(i));
+      c.values.erase(c.values.begin() + static_cast<std::ptrdiff_t>(i));
+    } else if (kind == 2) {
+      const Point3 p{u(rng), u(rng), u(rng)};
+      f.move_constraint(i, p);
+      c.points[i] = p;
+    } else {
+      const double v = u(rng);
+      f.set_value(i, v);
+      c.values[i] = v;
+    }
+    REQUIRE(f.size() == c.size());
+  }
+  CHECK(f.edits_since_fit() == 60);
+  CHECK(f.refits_by_edits() == 0);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    CHECK(f.constraints().points[i] == c.points[i]);
+    CHECK(f.constraints().values[i] == c.values[i]);
+  }
+  Rbf g(c);
+  CHECK(probe_difference(f, g, seed) <= 1e-8);
+  f.check_drift();
+  CHECK(f.report().relative_residual <= 1e-9);
+}
+
+TEST_CASE("rbf edits that hit the anchors: removing and moving every constraint in turn", "[rbf][edits]") {
+  std::mt19937 rng(77);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Constraints c = random_constraints(40, rng);
+  vitri::RbfOptions opt;
+  opt.drift_check_interval = 0;
+  Rbf f(c, opt);
+  // Moving every constraint touches the four anchors as well.
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    const Point3 p{u(rng), u(rng), u(rng)};
+    f.move_constraint(i, p);
+    c.points[i] = p;
+  }
+  CHECK(probe_difference(f, Rbf(c), 5) <= 1e-8);
+  // Remove from the front until 10 remain: every original index is removed once.
+  while (c.size() > 10) {
+    f.remove_constraint(0);
+    c.points.erase(c.points.begin());
+    c.values.erase(c.values.begin());
+  }
+  CHECK(probe_difference(f, Rbf(c), 6) <= 1e-8);
+  CHECK(f.refits_by_edits() == 0);
+}
+
+TEST_CASE("rbf edit errors leave the function unchanged", "[rbf][edits][errors]") {
+  std::mt19937 rng(8);
+  Constraints c = random_constraints(12, rng);
+  Rbf f(c);
+  const Rbf before = f;
+  CHECK_THROWS_AS(f.remove_constraint(12), vitri::InvalidPoint);
+  CHECK_THROWS_AS(f.add_constraint(c.points[3], c.values[3] + 1), vitri::InvalidPoint);
+  CHECK_THROWS_WITH(f.add_constraint(c.points[3], 0.5), Catch::Contains("constraint 3"));
+  CHECK_THROWS_AS(f.add_constraint({std::nan(""), 0, 0}, 0.0), vitri::InvalidPoint);
+  CHECK_THROWS_AS(f.move_constraint(2, c.points[5]), vitri::InvalidPoint);
+  CHECK_THROWS_AS(f.set_value(1, std::numeric_limits<double>::infinity()), vitri::InvalidPoint);
+  CHECK(f.size() == 12);
+  CHECK(probe_difference(f, before, 1) == 0.0);
+
+  // Down to 4 constraints, then no further; coplanar remainders are refused.
+  Constraints sq;
+  sq.add({0, 0, 0}, 1), sq.add({1, 0, 0}, -1), sq.add({0, 1, 0}, 1), sq.add({1, 1, 0}, 2), sq.add({0, 0, 1}, 3);
+  Rbf h(sq);
+  CHECK_THROWS_WITH(h.remove_constraint(4), Catch::Contains("coplanar"));
+  CHECK(h.size() == 5);
+  h.remove_constraint(3);
+  CHECK(h.size() == 4);
+  CHECK_THROWS_WITH(h.remove_constraint(0), Catch::Contains("at least 4"));
+  Constraints z = sq;
+  z.values = {0, 0, 0, 0, 1};
+  Rbf zf(z);
+  CHECK_THROWS_WITH(zf.set_value(4, 0.0), Catch::Contains("zero"));
+  CHECK_THROWS_WITH(zf.remove_constraint(4), Catch::Contains("zero"));
+}
+
+TEST_CASE("rbf drift check refits when asked and keeps accuracy over many edits", "[rbf][edits]") {
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Constraints c = random_constraints(80, rng);
+  vitri::RbfOptions opt;
+  opt.drift_check_interval = 25;
+  Rbf f(c, opt);
+  for (int step = 0; step < 200; ++step) {
+    const std::size_t i = rng() % c.size();
+    const Point3 p{u(rng), u(rng), u(rng)};
+    f.move_constraint(i, p);
+    c.points[i] = p;
+  }
+  f.check_drift();
+  CHECK(f.report().relative_residual <= 1e-9);
+  CHECK(probe_difference(f, Rbf(c), 3) <= 1e-8);
+}

@@ -16,9 +16,11 @@
 #include "vitri/core/point.hpp"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <vector>
 
 namespace vitri {
@@ -50,22 +52,55 @@ struct ChangeSet {
   }
 };
 
-/// Exact, dynamic Delaunay tetrahedralization of points inside a box. Not thread-safe for writes.
+/// Construction options of a Triangulation.
+struct TriangulationOptions {
+  /// Keep the history DAG (default). Dead tetrahedra then keep their slot and their vertices forever,
+  /// insert() and locate() descend the history in O(log n) expected, and killed ids are never reused.
+  /// false: dead slots are recycled (a killed id may come back as a created id in a later operation),
+  /// memory is that of the live mesh only, and location walks from the last created tetrahedron.
+  bool keep_history = true;
+};
+
+/// Exact, dynamic Delaunay tetrahedralization of points inside a box. Not thread-safe for writes;
+/// const member functions may be called concurrently.
+///
+/// @note Points must lie strictly inside the box (the open box): the corners are the only vertices on
+/// its boundary, so no tetrahedron can be flat against a hull face.
+/// @note ChangeSet semantics: `killed` were live before the operation and are dead after it, `created`
+/// are live after it and were not before (a move nets out tetrahedra that it created then killed).
 class Triangulation {
  public:
   /// Builds the tetrahedralization of the 8 corners of `box`.
   /// @throws InvalidArgument when the box is empty, flat, or has non-finite coordinates.
   explicit Triangulation(const Box3& box);
+  /// Same, with options (see TriangulationOptions).
+  Triangulation(const Box3& box, const TriangulationOptions& options);
+  ~Triangulation();
+  Triangulation(const Triangulation& other);
+  Triangulation& operator=(const Triangulation& other);
+  Triangulation(Triangulation&&) noexcept;
+  Triangulation& operator=(Triangulation&&) noexcept;
 
   // ---- Modification -------------------------------------------------------------------------------
   /// Inserts p, locating it through the history DAG. Returns TooClose (and changes nothing) when p is
   /// closer than min_distance to an existing vertex; an exact duplicate is always TooClose.
-  /// @throws InvalidPoint (index 0) when p is not finite or lies outside the box.
+  /// @throws InvalidPoint (index 0) when p is not finite or lies outside the box (or on its boundary);
+  /// InvalidArgument when min_distance is negative or NaN; LimitError when an id would overflow.
   InsertResult insert(const Point3& p, double min_distance = 0.0, ChangeSet* changes = nullptr);
+
+  /// Inserts many points: spatially sorted in randomized rounds (BRIO, Hilbert order within a round)
+  /// and located by walking from the last created tetrahedron. The history is recorded as for insert().
+  /// Returns one result per input point, in input order. With min_distance > 0 which of two close
+  /// points survives depends on the internal order (deterministic for given input).
+  /// All points are validated first: @throws InvalidPoint(i) naming the first bad point (nothing
+  /// inserted). `changes` receives the net change of the whole batch.
+  std::vector<InsertResult> insert_points(const std::vector<Point3>& points, double min_distance = 0.0,
+                                          ChangeSet* changes = nullptr);
 
   /// Inserts p known to be in conflict with the live tetrahedron `conflict` (p inside its
   /// circumsphere, perturbed sense): no point location. Used by refinement to insert circumcenters.
   /// @pre is_live(conflict) and p in conflict with it.
+  /// @throws InvalidArgument when `conflict` is not live or p is not in conflict with it, and as insert().
   InsertResult insert_in_conflict(const Point3& p, TetId conflict, double min_distance = 0.0,
                                   ChangeSet* changes = nullptr);
 
@@ -75,25 +110,47 @@ class Triangulation {
 
   /// Moves vertex v to p; v keeps its id. Returns TooClose (and leaves v where it was) when p is closer
   /// than min_distance to another vertex. @throws as remove() and insert().
+  /// When every tetrahedron around v stays positively oriented and locally Delaunay at p, only the
+  /// star of v is rebuilt (same combinatorics); otherwise v is removed and reinserted.
   InsertResult move(VertexId v, const Point3& p, double min_distance = 0.0, ChangeSet* changes = nullptr);
 
   // ---- Queries --------------------------------------------------------------------------------------
   /// A live tetrahedron containing p (closed); p must lie in the box. Uses the history DAG.
   TetId locate(const Point3& p) const;
 
-  const Box3& box() const;
-  std::size_t num_vertices() const;      ///< live vertices, corners included
-  std::size_t num_tetrahedra() const;    ///< live tetrahedra
-  std::size_t vertex_capacity() const;   ///< one past the largest vertex id ever used
-  std::size_t tet_capacity() const;      ///< one past the largest tetrahedron id ever used (history)
+  const Box3& box() const { return box_; }
+  bool keeps_history() const { return keep_history_; }
+  std::size_t num_vertices() const { return num_live_vertices_; }  ///< live vertices, corners included
+  std::size_t num_tetrahedra() const { return num_live_tets_; }    ///< live tetrahedra
+  /// One past the largest vertex id ever used.
+  std::size_t vertex_capacity() const { return pid_of_vid_.empty() ? pos_.size() : pid_of_vid_.size(); }
+  /// One past the largest tetrahedron id ever used (history included).
+  std::size_t tet_capacity() const { return tf_.size(); }
 
-  bool is_vertex(VertexId v) const;      ///< v is a live vertex
+  /// v is a live vertex.
+  bool is_vertex(VertexId v) const { return v < vertex_capacity() && vtet_[pid(v)] != kNoTet; }
   bool is_corner(VertexId v) const { return v < 8; }
-  const Point3& point(VertexId v) const;
-  bool is_live(TetId t) const;
-  VertexId tet_vertex(TetId t, int i) const;
-  TetId tet_neighbor(TetId t, int i) const;  ///< across the face opposite vertex i; kNoTet on the hull
-  std::array<VertexId, 4> tet_vertices(TetId t) const;
+  /// Position of vertex v (for a removed vertex: its last position). @pre v < vertex_capacity().
+  const Point3& point(VertexId v) const { return pos_[pid(v)]; }
+  /// t is a live tetrahedron (false for dead, recycled or out-of-range ids).
+  bool is_live(TetId t) const { return t < tf_.size() && !(tf_[t] & kDead); }
+  /// Vertex i (0..3) of tetrahedron t (live or dead).
+  VertexId tet_vertex(TetId t, int i) const { return vid(tv_[4 * std::size_t(t) + i]); }
+  /// Position of vertex i of t: point(tet_vertex(t, i)) without the id translation.
+  const Point3& tet_point(TetId t, int i) const { return pos_[tv_[4 * std::size_t(t) + i]]; }
+  /// Across the face opposite vertex i; kNoTet on the hull. @pre is_live(t).
+  TetId tet_neighbor(TetId t, int i) const { return tn_[4 * std::size_t(t) + i]; }
+  std::array<VertexId, 4> tet_vertices(TetId t) const {
+    return {tet_vertex(t, 0), tet_vertex(t, 1), tet_vertex(t, 2), tet_vertex(t, 3)};
+  }
+  /// One live tetrahedron incident to v, kNoTet when v is not a live vertex.
+  TetId vertex_tet(VertexId v) const { return v < vertex_capacity() ? vtet_[pid(v)] : kNoTet; }
+  /// Index (0..3) of vertex v in tetrahedron t, or -1.
+  int vertex_index(TetId t, VertexId v) const {
+    for (int i = 0; i < 4; ++i)
+      if (tet_vertex(t, i) == v) return i;
+    return -1;
+  }
 
   /// Ids of all live tetrahedra (a snapshot).
   std::vector<TetId> live_tetrahedra() const;
@@ -120,6 +177,64 @@ class Triangulation {
   // Flat-array members and inline accessors are the implementer's choice (no pimpl: accessors are
   // on the hot path of refinement and extraction).
  private:
+  // Internal point ids (PointId) index pos_, whose entries never change once written, because dead
+  // tetrahedra of the history refer to them. A moved vertex gets a new PointId and keeps its VertexId;
+  // until the first move the two numberings coincide and the translation tables are empty.
+  using PointId = std::uint32_t;
+  // One history record: the tetrahedra [first, first + count) created by one operation cover exactly
+  // the region of the tetrahedra it killed. apex: the inserted point for an insertion (all created
+  // tetrahedra share it), kNoVertex for the root, a removal or a move.
+  struct Op {
+    TetId first;
+    std::uint32_t count;
+    PointId apex;
+  };
+  struct Scratch;
+  static constexpr std::uint8_t kDead = 1;      // tetrahedron is dead (or a free slot)
+  static constexpr std::uint8_t kMark = 2;      // temporary: in the current cavity / star
+  static constexpr std::uint8_t kTested = 4;    // temporary: tested, not in conflict
+
+  PointId pid(VertexId v) const { return pid_of_vid_.empty() ? v : pid_of_vid_[v]; }
+  VertexId vid(PointId p) const { return vid_of_pid_.empty() ? p : vid_of_pid_[p]; }
+
+  void init_corners();
+  void check_point(const Point3& p, std::size_t index) const;
+  void check_vertex(VertexId v, const char* what) const;
+  TetId walk(const Point3& p, TetId start) const;
+  TetId locate_history(const Point3& p) const;
+  bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
+  TetId alloc_tet();
+  void free_tet(TetId t);
+  PointId alloc_point(const Point3& p, VertexId reuse_vid);
+  bool grow_cavity(const Point3& p, TetId start, PointId& duplicate);
+  void clear_cavity_marks();
+  InsertResult insert_at(const Point3& p, TetId start, double min_distance, ChangeSet* changes,
+                         VertexId reuse_vid);
+  void collect_star(PointId v);
+  void remove_impl(VertexId v, ChangeSet* changes);
+  bool try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,
+                         ChangeSet* changes);
+  void record_op(TetId first, std::uint32_t count, PointId apex);
+  void kill(TetId t, std::uint32_t op, TetId hint);
+  void reset_to_corners();
+
+  Box3 box_;
+  bool keep_history_ = true;
+  std::vector<Point3> pos_;            // by PointId; immutable once written
+  std::vector<TetId> vtet_;            // by PointId: one incident live tetrahedron, kNoTet if not live
+  std::vector<VertexId> vid_of_pid_;   // empty until the first move
+  std::vector<PointId> pid_of_vid_;    // empty until the first move
+  std::vector<PointId> tv_;            // 4 per tetrahedron
+  std::vector<TetId> tn_;              // 4 per tetrahedron; dead: [0] history op, [1] hint
+  std::vector<std::uint8_t> tf_;       // flags per tetrahedron
+  std::vector<Op> ops_;                // history records (insertions, removals, moves)
+  std::size_t num_live_vertices_ = 0;
+  std::size_t num_live_tets_ = 0;
+  TetId free_head_ = kNoTet;           // recycled slots (keep_history == false)
+  TetId last_tet_ = 0;                 // a live tetrahedron near the last operation (walk start)
+  std::vector<PointId> init_tv_;       // the 8-corner triangulation, for reset_to_corners()
+  std::vector<TetId> init_tn_;
+  std::unique_ptr<Scratch> scratch_;   // work buffers, never shared between copies
 };
 
 }  // namespace vitri

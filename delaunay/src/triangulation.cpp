@@ -1,0 +1,1204 @@
+// The Delaunay tree: exact, fully dynamic 3D Delaunay tetrahedralization inside a box.
+//
+// A brief explanation (details and a sketch in docs/delaunay.md):
+//
+// * Storage is flat. Tetrahedron t owns slots 4t..4t+3 of tv_ (vertices, internal point ids) and tn_
+//   (neighbour across the face opposite vertex i). Live tetrahedra are positively oriented. Flags tf_[t]
+//   say dead/live plus temporary marks used inside one operation.
+// * Start: the 8 box corners are cospherical; their Delaunay tetrahedralization under the symbolic
+//   perturbation of insphere_sos() is computed by brute force (every non-flat 4-subset whose perturbed
+//   circumsphere is empty of the other corners) and is the root of the history.
+// * Insertion (Bowyer-Watson): from one tetrahedron in conflict with p, grow the cavity (all tetrahedra
+//   whose perturbed circumsphere contains p) by adjacency; it is star-shaped from p. Then build one new
+//   tetrahedron per boundary face of the cavity (p replaces the vertex of the killed tetrahedron
+//   opposite that face, which keeps the orientation) and link the new ones around each boundary edge by
+//   rotating through the killed tetrahedra.
+// * History (containment DAG): each operation records the contiguous id range of the tetrahedra it
+//   created (Op). Those cover exactly the region of the tetrahedra it killed, and each killed tetrahedron
+//   stores the index of its Op (plus a hint) in its freed neighbour slots. Location descends from the root:
+//   in a dead tetrahedron containing p, find the tetrahedron of its Op's range that contains p. For an
+//   insertion all new tetrahedra share the apex, and the cavity is star-shaped from it, so three
+//   orientation tests (the faces through the apex) decide. For removals and moves the full closed
+//   containment test is used. The sequence of tetrahedra containing a fixed point changes O(log n) times
+//   in expectation for a random insertion order (backward analysis), which bounds the descent.
+// * Removal: the hole is the star of v. The tetrahedra filling it in DT(S \ v) are Delaunay for the link
+//   vertices plus the 8 corners (all in S \ v), so they are exactly the tetrahedra of the perturbed
+//   DT(link + corners), built in a small scratch Triangulation over the same box, that lie inside the
+//   hole. They are found by a flood fill from a link face that stops at link faces.
+// * Move: if every tetrahedron of the star stays positive and every face of the star stays locally
+//   Delaunay at the new position, the star is rebuilt with the same combinatorics; otherwise remove then
+//   insert. Positions are immutable (the history refers to them): a moved vertex gets a new internal
+//   point id and keeps its public VertexId.
+#include "vitri/delaunay/triangulation.hpp"
+
+#include "vitri/core/error.hpp"
+#include "vitri/core/predicates.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <unordered_set>
+#include <utility>
+
+namespace vitri {
+
+namespace {
+
+// orient3d of the four points P with P[i] replaced by p.
+inline Sign orient_replace(const Point3* const P[4], int i, const Point3& p) {
+  switch (i) {
+    case 0: return orient3d(p, *P[1], *P[2], *P[3]);
+    case 1: return orient3d(*P[0], p, *P[2], *P[3]);
+    case 2: return orient3d(*P[0], *P[1], p, *P[3]);
+    default: return orient3d(*P[0], *P[1], *P[2], p);
+  }
+}
+
+std::string fmt_point(const Point3& p) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+  return s.str();
+}
+
+template <class V>
+void grow_to(V& v, std::size_t n) {
+  if (n > v.capacity()) v.reserve(std::max(n, v.capacity() + v.capacity() / 2 + 64));
+  v.resize(n);
+}
+
+template <class V>
+std::size_t bytes_of(const V& v) {
+  return v.capacity() * sizeof(typename V::value_type);
+}
+
+// Hilbert index of a point of a 2^21 grid (Skilling's transpose algorithm, then bit interleaving).
+std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
+  constexpr int kBits = 21;
+  std::uint32_t X[3] = {x, y, z};
+  const std::uint32_t m = 1u << (kBits - 1);
+  for (std::uint32_t q = m; q > 1; q >>= 1) {
+    const std::uint32_t p = q - 1;
+    for (int i = 0; i < 3; ++i) {
+      if (X[i] & q) {
+        X[0] ^= p;
+      } else {
+        const std::uint32_t t = (X[0] ^ X[i]) & p;
+        X[0] ^= t;
+        X[i] ^= t;
+      }
+    }
+  }
+  for (int i = 1; i < 3; ++i) X[i] ^= X[i - 1];
+  std::uint32_t t = 0;
+  for (std::uint32_t q = m; q > 1; q >>= 1)
+    if (X[2] & q) t ^= q - 1;
+  for (int i = 0; i < 3; ++i) X[i] ^= t;
+  std::uint64_t key = 0;
+  for (int b = kBits - 1; b >= 0; --b)
+    for (int i = 0; i < 3; ++i) key = (key << 1) | ((X[i] >> b) & 1u);
+  return key;
+}
+
+// BRIO: a fixed-seed shuffle cut into rounds of growing size (each 8x the previous), each round sorted
+// along a Hilbert curve. Rounds keep the randomness that bounds the cavity sizes; the sort keeps walks
+// short.
+std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3& box) {
+  const std::size_t n = pts.size();
+  std::vector<std::uint32_t> idx(n);
+  std::iota(idx.begin(), idx.end(), 0u);
+  std::mt19937_64 rng(0x5eedf00dULL);
+  for (std::size_t i = n; i > 1; --i) std::swap(idx[i - 1], idx[rng() % i]);
+  std::vector<std::uint64_t> key(n);
+  const Point3 lo = box.lo;
+  const Point3 ext = box.extent();
+  const double scale = double((1u << 21) - 1);
+  for (std::size_t i = 0; i < n; ++i) {
+    auto q = [&](double v, double l, double e) {
+      double f = (v - l) / e * scale;
+      f = std::min(std::max(f, 0.0), scale);
+      return static_cast<std::uint32_t>(f);
+    };
+    key[i] = hilbert_key(q(pts[i].x, lo.x, ext.x), q(pts[i].y, lo.y, ext.y), q(pts[i].z, lo.z, ext.z));
+  }
+  std::size_t e = n;
+  while (e > 0) {
+    const std::size_t b = e > 64 ? e / 8 : 0;
+    std::sort(idx.begin() + std::ptrdiff_t(b), idx.begin() + std::ptrdiff_t(e),
+              [&](std::uint32_t a, std::uint32_t c) { return key[a] < key[c]; });
+    e = b;
+  }
+  return idx;
+}
+
+// Reduces a sequence of (slot, created?) events to the net change: a slot whose first event is a kill
+// held a tetrahedron that was live before (killed); a slot whose last event is a creation holds one that
+// is live after (created).
+void net_changes(std::vector<std::pair<TetId, bool>>& events, ChangeSet& out) {
+  std::vector<std::size_t> order(events.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return events[a].first < events[b].first; });
+  for (std::size_t i = 0; i < order.size();) {
+    std::size_t j = i;
+    while (j + 1 < order.size() && events[order[j + 1]].first == events[order[i]].first) ++j;
+    if (!events[order[i]].second) out.killed.push_back(events[order[i]].first);
+    if (events[order[j]].second) out.created.push_back(events[order[j]].first);
+    i = j + 1;
+  }
+}
+
+}  // namespace
+
+// Work buffers of one Triangulation (never shared between copies).
+struct Triangulation::Scratch {
+  struct Boundary {
+    TetId tet;  // killed tetrahedron
+    int face;   // index of the face on the cavity boundary
+  };
+  struct LinkFace {
+    std::array<PointId, 3> key;  // sorted vertex ids
+    TetId star_tet;              // the star tetrahedron that owns it
+    TetId new_tet;               // the new tetrahedron on its inner side
+  };
+  std::vector<TetId> cavity, tested, created, star;
+  std::vector<Boundary> boundary;
+  std::vector<PointId> link;      // link vertices of a removed vertex, sorted
+  std::vector<VertexId> link_sub; // their ids in `sub`
+  std::vector<PointId> sub_to_main;
+  std::vector<LinkFace> link_faces;
+  std::vector<TetId> inside, sub_to_new;
+  std::vector<std::pair<TetId, TetId>> old_to_new;
+  std::unique_ptr<Triangulation> sub;  // small triangulation used by remove()
+};
+
+// ---- Construction ----------------------------------------------------------------------------------
+
+Triangulation::Triangulation(const Box3& box) : Triangulation(box, TriangulationOptions{}) {}
+
+Triangulation::Triangulation(const Box3& box, const TriangulationOptions& options)
+    : box_(box), keep_history_(options.keep_history), scratch_(std::make_unique<Scratch>()) {
+  if (!is_finite(box.lo) || !is_finite(box.hi))
+    throw InvalidArgument("Triangulation: the box has non-finite coordinates");
+  if (!(box.lo.x < box.hi.x && box.lo.y < box.hi.y && box.lo.z < box.hi.z))
+    throw InvalidArgument("Triangulation: the box is empty or flat (need lo < hi on every axis), lo = " +
+                          fmt_point(box.lo) + ", hi = " + fmt_point(box.hi));
+  init_corners();
+}
+
+Triangulation::~Triangulation() = default;
+Triangulation::Triangulation(Triangulation&&) noexcept = default;
+Triangulation& Triangulation::operator=(Triangulation&&) noexcept = default;
+
+Triangulation::Triangulation(const Triangulation& o)
+    : box_(o.box_),
+      keep_history_(o.keep_history_),
+      pos_(o.pos_),
+      vtet_(o.vtet_),
+      vid_of_pid_(o.vid_of_pid_),
+      pid_of_vid_(o.pid_of_vid_),
+      tv_(o.tv_),
+      tn_(o.tn_),
+      tf_(o.tf_),
+      ops_(o.ops_),
+      num_live_vertices_(o.num_live_vertices_),
+      num_live_tets_(o.num_live_tets_),
+      free_head_(o.free_head_),
+      last_tet_(o.last_tet_),
+      init_tv_(o.init_tv_),
+      init_tn_(o.init_tn_),
+      scratch_(std::make_unique<Scratch>()) {}
+
+Triangulation& Triangulation::operator=(const Triangulation& o) {
+  if (this != &o) {
+    Triangulation copy(o);
+    *this = std::move(copy);
+  }
+  return *this;
+}
+
+void Triangulation::init_corners() {
+  Point3 c[8];
+  for (int k = 0; k < 8; ++k) c[k] = box_.corner(k);
+  // Brute force: a non-flat tetrahedron of corners belongs to the perturbed Delaunay tetrahedralization
+  // iff no other corner is inside its perturbed circumsphere.
+  std::vector<std::array<PointId, 4>> tets;
+  for (PointId a = 0; a < 8; ++a)
+    for (PointId b = a + 1; b < 8; ++b)
+      for (PointId d0 = b + 1; d0 < 8; ++d0)
+        for (PointId d1 = d0 + 1; d1 < 8; ++d1) {
+          std::array<PointId, 4> t = {a, b, d0, d1};
+          const Sign o = orient3d(c[t[0]], c[t[1]], c[t[2]], c[t[3]]);
+          if (o == Sign::Zero) continue;
+          if (o == Sign::Negative) std::swap(t[0], t[1]);
+          bool empty = true;
+          for (PointId e = 0; e < 8 && empty; ++e) {
+            if (e == a || e == b || e == d0 || e == d1) continue;
+            if (insphere_sos(c[t[0]], c[t[1]], c[t[2]], c[t[3]], c[e]) == Sign::Positive) empty = false;
+          }
+          if (empty) tets.push_back(t);
+        }
+  const std::size_t m = tets.size();
+  init_tv_.assign(4 * m, kNoVertex);
+  init_tn_.assign(4 * m, kNoTet);
+  for (std::size_t t = 0; t < m; ++t)
+    for (int i = 0; i < 4; ++i) init_tv_[4 * t + i] = tets[t][i];
+  auto face = [&](std::size_t t, int i) {
+    std::array<PointId, 3> f{};
+    int k = 0;
+    for (int j = 0; j < 4; ++j)
+      if (j != i) f[k++] = tets[t][j];
+    std::sort(f.begin(), f.end());
+    return f;
+  };
+  for (std::size_t t = 0; t < m; ++t)
+    for (int i = 0; i < 4; ++i)
+      for (std::size_t u = 0; u < m; ++u)
+        for (int j = 0; j < 4 && u != t; ++j)
+          if (face(t, i) == face(u, j)) init_tn_[4 * t + i] = TetId(u);
+  reset_to_corners();
+}
+
+void Triangulation::reset_to_corners() {
+  const std::size_t m = init_tv_.size() / 4;
+  pos_.resize(8);
+  for (int k = 0; k < 8; ++k) pos_[k] = box_.corner(k);
+  vtet_.assign(8, kNoTet);
+  vid_of_pid_.clear();
+  pid_of_vid_.clear();
+  tv_ = init_tv_;
+  tn_ = init_tn_;
+  tf_.assign(m, 0);
+  for (std::size_t t = 0; t < m; ++t)
+    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * t + i]] = TetId(t);
+  ops_.clear();
+  if (keep_history_) ops_.push_back({0, std::uint32_t(m), kNoVertex});
+  num_live_vertices_ = 8;
+  num_live_tets_ = m;
+  free_head_ = kNoTet;
+  last_tet_ = 0;
+}
+
+// ---- Checks ----------------------------------------------------------------------------------------
+
+void Triangulation::check_point(const Point3& p, std::size_t index) const {
+  if (!is_finite(p)) throw InvalidPoint(index, "coordinates are not finite " + fmt_point(p));
+  if (!(p.x > box_.lo.x && p.x < box_.hi.x && p.y > box_.lo.y && p.y < box_.hi.y && p.z > box_.lo.z &&
+        p.z < box_.hi.z))
+    throw InvalidPoint(index, fmt_point(p) + " is not strictly inside the box [" + fmt_point(box_.lo) +
+                                  ", " + fmt_point(box_.hi) + "]");
+}
+
+void Triangulation::check_vertex(VertexId v, const char* what) const {
+  if (v >= vertex_capacity())
+    throw InvalidArgument(std::string("Triangulation::") + what + ": unknown vertex " + std::to_string(v));
+  if (is_corner(v))
+    throw InvalidArgument(std::string("Triangulation::") + what + ": vertex " + std::to_string(v) +
+                          " is a box corner");
+  if (!is_vertex(v))
+    throw InvalidArgument(std::string("Triangulation::") + what + ": vertex " + std::to_string(v) +
+                          " was removed");
+}
+
+static void check_min_distance(double d) {
+  if (!(d >= 0.0) || !std::isfinite(d))
+    throw InvalidArgument("Triangulation: min_distance must be finite and >= 0, got " + std::to_string(d));
+}
+
+// ---- Location --------------------------------------------------------------------------------------
+
+// Visibility walk with a random choice among the faces that separate p from the current tetrahedron:
+// terminates with probability 1 in any triangulation. p lies strictly inside the box, hence never beyond
+// a hull face.
+TetId Triangulation::walk(const Point3& p, TetId t) const {
+  TetId prev = kNoTet;
+  std::uint32_t rng = 0x9e3779b9u ^ t;
+  for (;;) {
+    rng = rng * 1664525u + 1013904223u;
+    const int r = int(rng >> 30);
+    const std::size_t b = 4 * std::size_t(t);
+    const Point3* const P[4] = {&pos_[tv_[b]], &pos_[tv_[b + 1]], &pos_[tv_[b + 2]], &pos_[tv_[b + 3]]};
+    TetId next = kNoTet;
+    for (int k = 0; k < 4; ++k) {
+      const int i = (r + k) & 3;
+      const TetId n = tn_[b + i];
+      if (n == kNoTet || n == prev) continue;
+      if (orient_replace(P, i, p) == Sign::Negative) {
+        next = n;
+        break;
+      }
+    }
+    if (next == kNoTet) return t;
+    prev = t;
+    t = next;
+  }
+}
+
+bool Triangulation::in_op_tet(const Op& op, TetId s, const Point3& p) const {
+  const std::size_t b = 4 * std::size_t(s);
+  const Point3* const P[4] = {&pos_[tv_[b]], &pos_[tv_[b + 1]], &pos_[tv_[b + 2]], &pos_[tv_[b + 3]]};
+  for (int i = 0; i < 4; ++i) {
+    if (tv_[b + i] == op.apex) continue;  // insertion: the face opposite the apex needs no test
+    if (orient_replace(P, i, p) == Sign::Negative) return false;
+  }
+  return true;
+}
+
+TetId Triangulation::locate_history(const Point3& p) const {
+  TetId t = kNoTet;
+  const Op& root = ops_[0];
+  for (TetId s = root.first; s < root.first + root.count && t == kNoTet; ++s)
+    if (in_op_tet(root, s, p)) t = s;
+  if (t == kNoTet) throw std::logic_error("Triangulation::locate: point not in the root tetrahedra");
+  while (tf_[t] & kDead) {
+    const Op& op = ops_[tn_[4 * std::size_t(t)]];
+    const TetId hint = tn_[4 * std::size_t(t) + 1];
+    TetId found = kNoTet;
+    for (std::uint32_t k = 0; k < op.count; ++k) {
+      const TetId s = op.first + (hint - op.first + k) % op.count;
+      if (in_op_tet(op, s, p)) {
+        found = s;
+        break;
+      }
+    }
+    if (found == kNoTet)
+      throw std::logic_error("Triangulation::locate: history record " + std::to_string(tn_[4 * t]) +
+                             " does not cover the point " + fmt_point(p));
+    t = found;
+  }
+  return t;
+}
+
+TetId Triangulation::locate(const Point3& p) const {
+  check_point(p, 0);
+  return keep_history_ ? locate_history(p) : walk(p, last_tet_);
+}
+
+// ---- Allocation ------------------------------------------------------------------------------------
+
+TetId Triangulation::alloc_tet() {
+  if (!keep_history_ && free_head_ != kNoTet) {
+    const TetId t = free_head_;
+    free_head_ = tn_[4 * std::size_t(t)];
+    tf_[t] = 0;
+    return t;
+  }
+  const TetId t = TetId(tf_.size());
+  grow_to(tv_, tv_.size() + 4);
+  grow_to(tn_, tn_.size() + 4);
+  grow_to(tf_, tf_.size() + 1);
+  tf_[t] = 0;
+  return t;
+}
+
+void Triangulation::kill(TetId t, std::uint32_t op, TetId hint) {
+  tf_[t] = kDead;
+  if (keep_history_) {
+    tn_[4 * std::size_t(t)] = op;
+    tn_[4 * std::size_t(t) + 1] = hint;
+  } else {
+    tn_[4 * std::size_t(t)] = free_head_;
+    free_head_ = t;
+  }
+}
+
+Triangulation::PointId Triangulation::alloc_point(const Point3& p, VertexId reuse_vid) {
+  if (pos_.size() >= std::size_t(kNoVertex) - 1)
+    throw LimitError("Triangulation: more than 2^32 - 2 point slots (moves included)");
+  const PointId id = PointId(pos_.size());
+  pos_.push_back(p);
+  vtet_.push_back(kNoTet);
+  if (reuse_vid == kNoVertex) {
+    if (!pid_of_vid_.empty()) {
+      if (pid_of_vid_.size() >= std::size_t(kNoVertex) - 1)
+        throw LimitError("Triangulation: more than 2^32 - 2 vertex ids");
+      vid_of_pid_.push_back(VertexId(pid_of_vid_.size()));
+      pid_of_vid_.push_back(id);
+    }
+  } else {
+    if (pid_of_vid_.empty()) {  // first move: the numberings start to differ
+      vid_of_pid_.resize(id);
+      std::iota(vid_of_pid_.begin(), vid_of_pid_.end(), 0u);
+      pid_of_vid_ = vid_of_pid_;
+    }
+    vid_of_pid_.push_back(reuse_vid);
+    pid_of_vid_[reuse_vid] = id;
+  }
+  return id;
+}
+
+void Triangulation::record_op(TetId first, std::uint32_t count, PointId apex) {
+  if (keep_history_) ops_.push_back({first, count, apex});
+}
+
+// ---- Insertion -------------------------------------------------------------------------------------
+
+bool Triangulation::grow_cavity(const Point3& p, TetId start, PointId& duplicate) {
+  Scratch& S = *scratch_;
+  S.cavity.clear();
+  S.boundary.clear();
+  S.tested.clear();
+  tf_[start] |= kMark;
+  S.cavity.push_back(start);
+  for (std::size_t k = 0; k < S.cavity.size(); ++k) {
+    const TetId t = S.cavity[k];
+    for (int i = 0; i < 4; ++i) {
+      const TetId n = tn_[4 * std::size_t(t) + i];
+      if (n == kNoTet) {
+        S.boundary.push_back({t, i});
+        continue;
+      }
+      const std::uint8_t f = tf_[n];
+      if (f & kMark) continue;
+      if (f & kTested) {
+        S.boundary.push_back({t, i});
+        continue;
+      }
+      const std::size_t b = 4 * std::size_t(n);
+      const Point3& a0 = pos_[tv_[b]];
+      const Point3& a1 = pos_[tv_[b + 1]];
+      const Point3& a2 = pos_[tv_[b + 2]];
+      const Point3& a3 = pos_[tv_[b + 3]];
+      if (p == a0 || p == a1 || p == a2 || p == a3) {
+        duplicate = tv_[b + (p == a0 ? 0 : p == a1 ? 1 : p == a2 ? 2 : 3)];
+        clear_cavity_marks();
+        return false;
+      }
+      if (insphere_sos(a0, a1, a2, a3, p) == Sign::Positive) {
+        tf_[n] |= kMark;
+        S.cavity.push_back(n);
+      } else {
+        tf_[n] |= kTested;
+        S.tested.push_back(n);
+        S.boundary.push_back({t, i});
+      }
+    }
+  }
+  return true;
+}
+
+void Triangulation::clear_cavity_marks() {
+  Scratch& S = *scratch_;
+  for (TetId t : S.cavity) tf_[t] &= std::uint8_t(~kMark);
+  for (TetId t : S.tested) tf_[t] &= std::uint8_t(~kTested);
+}
+
+InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_distance, ChangeSet* changes,
+                                      VertexId reuse_vid) {
+  Scratch& S = *scratch_;
+  InsertResult res;
+  for (int i = 0; i < 4; ++i) {
+    const PointId w = tv_[4 * std::size_t(start) + i];
+    if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
+  }
+  PointId dup = kNoVertex;
+  if (!grow_cavity(p, start, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
+
+  if (min_distance > 0.0) {
+    // The nearest vertex of p is a Delaunay neighbour of p, hence a vertex of the cavity.
+    double best = min_distance * min_distance;
+    PointId nearest = kNoVertex;
+    for (TetId t : S.cavity)
+      for (int i = 0; i < 4; ++i) {
+        const PointId w = tv_[4 * std::size_t(t) + i];
+        const double d2 = squared_distance(pos_[w], p);
+        if (d2 < best) {
+          best = d2;
+          nearest = w;
+        }
+      }
+    if (nearest != kNoVertex) {
+      clear_cavity_marks();
+      return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+    }
+  }
+  if (tf_.size() + S.boundary.size() >= std::size_t(kNoTet) - 1) {
+    clear_cavity_marks();
+    throw LimitError("Triangulation: more than 2^32 - 2 tetrahedra (history included)");
+  }
+  PointId q;
+  try {
+    q = alloc_point(p, reuse_vid);
+  } catch (...) {
+    clear_cavity_marks();
+    throw;
+  }
+
+  // One new tetrahedron per boundary face: q replaces the killed tetrahedron's vertex opposite the face.
+  // The killed tetrahedron's slot for that face is overwritten with the new id (used by the rotation).
+  const TetId first = TetId(tf_.size());
+  S.created.clear();
+  for (const auto& bf : S.boundary) {
+    const TetId s = alloc_tet();
+    const std::size_t bs = 4 * std::size_t(s), bt = 4 * std::size_t(bf.tet);
+    for (int j = 0; j < 4; ++j) {
+      tv_[bs + j] = tv_[bt + j];
+      tn_[bs + j] = kNoTet;
+    }
+    tv_[bs + bf.face] = q;
+    const TetId n = tn_[bt + bf.face];
+    tn_[bs + bf.face] = n;
+    if (n != kNoTet)
+      for (int k = 0; k < 4; ++k)
+        if (tn_[4 * std::size_t(n) + k] == bf.tet) tn_[4 * std::size_t(n) + k] = s;
+    tn_[bt + bf.face] = s;
+    S.created.push_back(s);
+  }
+  // Faces through q: rotate around the boundary edge through killed tetrahedra until the next boundary
+  // face; the new tetrahedron there is the neighbour.
+  //
+  //        killed tc                 across face b of tc: killed n? continue around edge e = tc \ {a, b}
+  //      a *------* e1               otherwise n is the new tetrahedron on (tc, b); its face opposite
+  //         \    /|                  index a (vertex tc[a]) is the one shared with s.
+  //          \  / |
+  //        e0 *---* b
+  for (std::size_t k = 0; k < S.created.size(); ++k) {
+    const TetId s = S.created[k];
+    const auto& bf = S.boundary[k];
+    for (int j = 0; j < 4; ++j) {
+      if (j == bf.face || tn_[4 * std::size_t(s) + j] != kNoTet) continue;
+      TetId tc = bf.tet;
+      int a = bf.face, b = j;
+      TetId n;
+      for (;;) {
+        n = tn_[4 * std::size_t(tc) + b];
+        if (!(tf_[n] & kMark)) break;
+        const PointId va = tv_[4 * std::size_t(tc) + a];
+        int ka = 0, kw = 0;
+        for (int m = 0; m < 4; ++m) {
+          if (tv_[4 * std::size_t(n) + m] == va) ka = m;
+          if (tn_[4 * std::size_t(n) + m] == tc) kw = m;
+        }
+        tc = n;
+        a = kw;
+        b = ka;
+      }
+      tn_[4 * std::size_t(s) + j] = n;
+      tn_[4 * std::size_t(n) + a] = s;
+    }
+    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * std::size_t(s) + i]] = s;
+  }
+  // Kill the cavity; in the history each killed tetrahedron points to this Op and to a new tetrahedron
+  // built on one of its faces (where the descent is likely to continue).
+  const std::uint32_t op = std::uint32_t(ops_.size());
+  record_op(first, std::uint32_t(S.created.size()), q);
+  for (TetId t : S.cavity) {
+    TetId hint = first;
+    if (keep_history_)
+      for (int i = 0; i < 4; ++i)
+        if (tn_[4 * std::size_t(t) + i] >= first) hint = tn_[4 * std::size_t(t) + i];
+    kill(t, op, hint);
+  }
+  for (TetId t : S.tested) tf_[t] &= std::uint8_t(~kTested);
+  num_live_tets_ = num_live_tets_ + S.created.size() - S.cavity.size();
+  ++num_live_vertices_;
+  last_tet_ = S.created.back();
+  if (changes) {
+    changes->killed.insert(changes->killed.end(), S.cavity.begin(), S.cavity.end());
+    changes->created.insert(changes->created.end(), S.created.begin(), S.created.end());
+  }
+  res.vertex = vid(q);
+  return res;
+}
+
+InsertResult Triangulation::insert(const Point3& p, double min_distance, ChangeSet* changes) {
+  check_point(p, 0);
+  check_min_distance(min_distance);
+  if (changes) changes->clear();
+  const TetId t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
+  return insert_at(p, t, min_distance, changes, kNoVertex);
+}
+
+InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, double min_distance,
+                                               ChangeSet* changes) {
+  check_point(p, 0);
+  check_min_distance(min_distance);
+  if (!is_live(conflict))
+    throw InvalidArgument("Triangulation::insert_in_conflict: tetrahedron " + std::to_string(conflict) +
+                          " is not live");
+  if (changes) changes->clear();
+  const std::size_t b = 4 * std::size_t(conflict);
+  for (int i = 0; i < 4; ++i)
+    if (pos_[tv_[b + i]] == p) return {InsertStatus::TooClose, kNoVertex, vid(tv_[b + i])};
+  if (insphere_sos(pos_[tv_[b]], pos_[tv_[b + 1]], pos_[tv_[b + 2]], pos_[tv_[b + 3]], p) != Sign::Positive)
+    throw InvalidArgument("Triangulation::insert_in_conflict: point " + fmt_point(p) +
+                          " is not in conflict with tetrahedron " + std::to_string(conflict));
+  return insert_at(p, conflict, min_distance, changes, kNoVertex);
+}
+
+std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>& points, double min_distance,
+                                                       ChangeSet* changes) {
+  for (std::size_t i = 0; i < points.size(); ++i) check_point(points[i], i);
+  check_min_distance(min_distance);
+  if (changes) changes->clear();
+  std::vector<InsertResult> results(points.size());
+  if (points.empty()) return results;
+  const std::vector<std::uint32_t> order = brio_order(points, box_);
+  if (keep_history_) {  // about 27 tetrahedra are created per insertion of a uniform point
+    tv_.reserve(tv_.size() + 4 * 28 * points.size());
+    tn_.reserve(tn_.size() + 4 * 28 * points.size());
+    tf_.reserve(tf_.size() + 28 * points.size());
+    ops_.reserve(ops_.size() + points.size());
+  }
+  pos_.reserve(pos_.size() + points.size());
+  vtet_.reserve(vtet_.size() + points.size());
+  ChangeSet one;
+  std::vector<std::pair<TetId, bool>> events;
+  for (std::uint32_t i : order) {
+    const TetId t = walk(points[i], last_tet_);
+    one.clear();
+    results[i] = insert_at(points[i], t, min_distance, changes ? &one : nullptr, kNoVertex);
+    if (changes) {
+      for (TetId k : one.killed) events.emplace_back(k, false);
+      for (TetId c : one.created) events.emplace_back(c, true);
+    }
+  }
+  if (changes) net_changes(events, *changes);
+  return results;
+}
+
+// ---- Removal ---------------------------------------------------------------------------------------
+
+void Triangulation::collect_star(PointId v) {
+  Scratch& S = *scratch_;
+  S.star.clear();
+  const TetId t0 = vtet_[v];
+  tf_[t0] |= kMark;
+  S.star.push_back(t0);
+  for (std::size_t k = 0; k < S.star.size(); ++k) {
+    const std::size_t b = 4 * std::size_t(S.star[k]);
+    for (int i = 0; i < 4; ++i) {
+      if (tv_[b + i] == v) continue;
+      const TetId n = tn_[b + i];
+      if (n == kNoTet || (tf_[n] & kMark)) continue;
+      tf_[n] |= kMark;
+      S.star.push_back(n);
+    }
+  }
+}
+
+void Triangulation::remove(VertexId v, ChangeSet* changes) {
+  check_vertex(v, "remove");
+  if (changes) changes->clear();
+  remove_impl(v, changes);
+}
+
+void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
+  Scratch& S = *scratch_;
+  const PointId pv = pid(v);
+  collect_star(pv);
+  auto face_key = [](const std::vector<PointId>& tv, const std::size_t b, int skip,
+                     const std::vector<PointId>* map) {
+    std::array<PointId, 3> f{};
+    std::size_t k = 0;
+    for (std::size_t j = 0; j < 4; ++j)
+      if (int(j) != skip) f[k++] = map ? (*map)[tv[b + j]] : tv[b + j];
+    std::sort(f.begin(), f.end());
+    return f;
+  };
+  // Link vertices and link faces (the face of each star tetrahedron opposite v).
+  S.link.clear();
+  S.link_faces.clear();
+  for (TetId t : S.star) {
+    const std::size_t b = 4 * std::size_t(t);
+    int iv = 0;
+    for (int i = 0; i < 4; ++i) {
+      if (tv_[b + i] == pv)
+        iv = i;
+      else
+        S.link.push_back(tv_[b + i]);
+    }
+    S.link_faces.push_back({face_key(tv_, b, iv, nullptr), t, kNoTet});
+  }
+  std::sort(S.link.begin(), S.link.end());
+  S.link.erase(std::unique(S.link.begin(), S.link.end()), S.link.end());
+  auto face_less = [](const Scratch::LinkFace& x, const Scratch::LinkFace& y) { return x.key < y.key; };
+  std::sort(S.link_faces.begin(), S.link_faces.end(), face_less);
+  auto find_face = [&](const std::array<PointId, 3>& key) -> Scratch::LinkFace* {
+    auto it = std::lower_bound(S.link_faces.begin(), S.link_faces.end(), Scratch::LinkFace{key, 0, 0},
+                               face_less);
+    return (it != S.link_faces.end() && it->key == key) ? &*it : nullptr;
+  };
+
+  // The perturbed DT of the link vertices plus the corners, in the same box.
+  if (!S.sub)
+    S.sub = std::make_unique<Triangulation>(box_, TriangulationOptions{false});
+  else
+    S.sub->reset_to_corners();
+  Triangulation& sub = *S.sub;
+  S.sub_to_main.resize(8);
+  std::iota(S.sub_to_main.begin(), S.sub_to_main.end(), 0u);
+  S.link_sub.resize(S.link.size());
+  for (std::size_t k = 0; k < S.link.size(); ++k) {
+    const PointId w = S.link[k];
+    if (w < 8) {
+      S.link_sub[k] = w;
+      continue;
+    }
+    const InsertResult r = sub.insert_at(pos_[w], sub.walk(pos_[w], sub.last_tet_), 0.0, nullptr, kNoVertex);
+    if (r.status != InsertStatus::Inserted || r.vertex != S.sub_to_main.size())
+      throw std::logic_error("Triangulation::remove: link vertex rejected by the hole triangulation");
+    S.link_sub[k] = r.vertex;
+    S.sub_to_main.push_back(w);
+  }
+  auto sub_id = [&](PointId w) {
+    return S.link_sub[std::size_t(std::lower_bound(S.link.begin(), S.link.end(), w) - S.link.begin())];
+  };
+
+  // Seed: the sub tetrahedron on v's side of the link face of the first star tetrahedron.
+  const TetId t0 = S.star[0];
+  const std::size_t b0 = 4 * std::size_t(t0);
+  int iv0 = 0;
+  for (int i = 0; i < 4; ++i)
+    if (tv_[b0 + i] == pv) iv0 = i;
+  const Point3* const P0[4] = {&pos_[tv_[b0]], &pos_[tv_[b0 + 1]], &pos_[tv_[b0 + 2]], &pos_[tv_[b0 + 3]]};
+  VertexId fs[3];
+  for (int i = 0, k = 0; i < 4; ++i)
+    if (i != iv0) fs[k++] = sub_id(tv_[b0 + i]);
+  TetId seed = kNoTet;
+  sub.collect_star(fs[0]);
+  for (TetId st : sub.scratch_->star) {
+    const std::size_t bs = 4 * std::size_t(st);
+    int found = 0, other = -1;
+    for (int i = 0; i < 4; ++i) {
+      const PointId w = sub.tv_[bs + i];
+      if (w == fs[0] || w == fs[1] || w == fs[2])
+        ++found;
+      else
+        other = i;
+    }
+    if (found == 3 && orient_replace(P0, iv0, sub.pos_[sub.tv_[bs + other]]) == Sign::Positive) seed = st;
+  }
+  for (TetId st : sub.scratch_->star) sub.tf_[st] &= std::uint8_t(~kMark);
+  if (seed == kNoTet) throw std::logic_error("Triangulation::remove: no hole tetrahedron on a link face");
+
+  // Flood fill inside the hole, stopping at link faces.
+  S.inside.clear();
+  S.inside.push_back(seed);
+  sub.tf_[seed] |= kMark;
+  for (std::size_t k = 0; k < S.inside.size(); ++k) {
+    const std::size_t bs = 4 * std::size_t(S.inside[k]);
+    for (int j = 0; j < 4; ++j) {
+      if (find_face(face_key(sub.tv_, bs, j, &S.sub_to_main))) continue;
+      const TetId n = sub.tn_[bs + j];
+      if (n == kNoTet) throw std::logic_error("Triangulation::remove: hole leaks to the hull");
+      if (sub.tf_[n] & kMark) continue;
+      sub.tf_[n] |= kMark;
+      S.inside.push_back(n);
+    }
+  }
+  for (TetId st : S.inside) sub.tf_[st] &= std::uint8_t(~kMark);
+  if (tf_.size() + S.inside.size() >= std::size_t(kNoTet) - 1) {
+    for (TetId t : S.star) tf_[t] &= std::uint8_t(~kMark);
+    throw LimitError("Triangulation: more than 2^32 - 2 tetrahedra (history included)");
+  }
+
+  // Copy the hole tetrahedra into the main structure and link them.
+  const TetId first = TetId(tf_.size());
+  S.created.clear();
+  S.sub_to_new.assign(sub.tf_.size(), kNoTet);
+  for (TetId st : S.inside) {
+    const TetId s = alloc_tet();
+    for (int j = 0; j < 4; ++j) tv_[4 * std::size_t(s) + j] = S.sub_to_main[sub.tv_[4 * std::size_t(st) + j]];
+    S.sub_to_new[st] = s;
+    S.created.push_back(s);
+  }
+  for (std::size_t k = 0; k < S.inside.size(); ++k) {
+    const TetId st = S.inside[k], s = S.created[k];
+    const std::size_t bs = 4 * std::size_t(st);
+    for (int j = 0; j < 4; ++j) {
+      Scratch::LinkFace* lf = find_face(face_key(sub.tv_, bs, j, &S.sub_to_main));
+      TetId n;
+      if (lf) {
+        const std::size_t bt = 4 * std::size_t(lf->star_tet);
+        int iv = 0;
+        for (int i = 0; i < 4; ++i)
+          if (tv_[bt + i] == pv) iv = i;
+        n = tn_[bt + iv];
+        if (n != kNoTet)
+          for (int m = 0; m < 4; ++m)
+            if (tn_[4 * std::size_t(n) + m] == lf->star_tet) tn_[4 * std::size_t(n) + m] = s;
+        lf->new_tet = s;
+      } else {
+        n = S.sub_to_new[sub.tn_[bs + j]];
+      }
+      tn_[4 * std::size_t(s) + j] = n;
+    }
+  }
+  for (TetId s : S.created)
+    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * std::size_t(s) + i]] = s;
+  vtet_[pv] = kNoTet;
+  --num_live_vertices_;
+  const std::uint32_t op = std::uint32_t(ops_.size());
+  record_op(first, std::uint32_t(S.created.size()), kNoVertex);
+  for (TetId t : S.star) {
+    int iv = 0;
+    for (int i = 0; i < 4; ++i)
+      if (tv_[4 * std::size_t(t) + i] == pv) iv = i;
+    const Scratch::LinkFace* lf = find_face(face_key(tv_, 4 * std::size_t(t), iv, nullptr));
+    kill(t, op, lf && lf->new_tet != kNoTet ? lf->new_tet : first);
+  }
+  num_live_tets_ = num_live_tets_ + S.created.size() - S.star.size();
+  last_tet_ = S.created.front();
+  if (changes) {
+    changes->killed.insert(changes->killed.end(), S.star.begin(), S.star.end());
+    changes->created.insert(changes->created.end(), S.created.begin(), S.created.end());
+  }
+}
+
+// ---- Move ------------------------------------------------------------------------------------------
+
+bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,
+                                      ChangeSet* changes) {
+  Scratch& S = *scratch_;
+  const PointId pv = pid(v);
+  collect_star(pv);
+  auto unmark = [&] {
+    for (TetId t : S.star) tf_[t] &= std::uint8_t(~kMark);
+  };
+  auto moved_points = [&](TetId t, const Point3* P[4]) {
+    for (int i = 0; i < 4; ++i) {
+      const PointId w = tv_[4 * std::size_t(t) + i];
+      P[i] = w == pv ? &p : &pos_[w];
+    }
+  };
+  // Every star tetrahedron stays positive...
+  for (TetId t : S.star) {
+    const Point3* P[4];
+    moved_points(t, P);
+    if (orient3d(*P[0], *P[1], *P[2], *P[3]) != Sign::Positive) {
+      unmark();
+      return false;
+    }
+  }
+  // ... and every face of the star stays locally Delaunay (one side of each face suffices: the perturbed
+  // test is the orientation of the five lifted points, the same from both sides).
+  for (TetId t : S.star) {
+    const Point3* P[4];
+    moved_points(t, P);
+    for (int j = 0; j < 4; ++j) {
+      const TetId n = tn_[4 * std::size_t(t) + j];
+      if (n == kNoTet || ((tf_[n] & kMark) && n < t)) continue;
+      int k = 0;
+      while (tn_[4 * std::size_t(n) + k] != t) ++k;
+      const Point3& w = pos_[tv_[4 * std::size_t(n) + k]];
+      if (insphere_sos(*P[0], *P[1], *P[2], *P[3], w) != Sign::Negative) {
+        unmark();
+        return false;
+      }
+    }
+  }
+  // The new Delaunay neighbours of v are its link vertices.
+  if (min_distance > 0.0) {
+    double best = min_distance * min_distance;
+    PointId nearest = kNoVertex;
+    for (TetId t : S.star)
+      for (int i = 0; i < 4; ++i) {
+        const PointId w = tv_[4 * std::size_t(t) + i];
+        if (w == pv) continue;
+        const double d2 = squared_distance(pos_[w], p);
+        if (d2 < best) {
+          best = d2;
+          nearest = w;
+        }
+      }
+    if (nearest != kNoVertex) {
+      unmark();
+      result = {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+      return true;
+    }
+  }
+  if (tf_.size() + S.star.size() >= std::size_t(kNoTet) - 1) {
+    unmark();
+    throw LimitError("Triangulation: more than 2^32 - 2 tetrahedra (history included)");
+  }
+  // Rebuild the star with the same combinatorics around a new point id.
+  PointId np;
+  if (keep_history_) {
+    try {
+      np = alloc_point(p, v);
+    } catch (...) {
+      unmark();
+      throw;
+    }
+  } else {
+    np = pv;
+    pos_[pv] = p;
+  }
+  const TetId first = TetId(tf_.size());
+  S.created.clear();
+  S.old_to_new.clear();
+  for (TetId t : S.star) {
+    const TetId s = alloc_tet();
+    for (int j = 0; j < 4; ++j) {
+      const PointId w = tv_[4 * std::size_t(t) + j];
+      tv_[4 * std::size_t(s) + j] = w == pv ? np : w;
+    }
+    S.created.push_back(s);
+    S.old_to_new.emplace_back(t, s);
+  }
+  std::sort(S.old_to_new.begin(), S.old_to_new.end());
+  for (std::size_t k = 0; k < S.star.size(); ++k) {
+    const TetId t = S.star[k], s = S.created[k];
+    for (int j = 0; j < 4; ++j) {
+      TetId n = tn_[4 * std::size_t(t) + j];
+      if (n != kNoTet && (tf_[n] & kMark)) {
+        n = std::lower_bound(S.old_to_new.begin(), S.old_to_new.end(), std::make_pair(n, TetId(0)))->second;
+      } else if (n != kNoTet) {
+        for (int m = 0; m < 4; ++m)
+          if (tn_[4 * std::size_t(n) + m] == t) tn_[4 * std::size_t(n) + m] = s;
+      }
+      tn_[4 * std::size_t(s) + j] = n;
+    }
+  }
+  for (TetId s : S.created)
+    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * std::size_t(s) + i]] = s;
+  if (np != pv) vtet_[pv] = kNoTet;
+  const std::uint32_t op = std::uint32_t(ops_.size());
+  record_op(first, std::uint32_t(S.created.size()), kNoVertex);
+  for (std::size_t k = 0; k < S.star.size(); ++k) kill(S.star[k], op, S.created[k]);
+  last_tet_ = S.created.front();
+  if (changes) {
+    changes->killed.insert(changes->killed.end(), S.star.begin(), S.star.end());
+    changes->created.insert(changes->created.end(), S.created.begin(), S.created.end());
+  }
+  result = {InsertStatus::Inserted, v, kNoVertex};
+  return true;
+}
+
+InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distance, ChangeSet* changes) {
+  check_vertex(v, "move");
+  check_point(p, 0);
+  check_min_distance(min_distance);
+  if (changes) changes->clear();
+  const PointId pv = pid(v);
+  if (pos_[pv] == p) return {InsertStatus::Inserted, v, kNoVertex};
+  InsertResult result;
+  if (try_move_in_place(v, p, min_distance, result, changes)) return result;
+
+  // Before changing anything, find the nearest vertex of p among the others. It is a Delaunay neighbour
+  // of p in DT(S \ v + p): either a vertex of p's cavity in DT(S), or (when the edge appears only once v
+  // is gone) a link vertex of v.
+  Scratch& S = *scratch_;
+  collect_star(pv);
+  std::vector<PointId> candidates;
+  for (TetId t : S.star) {
+    tf_[t] &= std::uint8_t(~kMark);
+    for (int i = 0; i < 4; ++i) candidates.push_back(tv_[4 * std::size_t(t) + i]);
+  }
+  const TetId start = keep_history_ ? locate_history(p) : walk(p, vtet_[pv]);
+  for (int i = 0; i < 4; ++i) {
+    const PointId w = tv_[4 * std::size_t(start) + i];
+    if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
+  }
+  PointId dup = kNoVertex;
+  if (!grow_cavity(p, start, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
+  for (TetId t : S.cavity)
+    for (int i = 0; i < 4; ++i) candidates.push_back(tv_[4 * std::size_t(t) + i]);
+  clear_cavity_marks();
+  if (min_distance > 0.0) {
+    double best = min_distance * min_distance;
+    PointId nearest = kNoVertex;
+    for (PointId w : candidates) {
+      if (w == pv) continue;
+      const double d2 = squared_distance(pos_[w], p);
+      if (d2 < best) {
+        best = d2;
+        nearest = w;
+      }
+    }
+    if (nearest != kNoVertex) return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+  }
+
+  ChangeSet removal, insertion;
+  remove_impl(v, changes ? &removal : nullptr);
+  const TetId t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
+  result = insert_at(p, t, 0.0, changes ? &insertion : nullptr, v);
+  if (result.status != InsertStatus::Inserted)
+    throw std::logic_error("Triangulation::move: reinsertion rejected after the proximity check");
+  if (changes) {
+    std::vector<std::pair<TetId, bool>> events;
+    for (TetId k : removal.killed) events.emplace_back(k, false);
+    for (TetId c : removal.created) events.emplace_back(c, true);
+    for (TetId k : insertion.killed) events.emplace_back(k, false);
+    for (TetId c : insertion.created) events.emplace_back(c, true);
+    net_changes(events, *changes);
+  }
+  return result;
+}
+
+// ---- Queries ---------------------------------------------------------------------------------------
+
+std::vector<TetId> Triangulation::live_tetrahedra() const {
+  std::vector<TetId> out;
+  out.reserve(num_live_tets_);
+  for (TetId t = 0; t < tf_.size(); ++t)
+    if (!(tf_[t] & kDead)) out.push_back(t);
+  return out;
+}
+
+void Triangulation::for_each_tetrahedron(const std::function<void(TetId)>& fn) const {
+  for (TetId t = 0; t < tf_.size(); ++t)
+    if (!(tf_[t] & kDead)) fn(t);
+}
+
+std::vector<TetId> Triangulation::incident_tetrahedra(VertexId v) const {
+  std::vector<TetId> out;
+  if (!is_vertex(v)) return out;
+  const PointId pv = pid(v);
+  std::unordered_set<TetId> seen;
+  auto visited = [&](TetId t) {
+    if (out.size() < 64) return std::find(out.begin(), out.end(), t) != out.end();
+    if (seen.empty()) seen.insert(out.begin(), out.end());
+    return seen.count(t) > 0;
+  };
+  out.push_back(vtet_[pv]);
+  for (std::size_t k = 0; k < out.size(); ++k) {
+    const std::size_t b = 4 * std::size_t(out[k]);
+    for (int i = 0; i < 4; ++i) {
+      if (tv_[b + i] == pv) continue;
+      const TetId n = tn_[b + i];
+      if (n == kNoTet || visited(n)) continue;
+      out.push_back(n);
+      if (!seen.empty()) seen.insert(n);
+    }
+  }
+  return out;
+}
+
+Point3 Triangulation::circumcenter(TetId t) const {
+  const Point3& a = tet_point(t, 0);
+  const Point3 ba = tet_point(t, 1) - a, ca = tet_point(t, 2) - a, da = tet_point(t, 3) - a;
+  const Point3 cd = cross(ca, da), db = cross(da, ba), bc = cross(ba, ca);
+  const double det = dot(ba, cd);
+  const Point3 num = squared_norm(ba) * cd + squared_norm(ca) * db + squared_norm(da) * bc;
+  return a + num / (2.0 * det);
+}
+
+double Triangulation::circumradius(TetId t) const { return distance(circumcenter(t), tet_point(t, 0)); }
+
+std::size_t Triangulation::memory_live_bytes() const {
+  const std::size_t per_tet = 8 * sizeof(TetId) + 1;
+  const std::size_t per_vertex =
+      sizeof(Point3) + sizeof(TetId) + (pid_of_vid_.empty() ? 0 : sizeof(VertexId) + sizeof(PointId));
+  return sizeof(*this) + num_live_tets_ * per_tet + num_live_vertices_ * per_vertex;
+}
+
+std::size_t Triangulation::memory_total_bytes() const {
+  std::size_t s = sizeof(*this) + bytes_of(pos_) + bytes_of(vtet_) + bytes_of(vid_of_pid_) +
+                  bytes_of(pid_of_vid_) + bytes_of(tv_) + bytes_of(tn_) + bytes_of(tf_) + bytes_of(ops_) +
+                  bytes_of(init_tv_) + bytes_of(init_tn_);
+  if (scratch_) {
+    const Scratch& S = *scratch_;
+    s += sizeof(Scratch) + bytes_of(S.cavity) + bytes_of(S.tested) + bytes_of(S.created) + bytes_of(S.star) +
+         bytes_of(S.boundary) + bytes_of(S.link) + bytes_of(S.link_sub) + bytes_of(S.sub_to_main) +
+         bytes_of(S.link_faces) + bytes_of(S.inside) + bytes_of(S.sub_to_new) + bytes_of(S.old_to_new);
+    if (S.sub) s += S.sub->memory_total_bytes();
+  }
+  return s;
+}
+
+// ---- Validation ------------------------------------------------------------------------------------
+
+void Triangulation::verify_topology() const {
+  auto fail = [](const std::string& m) { throw std::logic_error("verify_topology: " + m); };
+  const std::string T = "tetrahedron ";
+  std::size_t live = 0;
+  for (TetId t = 0; t < tf_.size(); ++t) {
+    if (tf_[t] & kDead) continue;
+    ++live;
+    if (tf_[t] != 0) fail(T + std::to_string(t) + ": stale temporary flags");
+    const std::size_t b = 4 * std::size_t(t);
+    for (int i = 0; i < 4; ++i) {
+      const PointId w = tv_[b + i];
+      if (w >= pos_.size()) fail(T + std::to_string(t) + ": vertex slot " + std::to_string(i) + " out of range");
+      if (vtet_[w] == kNoTet) fail(T + std::to_string(t) + ": uses removed vertex " + std::to_string(vid(w)));
+      for (int j = 0; j < i; ++j)
+        if (tv_[b + j] == w) fail(T + std::to_string(t) + ": repeated vertex");
+    }
+    if (orient3d(pos_[tv_[b]], pos_[tv_[b + 1]], pos_[tv_[b + 2]], pos_[tv_[b + 3]]) != Sign::Positive)
+      fail(T + std::to_string(t) + " is not positively oriented");
+    for (int i = 0; i < 4; ++i) {
+      const TetId n = tn_[b + i];
+      if (n == kNoTet) {
+        // A hull face lies in a face of the box.
+        bool on_box = false;
+        for (int axis = 0; axis < 3 && !on_box; ++axis)
+          for (double side : {box_.lo[std::size_t(axis)], box_.hi[std::size_t(axis)]}) {
+            bool all = true;
+            for (int j = 0; j < 4; ++j)
+              if (j != i && pos_[tv_[b + j]][std::size_t(axis)] != side) all = false;
+            if (all) on_box = true;
+          }
+        if (!on_box) fail(T + std::to_string(t) + ": face " + std::to_string(i) + " has no neighbour but is not on the box");
+        continue;
+      }
+      if (n >= tf_.size() || (tf_[n] & kDead))
+        fail(T + std::to_string(t) + ": neighbour " + std::to_string(i) + " (" + std::to_string(n) + ") is not live");
+      int back = -1;
+      for (int k = 0; k < 4; ++k)
+        if (tn_[4 * std::size_t(n) + k] == t) back = k;
+      if (back < 0)
+        fail(T + std::to_string(t) + ": neighbour " + std::to_string(n) + " across face " + std::to_string(i) +
+             " does not point back");
+      std::array<PointId, 3> f1{}, f2{};
+      for (int j = 0, k = 0; j < 4; ++j)
+        if (j != i) f1[std::size_t(k++)] = tv_[b + j];
+      for (int j = 0, k = 0; j < 4; ++j)
+        if (j != back) f2[std::size_t(k++)] = tv_[4 * std::size_t(n) + j];
+      std::sort(f1.begin(), f1.end());
+      std::sort(f2.begin(), f2.end());
+      if (f1 != f2)
+        fail(T + std::to_string(t) + " and its neighbour " + std::to_string(n) + " do not share face " +
+             std::to_string(i));
+    }
+  }
+  if (live != num_live_tets_)
+    fail("counted " + std::to_string(live) + " live tetrahedra, expected " + std::to_string(num_live_tets_));
+  std::size_t verts = 0;
+  for (PointId w = 0; w < pos_.size(); ++w) {
+    const TetId t = vtet_[w];
+    if (t == kNoTet) continue;
+    ++verts;
+    if (t >= tf_.size() || (tf_[t] & kDead))
+      fail("vertex " + std::to_string(vid(w)) + ": incident tetrahedron " + std::to_string(t) + " is not live");
+    bool has = false;
+    for (int i = 0; i < 4; ++i)
+      if (tv_[4 * std::size_t(t) + i] == w) has = true;
+    if (!has) fail("vertex " + std::to_string(vid(w)) + ": incident tetrahedron does not contain it");
+    if (!pid_of_vid_.empty() && pid_of_vid_[vid_of_pid_[w]] != w)
+      fail("vertex " + std::to_string(vid(w)) + ": id translation is inconsistent");
+  }
+  if (verts != num_live_vertices_)
+    fail("counted " + std::to_string(verts) + " live vertices, expected " + std::to_string(num_live_vertices_));
+  for (int k = 0; k < 8; ++k)
+    if (vtet_[std::size_t(k)] == kNoTet || !(pos_[std::size_t(k)] == box_.corner(k)))
+      fail("corner " + std::to_string(k) + " is missing or moved");
+}
+
+void Triangulation::verify_delaunay() const {
+  for (TetId t = 0; t < tf_.size(); ++t) {
+    if (tf_[t] & kDead) continue;
+    const std::size_t b = 4 * std::size_t(t);
+    for (int i = 0; i < 4; ++i) {
+      const TetId n = tn_[b + i];
+      if (n == kNoTet) continue;
+      int k = 0;
+      while (k < 4 && tn_[4 * std::size_t(n) + k] != t) ++k;
+      if (k == 4) throw std::logic_error("verify_delaunay: asymmetric neighbours (run verify_topology)");
+      const PointId w = tv_[4 * std::size_t(n) + k];
+      if (insphere_sos(pos_[tv_[b]], pos_[tv_[b + 1]], pos_[tv_[b + 2]], pos_[tv_[b + 3]], pos_[w]) !=
+          Sign::Negative)
+        throw std::logic_error("verify_delaunay: vertex " + std::to_string(vid(w)) + " of tetrahedron " +
+                               std::to_string(n) + " is inside the (perturbed) circumsphere of tetrahedron " +
+                               std::to_string(t) + " across face " + std::to_string(i));
+    }
+  }
+}
+
+}  // namespace vitri

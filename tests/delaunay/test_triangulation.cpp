@@ -1,0 +1,592 @@
+// Property tests of the Delaunay tree (vitri/delaunay/triangulation.hpp): validators after every
+// operation, canonical output under shuffles and after removals, brute-force empty spheres, Euler
+// relation, change events, proximity rejection and bad input.
+#include "vitri/core/error.hpp"
+#include "vitri/core/predicates.hpp"
+#include "vitri/delaunay/triangulation.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <set>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+using Quad = std::array<long, 4>;
+using TetSet = std::set<Quad>;
+
+const Box3 kUnitBox{{0, 0, 0}, {1, 1, 1}};
+
+// Tetrahedra as sorted quadruples of *labels*: input index for points, -1-k for corner k.
+TetSet tet_set(const Triangulation& tr, const std::map<VertexId, long>& label) {
+  TetSet s;
+  tr.for_each_tetrahedron([&](TetId t) {
+    Quad q{};
+    for (int i = 0; i < 4; ++i) {
+      const VertexId v = tr.tet_vertex(t, i);
+      q[std::size_t(i)] = v < 8 ? -1 - long(v) : label.at(v);
+    }
+    std::sort(q.begin(), q.end());
+    s.insert(q);
+  });
+  return s;
+}
+
+void check(const Triangulation& tr) {
+  REQUIRE_NOTHROW(tr.verify_topology());
+  REQUIRE_NOTHROW(tr.verify_delaunay());
+}
+
+// V - E + F - T == 1 (the box is a ball), with counts from the live tetrahedra.
+void check_euler(const Triangulation& tr) {
+  std::set<std::array<VertexId, 2>> edges;
+  std::set<std::array<VertexId, 3>> faces;
+  std::set<VertexId> verts;
+  tr.for_each_tetrahedron([&](TetId t) {
+    auto v = tr.tet_vertices(t);
+    std::sort(v.begin(), v.end());
+    for (int i = 0; i < 4; ++i) {
+      verts.insert(v[std::size_t(i)]);
+      for (int j = i + 1; j < 4; ++j) edges.insert({v[std::size_t(i)], v[std::size_t(j)]});
+      std::array<VertexId, 3> f{};
+      for (int j = 0, k = 0; j < 4; ++j)
+        if (j != i) f[std::size_t(k++)] = v[std::size_t(j)];
+      faces.insert(f);
+    }
+  });
+  CHECK(verts.size() == tr.num_vertices());
+  const long V = long(verts.size()), E = long(edges.size()), F = long(faces.size()),
+             T = long(tr.num_tetrahedra());
+  CHECK(V - E + F - T == 1);
+  CHECK(4 * T == 2 * F - [&] {  // every face has two tetrahedra except the hull faces
+    long hull = 0;
+    tr.for_each_tetrahedron([&](TetId t) {
+      for (int i = 0; i < 4; ++i) hull += tr.tet_neighbor(t, i) == kNoTet;
+    });
+    return hull;
+  }());
+}
+
+// Every live tetrahedron's circumsphere is empty of all live vertices (exact test, all points), and
+// empty in the perturbed sense.
+void check_brute_force_empty(const Triangulation& tr) {
+  std::vector<VertexId> verts;
+  for (VertexId v = 0; v < tr.vertex_capacity(); ++v)
+    if (tr.is_vertex(v)) verts.push_back(v);
+  tr.for_each_tetrahedron([&](TetId t) {
+    const auto tv = tr.tet_vertices(t);
+    for (VertexId v : verts) {
+      if (std::find(tv.begin(), tv.end(), v) != tv.end()) continue;
+      const Point3 &a = tr.point(tv[0]), &b = tr.point(tv[1]), &c = tr.point(tv[2]), &d = tr.point(tv[3]);
+      REQUIRE(insphere(a, b, c, d, tr.point(v)) != Sign::Positive);
+      REQUIRE(insphere_sos(a, b, c, d, tr.point(v)) == Sign::Negative);
+    }
+  });
+}
+
+std::vector<Point3> uniform_points(std::size_t n, unsigned seed, double lo = 0.05, double hi = 0.95) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(lo, hi);
+  std::vector<Point3> p(n);
+  for (auto& q : p) q = {u(rng), u(rng), u(rng)};
+  return p;
+}
+
+std::vector<Point3> clustered_points(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.2, 0.8);
+  std::normal_distribution<double> g(0.0, 0.01);
+  Point3 centers[3] = {{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}};
+  std::vector<Point3> p(n);
+  for (std::size_t i = 0; i < n; ++i) p[i] = centers[i % 3] + Point3{g(rng), g(rng), g(rng)};
+  return p;
+}
+
+// Integer points on the sphere x^2 + y^2 + z^2 = 50 (exactly cospherical), shifted into the box
+// [-10, 10]^3, plus the center: a worst case for the perturbation.
+std::vector<Point3> integer_sphere_points() {
+  std::vector<Point3> p;
+  for (int x = -8; x <= 8; ++x)
+    for (int y = -8; y <= 8; ++y)
+      for (int z = -8; z <= 8; ++z)
+        if (x * x + y * y + z * z == 50) p.push_back({double(x), double(y), double(z)});
+  p.push_back({0, 0, 0});
+  return p;
+}
+
+std::vector<Point3> grid_points(int n) {
+  std::vector<Point3> p;
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y)
+      for (int z = 0; z < n; ++z) p.push_back({double(x), double(y), double(z)});
+  return p;
+}
+
+std::vector<Point3> coplanar_layers(std::size_t per_layer, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.1, 0.9);
+  std::vector<Point3> p;
+  for (int layer = 1; layer <= 3; ++layer)
+    for (std::size_t i = 0; i < per_layer; ++i) p.push_back({u(rng), u(rng), 0.25 * layer});
+  return p;
+}
+
+struct Built {
+  Triangulation tr;
+  std::map<VertexId, long> label;
+};
+
+// Inserts points[order[k]] one by one, checking the validators after every insertion when asked.
+Built build(const Box3& box, const std::vector<Point3>& points, const std::vector<std::size_t>& order,
+            bool check_each, TriangulationOptions opt = {}) {
+  Built b{Triangulation(box, opt), {}};
+  for (std::size_t i : order) {
+    const InsertResult r = b.tr.insert(points[i]);
+    REQUIRE(r.status == InsertStatus::Inserted);
+    b.label[r.vertex] = long(i);
+    if (check_each) check(b.tr);
+  }
+  return b;
+}
+
+std::vector<std::size_t> iota_order(std::size_t n) {
+  std::vector<std::size_t> o(n);
+  for (std::size_t i = 0; i < n; ++i) o[i] = i;
+  return o;
+}
+
+std::vector<std::size_t> shuffled(std::size_t n, unsigned seed) {
+  auto o = iota_order(n);
+  std::mt19937 rng(seed);
+  std::shuffle(o.begin(), o.end(), rng);
+  return o;
+}
+
+bool contains_closed(const Triangulation& tr, TetId t, const Point3& p) {
+  const Point3 &a = tr.tet_point(t, 0), &b = tr.tet_point(t, 1), &c = tr.tet_point(t, 2),
+               &d = tr.tet_point(t, 3);
+  return orient3d(p, b, c, d) != Sign::Negative && orient3d(a, p, c, d) != Sign::Negative &&
+         orient3d(a, b, p, d) != Sign::Negative && orient3d(a, b, c, p) != Sign::Negative;
+}
+
+}  // namespace
+
+TEST_CASE("delaunay: the box alone is the perturbed Delaunay tetrahedralization of its corners") {
+  for (const Box3& box : {kUnitBox, Box3{{-3, 1, 2}, {5, 1.5, 2.25}}}) {
+    Triangulation tr(box);
+    check(tr);
+    check_euler(tr);
+    check_brute_force_empty(tr);
+    CHECK(tr.num_vertices() == 8);
+    CHECK((tr.num_tetrahedra() == 5 || tr.num_tetrahedra() == 6));
+    for (VertexId k = 0; k < 8; ++k) CHECK(tr.point(k) == box.corner(int(k)));
+  }
+}
+
+TEST_CASE("delaunay: validators pass after every insertion on many kinds of input") {
+  SECTION("uniform") {
+    auto pts = uniform_points(150, 1);
+    auto b = build(kUnitBox, pts, iota_order(pts.size()), true);
+    check_euler(b.tr);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("clustered") {
+    auto pts = clustered_points(150, 2);
+    auto b = build(kUnitBox, pts, iota_order(pts.size()), true);
+    check_euler(b.tr);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("exactly cospherical integer points") {
+    auto pts = integer_sphere_points();
+    auto b = build(Box3{{-10, -10, -10}, {10, 10, 10}}, pts, iota_order(pts.size()), true);
+    check_euler(b.tr);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("points near a sphere") {
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> g;
+    std::vector<Point3> pts;
+    for (int i = 0; i < 150; ++i) {
+      Point3 d{g(rng), g(rng), g(rng)};
+      pts.push_back(Point3{0.5, 0.5, 0.5} + 0.3 / norm(d) * d);
+    }
+    auto b = build(kUnitBox, pts, iota_order(pts.size()), true);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("coplanar layers") {
+    auto pts = coplanar_layers(40, 4);
+    auto b = build(kUnitBox, pts, iota_order(pts.size()), true);
+    check_euler(b.tr);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("integer grid") {
+    auto pts = grid_points(5);
+    auto b = build(Box3{{-1, -1, -1}, {5, 5, 5}}, pts, shuffled(pts.size(), 5), true);
+    check_euler(b.tr);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("points one ulp apart") {
+    std::vector<Point3> pts;
+    Point3 p{0.3, 0.4, 0.5};
+    for (int i = 0; i < 20; ++i) {
+      pts.push_back(p);
+      p.x = std::nextafter(p.x, 1.0);
+      if (i % 3 == 0) p.y = std::nextafter(p.y, 0.0);
+      if (i % 5 == 0) p.z = std::nextafter(p.z, 1.0);
+    }
+    auto more = uniform_points(30, 6);
+    pts.insert(pts.end(), more.begin(), more.end());
+    auto b = build(kUnitBox, pts, shuffled(pts.size(), 7), true);
+    check_euler(b.tr);
+    check_brute_force_empty(b.tr);
+  }
+  SECTION("history off") {
+    auto pts = uniform_points(150, 8);
+    auto b = build(kUnitBox, pts, iota_order(pts.size()), true, TriangulationOptions{false});
+    check_euler(b.tr);
+  }
+}
+
+TEST_CASE("delaunay: the tetrahedralization does not depend on the insertion order") {
+  struct Input {
+    const char* name;
+    Box3 box;
+    std::vector<Point3> points;
+  };
+  std::vector<Input> inputs = {
+      {"uniform", kUnitBox, uniform_points(300, 11)},
+      {"grid", Box3{{-1, -1, -1}, {6, 6, 6}}, grid_points(6)},
+      {"integer sphere", Box3{{-10, -10, -10}, {10, 10, 10}}, integer_sphere_points()},
+      {"coplanar", kUnitBox, coplanar_layers(50, 12)},
+  };
+  for (const auto& in : inputs) {
+    INFO(in.name);
+    const std::size_t n = in.points.size();
+    auto ref = build(in.box, in.points, iota_order(n), false);
+    check(ref.tr);
+    const TetSet expected = tet_set(ref.tr, ref.label);
+    for (unsigned seed : {1u, 2u, 3u}) {
+      auto b = build(in.box, in.points, shuffled(n, seed), false, TriangulationOptions{seed % 2 == 0});
+      CHECK(tet_set(b.tr, b.label) == expected);
+    }
+    // Bulk insertion (BRIO order) gives the same set too.
+    Triangulation bulk(in.box);
+    auto res = bulk.insert_points(in.points);
+    std::map<VertexId, long> label;
+    for (std::size_t i = 0; i < n; ++i) {
+      REQUIRE(res[i].status == InsertStatus::Inserted);
+      label[res[i].vertex] = long(i);
+    }
+    check(bulk);
+    CHECK(tet_set(bulk, label) == expected);
+  }
+}
+
+TEST_CASE("delaunay: inserting then removing k points gives the tetrahedralization of the rest") {
+  struct Input {
+    const char* name;
+    Box3 box;
+    std::vector<Point3> points;
+  };
+  std::vector<Input> inputs = {
+      {"uniform", kUnitBox, uniform_points(200, 21)},
+      {"grid", Box3{{-1, -1, -1}, {5, 5, 5}}, grid_points(5)},
+      {"integer sphere", Box3{{-10, -10, -10}, {10, 10, 10}}, integer_sphere_points()},
+      {"clustered", kUnitBox, clustered_points(150, 22)},
+  };
+  for (bool history : {true, false}) {
+    for (const auto& in : inputs) {
+      INFO(in.name << " history " << history);
+      const std::size_t n = in.points.size();
+      auto b = build(in.box, in.points, iota_order(n), false, TriangulationOptions{history});
+      const auto removal = shuffled(n, 23);
+      const std::size_t k = n / 2;
+      std::set<std::size_t> removed;
+      for (std::size_t j = 0; j < k; ++j) {
+        const std::size_t i = removal[j];
+        VertexId v = kNoVertex;
+        for (const auto& [vid, lab] : b.label)
+          if (lab == long(i)) v = vid;
+        b.tr.remove(v);
+        b.label.erase(v);
+        removed.insert(i);
+        check(b.tr);
+      }
+      std::vector<std::size_t> rest;
+      for (std::size_t i = 0; i < n; ++i)
+        if (!removed.count(i)) rest.push_back(i);
+      auto direct = build(in.box, in.points, rest, false);
+      CHECK(tet_set(b.tr, b.label) == tet_set(direct.tr, direct.label));
+      check_euler(b.tr);
+      // Location keeps working after removals.
+      for (const Point3& p : uniform_points(50, 24, in.box.lo.x + 0.01, in.box.hi.x - 0.01)) {
+        const TetId t = b.tr.locate(p);
+        REQUIRE(b.tr.is_live(t));
+        REQUIRE(contains_closed(b.tr, t, p));
+      }
+    }
+  }
+}
+
+TEST_CASE("delaunay: long random insert / remove / move sequences stay valid and canonical") {
+  for (bool history : {true, false}) {
+    INFO("history " << history);
+    Triangulation tr(kUnitBox, TriangulationOptions{history});
+    std::mt19937_64 rng(31 + history);
+    std::uniform_real_distribution<double> u(0.01, 0.99);
+    std::uniform_real_distribution<double> small(-0.02, 0.02);
+    std::map<VertexId, Point3> alive;
+    std::size_t moves_in_place = 0, ops = 0;
+    const int kOps = 2500;
+    for (int op = 0; op < kOps; ++op) {
+      const int kind = alive.size() < 40 ? 0 : int(rng() % 3);
+      ChangeSet ch;
+      const std::vector<TetId> before = tr.live_tetrahedra();
+      if (kind == 0) {
+        const Point3 p{u(rng), u(rng), u(rng)};
+        const InsertResult r = tr.insert(p, 0.0, &ch);
+        REQUIRE(r.status == InsertStatus::Inserted);
+        alive[r.vertex] = p;
+      } else {
+        auto it = alive.begin();
+        std::advance(it, long(rng() % alive.size()));
+        const VertexId v = it->first;
+        if (kind == 1) {
+          tr.remove(v, &ch);
+          alive.erase(it);
+          REQUIRE_FALSE(tr.is_vertex(v));
+        } else {
+          // Small moves usually keep the combinatorics; large ones do not.
+          Point3 p = (rng() % 2) ? it->second + Point3{small(rng), small(rng), small(rng)}
+                                 : Point3{u(rng), u(rng), u(rng)};
+          p = {std::clamp(p.x, 0.001, 0.999), std::clamp(p.y, 0.001, 0.999), std::clamp(p.z, 0.001, 0.999)};
+          const std::size_t cap = tr.tet_capacity();
+          const InsertResult r = tr.move(v, p, 0.0, &ch);
+          REQUIRE(r.status == InsertStatus::Inserted);
+          REQUIRE(r.vertex == v);
+          REQUIRE(tr.point(v) == p);
+          it->second = p;
+          if (ch.created.size() == ch.killed.size() && tr.tet_capacity() - cap <= ch.created.size())
+            ++moves_in_place;
+        }
+      }
+      ++ops;
+      // Change events: killed were live and are dead, created are live, and live = before - killed + created.
+      std::set<TetId> live_before(before.begin(), before.end());
+      for (TetId t : ch.killed) REQUIRE(live_before.count(t));
+      for (TetId t : ch.created) REQUIRE(tr.is_live(t));
+      std::set<TetId> expect = live_before;
+      for (TetId t : ch.killed) expect.erase(t);
+      for (TetId t : ch.created) expect.insert(t);
+      const auto after = tr.live_tetrahedra();
+      REQUIRE(expect == std::set<TetId>(after.begin(), after.end()));
+      if (op % 10 == 0 || op > kOps - 20) check(tr);
+    }
+    check(tr);
+    check_euler(tr);
+    CHECK(moves_in_place > 0);
+    CHECK(tr.num_vertices() == alive.size() + 8);
+    // Canonical: the same as building the surviving points directly.
+    std::vector<Point3> pts;
+    std::map<VertexId, long> label;
+    for (const auto& [v, p] : alive) {
+      label[v] = long(pts.size());
+      pts.push_back(p);
+    }
+    auto direct = build(kUnitBox, pts, iota_order(pts.size()), false);
+    CHECK(tet_set(tr, label) == tet_set(direct.tr, direct.label));
+    for (const Point3& p : uniform_points(100, 33, 0.001, 0.999)) {
+      const TetId t = tr.locate(p);
+      REQUIRE(tr.is_live(t));
+      REQUIRE(contains_closed(tr, t, p));
+    }
+  }
+}
+
+TEST_CASE("delaunay: proximity rejection and exact duplicates") {
+  auto pts = uniform_points(300, 41);
+  // Repeated points and near neighbours.
+  for (int i = 0; i < 30; ++i) pts.push_back(pts[std::size_t(i)]);
+  for (int i = 30; i < 60; ++i) pts.push_back(pts[std::size_t(i)] + Point3{1e-4, -2e-4, 1e-4});
+  const double md = 0.02;
+  for (bool bulk : {false, true}) {
+    Triangulation tr(kUnitBox);
+    std::vector<InsertResult> res;
+    if (bulk) {
+      res = tr.insert_points(pts, md);
+    } else {
+      for (const Point3& p : pts) res.push_back(tr.insert(p, md));
+    }
+    check(tr);
+    std::vector<VertexId> kept;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (res[i].status == InsertStatus::Inserted) {
+        kept.push_back(res[i].vertex);
+        continue;
+      }
+      // The reported vertex is live and really too close.
+      REQUIRE(tr.is_vertex(res[i].nearest));
+      CHECK(distance(tr.point(res[i].nearest), pts[i]) < md);
+    }
+    // Kept points are pairwise at least md apart (brute force), and every rejected point is within md
+    // of a kept one.
+    for (std::size_t a = 0; a < kept.size(); ++a)
+      for (std::size_t b = a + 1; b < kept.size(); ++b)
+        REQUIRE(distance(tr.point(kept[a]), tr.point(kept[b])) >= md);
+    // Exact duplicates are always rejected, even with min_distance 0.
+    for (int i = 0; i < 30; ++i) {
+      const std::size_t before = tr.num_tetrahedra();
+      const InsertResult r = tr.insert(tr.point(kept[std::size_t(i)]));
+      CHECK(r.status == InsertStatus::TooClose);
+      CHECK(r.nearest == kept[std::size_t(i)]);
+      CHECK(tr.num_tetrahedra() == before);
+    }
+    check(tr);
+  }
+}
+
+TEST_CASE("delaunay: move keeps the id, rejects too-close targets without change") {
+  auto pts = uniform_points(120, 51);
+  auto b = build(kUnitBox, pts, iota_order(pts.size()), false);
+  Triangulation& tr = b.tr;
+  const VertexId v = b.label.begin()->first, w = std::next(b.label.begin())->first;
+  const Point3 old = tr.point(v);
+  const TetSet before = tet_set(tr, b.label);
+  ChangeSet ch;
+  InsertResult r = tr.move(v, tr.point(w), 0.0, &ch);
+  CHECK(r.status == InsertStatus::TooClose);
+  CHECK(r.nearest == w);
+  CHECK(tr.point(v) == old);
+  CHECK(ch.killed.empty());
+  CHECK(ch.created.empty());
+  CHECK(tet_set(tr, b.label) == before);
+  r = tr.move(v, tr.point(w) + Point3{0.001, 0, 0}, 0.01, &ch);
+  CHECK(r.status == InsertStatus::TooClose);
+  CHECK(tet_set(tr, b.label) == before);
+  CHECK_THROWS_AS(tr.move(3, {0.5, 0.5, 0.5}), InvalidArgument);
+  CHECK_THROWS_AS(tr.move(v, {2, 0.5, 0.5}), InvalidPoint);
+  // A tiny move keeps the combinatorics; a long one does not; both end canonical.
+  pts[std::size_t(b.label.at(v))] = old + Point3{1e-9, 0, 0};
+  r = tr.move(v, old + Point3{1e-9, 0, 0}, 0.0, &ch);
+  CHECK(r.status == InsertStatus::Inserted);
+  CHECK(ch.killed.size() == ch.created.size());
+  check(tr);
+  pts[std::size_t(b.label.at(v))] = {0.9, 0.1, 0.5};
+  r = tr.move(v, {0.9, 0.1, 0.5}, 0.0, &ch);
+  CHECK(r.status == InsertStatus::Inserted);
+  CHECK(r.vertex == v);
+  check(tr);
+  auto direct = build(kUnitBox, pts, iota_order(pts.size()), false);
+  CHECK(tet_set(tr, b.label) == tet_set(direct.tr, direct.label));
+}
+
+TEST_CASE("delaunay: insert_in_conflict inserts circumcenters without location") {
+  auto pts = uniform_points(100, 61);
+  auto b = build(kUnitBox, pts, iota_order(pts.size()), false);
+  Triangulation& tr = b.tr;
+  int inserted = 0;
+  for (TetId t : tr.live_tetrahedra()) {
+    if (!tr.is_live(t)) continue;
+    const Point3 c = tr.circumcenter(t);
+    for (int i = 0; i < 4; ++i)
+      CHECK(distance(c, tr.tet_point(t, i)) == Approx(tr.circumradius(t)).epsilon(1e-9));
+    if (!(c.x > 0 && c.x < 1 && c.y > 0 && c.y < 1 && c.z > 0 && c.z < 1)) continue;
+    if (insphere_sos(tr.tet_point(t, 0), tr.tet_point(t, 1), tr.tet_point(t, 2), tr.tet_point(t, 3), c) !=
+        Sign::Positive)
+      continue;  // a rounded circumcenter can land just outside its own sphere
+    ChangeSet ch;
+    const InsertResult r = tr.insert_in_conflict(c, t, 0.0, &ch);
+    if (r.status != InsertStatus::Inserted) continue;
+    CHECK(std::find(ch.killed.begin(), ch.killed.end(), t) != ch.killed.end());
+    b.label[r.vertex] = long(pts.size());
+    pts.push_back(c);
+    if (++inserted == 60) break;
+  }
+  CHECK(inserted > 20);
+  check(tr);
+  auto direct = build(kUnitBox, pts, shuffled(pts.size(), 62), false);
+  CHECK(tet_set(tr, b.label) == tet_set(direct.tr, direct.label));
+  // A tetrahedron that is not in conflict, or dead, is refused.
+  const TetId t = tr.live_tetrahedra().front();
+  const Point3 far = tr.tet_point(t, 0) == Point3{0, 0, 0} ? Point3{0.99, 0.99, 0.99} : Point3{0.01, 0.01, 0.01};
+  if (insphere_sos(tr.tet_point(t, 0), tr.tet_point(t, 1), tr.tet_point(t, 2), tr.tet_point(t, 3), far) !=
+      Sign::Positive)
+    CHECK_THROWS_AS(tr.insert_in_conflict(far, t), InvalidArgument);
+  CHECK_THROWS_AS(tr.insert_in_conflict({0.5, 0.5, 0.5}, kNoTet), InvalidArgument);
+}
+
+TEST_CASE("delaunay: location and incident tetrahedra") {
+  auto pts = uniform_points(200, 71);
+  auto b = build(kUnitBox, pts, iota_order(pts.size()), false);
+  const Triangulation& tr = b.tr;
+  for (const Point3& p : uniform_points(200, 72, 0.0001, 0.9999)) {
+    const TetId t = tr.locate(p);
+    REQUIRE(tr.is_live(t));
+    REQUIRE(contains_closed(tr, t, p));
+  }
+  // A vertex position is located in one of its tetrahedra.
+  for (const auto& [v, lab] : b.label) {
+    const TetId t = tr.locate(tr.point(v));
+    CHECK(tr.vertex_index(t, v) >= 0);
+    auto inc = tr.incident_tetrahedra(v);
+    std::set<TetId> got(inc.begin(), inc.end()), brute;
+    tr.for_each_tetrahedron([&](TetId u) {
+      if (tr.vertex_index(u, v) >= 0) brute.insert(u);
+    });
+    CHECK(got.size() == inc.size());
+    CHECK(got == brute);
+  }
+  CHECK(tr.memory_total_bytes() > tr.memory_live_bytes());
+  CHECK(tr.memory_live_bytes() > tr.num_tetrahedra() * 32);
+}
+
+TEST_CASE("delaunay: bad input is rejected with clear errors") {
+  CHECK_THROWS_AS(Triangulation(Box3{}), InvalidArgument);
+  CHECK_THROWS_AS(Triangulation(Box3{{0, 0, 0}, {1, 0, 1}}), InvalidArgument);
+  CHECK_THROWS_AS(Triangulation(Box3{{0, 0, 0}, {1, std::numeric_limits<double>::infinity(), 1}}),
+                  InvalidArgument);
+  Triangulation tr(kUnitBox);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(tr.insert({nan, 0.5, 0.5}), InvalidPoint);
+  CHECK_THROWS_AS(tr.insert({0.5, 1.5, 0.5}), InvalidPoint);
+  CHECK_THROWS_AS(tr.insert({0.5, 0.5, 1.0}), InvalidPoint);  // on the boundary
+  CHECK_THROWS_AS(tr.insert({0.5, 0.5, 0.5}, -1.0), InvalidArgument);
+  CHECK_THROWS_AS(tr.insert({0.5, 0.5, 0.5}, nan), InvalidArgument);
+  try {
+    tr.insert_points({{0.5, 0.5, 0.5}, {0.2, 0.2, 0.2}, {0.5, 2.0, 0.5}});
+    FAIL("no exception");
+  } catch (const InvalidPoint& e) {
+    CHECK(e.index() == 2);
+    CHECK(std::string(e.what()).find("box") != std::string::npos);
+  }
+  CHECK(tr.num_vertices() == 8);  // nothing inserted
+  CHECK_THROWS_AS(tr.remove(0), InvalidArgument);
+  CHECK_THROWS_AS(tr.remove(1000), InvalidArgument);
+  const VertexId v = tr.insert({0.5, 0.5, 0.5}).vertex;
+  tr.remove(v);
+  CHECK_THROWS_AS(tr.remove(v), InvalidArgument);
+  CHECK_THROWS_AS(tr.locate({nan, 0, 0}), InvalidPoint);
+  check(tr);
+}
+
+TEST_CASE("delaunay: copies are independent") {
+  auto pts = uniform_points(50, 81);
+  Triangulation a(kUnitBox);
+  a.insert_points(pts);
+  Triangulation b = a;
+  b.remove(20);
+  b.insert({0.5, 0.5, 0.5});
+  check(a);
+  check(b);
+  CHECK(a.num_vertices() == 58);
+  CHECK(b.num_vertices() == 58);
+  CHECK(a.is_vertex(20));
+  CHECK_FALSE(b.is_vertex(20));
+}

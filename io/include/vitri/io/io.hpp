@@ -1,0 +1,116 @@
+#pragma once
+/// @file io.hpp
+/// Reading and writing the files vitri consumes and produces (formats in docs/formats.md):
+/// - constraints `.xyzv`: `x y z value` per line;
+/// - points `.xyz` (3 columns: positions; 6 columns: positions and normals) and `.pwn` (6 columns);
+/// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little-endian) in;
+///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known.
+///
+/// Every reader throws vitri::ParseError(file, line, what) on a malformed file (truncated, wrong counts,
+/// non-numeric tokens, indices out of range, non-finite numbers), and ParseError with line 0 when the file
+/// cannot be opened. Binary PLY errors carry line 0 and a byte offset in the message. Readers never
+/// allocate more than the input can describe, so a corrupt count fails cleanly.
+///
+/// The `parse_*` functions read from memory (what the fuzz targets call); `read_*` open a file and call
+/// them with the file name used in messages.
+
+#include "vitri/core/point.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vitri {
+
+/// Points with values (a constraint set). Same layout as vitri::Constraints of the rbf module, which is
+/// an aggregate: `Constraints c{pv.points, pv.values};`.
+struct PointValues {
+  std::vector<Point3> points;  ///< Positions.
+  std::vector<double> values;  ///< One value per position.
+};
+
+/// Points, optionally with one normal each (normals empty when the file had none). Normals are stored as
+/// read (not normalized).
+struct OrientedPoints {
+  std::vector<Point3> points;   ///< Positions.
+  std::vector<Point3> normals;  ///< Empty, or one per point.
+  /// True when every point has a normal.
+  bool has_normals() const { return !normals.empty() && normals.size() == points.size(); }
+};
+
+/// An indexed triangle mesh at the API boundary.
+struct TriangleMesh {
+  Eigen::MatrixXd V;  ///< #V x 3 vertex positions.
+  Eigen::MatrixXi F;  ///< #F x 3 zero-based vertex indices, counter-clockwise seen from outside.
+  Eigen::MatrixXd N;  ///< Empty (0 x 3) or #V x 3 vertex normals.
+};
+
+/// Encoding of a written PLY file.
+enum class PlyEncoding { Ascii, BinaryLittleEndian };
+
+// ----- constraints -----
+/// Parses `.xyzv` text: one `x y z value` per line, `#` comments and blank lines allowed.
+PointValues parse_xyzv(std::string_view text, const std::string& name = "<memory>");
+PointValues read_xyzv(const std::string& path);
+/// Writes `x y z value` lines with 17 significant digits (round-trips exactly).
+void write_xyzv(const std::string& path, const PointValues& c);
+
+// ----- points -----
+/// Parses `.xyz` / `.pwn` text: every data line has 3 (positions) or 6 (positions, normals) numbers,
+/// the same count on every line; `#` comments and blank lines allowed; an optional first line holding a
+/// single integer (the point count) is checked and skipped. `require_normals` makes 3 columns an error.
+OrientedPoints parse_points(std::string_view text, const std::string& name = "<memory>",
+                            bool require_normals = false);
+/// Reads `.xyz` (3 or 6 columns) or `.pwn` (6 columns required).
+OrientedPoints read_points(const std::string& path);
+/// Writes 3 columns, or 6 when normals are present.
+void write_points(const std::string& path, const OrientedPoints& p);
+
+// ----- meshes -----
+/// OFF, COFF, NOFF, CNOFF (header keyword alone on its line or followed by the counts), `#` comments.
+/// Polygons with more than 3 vertices are fan-triangulated; colors and extra tokens are ignored.
+TriangleMesh parse_off(std::string_view text, const std::string& name = "<memory>");
+/// OBJ: `v`, `vn`, `f` (forms `a`, `a/t`, `a//n`, `a/t/n`, negative = relative); other keywords are
+/// ignored; polygons are fan-triangulated. Normals are kept when each vertex gets a single normal.
+TriangleMesh parse_obj(std::string_view text, const std::string& name = "<memory>");
+/// PLY ascii 1.0 or binary_little_endian 1.0: element vertex (x, y, z, optional nx, ny, nz, any other
+/// properties skipped) and element face (a list property named vertex_indices or vertex_index);
+/// other elements are skipped. Big-endian files are rejected with a ParseError.
+TriangleMesh parse_ply(std::string_view bytes, const std::string& name = "<memory>");
+/// Reads a mesh by extension: .off, .obj, .ply (case-insensitive).
+TriangleMesh read_mesh(const std::string& path);
+/// Writes a mesh by extension (.off, .obj, .ply); N is written when it has #V rows. 17 significant
+/// digits in text formats.
+void write_mesh(const std::string& path, const TriangleMesh& mesh, PlyEncoding ply = PlyEncoding::Ascii);
+void write_off(const std::string& path, const TriangleMesh& mesh);
+void write_obj(const std::string& path, const TriangleMesh& mesh);
+void write_ply(const std::string& path, const TriangleMesh& mesh, PlyEncoding encoding = PlyEncoding::Ascii);
+
+// ----- any input -----
+/// What read_input() found.
+enum class InputKind {
+  Constraints,     ///< .xyzv: `constraints` is set.
+  OrientedPoints,  ///< .pwn or 6-column .xyz: `points` with normals.
+  Points,          ///< 3-column .xyz: `points` without normals (not enough to define a surface).
+  Mesh,            ///< .off, .obj, .ply: `mesh`.
+};
+
+/// One input file of any supported kind; only the member matching `kind` is filled.
+struct Input {
+  InputKind kind = InputKind::Constraints;
+  PointValues constraints;
+  OrientedPoints points;
+  TriangleMesh mesh;
+};
+
+/// Reads any supported input, detected by extension (.xyzv, .xyz, .pwn, .off, .obj, .ply).
+/// @throws ParseError for an unknown extension (line 0) or a malformed file.
+Input read_input(const std::string& path);
+
+/// Lower-case extension of path without the dot ("" when none).
+std::string file_extension(const std::string& path);
+
+}  // namespace vitri

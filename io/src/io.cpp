@@ -1,0 +1,404 @@
+// Readers and writers of the text formats (xyzv, xyz, pwn, OFF, OBJ), the PLY reader/writer, and
+// read_input(). Every reader works on an in-memory view of the file so that the fuzz targets exercise
+// exactly the same code; counts read from a file are checked against what the rest of the file can hold
+// before anything is allocated.
+
+#include "vitri/io/io.hpp"
+
+#include "text.hpp"
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace vitri {
+
+namespace io_detail {
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ParseError(path, 0, "cannot open file for reading");
+  std::ostringstream s;
+  s << in.rdbuf();
+  if (in.bad()) throw ParseError(path, 0, "read error");
+  return s.str();
+}
+
+}  // namespace io_detail
+
+using io_detail::LineScanner;
+
+namespace {
+
+constexpr long long kMaxIndex = std::numeric_limits<int>::max();
+
+std::ofstream open_out(const std::string& path, bool binary = false) {
+  std::ofstream out(path, binary ? std::ios::binary : std::ios::out);
+  if (!out) throw ParseError(path, 0, "cannot open file for writing");
+  return out;
+}
+
+void finish_out(std::ofstream& out, const std::string& path) {
+  out.flush();
+  if (!out) throw ParseError(path, 0, "write error");
+}
+
+// Full precision, locale-independent.
+std::string num(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+bool has_normals(const TriangleMesh& m) { return m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0; }
+
+void check_mesh_shape(const TriangleMesh& m, const std::string& path) {
+  if (m.V.cols() != 3 || m.F.cols() != 3) throw InvalidArgument(path + ": mesh V and F must have 3 columns");
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (m.F(f, k) < 0 || m.F(f, k) >= m.V.rows())
+        throw InvalidArgument(path + ": triangle " + std::to_string(f) + " has vertex index " +
+                              std::to_string(m.F(f, k)) + " out of range");
+}
+
+// Fan-triangulates polygon `poly` into tris.
+void add_polygon(std::vector<int>& tris, const std::vector<int>& poly) {
+  for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
+    tris.push_back(poly[0]);
+    tris.push_back(poly[k]);
+    tris.push_back(poly[k + 1]);
+  }
+}
+
+TriangleMesh make_mesh(const std::vector<double>& v, const std::vector<int>& t, const std::vector<double>& n) {
+  TriangleMesh m;
+  const auto nv = static_cast<Eigen::Index>(v.size() / 3), nt = static_cast<Eigen::Index>(t.size() / 3);
+  m.V.resize(nv, 3);
+  m.F.resize(nt, 3);
+  for (Eigen::Index i = 0; i < nv; ++i)
+    for (int k = 0; k < 3; ++k) m.V(i, k) = v[static_cast<std::size_t>(3 * i + k)];
+  for (Eigen::Index i = 0; i < nt; ++i)
+    for (int k = 0; k < 3; ++k) m.F(i, k) = t[static_cast<std::size_t>(3 * i + k)];
+  if (!n.empty() && n.size() == v.size()) {
+    m.N.resize(nv, 3);
+    for (Eigen::Index i = 0; i < nv; ++i)
+      for (int k = 0; k < 3; ++k) m.N(i, k) = n[static_cast<std::size_t>(3 * i + k)];
+  } else {
+    m.N.resize(0, 3);
+  }
+  return m;
+}
+
+// Number of lines left after the scanner position (an upper bound of the records a text can hold).
+std::size_t lines_left(std::string_view text, std::size_t offset) {
+  if (offset >= text.size()) return 0;
+  return static_cast<std::size_t>(std::count(text.begin() + static_cast<std::ptrdiff_t>(offset), text.end(), '\n')) + 1;
+}
+
+}  // namespace
+
+std::string file_extension(const std::string& path) {
+  const std::size_t slash = path.find_last_of("/\\");
+  const std::size_t dot = path.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+  std::string e = path.substr(dot + 1);
+  for (char& c : e) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return e;
+}
+
+// ------------------------------------------------------------------ xyzv
+PointValues parse_xyzv(std::string_view text, const std::string& name) {
+  LineScanner s(text, name);
+  PointValues c;
+  while (s.next_data_line()) {
+    if (s.tokens().size() != 4)
+      s.fail("expected 4 numbers 'x y z value', got " + std::to_string(s.tokens().size()) + " tokens");
+    c.points.push_back({s.number(0), s.number(1), s.number(2)});
+    c.values.push_back(s.number(3));
+  }
+  if (c.points.empty()) throw ParseError(name, 0, "no constraint in file");
+  return c;
+}
+
+PointValues read_xyzv(const std::string& path) { return parse_xyzv(io_detail::slurp(path), path); }
+
+void write_xyzv(const std::string& path, const PointValues& c) {
+  if (c.points.size() != c.values.size()) throw InvalidArgument(path + ": points and values differ in count");
+  auto out = open_out(path);
+  out << "# x y z value\n";
+  for (std::size_t i = 0; i < c.points.size(); ++i)
+    out << num(c.points[i].x) << ' ' << num(c.points[i].y) << ' ' << num(c.points[i].z) << ' ' << num(c.values[i])
+        << '\n';
+  finish_out(out, path);
+}
+
+// ------------------------------------------------------------------ xyz / pwn
+OrientedPoints parse_points(std::string_view text, const std::string& name, bool require_normals) {
+  LineScanner s(text, name);
+  OrientedPoints p;
+  std::size_t columns = 0;
+  long long declared = -1;
+  bool first = true;
+  while (s.next_data_line()) {
+    const std::size_t nt = s.tokens().size();
+    if (first && nt == 1) {  // optional point count
+      declared = s.integer(0, 0, std::numeric_limits<long long>::max());
+      first = false;
+      continue;
+    }
+    first = false;
+    if (columns == 0) {
+      if (nt != 3 && nt != 6) s.fail("expected 3 (x y z) or 6 (x y z nx ny nz) numbers, got " + std::to_string(nt));
+      if (require_normals && nt != 6) s.fail("expected 6 numbers 'x y z nx ny nz' (points with normals), got 3");
+      columns = nt;
+    } else if (nt != columns) {
+      s.fail("expected " + std::to_string(columns) + " numbers like the previous lines, got " + std::to_string(nt));
+    }
+    p.points.push_back({s.number(0), s.number(1), s.number(2)});
+    if (columns == 6) p.normals.push_back({s.number(3), s.number(4), s.number(5)});
+  }
+  if (p.points.empty()) throw ParseError(name, 0, "no point in file");
+  if (declared >= 0 && static_cast<std::size_t>(declared) != p.points.size())
+    throw ParseError(name, 1, "header declares " + std::to_string(declared) + " points, file has " +
+                                  std::to_string(p.points.size()));
+  return p;
+}
+
+OrientedPoints read_points(const std::string& path) {
+  return parse_points(io_detail::slurp(path), path, file_extension(path) == "pwn");
+}
+
+void write_points(const std::string& path, const OrientedPoints& p) {
+  const bool n = p.has_normals();
+  auto out = open_out(path);
+  for (std::size_t i = 0; i < p.points.size(); ++i) {
+    out << num(p.points[i].x) << ' ' << num(p.points[i].y) << ' ' << num(p.points[i].z);
+    if (n) out << ' ' << num(p.normals[i].x) << ' ' << num(p.normals[i].y) << ' ' << num(p.normals[i].z);
+    out << '\n';
+  }
+  finish_out(out, path);
+}
+
+// ------------------------------------------------------------------ OFF
+TriangleMesh parse_off(std::string_view text, const std::string& name) {
+  LineScanner s(text, name);
+  if (!s.next_data_line()) throw ParseError(name, 0, "empty file (expected an OFF header)");
+  std::string_view key = s.tokens()[0];
+  bool normals = false, colors = false;
+  {
+    std::string_view k = key;
+    if (!k.empty() && k.substr(0, 2) == "ST") k.remove_prefix(2);  // texture coordinates: unsupported
+    if (k.size() >= 3 && k.substr(k.size() - 3) == "OFF") {
+      const std::string_view prefix = k.substr(0, k.size() - 3);
+      for (char c : prefix) {
+        if (c == 'C') colors = true;
+        else if (c == 'N') normals = true;
+        else s.fail("unsupported OFF variant '" + std::string(key) + "' (OFF, COFF, NOFF, CNOFF are supported)");
+      }
+      if (key.substr(0, 2) == "ST") s.fail("texture-coordinate OFF ('" + std::string(key) + "') is not supported");
+    } else {
+      s.fail("not an OFF file: expected the keyword OFF, COFF, NOFF or CNOFF, got '" + std::string(key) + "'");
+    }
+  }
+  (void)colors;
+  std::size_t count_col = 1;
+  if (s.tokens().size() == 1) {
+    if (!s.next_data_line()) s.fail("missing vertex and face counts");
+    count_col = 0;
+  }
+  if (s.tokens().size() < count_col + 2) s.fail("expected the counts 'vertices faces [edges]'");
+  const long long nv = s.integer(count_col, 0, kMaxIndex);
+  const long long nf = s.integer(count_col + 1, 0, kMaxIndex);
+  if (static_cast<std::size_t>(nv + nf) > lines_left(text, s.offset()))
+    s.fail("counts " + std::to_string(nv) + " vertices and " + std::to_string(nf) +
+           " faces exceed the lines left in the file (truncated?)");
+  std::vector<double> v, n;
+  v.reserve(static_cast<std::size_t>(3 * nv));
+  if (normals) n.reserve(static_cast<std::size_t>(3 * nv));
+  for (long long i = 0; i < nv; ++i) {
+    if (!s.next_data_line()) s.fail("file ends after " + std::to_string(i) + " of " + std::to_string(nv) + " vertices");
+    const std::size_t need = normals ? 6 : 3;
+    if (s.tokens().size() < need)
+      s.fail("vertex " + std::to_string(i) + ": expected " + std::to_string(need) + " numbers, got " +
+             std::to_string(s.tokens().size()));
+    for (std::size_t k = 0; k < 3; ++k) v.push_back(s.number(k));
+    if (normals)
+      for (std::size_t k = 3; k < 6; ++k) n.push_back(s.number(k));
+  }
+  std::vector<int> tris, poly;
+  tris.reserve(static_cast<std::size_t>(3 * nf));
+  for (long long f = 0; f < nf; ++f) {
+    if (!s.next_data_line()) s.fail("file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
+    const long long k = s.integer(0, 0, kMaxIndex);
+    if (k < 3) s.fail("face " + std::to_string(f) + " has " + std::to_string(k) + " vertices (at least 3 needed)");
+    if (s.tokens().size() < static_cast<std::size_t>(k) + 1)
+      s.fail("face " + std::to_string(f) + ": expected " + std::to_string(k) + " vertex indices, got " +
+             std::to_string(s.tokens().size() - 1));
+    poly.clear();
+    for (long long j = 0; j < k; ++j) {
+      const long long idx = s.integer(static_cast<std::size_t>(j + 1), 0, kMaxIndex);
+      if (idx >= nv)
+        s.fail("face " + std::to_string(f) + ": vertex index " + std::to_string(idx) + " out of range (" +
+               std::to_string(nv) + " vertices)");
+      poly.push_back(static_cast<int>(idx));
+    }
+    add_polygon(tris, poly);
+  }
+  return make_mesh(v, tris, n);
+}
+
+// ------------------------------------------------------------------ OBJ
+TriangleMesh parse_obj(std::string_view text, const std::string& name) {
+  LineScanner s(text, name);
+  std::vector<double> v, vn;
+  std::vector<int> tris;
+  std::vector<std::array<long long, 2>> refs;  // (vertex, normal) of the current polygon
+  std::vector<long long> normal_of;            // per vertex: normal index, -1 none, -2 conflicting
+  bool any_normal_ref = false, normal_missing = false;
+  std::vector<int> poly;
+  while (s.next_data_line()) {
+    const auto& t = s.tokens();
+    if (t[0] == "v") {
+      if (t.size() < 4) s.fail("vertex: expected 'v x y z', got " + std::to_string(t.size() - 1) + " numbers");
+      for (std::size_t k = 1; k <= 3; ++k) v.push_back(s.number(k));
+    } else if (t[0] == "vn") {
+      if (t.size() < 4) s.fail("normal: expected 'vn x y z'");
+      for (std::size_t k = 1; k <= 3; ++k) vn.push_back(s.number(k));
+    } else if (t[0] == "f") {
+      if (t.size() < 4) s.fail("face with " + std::to_string(t.size() - 1) + " vertices (at least 3 needed)");
+      const auto nv = static_cast<long long>(v.size() / 3), nn = static_cast<long long>(vn.size() / 3);
+      normal_of.resize(static_cast<std::size_t>(nv), -1);
+      poly.clear();
+      for (std::size_t k = 1; k < t.size(); ++k) {
+        const std::string_view tok = t[k];
+        const std::size_t slash = tok.find('/');
+        auto resolve = [&](std::string_view part, long long count, const char* what) {
+          const long long raw = s.parse_integer(part, -kMaxIndex, kMaxIndex);
+          const long long idx = raw < 0 ? count + raw : raw - 1;
+          if (raw == 0 || idx < 0 || idx >= count)
+            s.fail(std::string(what) + " index " + std::to_string(raw) + " out of range (" + std::to_string(count) +
+                   " defined so far)");
+          return idx;
+        };
+        const long long vi = resolve(tok.substr(0, slash), nv, "vertex");
+        long long ni = -1;
+        if (slash != std::string_view::npos) {
+          const std::size_t slash2 = tok.find('/', slash + 1);
+          if (slash2 != std::string_view::npos && slash2 + 1 < tok.size())
+            ni = resolve(tok.substr(slash2 + 1), nn, "normal");
+        }
+        if (ni >= 0) {
+          any_normal_ref = true;
+          long long& cur = normal_of[static_cast<std::size_t>(vi)];
+          if (cur == -1) cur = ni;
+          else if (cur != ni && cur != -2) {
+            // Same vertex, two normal indices: keep only if the vectors are equal.
+            const auto a = static_cast<std::size_t>(3 * cur), b = static_cast<std::size_t>(3 * ni);
+            if (!(vn[a] == vn[b] && vn[a + 1] == vn[b + 1] && vn[a + 2] == vn[b + 2])) cur = -2;
+          }
+        } else {
+          normal_missing = true;
+        }
+        poly.push_back(static_cast<int>(vi));
+      }
+      add_polygon(tris, poly);
+    }
+    // Other keywords (vt, o, g, s, usemtl, mtllib, l, p, ...) carry nothing we use.
+  }
+  if (v.empty()) throw ParseError(name, 0, "no vertex in OBJ file");
+  std::vector<double> n;
+  normal_of.resize(v.size() / 3, -1);
+  if (any_normal_ref && !normal_missing) {
+    bool ok = true;
+    for (long long ni : normal_of) ok = ok && ni >= 0;  // every vertex used by a face with one normal
+    if (ok) {
+      for (long long ni : normal_of)
+        for (int k = 0; k < 3; ++k) n.push_back(vn[static_cast<std::size_t>(3 * ni + k)]);
+    }
+  } else if (!any_normal_ref && vn.size() == v.size()) {
+    n = vn;  // 'vn' listed one per vertex, faces without normal references
+  }
+  return make_mesh(v, tris, n);
+}
+
+// ------------------------------------------------------------------ mesh dispatch and writers
+TriangleMesh read_mesh(const std::string& path) {
+  const std::string e = file_extension(path);
+  if (e == "off") return parse_off(io_detail::slurp(path), path);
+  if (e == "obj") return parse_obj(io_detail::slurp(path), path);
+  if (e == "ply") return parse_ply(io_detail::slurp(path), path);
+  throw ParseError(path, 0, "unknown mesh extension '." + e + "' (expected .off, .obj or .ply)");
+}
+
+void write_off(const std::string& path, const TriangleMesh& m) {
+  check_mesh_shape(m, path);
+  const bool n = has_normals(m);
+  auto out = open_out(path);
+  out << (n ? "NOFF\n" : "OFF\n") << m.V.rows() << ' ' << m.F.rows() << " 0\n";
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    out << num(m.V(i, 0)) << ' ' << num(m.V(i, 1)) << ' ' << num(m.V(i, 2));
+    if (n) out << ' ' << num(m.N(i, 0)) << ' ' << num(m.N(i, 1)) << ' ' << num(m.N(i, 2));
+    out << '\n';
+  }
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) out << "3 " << m.F(f, 0) << ' ' << m.F(f, 1) << ' ' << m.F(f, 2) << '\n';
+  finish_out(out, path);
+}
+
+void write_obj(const std::string& path, const TriangleMesh& m) {
+  check_mesh_shape(m, path);
+  const bool n = has_normals(m);
+  auto out = open_out(path);
+  out << "# vitri\n";
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+    out << "v " << num(m.V(i, 0)) << ' ' << num(m.V(i, 1)) << ' ' << num(m.V(i, 2)) << '\n';
+  if (n)
+    for (Eigen::Index i = 0; i < m.N.rows(); ++i)
+      out << "vn " << num(m.N(i, 0)) << ' ' << num(m.N(i, 1)) << ' ' << num(m.N(i, 2)) << '\n';
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    out << 'f';
+    for (int k = 0; k < 3; ++k) {
+      const long long i = m.F(f, k) + 1LL;
+      out << ' ' << i;
+      if (n) out << "//" << i;
+    }
+    out << '\n';
+  }
+  finish_out(out, path);
+}
+
+void write_mesh(const std::string& path, const TriangleMesh& mesh, PlyEncoding ply) {
+  const std::string e = file_extension(path);
+  if (e == "off") return write_off(path, mesh);
+  if (e == "obj") return write_obj(path, mesh);
+  if (e == "ply") return write_ply(path, mesh, ply);
+  throw InvalidArgument(path + ": unknown mesh extension '." + e + "' (expected .off, .obj or .ply)");
+}
+
+// ------------------------------------------------------------------ any input
+Input read_input(const std::string& path) {
+  const std::string e = file_extension(path);
+  Input in;
+  if (e == "xyzv") {
+    in.kind = InputKind::Constraints;
+    in.constraints = read_xyzv(path);
+  } else if (e == "xyz" || e == "pwn") {
+    in.points = read_points(path);
+    in.kind = in.points.has_normals() ? InputKind::OrientedPoints : InputKind::Points;
+  } else if (e == "off" || e == "obj" || e == "ply") {
+    in.kind = InputKind::Mesh;
+    in.mesh = read_mesh(path);
+  } else {
+    throw ParseError(path, 0,
+                     "unknown input extension '." + e + "' (expected .xyzv, .xyz, .pwn, .off, .obj or .ply)");
+  }
+  return in;
+}
+
+}  // namespace vitri

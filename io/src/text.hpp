@@ -1,0 +1,109 @@
+#pragma once
+// Line- and token-level scanning of text files with line numbers for the error messages.
+
+#include "vitri/core/error.hpp"
+
+#include <charconv>
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vitri::io_detail {
+
+/// Iterates over the lines of a text, stripping `#` comments (when enabled) and '\r', splitting tokens
+/// on blanks. Lines with no token are skipped by next_data_line().
+class LineScanner {
+ public:
+  LineScanner(std::string_view text, std::string name, bool comments = true)
+      : text_(text), name_(std::move(name)), comments_(comments) {}
+
+  /// Advances to the next line holding a token; false at the end of the text.
+  bool next_data_line() {
+    while (pos_ < text_.size()) {
+      std::size_t end = text_.find('\n', pos_);
+      if (end == std::string_view::npos) end = text_.size();
+      std::string_view line = text_.substr(pos_, end - pos_);
+      pos_ = end < text_.size() ? end + 1 : text_.size();
+      ++line_no_;
+      if (comments_) {
+        const std::size_t hash = line.find('#');
+        if (hash != std::string_view::npos) line = line.substr(0, hash);
+      }
+      split(line);
+      if (!tokens_.empty()) return true;
+    }
+    tokens_.clear();
+    return false;
+  }
+
+  const std::vector<std::string_view>& tokens() const { return tokens_; }
+  std::size_t line() const { return line_no_; }
+  const std::string& name() const { return name_; }
+  /// Byte offset just after the current line (binary payloads start there).
+  std::size_t offset() const { return pos_; }
+
+  [[noreturn]] void fail(const std::string& what) const { throw ParseError(name_, line_no_, what); }
+
+  /// Token i as a finite double.
+  double number(std::size_t i) const {
+    if (i >= tokens_.size()) fail("expected a number in column " + std::to_string(i + 1) + ", line has " +
+                                  std::to_string(tokens_.size()) + " tokens");
+    return parse_double(tokens_[i]);
+  }
+
+  double parse_double(std::string_view t) const {
+    double v = 0;
+    const char* b = t.data();
+    const char* e = t.data() + t.size();
+    if (b != e && *b == '+') ++b;
+    const auto r = std::from_chars(b, e, v);
+    if (r.ec != std::errc() || r.ptr != e) fail("not a number: '" + std::string(t) + "'");
+    if (!std::isfinite(v)) fail("non-finite number: '" + std::string(t) + "'");
+    return v;
+  }
+
+  /// Token i as an integer in [lo, hi].
+  long long integer(std::size_t i, long long lo, long long hi) const {
+    if (i >= tokens_.size()) fail("expected an integer in column " + std::to_string(i + 1));
+    return parse_integer(tokens_[i], lo, hi);
+  }
+
+  long long parse_integer(std::string_view t, long long lo, long long hi) const {
+    long long v = 0;
+    const char* b = t.data();
+    const char* e = t.data() + t.size();
+    if (b != e && *b == '+') ++b;
+    const auto r = std::from_chars(b, e, v);
+    if (r.ec != std::errc() || r.ptr != e) fail("not an integer: '" + std::string(t) + "'");
+    if (v < lo || v > hi)
+      fail("integer " + std::to_string(v) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return v;
+  }
+
+ private:
+  void split(std::string_view line) {
+    tokens_.clear();
+    std::size_t i = 0;
+    while (i < line.size()) {
+      while (i < line.size() && is_blank(line[i])) ++i;
+      const std::size_t b = i;
+      while (i < line.size() && !is_blank(line[i])) ++i;
+      if (i > b) tokens_.push_back(line.substr(b, i - b));
+    }
+  }
+  static bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+
+  std::string_view text_;
+  std::string name_;
+  bool comments_;
+  std::size_t pos_ = 0;
+  std::size_t line_no_ = 0;
+  std::vector<std::string_view> tokens_;
+};
+
+/// Reads a whole file; ParseError(path, 0, ...) when it cannot be opened.
+std::string slurp(const std::string& path);
+
+}  // namespace vitri::io_detail

@@ -1,0 +1,195 @@
+/// @file predicates.cpp
+/// The exact fallbacks of the predicates in predicates.hpp, and the symbolic perturbation.
+///
+/// A brief explanation. The inline filters in the header evaluate each determinant in doubles and
+/// certify its sign with a semi-static error bound. When the bound does not certify it (near-degenerate
+/// input, or magnitudes where under/overflow could break the bound), we come here and compute the same
+/// determinant exactly with expansion arithmetic (expansion.hpp):
+///   1. Pre-scale all coordinates of the call by one power of two 2^k (exact; the sign of a homogeneous
+///      determinant does not change) so that the largest |coordinate| lands just below 2^E, with E
+///      chosen per predicate so that no intermediate can overflow (nor overflow Dekker's split) while
+///      leaving as much room as possible below for small coordinates. This makes the result exact for
+///      huge and tiny inputs alike, as long as the coordinates of one call span less than a
+///      predicate-dependent number of binary orders (docs/predicates.md, "Valid input range").
+///   2. Form the differences exactly as two-component expansions (two_diff).
+///   3. Evaluate the determinant with the same cofactor scheme as the filter, every product and sum
+///      exact, zero components eliminated (on grids and nearby points most differences are exact
+///      single doubles and the expansions stay a few components long).
+///   4. The sign is the sign of the largest component.
+
+#include "vitri/core/predicates.hpp"
+
+#include "expansion.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vitri {
+
+PredicateStats& predicate_stats() {
+  thread_local PredicateStats stats;
+  return stats;
+}
+
+namespace detail {
+namespace {
+
+// Target binary exponents of the largest |coordinate| after pre-scaling (see docs/predicates.md):
+// orient3d: |det| < 2^(3E + 6) must stay below 2^1023, E <= 338;
+// insphere: |det| < 2^(5E + 12) must stay below 2^1023 (and lifts / minors below the split limit
+//           2^996), E <= 202;
+// orient2d: |det| < 2^(2E + 3), E <= 509.
+// Each is taken a few binary orders below its limit.
+constexpr int kOrient3dExponent = 330;
+constexpr int kInsphereExponent = 195;
+constexpr int kOrient2dExponent = 500;
+
+/// Scales v[0..n) by one power of two so that max |v[i]| lies in [2^(target - 1), 2^target).
+/// Returns false when some value is not finite (the predicates then answer Zero: no precondition
+/// violation may crash or hit undefined behaviour).
+bool prescale(double* v, int n, int target) {
+  double m = 0.0;
+  for (int i = 0; i < n; ++i) {
+    if (!std::isfinite(v[i])) return false;
+    m = std::max(m, std::fabs(v[i]));
+  }
+  if (m == 0.0) return true;
+  const int k = target - 1 - std::ilogb(m);
+  if (k != 0)
+    for (int i = 0; i < n; ++i) v[i] = std::ldexp(v[i], k);
+  return true;
+}
+
+Sign to_sign(int s) { return s > 0 ? Sign::Positive : (s < 0 ? Sign::Negative : Sign::Zero); }
+
+/// h = p * q - r * s, exactly.
+void cross_minor(const Expansion& p, const Expansion& q, const Expansion& r, const Expansion& s,
+                 Expansion& h) {
+  Expansion t1, t2;
+  expansion_product(p, q, t1);
+  expansion_product(r, s, t2);
+  expansion_sum(t1, t2, h, -1.0);
+}
+
+/// h = s1 * p1 * m1 + s2 * p2 * m2 + s3 * p3 * m3 (the signs s_i are +1 or -1), exactly.
+void combine3(const Expansion& p1, const Expansion& m1, double s1, const Expansion& p2,
+              const Expansion& m2, double s2, const Expansion& p3, const Expansion& m3, double s3,
+              Expansion& h) {
+  Expansion t1, t2, t3, zero, acc1, acc2;
+  expansion_product(p1, m1, t1);
+  expansion_product(p2, m2, t2);
+  expansion_product(p3, m3, t3);
+  expansion_sum(zero, t1, acc1, s1);
+  expansion_sum(acc1, t2, acc2, s2);
+  expansion_sum(acc2, t3, h, s3);
+  expansion_compress(h);
+}
+
+}  // namespace
+
+Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+#ifdef VITRI_PREDICATE_STATS
+  ++predicate_stats().orient3d_exact;
+#endif
+  double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+  if (!prescale(v, 12, kOrient3dExponent)) return Sign::Zero;
+  // Rows u = b - a, v = c - a, w = d - a; columns x, y, z.
+  Expansion m[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) m[r][k].assign_difference(v[3 * (r + 1) + k], v[k]);
+  const Expansion(&u)[3] = m[0];
+  const Expansion(&vv)[3] = m[1];
+  const Expansion(&w)[3] = m[2];
+  Expansion m1, m2, m3, det;
+  cross_minor(vv[1], w[2], vv[2], w[1], m1);
+  cross_minor(vv[2], w[0], vv[0], w[2], m2);
+  cross_minor(vv[0], w[1], vv[1], w[0], m3);
+  combine3(u[0], m1, 1.0, u[1], m2, 1.0, u[2], m3, 1.0, det);
+  return to_sign(det.sign());
+}
+
+Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+#ifdef VITRI_PREDICATE_STATS
+  ++predicate_stats().insphere_exact;
+#endif
+  double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
+  if (!prescale(v, 15, kInsphereExponent)) return Sign::Zero;
+  // q[r][k] = coordinate k of (point r - e), r = a, b, c, d.
+  Expansion q[4][3];
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 3; ++k) q[r][k].assign_difference(v[3 * r + k], v[12 + k]);
+  // 2x2 minors of the (x, y) columns, as in the filter.
+  Expansion ab, bc, cd, da, ac, bd;
+  cross_minor(q[0][0], q[1][1], q[1][0], q[0][1], ab);
+  cross_minor(q[1][0], q[2][1], q[2][0], q[1][1], bc);
+  cross_minor(q[2][0], q[3][1], q[3][0], q[2][1], cd);
+  cross_minor(q[3][0], q[0][1], q[0][0], q[3][1], da);
+  cross_minor(q[0][0], q[2][1], q[2][0], q[0][1], ac);
+  cross_minor(q[1][0], q[3][1], q[3][0], q[1][1], bd);
+  // 3x3 minors with the z column.
+  Expansion abc, bcd, cda, dab;
+  combine3(q[0][2], bc, 1.0, q[1][2], ac, -1.0, q[2][2], ab, 1.0, abc);
+  combine3(q[1][2], cd, 1.0, q[2][2], bd, -1.0, q[3][2], bc, 1.0, bcd);
+  combine3(q[2][2], da, 1.0, q[3][2], ac, 1.0, q[0][2], cd, 1.0, cda);
+  combine3(q[3][2], ab, 1.0, q[0][2], bd, 1.0, q[1][2], da, 1.0, dab);
+  // Lifts |p - e|^2.
+  Expansion lift[4];
+  for (int r = 0; r < 4; ++r) combine3(q[r][0], q[r][0], 1.0, q[r][1], q[r][1], 1.0, q[r][2], q[r][2], 1.0, lift[r]);
+  // det = (alift * bcd - blift * cda) + (clift * dab - dlift * abc).
+  Expansion t[4], s1, s2, det;
+  expansion_product(lift[0], bcd, t[0]);
+  expansion_product(lift[1], cda, t[1]);
+  expansion_product(lift[2], dab, t[2]);
+  expansion_product(lift[3], abc, t[3]);
+  expansion_sum(t[0], t[1], s1, -1.0);
+  expansion_sum(t[2], t[3], s2, -1.0);
+  expansion_sum(s1, s2, det);
+  return to_sign(det.sign());
+}
+
+Sign orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {
+#ifdef VITRI_PREDICATE_STATS
+  ++predicate_stats().orient2d_exact;
+#endif
+  double v[6] = {ax, ay, bx, by, cx, cy};
+  if (!prescale(v, 6, kOrient2dExponent)) return Sign::Zero;
+  Expansion ux, uy, vx, vy, det;
+  ux.assign_difference(v[2], v[0]);
+  uy.assign_difference(v[3], v[1]);
+  vx.assign_difference(v[4], v[0]);
+  vy.assign_difference(v[5], v[1]);
+  cross_minor(ux, vy, uy, vx, det);
+  return to_sign(det.sign());
+}
+
+Sign insphere_sos_perturbed(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                            const Point3& e) {
+#ifdef VITRI_PREDICATE_STATS
+  ++predicate_stats().insphere_sos_perturbed;
+#endif
+  // Argument slots 0..4 = a, b, c, d, e, sorted from the lexicographically largest point down. Ties
+  // (repeated points, a precondition violation) are broken by the slot so that the answer stays
+  // deterministic.
+  const Point3* p[5] = {&a, &b, &c, &d, &e};
+  int order[5] = {0, 1, 2, 3, 4};
+  std::sort(order, order + 5, [&](int i, int j) {
+    if (lex_less(*p[j], *p[i])) return true;
+    if (lex_less(*p[i], *p[j])) return false;
+    return i > j;
+  });
+  // The perturbed determinant is insphere + sum over points q of eps_q * (d insphere / d lift_q), with
+  // eps_q more dominant the larger q. d/d lift_e = -orient3d(a, b, c, d); by antisymmetry, the
+  // coefficient of a point in slot k < 4 is orient3d(a, b, c, d) with e put in slot k.
+  for (int idx = 0; idx < 5; ++idx) {
+    const int slot = order[idx];
+    if (slot == 4) return -orient3d(a, b, c, d);
+    const Point3* q[4] = {&a, &b, &c, &d};
+    q[slot] = &e;
+    const Sign s = orient3d(*q[0], *q[1], *q[2], *q[3]);
+    if (s != Sign::Zero) return s;
+  }
+  return Sign::Zero;  // unreachable: slot 4 occurs in the loop
+}
+
+}  // namespace detail
+}  // namespace vitri

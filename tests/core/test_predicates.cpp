@@ -1,0 +1,596 @@
+// Tests of the exact predicates (vitri/core/predicates.hpp): sign conventions, exact oracles on integer
+// grids (128-bit integers) and on arbitrary doubles (big integers, exact_oracle.hpp), one test per
+// degenerate configuration, and the symbolic perturbation of insphere_sos.
+
+#include "vitri/core/predicates.hpp"
+
+#include "core/exact_oracle.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+using vitri::insphere;
+using vitri::insphere_sos;
+using vitri::orient2d;
+using vitri::orient3d;
+using vitri::Point3;
+using vitri::Sign;
+using vitri::to_int;
+
+namespace {
+
+__extension__ typedef __int128 Int128;
+
+// --- 128-bit oracles for integer coordinates |x| <= 2^20 -------------------------------------------
+// Differences are below 2^21, so orient3d < 6 * 2^63 and insphere < 4 * 3 * 2^42 * 6 * 2^63 < 2^112:
+// both fit in a signed 128-bit integer.
+
+Int128 to_i(double x) { return static_cast<Int128>(static_cast<long long>(x)); }
+
+int sign_i(Int128 v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
+
+Int128 det3_i(const Int128 m[3][3]) {
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+         m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+}
+
+int orient3d_i128(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+  const Point3* p[3] = {&b, &c, &d};
+  Int128 m[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (std::size_t k = 0; k < 3; ++k) m[r][k] = to_i((*p[r])[k]) - to_i(a[k]);
+  return sign_i(det3_i(m));
+}
+
+int insphere_i128(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+  const Point3* p[4] = {&a, &b, &c, &d};
+  Int128 q[4][4];
+  for (int r = 0; r < 4; ++r) {
+    Int128 lift = 0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      q[r][k] = to_i((*p[r])[k]) - to_i(e[k]);
+      lift += q[r][k] * q[r][k];
+    }
+    q[r][3] = lift;
+  }
+  // -det4 by Laplace expansion along the lift column.
+  Int128 det = 0;
+  for (int r = 0; r < 4; ++r) {
+    Int128 minor[3][3];
+    for (int i = 0, ii = 0; i < 4; ++i) {
+      if (i == r) continue;
+      for (int k = 0; k < 3; ++k) minor[ii][k] = q[i][k];
+      ++ii;
+    }
+    // Cofactor sign of entry (r, 3) is (-1)^(r + 3).
+    const Int128 t = q[r][3] * det3_i(minor);
+    det += ((r + 3) % 2 == 0) ? t : -t;
+  }
+  return -sign_i(det);
+}
+
+Point3 random_grid_point(std::mt19937_64& rng, long long half_width) {
+  std::uniform_int_distribution<long long> dist(-half_width, half_width);
+  return {static_cast<double>(dist(rng)), static_cast<double>(dist(rng)), static_cast<double>(dist(rng))};
+}
+
+Point3 random_point(std::mt19937_64& rng, double lo, double hi) {
+  std::uniform_real_distribution<double> dist(lo, hi);
+  return {dist(rng), dist(rng), dist(rng)};
+}
+
+Point3 scaled(const Point3& p, double s) { return {p.x * s, p.y * s, p.z * s}; }
+
+// One-ulp neighbours of a point along each axis and direction.
+std::vector<Point3> ulp_neighbours(const Point3& p, int steps) {
+  std::vector<Point3> out;
+  for (std::size_t k = 0; k < 3; ++k) {
+    for (const double dir : {-1.0, 1.0}) {
+      Point3 q = p;
+      for (int s = 0; s < steps; ++s) {
+        q[k] = std::nextafter(q[k], dir * std::numeric_limits<double>::infinity());
+        out.push_back(q);
+      }
+    }
+  }
+  return out;
+}
+
+// The rule of CGAL's Delaunay_triangulation_3::side_of_oriented_sphere(perturb = true), written out
+// independently for a positively oriented (a, b, c, d): largest point first; e decides Negative, a
+// vertex decides by orient3d with e in its slot.
+Sign cgal_rule(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+  const Sign s = insphere(a, b, c, d, e);
+  if (s != Sign::Zero) return s;
+  std::array<const Point3*, 5> pts = {&a, &b, &c, &d, &e};
+  std::sort(pts.begin(), pts.end(), [](const Point3* p, const Point3* q) { return vitri::lex_less(*p, *q); });
+  for (int i = 4; i > 2; --i) {
+    if (pts[i] == &e) return Sign::Negative;
+    Sign o = Sign::Zero;
+    if (pts[i] == &d && (o = orient3d(a, b, c, e)) != Sign::Zero) return o;
+    if (pts[i] == &c && (o = orient3d(a, b, e, d)) != Sign::Zero) return o;
+    if (pts[i] == &b && (o = orient3d(a, e, c, d)) != Sign::Zero) return o;
+    if (pts[i] == &a && (o = orient3d(e, b, c, d)) != Sign::Zero) return o;
+  }
+  return Sign::Zero;  // CGAL asserts this is unreachable
+}
+
+void check_orient3d_oracle(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+  INFO("a=(" << a.x << "," << a.y << "," << a.z << ") d=(" << d.x << "," << d.y << "," << d.z << ")");
+  REQUIRE(to_int(orient3d(a, b, c, d)) == vitri::test::oracle_orient3d(a, b, c, d));
+}
+
+void check_insphere_oracle(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+  INFO("e=(" << e.x << "," << e.y << "," << e.z << ")");
+  REQUIRE(to_int(insphere(a, b, c, d, e)) == vitri::test::oracle_insphere(a, b, c, d, e));
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------------
+// Conventions
+
+TEST_CASE("orient3d convention: the unit tetrahedron is positively oriented", "[predicates]") {
+  const Point3 o{0, 0, 0}, x{1, 0, 0}, y{0, 1, 0}, z{0, 0, 1};
+  CHECK(orient3d(o, x, y, z) == Sign::Positive);
+  CHECK(orient3d(o, y, x, z) == Sign::Negative);
+  CHECK(orient3d(o, x, y, -z) == Sign::Negative);
+  CHECK(vitri::orient3d_fast(o, x, y, z) > 0.0);
+}
+
+TEST_CASE("insphere convention: the circumcenter is inside a positive tetrahedron", "[predicates]") {
+  const Point3 o{0, 0, 0}, x{1, 0, 0}, y{0, 1, 0}, z{0, 0, 1};
+  const Point3 center{0.5, 0.5, 0.5}, far{3, 3, 3};
+  REQUIRE(orient3d(o, x, y, z) == Sign::Positive);
+  CHECK(insphere(o, x, y, z, center) == Sign::Positive);
+  CHECK(insphere(o, x, y, z, far) == Sign::Negative);
+  CHECK(vitri::insphere_fast(o, x, y, z, center) > 0.0);
+  // Negatively oriented: the sign flips.
+  CHECK(insphere(x, o, y, z, center) == Sign::Negative);
+  CHECK(insphere(x, o, y, z, far) == Sign::Positive);
+  // The same convention for insphere_sos on non-degenerate input.
+  CHECK(insphere_sos(o, x, y, z, center) == Sign::Positive);
+  CHECK(insphere_sos(o, x, y, z, far) == Sign::Negative);
+}
+
+TEST_CASE("orient2d convention: counter-clockwise in the (i, j) plane is positive", "[predicates]") {
+  const Point3 a{0, 0, 7}, b{1, 0, -3}, c{0, 1, 2};
+  CHECK(orient2d(a, b, c, 0, 1) == Sign::Positive);
+  CHECK(orient2d(a, b, c, 1, 0) == Sign::Negative);
+  CHECK(orient2d(a, c, b, 0, 1) == Sign::Negative);
+  const Point3 p{5, 0, 0}, q{5, 1, 0}, r{5, 0, 1};
+  CHECK(orient2d(p, q, r, 1, 2) == Sign::Positive);
+  CHECK(orient2d(p, q, r, 0, 1) == Sign::Zero);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Exact oracles on integer grids (128-bit integers)
+
+TEST_CASE("orient3d equals the 128-bit integer oracle on random 2^20 grid points", "[predicates][oracle]") {
+  std::mt19937_64 rng(20240601);
+  for (const long long w : {2LL, 8LL, 1LL << 20}) {  // small grids: many exact zeros; large: generic
+    for (int i = 0; i < 20000; ++i) {
+      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w), c = random_grid_point(rng, w),
+                   d = random_grid_point(rng, w);
+      REQUIRE(to_int(orient3d(a, b, c, d)) == orient3d_i128(a, b, c, d));
+    }
+  }
+}
+
+TEST_CASE("orient3d equals the 128-bit oracle on near-coplanar 2^20 grid points", "[predicates][oracle]") {
+  // d = a + s (b - a) + t (c - a) is exactly coplanar; then nudge one coordinate by -1, 0 or +1.
+  std::mt19937_64 rng(7);
+  std::uniform_int_distribution<long long> small(-3, 3), nudge(-1, 1);
+  int zeros = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Point3 a = random_grid_point(rng, 1 << 17), b = random_grid_point(rng, 1 << 17),
+                 c = random_grid_point(rng, 1 << 17);
+    const double s = static_cast<double>(small(rng)), t = static_cast<double>(small(rng));
+    Point3 d = a + s * (b - a) + t * (c - a);
+    d.z += static_cast<double>(nudge(rng));
+    const int expected = orient3d_i128(a, b, c, d);
+    zeros += expected == 0;
+    REQUIRE(to_int(orient3d(a, b, c, d)) == expected);
+  }
+  CHECK(zeros > 1000);  // the degenerate case was really exercised
+}
+
+TEST_CASE("insphere equals the 128-bit integer oracle on random 2^20 grid points", "[predicates][oracle]") {
+  std::mt19937_64 rng(99);
+  for (const long long w : {1LL, 2LL, 4LL, 1LL << 20}) {
+    for (int i = 0; i < 20000; ++i) {
+      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w), c = random_grid_point(rng, w),
+                   d = random_grid_point(rng, w), e = random_grid_point(rng, w);
+      REQUIRE(to_int(insphere(a, b, c, d, e)) == insphere_i128(a, b, c, d, e));
+    }
+  }
+}
+
+TEST_CASE("insphere equals the 128-bit oracle on near-cospherical 2^20 grid points", "[predicates][oracle]") {
+  // Integer points on spheres x^2 + y^2 + z^2 = r^2 with large r (found by search on a random
+  // direction), centred at a random grid point, then e nudged by one unit.
+  std::mt19937_64 rng(3);
+  std::uniform_int_distribution<long long> coord(-(1 << 18), 1 << 18), nudge(-1, 1);
+  // Points on x^2 + y^2 + z^2 = 3^2 * 5^2 * 13^2 = 38025 (many integer solutions), scaled by 2^6.
+  std::vector<Point3> sphere;
+  for (int x = -195; x <= 195; ++x)
+    for (int y = -195; y <= 195; ++y) {
+      const int z2 = 38025 - x * x - y * y;
+      if (z2 < 0) continue;
+      const int z = static_cast<int>(std::lround(std::sqrt(static_cast<double>(z2))));
+      if (z * z == z2) {
+        sphere.push_back({64.0 * x, 64.0 * y, 64.0 * z});
+        if (z != 0) sphere.push_back({64.0 * x, 64.0 * y, -64.0 * z});
+      }
+    }
+  REQUIRE(sphere.size() > 100);
+  std::uniform_int_distribution<std::size_t> pick(0, sphere.size() - 1);
+  int zeros = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Point3 center{static_cast<double>(coord(rng)), static_cast<double>(coord(rng)),
+                        static_cast<double>(coord(rng))};
+    const Point3 a = center + sphere[pick(rng)], b = center + sphere[pick(rng)], c = center + sphere[pick(rng)],
+                 d = center + sphere[pick(rng)];
+    Point3 e = center + sphere[pick(rng)];
+    e.x += static_cast<double>(nudge(rng));
+    const int expected = insphere_i128(a, b, c, d, e);
+    zeros += expected == 0;
+    REQUIRE(to_int(insphere(a, b, c, d, e)) == expected);
+  }
+  CHECK(zeros > 1000);
+}
+
+TEST_CASE("orient2d equals the 128-bit integer oracle on random grid points", "[predicates][oracle]") {
+  std::mt19937_64 rng(5);
+  for (const long long w : {2LL, 1LL << 20}) {
+    for (int n = 0; n < 20000; ++n) {
+      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w), c = random_grid_point(rng, w);
+      const int i = static_cast<int>(n % 3), j = (i + 1 + static_cast<int>((n / 3) % 2)) % 3;
+      const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
+      const Int128 det = (to_i(b[si]) - to_i(a[si])) * (to_i(c[sj]) - to_i(a[sj])) -
+                         (to_i(b[sj]) - to_i(a[sj])) * (to_i(c[si]) - to_i(a[si]));
+      REQUIRE(to_int(orient2d(a, b, c, i, j)) == sign_i(det));
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Degenerate and near-degenerate configurations, one per test case, checked against the big-integer
+// oracle on arbitrary doubles.
+
+TEST_CASE("degenerate: point one ulp off a plane", "[predicates][degenerate]") {
+  // Dyadic points on the plane x + y + z = 1: exactly coplanar.
+  const Point3 a{0.5, 0.25, 0.25}, b{0.125, 0.375, 0.5}, c{0.75, 0.0625, 0.1875}, d{0.3125, 0.3125, 0.375};
+  REQUIRE(orient3d(a, b, c, d) == Sign::Zero);
+  const Sign up = orient3d(a, b, c, {d.x, d.y, std::nextafter(d.z, 1.0)});
+  const Sign down = orient3d(a, b, c, {d.x, d.y, std::nextafter(d.z, 0.0)});
+  CHECK(up != Sign::Zero);
+  CHECK(down == -up);
+  CHECK(to_int(up) == vitri::test::oracle_orient3d(a, b, c, {d.x, d.y, std::nextafter(d.z, 1.0)}));
+  for (const Point3& q : ulp_neighbours(d, 3)) check_orient3d_oracle(a, b, c, q);
+
+  // Generic doubles: d is the rounded affine combination, then its ulp neighbourhood.
+  std::mt19937_64 rng(11);
+  for (int i = 0; i < 300; ++i) {
+    const Point3 p = random_point(rng, -1, 1), q = random_point(rng, -1, 1), r = random_point(rng, -1, 1);
+    std::uniform_real_distribution<double> st(-2, 2);
+    const Point3 m = p + st(rng) * (q - p) + st(rng) * (r - p);
+    check_orient3d_oracle(p, q, r, m);
+    for (const Point3& n : ulp_neighbours(m, 2)) check_orient3d_oracle(p, q, r, n);
+  }
+}
+
+TEST_CASE("degenerate: point one ulp off a sphere", "[predicates][degenerate]") {
+  // Integer points on the sphere of radius 3 about the origin: 1 + 4 + 4 = 9.
+  const Point3 a{3, 0, 0}, b{0, 3, 0}, c{0, 0, 3}, d{-2, -1, 2}, e{1, -2, -2};
+  const Sign o = orient3d(a, b, c, d);
+  REQUIRE(o != Sign::Zero);
+  REQUIRE(insphere(a, b, c, d, e) == Sign::Zero);
+  // One ulp further from the centre is outside, one ulp closer is inside.
+  const Point3 out{e.x, e.y, std::nextafter(e.z, -10.0)}, in{e.x, e.y, std::nextafter(e.z, 0.0)};
+  CHECK(insphere(a, b, c, d, out) == -o);
+  CHECK(insphere(a, b, c, d, in) == o);
+  for (const Point3& q : ulp_neighbours(e, 3)) check_insphere_oracle(a, b, c, d, q);
+
+  // Generic doubles: points rounded onto the unit sphere about a generic centre, e perturbed by ulps.
+  std::mt19937_64 rng(12);
+  std::normal_distribution<double> g;
+  auto on_sphere = [&](const Point3& center) {
+    Point3 v{g(rng), g(rng), g(rng)};
+    v = v / vitri::norm(v);
+    return center + v;
+  };
+  for (int i = 0; i < 200; ++i) {
+    const Point3 center = random_point(rng, -10, 10);
+    const Point3 p = on_sphere(center), q = on_sphere(center), r = on_sphere(center), s = on_sphere(center),
+                 t = on_sphere(center);
+    check_insphere_oracle(p, q, r, s, t);
+    for (const Point3& n : ulp_neighbours(t, 2)) check_insphere_oracle(p, q, r, s, n);
+  }
+}
+
+TEST_CASE("degenerate: huge coordinates (1e100 scale)", "[predicates][degenerate]") {
+  std::mt19937_64 rng(13);
+  for (int i = 0; i < 300; ++i) {
+    const Point3 p = scaled(random_point(rng, -1, 1), 1e100), q = scaled(random_point(rng, -1, 1), 1e100),
+                 r = scaled(random_point(rng, -1, 1), 1e100), s = scaled(random_point(rng, -1, 1), 1e100);
+    check_orient3d_oracle(p, q, r, s);
+    check_orient3d_oracle(p, q, r, p + 0.5 * (q - p) + 0.25 * (r - p));  // (nearly) coplanar
+    const Point3 t = scaled(random_point(rng, -1, 1), 1e100);
+    check_insphere_oracle(p, q, r, s, t);  // 1e500 would overflow a double evaluation
+  }
+  // Exactly coplanar and cospherical at 2^300 scale.
+  const double big = std::ldexp(1.0, 300);
+  const Point3 a{3 * big, 0, 0}, b{0, 3 * big, 0}, c{0, 0, 3 * big}, d{-2 * big, -big, 2 * big},
+      e{big, -2 * big, -2 * big};
+  CHECK(insphere(a, b, c, d, e) == Sign::Zero);
+  CHECK(insphere(a, b, c, d, {e.x, e.y, std::nextafter(e.z, 0.0)}) == orient3d(a, b, c, d));
+  CHECK(orient3d(a, b, 0.5 * (a + b), e) == Sign::Zero);
+  // Near the top of the double range.
+  const double top = 1e300;
+  CHECK(orient3d({0, 0, 0}, {top, 0, 0}, {0, top, 0}, {0, 0, top}) == Sign::Positive);
+  CHECK(orient3d({-top, -top, -top}, {top, -top, -top}, {-top, top, -top}, {-top, -top, top}) == Sign::Positive);
+}
+
+TEST_CASE("degenerate: tiny coordinates (1e-100 scale)", "[predicates][degenerate]") {
+  std::mt19937_64 rng(14);
+  for (int i = 0; i < 300; ++i) {
+    const Point3 p = scaled(random_point(rng, -1, 1), 1e-100), q = scaled(random_point(rng, -1, 1), 1e-100),
+                 r = scaled(random_point(rng, -1, 1), 1e-100), s = scaled(random_point(rng, -1, 1), 1e-100);
+    check_orient3d_oracle(p, q, r, s);
+    check_orient3d_oracle(p, q, r, p + 0.5 * (q - p) + 0.25 * (r - p));
+    check_insphere_oracle(p, q, r, s, scaled(random_point(rng, -1, 1), 1e-100));
+  }
+  const Point3 a{3e-100, 0, 0}, b{0, 3e-100, 0}, c{0, 0, 3e-100};
+  CHECK(orient3d({0, 0, 0}, a, b, c) == Sign::Positive);
+  CHECK(insphere(a, b, c, {-3e-100, 0, 0}, {0, -1e-100, 0}) != Sign::Zero);
+}
+
+TEST_CASE("degenerate: subnormal coordinates", "[predicates][degenerate]") {
+  const double t = std::numeric_limits<double>::denorm_min();
+  const Point3 o{0, 0, 0}, x{3 * t, 0, 0}, y{0, 5 * t, 0}, z{0, 0, 7 * t};
+  CHECK(orient3d(o, x, y, z) == Sign::Positive);
+  CHECK(orient3d(o, y, x, z) == Sign::Negative);
+  CHECK(insphere(o, x, y, z, {t, t, t}) == Sign::Positive);
+  CHECK(insphere(o, x, y, z, {100 * t, 100 * t, 100 * t}) == Sign::Negative);
+  std::mt19937_64 rng(15);
+  std::uniform_int_distribution<long long> m(-1000000, 1000000);
+  auto sub = [&]() {
+    return Point3{static_cast<double>(m(rng)) * t, static_cast<double>(m(rng)) * t,
+                  static_cast<double>(m(rng)) * t};
+  };
+  for (int i = 0; i < 200; ++i) {
+    const Point3 p = sub(), q = sub(), r = sub(), s = sub(), u = sub();
+    check_orient3d_oracle(p, q, r, s);
+    check_insphere_oracle(p, q, r, s, u);
+  }
+}
+
+TEST_CASE("degenerate: mixed magnitudes within the documented range", "[predicates][degenerate]") {
+  // Coordinates from 1e-40 to 1e40 in one call (about 2^266 apart: inside the insphere range).
+  std::mt19937_64 rng(16);
+  std::uniform_int_distribution<int> ex(-40, 40);
+  std::uniform_real_distribution<double> mant(-1, 1);
+  auto mixed = [&]() {
+    return Point3{mant(rng) * std::pow(10.0, ex(rng)), mant(rng) * std::pow(10.0, ex(rng)),
+                  mant(rng) * std::pow(10.0, ex(rng))};
+  };
+  for (int i = 0; i < 200; ++i) {
+    const Point3 p = mixed(), q = mixed(), r = mixed(), s = mixed(), u = mixed();
+    check_orient3d_oracle(p, q, r, s);
+    check_insphere_oracle(p, q, r, s, u);
+    // A mixed-magnitude point nudged off the plane of three others.
+    check_orient3d_oracle(p, q, r, p + 0.5 * (q - p) + 0.5 * (r - p));
+  }
+}
+
+TEST_CASE("degenerate: repeated points", "[predicates][degenerate]") {
+  const Point3 a{0.1, 0.2, 0.3}, b{1.7, -0.4, 2.2}, c{-3.3, 0.9, 0.01}, d{0.5, 0.5, -1.5};
+  CHECK(orient3d(a, a, c, d) == Sign::Zero);
+  CHECK(orient3d(a, b, c, b) == Sign::Zero);
+  CHECK(orient3d(a, a, a, a) == Sign::Zero);
+  CHECK(insphere(a, b, c, d, a) == Sign::Zero);
+  CHECK(insphere(a, b, c, d, d) == Sign::Zero);
+  CHECK(insphere(a, a, c, d, b) == Sign::Zero);
+  CHECK(orient2d(a, a, b, 0, 1) == Sign::Zero);
+  // insphere_sos with e repeating a vertex violates its precondition but stays non-zero.
+  REQUIRE(orient3d(a, b, c, d) != Sign::Zero);
+  CHECK(insphere_sos(a, b, c, d, a) != Sign::Zero);
+  CHECK(insphere_sos(a, b, c, d, c) != Sign::Zero);
+}
+
+TEST_CASE("degenerate: collinear points", "[predicates][degenerate]") {
+  // Exactly collinear: b = a + (c - a) / 4 with dyadic coordinates.
+  const Point3 a{1.5, -2.25, 0.125}, c{5.5, 1.75, -3.875};
+  const Point3 b = a + 0.25 * (c - a);
+  std::mt19937_64 rng(17);
+  for (int i = 0; i < 100; ++i) CHECK(orient3d(a, b, c, random_point(rng, -10, 10)) == Sign::Zero);
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i != j) CHECK(orient2d(a, b, c, i, j) == Sign::Zero);
+  // One ulp off the line in the projection.
+  const Point3 b2{b.x, std::nextafter(b.y, 10.0), b.z};
+  CHECK(to_int(orient2d(a, b2, c, 0, 1)) == vitri::test::oracle_orient2d(a, b2, c, 0, 1));
+  CHECK(orient2d(a, b2, c, 0, 1) != Sign::Zero);
+  // Generic near-collinear doubles in every projection.
+  for (int n = 0; n < 300; ++n) {
+    const Point3 p = random_point(rng, -1, 1), q = random_point(rng, -1, 1);
+    std::uniform_real_distribution<double> t(-2, 2);
+    const Point3 r = p + t(rng) * (q - p);
+    for (const Point3& s : ulp_neighbours(r, 1))
+      for (int i = 0; i < 3; ++i) {
+        const int j = (i + 1) % 3;
+        REQUIRE(to_int(orient2d(p, q, s, i, j)) == vitri::test::oracle_orient2d(p, q, s, i, j));
+      }
+  }
+}
+
+TEST_CASE("degenerate: coplanar points", "[predicates][degenerate]") {
+  // Five coplanar points: the columns x, y, z, 1 of the lifted 5x5 matrix are dependent, so insphere
+  // is Zero, whatever the plane.
+  const Point3 a{0, 0, 2}, b{4, 0, 2}, c{0, 4, 2}, d{4, 4, 2}, e{1, 3, 2};
+  CHECK(orient3d(a, b, c, d) == Sign::Zero);
+  CHECK(orient3d(a, b, c, e) == Sign::Zero);
+  CHECK(insphere(a, b, c, e, d) == Sign::Zero);
+  // The plane 0.5 x - 0.25 y + z = 1, with dyadic points exactly on it.
+  auto on_plane = [](double x, double y) { return Point3{x, y, 1.0 - 0.5 * x + 0.25 * y}; };
+  CHECK(orient3d(on_plane(0, 0), on_plane(4, 1), on_plane(-2, 3), on_plane(1.5, -6)) == Sign::Zero);
+  CHECK(insphere(on_plane(0, 0), on_plane(4, 1), on_plane(-2, 3), on_plane(1.5, -6), on_plane(7, 7)) == Sign::Zero);
+  // A flat, cocircular (a, b, c, d) (a square) and e off the plane: the lifted points span only 3
+  // dimensions, Zero again.
+  CHECK(insphere(a, b, d, c, {1, 1, 5}) == Sign::Zero);
+  // A flat but not cocircular (a, b, c, e): insphere is the non-zero lifted orientation.
+  const Point3 off{1, 1, 5};
+  CHECK(insphere(a, b, c, e, off) != Sign::Zero);
+  CHECK(to_int(insphere(a, b, c, e, off)) == vitri::test::oracle_insphere(a, b, c, e, off));
+}
+
+TEST_CASE("degenerate: the 8 corners of a cube are cospherical", "[predicates][degenerate]") {
+  std::vector<Point3> corners;
+  for (int k = 0; k < 8; ++k)
+    corners.push_back({(k & 1) ? 1.25 : -0.75, (k & 2) ? 2.5 : 0.5, (k & 4) ? -1.0 : -3.0});
+  int tested = 0;
+  for (int i = 0; i < 8; ++i)
+    for (int j = 0; j < 8; ++j)
+      for (int k = 0; k < 8; ++k)
+        for (int l = 0; l < 8; ++l)
+          for (int m = 0; m < 8; ++m) {
+            const int ids[5] = {i, j, k, l, m};
+            bool distinct = true;
+            for (int s = 0; s < 5; ++s)
+              for (int t = s + 1; t < 5; ++t) distinct = distinct && ids[s] != ids[t];
+            if (!distinct) continue;
+            const Point3 &a = corners[static_cast<std::size_t>(i)], &b = corners[static_cast<std::size_t>(j)],
+                         &c = corners[static_cast<std::size_t>(k)], &d = corners[static_cast<std::size_t>(l)],
+                         &e = corners[static_cast<std::size_t>(m)];
+            REQUIRE(insphere(a, b, c, d, e) == Sign::Zero);
+            if (orient3d(a, b, c, d) == Sign::Zero) continue;
+            const Sign s = insphere_sos(a, b, c, d, e);
+            REQUIRE(s != Sign::Zero);
+            REQUIRE(to_int(s) == vitri::test::oracle_insphere_sos(a, b, c, d, e));
+            if (orient3d(a, b, c, d) == Sign::Positive) REQUIRE(s == cgal_rule(a, b, c, d, e));
+            ++tested;
+          }
+  CHECK(tested > 1000);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// The symbolic perturbation
+
+TEST_CASE("insphere_sos never answers Zero and agrees with insphere on degenerate grids", "[predicates][sos]") {
+  std::mt19937_64 rng(18);
+  int degenerate = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const Point3 a = random_grid_point(rng, 1), b = random_grid_point(rng, 1), c = random_grid_point(rng, 1),
+                 d = random_grid_point(rng, 1), e = random_grid_point(rng, 1);
+    if (orient3d(a, b, c, d) == Sign::Zero) continue;
+    if (e == a || e == b || e == c || e == d) continue;
+    const Sign exact = insphere(a, b, c, d, e);
+    const Sign sos = insphere_sos(a, b, c, d, e);
+    REQUIRE(sos != Sign::Zero);
+    if (exact != Sign::Zero) {
+      REQUIRE(sos == exact);
+    } else {
+      ++degenerate;
+      REQUIRE(to_int(sos) == vitri::test::oracle_insphere_sos(a, b, c, d, e));
+      if (orient3d(a, b, c, d) == Sign::Positive) REQUIRE(sos == cgal_rule(a, b, c, d, e));
+      else REQUIRE(sos == -cgal_rule(b, a, c, d, e));
+    }
+  }
+  CHECK(degenerate > 500);
+}
+
+TEST_CASE("insphere_sos is antisymmetric under permutations of its arguments", "[predicates][sos]") {
+  // Odd permutations flip the sign, even ones keep it, whenever the new first four are not flat.
+  std::mt19937_64 rng(19);
+  int checked = 0;
+  for (int n = 0; n < 400; ++n) {
+    std::array<Point3, 5> p;
+    for (auto& q : p) q = random_grid_point(rng, 1);
+    bool distinct = true;
+    for (int s = 0; s < 5; ++s)
+      for (int t = s + 1; t < 5; ++t) distinct = distinct && p[static_cast<std::size_t>(s)] != p[static_cast<std::size_t>(t)];
+    if (!distinct || orient3d(p[0], p[1], p[2], p[3]) == Sign::Zero) continue;
+    const Sign ref = insphere_sos(p[0], p[1], p[2], p[3], p[4]);
+    std::array<int, 5> perm = {0, 1, 2, 3, 4};
+    do {
+      const auto& q = [&](int k) -> const Point3& { return p[static_cast<std::size_t>(perm[static_cast<std::size_t>(k)])]; };
+      if (orient3d(q(0), q(1), q(2), q(3)) == Sign::Zero) continue;
+      int inversions = 0;
+      for (int s = 0; s < 5; ++s)
+        for (int t = s + 1; t < 5; ++t) inversions += perm[static_cast<std::size_t>(s)] > perm[static_cast<std::size_t>(t)];
+      const Sign expected = inversions % 2 == 0 ? ref : -ref;
+      REQUIRE(insphere_sos(q(0), q(1), q(2), q(3), q(4)) == expected);
+      ++checked;
+    } while (std::next_permutation(perm.begin(), perm.end()));
+  }
+  CHECK(checked > 1000);
+}
+
+TEST_CASE("insphere_sos equals the literal lifted perturbation on cospherical grids", "[predicates][sos]") {
+  // All integer points of the sphere of radius 5 (3-4-5 triples and permutations): many cospherical
+  // 5-tuples with ties in x and y, which exercise the lexicographic order.
+  std::vector<Point3> sphere;
+  for (int x = -5; x <= 5; ++x)
+    for (int y = -5; y <= 5; ++y)
+      for (int z = -5; z <= 5; ++z)
+        if (x * x + y * y + z * z == 25) sphere.push_back({x + 0.5, y - 0.25, static_cast<double>(z)});
+  std::mt19937_64 rng(20);
+  std::uniform_int_distribution<std::size_t> pick(0, sphere.size() - 1);
+  int checked = 0;
+  for (int n = 0; n < 3000; ++n) {
+    const Point3 a = sphere[pick(rng)], b = sphere[pick(rng)], c = sphere[pick(rng)], d = sphere[pick(rng)],
+                 e = sphere[pick(rng)];
+    if (orient3d(a, b, c, d) == Sign::Zero || e == a || e == b || e == c || e == d) continue;
+    REQUIRE(insphere(a, b, c, d, e) == Sign::Zero);
+    REQUIRE(to_int(insphere_sos(a, b, c, d, e)) == vitri::test::oracle_insphere_sos(a, b, c, d, e));
+    ++checked;
+  }
+  CHECK(checked > 500);
+}
+
+TEST_CASE("predicates are invariant under integer translation of integer input", "[predicates]") {
+  std::mt19937_64 rng(21);
+  for (int i = 0; i < 5000; ++i) {
+    const Point3 a = random_grid_point(rng, 2), b = random_grid_point(rng, 2), c = random_grid_point(rng, 2),
+                 d = random_grid_point(rng, 2), e = random_grid_point(rng, 2);
+    const Point3 t = random_grid_point(rng, 1 << 20);
+    REQUIRE(orient3d(a + t, b + t, c + t, d + t) == orient3d(a, b, c, d));
+    REQUIRE(insphere(a + t, b + t, c + t, d + t, e + t) == insphere(a, b, c, d, e));
+    REQUIRE(orient2d(a + t, b + t, c + t, 0, 2) == orient2d(a, b, c, 0, 2));
+    if (orient3d(a, b, c, d) != Sign::Zero && e != a && e != b && e != c && e != d) {
+      // Translation keeps the lexicographic order, hence the perturbation.
+      REQUIRE(insphere_sos(a + t, b + t, c + t, d + t, e + t) == insphere_sos(a, b, c, d, e));
+    }
+  }
+}
+
+TEST_CASE("non-finite input answers Zero without undefined behaviour", "[predicates]") {
+  const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
+  const Point3 o{0, 0, 0}, x{1, 0, 0}, y{0, 1, 0};
+  CHECK(orient3d(o, x, y, {0, 0, inf}) == Sign::Zero);
+  CHECK(orient3d(o, x, y, {nan, 0, 1}) == Sign::Zero);
+  CHECK(insphere(o, x, y, {0, 0, 1}, {nan, 0, 0}) == Sign::Zero);
+  CHECK(orient2d(o, x, {inf, 1, 0}, 0, 1) == Sign::Zero);
+}
+
+TEST_CASE("predicate statistics count calls and exact fallbacks when enabled", "[predicates]") {
+  auto& stats = vitri::predicate_stats();
+  const auto before = stats;
+  const Point3 a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0}, d{1, 1, 0}, e{0, 0, 1};
+  (void)orient3d(a, b, c, e);  // filter
+  (void)orient3d(a, b, c, d);  // coplanar: exact
+  if (vitri::predicate_stats_enabled()) {
+    CHECK(stats.orient3d_calls == before.orient3d_calls + 2);
+    CHECK(stats.orient3d_exact == before.orient3d_exact + 1);
+  } else {
+    CHECK(stats.orient3d_calls == before.orient3d_calls);
+    CHECK(stats.orient3d_exact == before.orient3d_exact);
+  }
+}

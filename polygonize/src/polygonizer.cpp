@@ -270,23 +270,26 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
                                   : 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
     r = tri_.insert(q, min_distance, &changes_);
     if (r.status != InsertStatus::Inserted) {
-      // Fallback 2: the midpoint of the longest edge, strictly inside the circumball, so in conflict.
+      // Fallback 2: the midpoint of the longest edge, pulled 10% towards the centroid: a point of the
+      // interior of t, hence strictly inside the box and strictly inside the circumball (in conflict).
       double best = -1.0;
       Point3 m;
+      const Point3 g = 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
       for (int i = 0; i < 4; ++i)
         for (int j = i + 1; j < 4; ++j) {
           const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
           if (d > best) {
             best = d;
-            m = 0.5 * (tri_.point(v[i]) + tri_.point(v[j]));
+            m = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
           }
         }
+      if (!strictly_inside(box, m)) m = g;  // rounding put it on a face (t is very flat there)
       changes_.clear();
-      r = tri_.insert_in_conflict(m, t, min_distance, &changes_);
+      if (strictly_inside(box, m)) r = tri_.insert_in_conflict(m, t, min_distance, &changes_);
     }
   }
   if (r.status != InsertStatus::Inserted) {
-    ++stats_.rejected;
+    if (kind == VertexKind::Refinement) ++stats_.rejected;
     return false;
   }
   grow_vertex_arrays();

@@ -101,8 +101,11 @@ TEST_CASE("blend of two spheres: one blob when close, two when far", "[polygoniz
     require_closed(poly.extract(), 2, 1);
   }
   SECTION("far") {
+    // Two blobs of radius ~0.42: the sampling radius (fraction x diagonal 6.9) must be below that.
     const BlendFunction f({-1.0, 0.0, 0.0}, 0.5, {1.0, 0.1, 0.0}, 0.5);
-    Polygonizer poly(f, kCube);
+    PolygonizerOptions o;
+    o.sampling_fraction = 0.05;
+    Polygonizer poly(f, kCube, {}, {}, o);
     REQUIRE(poly.refine(0.08));
     require_closed(poly.extract(), 4, 2);
   }
@@ -247,7 +250,7 @@ TEST_CASE("dynamic function: re-evaluation, local reclassification, garbage coll
   Polygonizer poly(f, kCube);
   REQUIRE(poly.refine(precision));
   const std::size_t fresh0 = poly.stats().vertices;
-  for (int step = 0; step < 12; ++step) {
+  for (int step = 0; step < 8; ++step) {
     f.c = {0.3 * std::sin(step), 0.2 * std::cos(1.3 * step), 0.1 * step / 12.0};
     f.r = 0.8 + 0.2 * ((step * 7) % 5) / 4.0;
     poly.function_changed();

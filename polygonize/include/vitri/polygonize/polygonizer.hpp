@@ -93,7 +93,7 @@ struct PolygonizerStats {
   std::size_t gradient_evaluations = 0; ///< of which for normals
   std::size_t insertions = 0;           ///< Delaunay insertions by refinement and sampling
   std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box replaced by a fallback point
-  std::size_t rejected = 0;             ///< refinement points rejected by proximity (tetrahedron dropped)
+  std::size_t rejected = 0;             ///< refine(): points rejected by proximity (tetrahedron dropped)
   std::size_t removed_steiner = 0;      ///< refinement vertices removed by collect_garbage()
   std::size_t zero_snapped = 0;         ///< last extract(): zero vertices used as mesh vertices
   std::size_t zero_offset = 0;          ///< last extract(): zero vertices whose crossings stayed offset

@@ -10,8 +10,11 @@
 namespace vitri::cli {
 
 // Each subcommand lives in its own cmd_*.cpp; declare it here and add it to the table below.
+int run_render(const Args& args);  // cmd_render.cpp
+const char* render_usage();
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
+      {"render", "draw meshes to a PNG picture (software renderer)", render_usage(), run_render},
   };
   return table;
 }

@@ -3,7 +3,7 @@
 # Usage: bash tools/test.sh   (build tree: build-test/)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/deps.sh cmake make g++ libeigen3-dev catch2
+bash tools/deps.sh cmake make g++ libeigen3-dev catch2 libstb-dev
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVITRI_SANITIZE=address,undefined \
       -DVITRI_BUILD_BENCH=OFF -DVITRI_WERROR=ON

@@ -12,9 +12,13 @@ namespace vitri::cli {
 // Each subcommand lives in its own cmd_*.cpp; declare it here and add it to the table below.
 int run_render(const Args& args);  // cmd_render.cpp
 const char* render_usage();
+int run_tetrahedralize(const Args& args);  // cmd_tetrahedralize.cpp
+const char* tetrahedralize_usage();
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"render", "draw meshes to a PNG picture (software renderer)", render_usage(), run_render},
+      {"tetrahedralize", "exact Delaunay tetrahedralization of a point file in a box", tetrahedralize_usage(),
+       run_tetrahedralize},
   };
   return table;
 }

@@ -1,0 +1,61 @@
+#pragma once
+/// @file constraints.hpp
+/// Building interpolation constraints from data, as in Turk et al. 2001 ("Modelling with implicit
+/// surfaces that interpolate"): every surface point p with outward unit normal n gives f(p) = 0, plus
+/// off-surface constraints f(p + d n) = +d (outside) and/or f(p - d n) = -d (inside), d being a small
+/// fraction of the bounding-box diagonal. See docs/rbf.md.
+
+#include "vitri/core/point.hpp"
+#include "vitri/rbf/rbf.hpp"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <vector>
+
+namespace vitri {
+
+/// Which off-surface constraints each surface point gets.
+enum class OffSurface {
+  Both,     ///< p + d n (value +d) and p - d n (value -d): 3 constraints per point (default).
+  Outside,  ///< p + d n only: 2 per point.
+  Inside,   ///< p - d n only: 2 per point.
+};
+
+/// Options of the constraint builders.
+struct ConstraintBuildOptions {
+  /// Off-surface distance d as a fraction of the diagonal of the bounding box of the surface points.
+  /// 0.01 by default. Where p +- d n would lie closer than d to another surface point (thin parts),
+  /// d is halved for that point, up to 4 times, and the constraint is dropped if it is still too close.
+  double offset = 0.01;
+  /// Off-surface constraints per point; see OffSurface.
+  OffSurface sides = OffSurface::Both;
+  /// At most this many constraints in total (0: no limit). Surface points are subsampled uniformly at
+  /// random (without replacement, input order kept) to floor(max_constraints / per-point count).
+  std::size_t max_constraints = 0;
+  /// Seed of the subsampling (deterministic on every platform: splitmix64, no std distributions).
+  std::uint64_t seed = 1;
+};
+
+/// Constraints from oriented points. Normals need not be unit length (they are normalized) and must
+/// point outwards (f > 0 outside). Exact duplicate positions are merged (the first one is kept).
+/// @throws InvalidPoint (index of the point) for non-finite data or a zero normal; InvalidArgument for
+///         mismatched sizes, an empty input or a missing normal array (points alone do not define an
+///         inside and an outside).
+Constraints constraints_from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                                             const ConstraintBuildOptions& options = {});
+
+/// Area-weighted vertex normals of a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3),
+/// oriented outwards: when the signed volume is negative (triangles wound inwards) every normal is
+/// flipped. Unreferenced vertices get a zero normal.
+/// @throws InvalidArgument naming an offending edge (a, b) when the mesh has a boundary edge (one
+///         triangle), a non-manifold edge (three or more) or inconsistently oriented neighbours, and
+///         naming the triangle for an out-of-range or repeated vertex index.
+Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+/// Constraints from a closed triangle mesh: its referenced vertices with closed_mesh_vertex_normals(),
+/// then constraints_from_oriented_points(). Same errors as both.
+Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                  const ConstraintBuildOptions& options = {});
+
+}  // namespace vitri

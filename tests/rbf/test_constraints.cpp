@@ -1,0 +1,170 @@
+// Constraint builders and fits on the bundled models: f ~ 0 at the input points, f < 0 inside (volume
+// centroid, inward offsets), f > 0 outside (far away, outward offsets); meshes with a boundary refused.
+#include "vitri/core/box.hpp"
+#include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
+#include "vitri/rbf/constraints.hpp"
+#include "vitri/rbf/rbf.hpp"
+
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace vitri;
+
+namespace {
+
+const std::string kData = VITRI_DATA_DIR;
+
+// Volume centroid of a closed outward mesh.
+Point3 volume_centroid(const TriangleMesh& m) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  double v = 0;
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    const Eigen::Vector3d a = m.V.row(m.F(f, 0)), b = m.V.row(m.F(f, 1)), d = m.V.row(m.F(f, 2));
+    const double t = a.dot(b.cross(d));
+    v += t;
+    c += t * (a + b + d) / 4.0;
+  }
+  return Point3::from(c / v);
+}
+
+struct Check {
+  std::size_t inside_ok = 0, outside_ok = 0, total = 0;
+  std::size_t near_ok = 0;
+};
+
+// For every vertex: |f| small at the vertex, f < 0 at p - d/2 n, f > 0 at p + d/2 n.
+Check check_vertices(const Rbf& f, const Eigen::MatrixXd& V, const Eigen::MatrixXd& N, double d) {
+  Check c;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    const Point3 p{V(i, 0), V(i, 1), V(i, 2)};
+    Point3 n{N(i, 0), N(i, 1), N(i, 2)};
+    n = n / norm(n);
+    c.near_ok += std::abs(f.value(p)) <= d;
+    c.inside_ok += f.value(p - 0.5 * d * n) < 0;
+    c.outside_ok += f.value(p + 0.5 * d * n) > 0;
+    ++c.total;
+  }
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("constraints from oriented points: values, offsets, subsampling", "[rbf][constraints]") {
+  std::vector<Point3> p{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
+  std::vector<Point3> n{{-1, -1, -1}, {2, 0, 0}, {0, 1, 0}, {0, 0, 1}, {1, 0, 0}};
+  ConstraintBuildOptions opt;
+  opt.offset = 0.1;
+  const Constraints c = constraints_from_oriented_points(p, n, opt);
+  const double d = 0.1 * std::sqrt(3.0);
+  REQUIRE(c.size() == 12);  // the duplicate (1,0,0) is merged: 4 points x 3
+  CHECK(c.values[0] == 0.0);
+  CHECK(c.points[4] == Point3{0, 0, 0} + d * (Point3{-1, -1, -1} / std::sqrt(3.0)));
+  CHECK(c.values[4] == Approx(d));
+  CHECK(c.values[5] == Approx(-d));
+  CHECK(c.points[6].x == Approx(1 + d));
+
+  opt.max_constraints = 6;
+  opt.sides = OffSurface::Outside;
+  const Constraints s1 = constraints_from_oriented_points(p, n, opt);
+  const Constraints s2 = constraints_from_oriented_points(p, n, opt);
+  CHECK(s1.size() == 6);
+  CHECK(s1.points == s2.points);
+  for (std::size_t i = 0; i < 3; ++i) CHECK(s1.values[i] == 0.0);
+  for (std::size_t i = 3; i < 6; ++i) CHECK(s1.values[i] > 0.0);
+
+  CHECK_THROWS_AS(constraints_from_oriented_points(p, {}, opt), InvalidArgument);
+  n[2] = {0, 0, 0};
+  try {
+    constraints_from_oriented_points(p, n, opt);
+    FAIL("no exception");
+  } catch (const InvalidPoint& e) {
+    CHECK(e.index() == 2);
+  }
+}
+
+TEST_CASE("constraints: a thin slab shrinks the offset instead of crossing to the other side", "[rbf][constraints]") {
+  // Two parallel 5x5 grids 0.02 apart, normals pointing away from each other; d = 1% of ~1.4 > 0.01.
+  std::vector<Point3> p, n;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      p.push_back({i * 0.25, j * 0.25, 0.0}), n.push_back({0, 0, -1});
+      p.push_back({i * 0.25, j * 0.25, 0.02}), n.push_back({0, 0, 1});
+    }
+  const Constraints c = constraints_from_oriented_points(p, n, {});
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (c.values[i] >= 0) continue;  // inside constraints lie between the sheets
+    CHECK(c.points[i].z > 0.0);
+    CHECK(c.points[i].z < 0.02);
+  }
+}
+
+TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary and non-manifold refused",
+          "[rbf][constraints]") {
+  Eigen::MatrixXd V(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  Eigen::MatrixXi F(4, 3);
+  F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  const Eigen::MatrixXd N = closed_mesh_vertex_normals(V, F);
+  CHECK(N(3, 2) > 0);
+  CHECK(N(0, 0) < 0);
+  const Eigen::MatrixXi G = F.rowwise().reverse();
+  const Eigen::MatrixXd M = closed_mesh_vertex_normals(V, G);
+  CHECK(M.isApprox(N));
+  CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, F.topRows(3)), Catch::Contains("boundary") && Catch::Contains("edge (1, 2)"));
+  Eigen::MatrixXi H = F;
+  H.row(0) << 0, 1, 2;
+  CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, H), Catch::Contains("same direction"));
+  const TriangleMesh pig = read_mesh(kData + "/pig.off");
+  CHECK_THROWS_WITH(constraints_from_mesh(pig.V, pig.F), Catch::Contains("boundary") && Catch::Contains("edge ("));
+}
+
+TEST_CASE("rbf on real models: ~0 on the surface, < 0 inside, > 0 outside", "[rbf][data]") {
+  const std::string name = GENERATE(std::string("hand.off"), std::string("bunny.off"), std::string("cactus.off"));
+  INFO(name);
+  const TriangleMesh m = read_mesh(kData + "/" + name);
+  ConstraintBuildOptions opt;
+  opt.max_constraints = 750;  // 250 surface points: keeps the Debug / sanitizer run short
+  const Constraints c = constraints_from_mesh(m.V, m.F, opt);
+  CHECK(c.size() <= 750);
+  Rbf f(c);
+  CHECK(f.report().relative_residual <= 1e-8);
+  Box3 box;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) box.extend({m.V(i, 0), m.V(i, 1), m.V(i, 2)});
+  const double diag = box.diagonal(), d = opt.offset * diag;
+  // Interpolation at the constraint points (values are 0 and +-d).
+  for (std::size_t i = 0; i < c.size(); ++i) CHECK(std::abs(f.value(c.points[i]) - c.values[i]) <= 1e-8 * d);
+  // Every vertex of the model (most are not constraints): f stays within the offset scale of 0 for
+  // the vast majority, and has the right sign half an offset inside and outside.
+  const Eigen::MatrixXd N = closed_mesh_vertex_normals(m.V, m.F);
+  const Check k = check_vertices(f, m.V, N, d);
+  CHECK(k.near_ok >= k.total * 90 / 100);
+  CHECK(k.inside_ok >= k.total * 80 / 100);
+  CHECK(k.outside_ok >= k.total * 80 / 100);
+  // Far away: positive. Volume centroid of the models with a bulky body: negative.
+  for (int corner = 0; corner < 8; ++corner) CHECK(f.value(box.scaled(3.0).corner(corner)) > 0);
+  if (name != "hand.off") CHECK(f.value(volume_centroid(m)) < 0);
+}
+
+TEST_CASE("rbf on sphere926.pwn: a sphere, negative at its center", "[rbf][data]") {
+  const Input in = read_input(kData + "/sphere926.pwn");
+  ConstraintBuildOptions opt;
+  opt.max_constraints = 600;
+  const Constraints c = constraints_from_oriented_points(in.points.points, in.points.normals, opt);
+  Rbf f(c);
+  Point3 center{0, 0, 0};
+  for (const auto& p : in.points.points) center = center + p;
+  center = center / static_cast<double>(in.points.points.size());
+  CHECK(f.value(center) < 0);
+  double rmean = 0;
+  for (const auto& p : in.points.points) rmean += distance(p, center);
+  rmean /= static_cast<double>(in.points.points.size());
+  for (const auto& p : in.points.points) CHECK(std::abs(f.value(p)) <= 1e-2 * rmean);  // most points are not constraints
+  CHECK(f.value(center + Point3{3 * rmean, 0, 0}) > 0);
+  Point3 g;
+  f.value_gradient(in.points.points[0], g);
+  CHECK(dot(g, in.points.normals[0]) > 0);  // gradient points outwards
+}

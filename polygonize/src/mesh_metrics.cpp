@@ -78,7 +78,12 @@ void triangle_angles(const Point3& a, const Point3& b, const Point3& c, bool fla
 
 struct UnionFind {
   std::vector<std::int64_t> parent;
-  explicit UnionFind(std::size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0); }
+  explicit UnionFind(std::size_t n) { reset(n); }
+  /// n singletons, reusing the storage.
+  void reset(std::size_t n) {
+    parent.resize(n);
+    std::iota(parent.begin(), parent.end(), 0);
+  }
   std::int64_t find(std::int64_t x) {
     while (parent[x] != x) {
       parent[x] = parent[parent[x]];
@@ -226,6 +231,7 @@ MeshMetrics compute_mesh_metrics(const Eigen::MatrixXd& V, const Eigen::MatrixXi
         for (Eigen::Index k = 0; k < 3; ++k) incident[fill[static_cast<std::size_t>(F(t, k))]++] = t;
   }
   std::vector<std::pair<int, std::int64_t>> link;  // (other vertex, local triangle index)
+  UnionFind fans(0);
   for (std::size_t v = 0; v < m.vertices; ++v) {
     const std::size_t k = start[v + 1] - start[v];
     if (k <= 1) continue;
@@ -236,7 +242,7 @@ MeshMetrics compute_mesh_metrics(const Eigen::MatrixXd& V, const Eigen::MatrixXi
         if (static_cast<std::size_t>(F(t, c)) != v) link.emplace_back(F(t, c), static_cast<std::int64_t>(i));
     }
     std::sort(link.begin(), link.end());
-    UnionFind fans(k);
+    fans.reset(k);
     for (std::size_t i = 1; i < link.size(); ++i)
       if (link[i].first == link[i - 1].first) fans.unite(link[i].second, link[i - 1].second);
     std::size_t groups = 0;

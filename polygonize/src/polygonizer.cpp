@@ -1,9 +1,9 @@
 // Refinement of transverse tetrahedra (Crespin 2003, sections 3.2-3.4 and 5).
 //
 // A brief explanation. The Delaunay tetrahedralization starts from the 8 corners of the domain box and
-// the seed points. An initial *sampling* pass refines every tetrahedron (transverse or not) down to a
-// coarse circumradius, so that every component of the surface that is not tiny shows up as a sign
-// change between two vertices, whether or not a seed lies on it. From then on only *transverse*
+// the seed points. An initial *sampling* lattice (cell centers, covering radius r_s) is inserted too, so
+// that every component of {f < 0} or {f > 0} containing a ball of radius r_s holds a vertex of its sign
+// and shows up as a sign change, whether or not a seed lies on it. From then on only *transverse*
 // tetrahedra (vertex signs differ; sign(0) = +) are refined: while the queue holds a transverse
 // tetrahedron whose circumradius exceeds the precision, its circumcenter is inserted with
 // insert_in_conflict() (the tetrahedron itself is in conflict, so no point location is needed).
@@ -25,6 +25,7 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -305,23 +306,35 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
 }
 
 void Polygonizer::sample(double radius) {
-  // Values are not needed here: every tetrahedron larger than `radius` is split, whatever its signs.
-  std::deque<TetId> queue;
-  tri_.for_each_tetrahedron([&](TetId t) {
-    if (tri_.circumradius(t) > radius) queue.push_back(t);
-  });
-  std::vector<TetId> created;
-  const double dmin = options_.min_distance_fraction * radius;
-  while (!queue.empty()) {
-    const TetId t = queue.front();
-    queue.pop_front();
-    if (!tri_.is_live(t) || tri_.circumradius(t) <= radius) continue;
-    const bool inserted = insert_refinement_point(t, dmin, VertexKind::Sampling, created);
-    if (!inserted) continue;
-    for (const TetId c : created)
-      if (tri_.is_live(c) && tri_.circumradius(c) > radius) queue.push_back(c);
-    if (tri_.is_live(t)) queue.push_back(t);  // a fallback point did not kill it: try again
-    created.clear();
+  // A cubic lattice of cell centers with spacing h = 2 radius / sqrt(3): every point of the box lies in
+  // a cell, within half a cell diagonal (= radius) of its center. Values are evaluated later in batch.
+  const Box3& box = tri_.box();
+  const double h = 2.0 * radius / std::sqrt(3.0);
+  std::array<std::size_t, 3> n;
+  std::size_t total = 1;
+  for (std::size_t k = 0; k < 3; ++k) {
+    n[k] = static_cast<std::size_t>(std::ceil(box.extent()[k] / h));
+    total *= n[k];
+  }
+  if (total > (std::size_t{1} << 24))
+    throw LimitError("initial sampling would insert " + std::to_string(total) +
+                     " points; raise PolygonizerOptions::sampling_fraction");
+  std::vector<Point3> lattice;
+  lattice.reserve(total);
+  const Point3 ext = box.extent();
+  for (std::size_t i = 0; i < n[0]; ++i)
+    for (std::size_t j = 0; j < n[1]; ++j)
+      for (std::size_t k = 0; k < n[2]; ++k)
+        lattice.push_back({box.lo.x + ext.x * (static_cast<double>(i) + 0.5) / static_cast<double>(n[0]),
+                           box.lo.y + ext.y * (static_cast<double>(j) + 0.5) / static_cast<double>(n[1]),
+                           box.lo.z + ext.z * (static_cast<double>(k) + 0.5) / static_cast<double>(n[2])});
+  const std::vector<InsertResult> res = tri_.insert_points(lattice, 0.0, nullptr);
+  grow_vertex_arrays();
+  for (const InsertResult& r : res) {
+    if (r.status != InsertStatus::Inserted) continue;  // coincides with a seed
+    kind_[r.vertex] = static_cast<std::uint8_t>(VertexKind::Sampling);
+    pending_.push_back(r.vertex);
+    ++stats_.insertions;
   }
 }
 

@@ -70,8 +70,9 @@ struct RbfOptions {
   /// 1 = the calling thread only. Small batches always run on the calling thread.
   unsigned threads = 0;
   /// Number of edits between two automatic drift checks (a residual computation, O(N^2) kernel
-  /// evaluations, about the cost of one edit). When the relative residual exceeds `warn_residual`, the
-  /// function is refitted from scratch. 0 disables the automatic check (check_drift() still works).
+  /// evaluations, about the cost of one edit). When the relative residual exceeds both `warn_residual`
+  /// and 10x the residual of the last full fit (after iterative refinement), the function is refitted
+  /// from scratch. 0 disables the automatic check (check_drift() still works).
   std::size_t drift_check_interval = 64;
 };
 
@@ -79,6 +80,7 @@ struct RbfOptions {
 struct FitReport {
   std::size_t constraints = 0;  ///< N.
   /// max_i |f(c_i) - h_i| / max_i |h_i|, evaluated with the final weights (the same code path as value()).
+  /// NaN after an edit until the next drift check (edits do not measure it; see check_drift()).
   double relative_residual = 0.0;
   /// |sum w| + |sum w c| relative to sum |w| |c|-scale: how well the side conditions hold (scaled coords).
   double side_condition_residual = 0.0;

@@ -34,6 +34,8 @@ const char* const kUsage =
     "  --ortho               orthographic instead of perspective projection\n"
     "  --columns N           views per row with several meshes (default min(count, 4))\n"
     "  --same-frame          frame every view with the union of all bounding boxes (same scale)\n"
+    "  --tight               zoom each view to fill the picture (default: the bounding sphere fills it,\n"
+    "                        so that the scale does not depend on the view direction)\n"
     "  --labels              caption every view with its file name\n"
     "  --supersample N       anti-aliasing samples per pixel and axis, 1..4 (default 2)\n";
 
@@ -232,6 +234,8 @@ int run_render(const Args& args) {
       columns = integer(value(i, a), "--columns");
     } else if (a == "--same-frame") {
       same_frame = true;
+    } else if (a == "--tight") {
+      options.framing = viz::Framing::tight;
     } else if (a == "--labels") {
       labels = true;
     } else if (a == "--supersample") {

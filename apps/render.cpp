@@ -117,6 +117,32 @@ struct Camera {
     }
   }
 
+  /// Zooms and shifts the image plane (focal length and principal point: the perspective is unchanged)
+  /// so that the projections of `points` fill the W x H image minus `margin` of each side.
+  void fit(const std::vector<Point3>& points, double margin, int W, int H) {
+    double lo[2] = {std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+    double hi[2] = {-lo[0], -lo[1]};
+    for (const Point3& p : points) {
+      double z = 0.0;
+      const Screen s = project(p, z);
+      if (perspective && z <= near) continue;
+      // Image-plane coordinates before scaling: a = (sx - cx) / scale, b = (cy - sy) / scale.
+      const double a = (s.x - cx) / scale, b = (cy - s.y) / scale;
+      lo[0] = std::min(lo[0], a);
+      hi[0] = std::max(hi[0], a);
+      lo[1] = std::min(lo[1], b);
+      hi[1] = std::max(hi[1], b);
+    }
+    if (!(lo[0] <= hi[0])) return;  // nothing in front of the camera
+    const double wx = hi[0] - lo[0], wy = hi[1] - lo[1];
+    double k = std::numeric_limits<double>::infinity();
+    if (wx > 0.0) k = std::min(k, W * (1.0 - margin) / wx);
+    if (wy > 0.0) k = std::min(k, H * (1.0 - margin) / wy);
+    if (std::isfinite(k)) scale = k;
+    cx = 0.5 * W - scale * 0.5 * (lo[0] + hi[0]);
+    cy = 0.5 * H + scale * 0.5 * (lo[1] + hi[1]);
+  }
+
   /// Screen position and depth of p.
   Screen project(const Point3& p, double& depth) const {
     const Point3 q = p - eye;
@@ -194,7 +220,16 @@ Image render_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Rend
 
   const int ss = o.supersample;
   const int W = o.width * ss, H = o.height * ss;
-  const Camera cam(o.frame ? *o.frame : mesh_bounds(V), o, W, H);
+  Camera cam(o.frame ? *o.frame : mesh_bounds(V), o, W, H);
+  if (o.framing == Framing::tight) {
+    std::vector<Point3> points;
+    if (o.frame) {
+      for (int k = 0; k < 8; ++k) points.push_back(o.frame->corner(k));
+    } else {
+      for (Eigen::Index i = 0; i < V.rows(); ++i) points.push_back(row(V, i));
+    }
+    cam.fit(points, o.margin, W, H);
+  }
 
   // Per-vertex screen positions and depths.
   std::vector<Screen> screen(static_cast<std::size_t>(V.rows()));

@@ -73,6 +73,16 @@ enum class Shading {
 /// Which world axis points up on the screen.
 enum class UpAxis { y, z };
 
+/// How the camera frames the scene.
+enum class Framing {
+  /// The bounding sphere of the frame box fills the smaller image side: the scale does not depend on the
+  /// view direction, so every view of a mesh (and every mesh given the same frame) has the same scale.
+  sphere,
+  /// Zoom and shift so that the projected points (the mesh's vertices, or the 8 corners of `frame` when
+  /// it is set) fill the image minus the margin on each side: the largest picture, view-dependent.
+  tight,
+};
+
 /// Camera, shading and output options of render_mesh(). Angles are in degrees.
 struct RenderOptions {
   int width = 800;   ///< Image width in pixels (>= 1).
@@ -90,6 +100,7 @@ struct RenderOptions {
   /// several meshes to render them at the same scale.
   double margin = 0.05;
   std::optional<Box3> frame;                  ///< Box to frame instead of the mesh's bounds.
+  Framing framing = Framing::sphere;          ///< Fixed scale (sphere) or largest picture (tight).
   Shading shading = Shading::flat;            ///< Flat (facets) or smooth.
   bool wireframe = false;                     ///< Draw the visible edges over the shading.
   double wire_width = 1.0;                    ///< Wireframe line width in output pixels (> 0).

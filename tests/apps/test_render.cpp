@@ -133,6 +133,34 @@ TEST_CASE("render: a sphere is a lit disc of the predicted radius", "[render]") 
   }
 }
 
+TEST_CASE("render: tight framing fills the image", "[render]") {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  icosphere(4, 1.0, {2.0, 1.0, -3.0}, V, F);  // has vertices at c +- x and c +- y: extents are exactly 2
+  RenderOptions o;
+  o.width = 240;
+  o.height = 200;
+  o.supersample = 1;
+  o.margin = 0.1;
+  o.azimuth = 0.0;
+  o.elevation = 0.0;
+  o.projection = vitri::viz::Projection::orthographic;
+  o.framing = vitri::viz::Framing::tight;
+  const Image img = vitri::viz::render_mesh(V, F, o);
+  const double expected = 0.5 * 200 * 0.9;  // the vertical extent fills 90% of the height
+  int wrong = 0;
+  for (int y = 0; y < img.height(); ++y)
+    for (int x = 0; x < img.width(); ++x) {
+      const double d = std::hypot(x + 0.5 - 120.0, y + 0.5 - 100.0);
+      const bool on = img.at(x, y) != o.background;
+      if ((d < expected - 1.5 && !on) || (d > expected + 1.5 && on)) ++wrong;
+    }
+  CHECK(wrong == 0);
+  // Sphere framing of the same mesh is smaller (its bounding sphere has radius sqrt(3)).
+  o.framing = vitri::viz::Framing::sphere;
+  CHECK(covered(vitri::viz::render_mesh(V, F, o), o.background) < covered(img, o.background) / 2);
+}
+
 TEST_CASE("render: orientation shows in the colour", "[render]") {
   Eigen::MatrixXd V;
   Eigen::MatrixXi F;

@@ -3,14 +3,12 @@
 #include "render.hpp"
 
 #include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <iostream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -20,7 +18,7 @@ namespace {
 const char* const kUsage =
     "usage: vitri render MESH [MESH...] -o PICTURE.png [options]\n"
     "\n"
-    "Draws one or several triangle meshes (.off or .obj) into a PNG picture: shaded triangles, optional\n"
+    "Draws one or several triangle meshes (.off, .obj or .ply) into a PNG picture: shaded triangles, optional\n"
     "wireframe, camera framing each mesh automatically. Several meshes are laid out as a grid of views.\n"
     "Back faces (holes, flipped triangles, the inside) are drawn in red-brown.\n"
     "\n"
@@ -38,143 +36,6 @@ const char* const kUsage =
     "                        so that the scale does not depend on the view direction)\n"
     "  --labels              caption every view with its file name\n"
     "  --supersample N       anti-aliasing samples per pixel and axis, 1..4 (default 2)\n";
-
-std::string lower_extension(const std::string& path) {
-  const auto dot = path.find_last_of('.');
-  if (dot == std::string::npos) return "";
-  std::string ext = path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
-double parse_double(const std::string& token, const std::string& file, std::size_t line) {
-  char* end = nullptr;
-  const double v = std::strtod(token.c_str(), &end);
-  if (end == token.c_str() || *end != '\0' || !std::isfinite(v))
-    throw ParseError(file, line, "expected a finite number, got '" + token + "'");
-  return v;
-}
-
-long parse_long(const std::string& token, const std::string& file, std::size_t line) {
-  char* end = nullptr;
-  const long v = std::strtol(token.c_str(), &end, 10);
-  if (end == token.c_str() || (*end != '\0' && *end != '/')) throw ParseError(file, line, "expected an integer, got '" + token + "'");
-  return v;
-}
-
-/// A mesh as read from a file: polygons are fan-triangulated.
-struct LoadedMesh {
-  std::vector<double> xyz;
-  std::vector<int> tri;
-};
-
-void add_polygon(LoadedMesh& m, const std::vector<long>& poly, const std::string& file, std::size_t line) {
-  const long nv = static_cast<long>(m.xyz.size() / 3);
-  if (poly.size() < 3) throw ParseError(file, line, "a face needs at least 3 vertices");
-  for (const long i : poly)
-    if (i < 0 || i >= nv)
-      throw ParseError(file, line, "vertex index " + std::to_string(i) + " out of range [0, " + std::to_string(nv) + ")");
-  for (std::size_t k = 1; k + 1 < poly.size(); ++k)
-    m.tri.insert(m.tri.end(), {static_cast<int>(poly[0]), static_cast<int>(poly[k]), static_cast<int>(poly[k + 1])});
-}
-
-// Local OFF reader (the io module's readers replace it when they land). Accepts OFF, COFF, NOFF, CNOFF:
-// only the first three numbers of a vertex line are used; '#' starts a comment.
-LoadedMesh read_off(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw ParseError(file, 0, "cannot open file");
-  LoadedMesh m;
-  std::string text;
-  std::size_t line = 0;
-  auto next_tokens = [&](std::vector<std::string>& tokens) {
-    while (std::getline(in, text)) {
-      ++line;
-      const auto hash = text.find('#');
-      if (hash != std::string::npos) text.resize(hash);
-      std::istringstream ss(text);
-      tokens.clear();
-      for (std::string t; ss >> t;) tokens.push_back(t);
-      if (!tokens.empty()) return true;
-    }
-    return false;
-  };
-  std::vector<std::string> tok;
-  if (!next_tokens(tok)) throw ParseError(file, line, "empty file");
-  const std::string& head = tok[0];
-  if (head.size() < 3 || head.compare(head.size() - 3, 3, "OFF") != 0) throw ParseError(file, line, "expected an OFF header, got '" + head + "'");
-  tok.erase(tok.begin());
-  if (tok.empty() && !next_tokens(tok)) throw ParseError(file, line, "missing vertex and face counts");
-  if (tok.size() < 2) throw ParseError(file, line, "expected vertex and face counts");
-  const long nv = parse_long(tok[0], file, line), nf = parse_long(tok[1], file, line);
-  if (nv < 0 || nf < 0 || nv > 100000000 || nf > 100000000) throw ParseError(file, line, "invalid vertex or face count");
-  for (long i = 0; i < nv; ++i) {
-    if (!next_tokens(tok)) throw ParseError(file, line, "expected " + std::to_string(nv) + " vertices, file ends after " + std::to_string(i));
-    if (tok.size() < 3) throw ParseError(file, line, "a vertex needs 3 coordinates");
-    for (int c = 0; c < 3; ++c) m.xyz.push_back(parse_double(tok[static_cast<std::size_t>(c)], file, line));
-  }
-  std::vector<long> poly;
-  for (long f = 0; f < nf; ++f) {
-    if (!next_tokens(tok)) throw ParseError(file, line, "expected " + std::to_string(nf) + " faces, file ends after " + std::to_string(f));
-    const long n = parse_long(tok[0], file, line);
-    if (n < 3 || static_cast<std::size_t>(n) + 1 > tok.size()) throw ParseError(file, line, "malformed face");
-    poly.clear();
-    for (long k = 1; k <= n; ++k) poly.push_back(parse_long(tok[static_cast<std::size_t>(k)], file, line));
-    add_polygon(m, poly, file, line);
-  }
-  return m;
-}
-
-// Local OBJ reader: `v x y z` and `f a b c ...` (a may be a, a/t, a//n or a/t/n; negative = relative).
-LoadedMesh read_obj(const std::string& file) {
-  std::ifstream in(file);
-  if (!in) throw ParseError(file, 0, "cannot open file");
-  LoadedMesh m;
-  std::string text;
-  std::size_t line = 0;
-  std::vector<long> poly;
-  while (std::getline(in, text)) {
-    ++line;
-    const auto hash = text.find('#');
-    if (hash != std::string::npos) text.resize(hash);
-    std::istringstream ss(text);
-    std::string kind;
-    if (!(ss >> kind)) continue;
-    if (kind == "v") {
-      std::string t;
-      for (int c = 0; c < 3; ++c) {
-        if (!(ss >> t)) throw ParseError(file, line, "a vertex needs 3 coordinates");
-        m.xyz.push_back(parse_double(t, file, line));
-      }
-    } else if (kind == "f") {
-      poly.clear();
-      const long nv = static_cast<long>(m.xyz.size() / 3);
-      for (std::string t; ss >> t;) {
-        const long i = parse_long(t, file, line);
-        if (i == 0) throw ParseError(file, line, "OBJ indices start at 1");
-        poly.push_back(i > 0 ? i - 1 : nv + i);
-      }
-      add_polygon(m, poly, file, line);
-    }
-  }
-  return m;
-}
-
-void load_mesh(const std::string& file, Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
-  const std::string ext = lower_extension(file);
-  LoadedMesh m;
-  if (ext == "off")
-    m = read_off(file);
-  else if (ext == "obj")
-    m = read_obj(file);
-  else
-    throw InvalidArgument("render: unsupported mesh format '" + file + "' (expected .off or .obj)");
-  V.resize(static_cast<Eigen::Index>(m.xyz.size() / 3), 3);
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    for (Eigen::Index c = 0; c < 3; ++c) V(i, c) = m.xyz[static_cast<std::size_t>(3 * i + c)];
-  F.resize(static_cast<Eigen::Index>(m.tri.size() / 3), 3);
-  for (Eigen::Index t = 0; t < F.rows(); ++t)
-    for (Eigen::Index c = 0; c < 3; ++c) F(t, c) = m.tri[static_cast<std::size_t>(3 * t + c)];
-}
 
 std::string base_name(const std::string& path) {
   const auto slash = path.find_last_of("/\\");
@@ -253,7 +114,9 @@ int run_render(const Args& args) {
   std::vector<Eigen::MatrixXi> Fs(inputs.size());
   Box3 all;
   for (std::size_t m = 0; m < inputs.size(); ++m) {
-    load_mesh(inputs[m], Vs[m], Fs[m]);
+    TriangleMesh mesh = read_mesh(inputs[m]);
+    Vs[m] = std::move(mesh.V);
+    Fs[m] = std::move(mesh.F);
     const Box3 b = viz::mesh_bounds(Vs[m]);
     if (!b.empty()) {
       all.extend(b.lo);

@@ -114,7 +114,7 @@ TEST_CASE("vitri render: errors", "[render][cli]") {
   CHECK(err.find("render_bad.off:6") != std::string::npos);  // file and line of the bad face
   CHECK(err.find("out of range") != std::string::npos);
 
-  write(bad, "OFF\n3 1 0\n0 0 0\n1 nan 0\n");
+  write(bad, "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
   CHECK(run(bad + " -o " + kDir + "/x.png", err) == 1);
   CHECK(err.find("render_bad.off:4") != std::string::npos);
 

@@ -16,10 +16,14 @@ int run_tetrahedralize(const Args& args);  // cmd_tetrahedralize.cpp
 const char* tetrahedralize_usage();
 int run_eval(const Args& args);  // cmd_eval.cpp
 const char* eval_usage();
+int run_mesh(const Args& args);  // cmd_mesh.cpp
+const char* mesh_usage();
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"eval", "fit the implicit function of an input and print f and its gradient at query points", eval_usage(),
        run_eval},
+      {"mesh", "mesh the implicit surface of constraints, oriented points or a mesh at levels of detail; replay edits",
+       mesh_usage(), run_mesh},
       {"render", "draw meshes to a PNG picture (software renderer)", render_usage(), run_render},
       {"tetrahedralize", "exact Delaunay tetrahedralization of a point file in a box", tetrahedralize_usage(),
        run_tetrahedralize},

@@ -1,0 +1,275 @@
+// `vitri mesh`: fit the implicit surface of an input, mesh it at one or more levels of detail, and
+// optionally replay an edit script (the paper's Tables 1, 2 and 3).
+#include "commands.hpp"
+
+#include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
+#include "vitri/mesher.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace vitri::cli {
+namespace {
+
+const char* const kUsage =
+    "usage: vitri mesh INPUT -o OUT.obj --precision P [--precision P2 ...] [--edits SCRIPT]\n"
+    "\n"
+    "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
+    "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
+    "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
+    "\n"
+    "INPUT   .xyzv  constraints 'x y z value' (f < 0 inside, f > 0 outside, 0 on the surface)\n"
+    "        .pwn / 6-column .xyz  oriented points (outward normals): normal constraints are built\n"
+    "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals\n"
+    "OUT     .obj, .ply or .off (with vertex normals where the format has them)\n"
+    "\n"
+    "options:\n"
+    "  -o, --output OUT     the mesh to write (required)\n"
+    "  --precision P        relative precision: transverse tetrahedra are refined until their\n"
+    "                       circumradius is at most P x the diagonal of the constraints' bounding box.\n"
+    "                       Repeat it (coarse to fine) for levels of detail: level k (0-based, in the\n"
+    "                       order given) goes to OUT with '-k' before the extension (hand-0.obj, ...);\n"
+    "                       with one precision, to OUT itself. Each level continues the previous one.\n"
+    "  --edits SCRIPT       after the last level, replay edits, one per line (# comments allowed):\n"
+    "                         add X Y Z V      add the constraint f(X, Y, Z) = V\n"
+    "                         move I X Y Z     move constraint I (0-based, input order) to (X, Y, Z)\n"
+    "                         remove I         remove constraint I (later indices shift down by one)\n"
+    "                         value I V        set the value of constraint I to V\n"
+    "                         write PATH       write the current mesh\n"
+    "                       and print the update time of each edit.\n"
+    "  --offset D           off-surface constraint distance for points/meshes, fraction of the\n"
+    "                       diagonal (default 0.01)\n"
+    "  -q, --quiet          no table, no progress\n"
+    "\n"
+    "Prints, per level: vertices, triangles, refinement and extraction times, and the running total\n"
+    "(the paper's Table 1). Exit status: 0 ok, 1 bad input, 2 usage error.\n";
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+int usage_error(const std::string& what) {
+  std::cerr << "vitri mesh: " << what << "\n(try vitri mesh --help)\n";
+  return 2;
+}
+
+bool parse_double(const std::string& s, double& out) {
+  const char* b = s.c_str();
+  char* e = nullptr;
+  out = std::strtod(b, &e);
+  return e != b && *e == '\0';
+}
+
+bool parse_index(const std::string& s, std::size_t& out) {
+  if (s.empty() || s[0] == '-' || s[0] == '+') return false;
+  const char* b = s.c_str();
+  char* e = nullptr;
+  const unsigned long long v = std::strtoull(b, &e, 10);
+  if (e == b || *e != '\0') return false;
+  out = static_cast<std::size_t>(v);
+  return true;
+}
+
+/// OUT with "-k" before the extension.
+std::string level_path(const std::string& out, std::size_t k) {
+  const std::size_t slash = out.find_last_of("/\\");
+  const std::size_t dot = out.find_last_of('.');
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash))
+    return out + "-" + std::to_string(k);
+  return out.substr(0, dot) + "-" + std::to_string(k) + out.substr(dot);
+}
+
+void write_current(Mesher& mesher, const std::string& path) {
+  TriangleMesh tm;
+  mesher.mesh(tm.V, tm.F, tm.N);
+  write_mesh(path, tm);
+}
+
+Mesher make_mesher(const std::string& input, const MesherOptions& options) {
+  Input in = read_input(input);
+  switch (in.kind) {
+    case InputKind::Constraints: {
+      Constraints c;
+      c.points = std::move(in.constraints.points);
+      c.values = std::move(in.constraints.values);
+      return Mesher(c, options);
+    }
+    case InputKind::OrientedPoints:
+      return Mesher::from_oriented_points(in.points.points, in.points.normals, options);
+    case InputKind::Mesh:
+      return Mesher::from_mesh(in.mesh.V, in.mesh.F, options);
+    case InputKind::Points:
+      break;
+  }
+  throw InvalidArgument(input + ": points without normals do not define an inside and an outside; give "
+                                "oriented points (.pwn, 6-column .xyz), constraints (.xyzv) or a closed mesh");
+}
+
+}  // namespace
+
+const char* mesh_usage() { return kUsage; }
+
+int run_mesh(const Args& args) {
+  std::string input, output, edits;
+  std::vector<double> precisions;
+  bool quiet = false;
+  MesherOptions options;
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    auto value = [&](std::string& out) {
+      if (i + 1 >= args.size()) return false;
+      out = args[++i];
+      return true;
+    };
+    std::string v;
+    if (a == "-o" || a == "--output") {
+      if (!value(output)) return usage_error("-o needs a path");
+    } else if (a == "--precision") {
+      double p;
+      if (!value(v) || !parse_double(v, p)) return usage_error("--precision needs a number");
+      if (!(p > 0.0) || !std::isfinite(p)) return usage_error("--precision must be positive and finite, got " + v);
+      precisions.push_back(p);
+    } else if (a == "--edits") {
+      if (!value(edits)) return usage_error("--edits needs a path");
+    } else if (a == "--offset") {
+      double d;
+      if (!value(v) || !parse_double(v, d) || !(d > 0.0)) return usage_error("--offset needs a positive number");
+      options.constraint_build.offset = d;
+    } else if (a == "-q" || a == "--quiet") {
+      quiet = true;
+    } else if (!a.empty() && a[0] == '-') {
+      return usage_error("unknown option '" + a + "'");
+    } else if (input.empty()) {
+      input = a;
+    } else {
+      return usage_error("more than one input ('" + input + "', '" + a + "')");
+    }
+  }
+  if (input.empty()) return usage_error("no input file");
+  if (output.empty()) return usage_error("no output file (-o OUT.obj)");
+  if (precisions.empty()) return usage_error("no --precision");
+  const std::string ext = file_extension(output);
+  if (ext != "obj" && ext != "ply" && ext != "off")
+    return usage_error("output must end in .obj, .ply or .off, got '" + output + "'");
+  // Read the edit script up front so that a bad script fails before the long work.
+  std::vector<std::string> script;
+  if (!edits.empty()) {
+    std::ifstream in(edits);
+    if (!in) throw ParseError(edits, 0, "cannot open file");
+    for (std::string line; std::getline(in, line);) script.push_back(line);
+  }
+
+  const auto t_start = Clock::now();
+  Mesher mesher = make_mesher(input, options);
+  const double diag = mesher.diagonal();
+  const double build_ms = ms_since(t_start);
+  if (!quiet) {
+    std::printf("%s: %zu constraints, diagonal %.6g; fit %.0f ms, initial tetrahedralization %.0f ms\n",
+                input.c_str(), mesher.size(), diag, mesher.stats().fit_seconds * 1e3,
+                build_ms - mesher.stats().fit_seconds * 1e3);
+    std::printf("%5s %10s %9s %10s %11s %11s %10s\n", "level", "precision", "vertices", "triangles", "refine ms",
+                "extract ms", "total ms");
+  }
+  double total_ms = build_ms;
+  for (std::size_t k = 0; k < precisions.size(); ++k) {
+    const auto t0 = Clock::now();
+    auto last_report = Clock::now();
+    bool reported = false;
+    mesher.refine(precisions[k] * diag, [&](const RefineProgress& p) {
+      if (!quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
+        std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
+                     p.queued);
+        last_report = Clock::now();
+        reported = true;
+      }
+      return true;
+    });
+    if (reported) std::fprintf(stderr, "\n");
+    const double refine_ms = ms_since(t0);
+    const auto t1 = Clock::now();
+    const SurfaceMesh& m = mesher.surface();
+    const double extract_ms = ms_since(t1);
+    total_ms += refine_ms + extract_ms;
+    const std::string path = precisions.size() == 1 ? output : level_path(output, k);
+    write_current(mesher, path);
+    if (!quiet)
+      std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precisions[k], m.vertices.size(),
+                  m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());
+  }
+
+  if (!script.empty() && !quiet)
+    std::printf("\n%5s %-28s %9s %10s %9s %9s %11s %9s\n", "line", "edit", "vertices", "triangles", "rbf ms",
+                "refine ms", "extract ms", "total ms");
+  for (std::size_t ln = 0; ln < script.size(); ++ln) {
+    std::istringstream in(script[ln]);
+    std::vector<std::string> tok;
+    for (std::string t; in >> t;) {
+      if (t[0] == '#') break;
+      tok.push_back(t);
+    }
+    if (tok.empty()) continue;
+    const std::size_t line = ln + 1;
+    auto bad = [&](const std::string& what) { return ParseError(edits, line, what); };
+    double x[4];
+    std::size_t idx = 0;
+    const std::string& op = tok[0];
+    try {
+      if (op == "write") {
+        if (tok.size() != 2) throw bad("expected 'write PATH'");
+        write_current(mesher, tok[1]);
+        if (!quiet) std::printf("%5zu %-28s -> %s\n", line, "write", tok[1].c_str());
+        continue;
+      }
+      const auto t0 = Clock::now();
+      if (op == "add") {
+        if (tok.size() != 5 || !parse_double(tok[1], x[0]) || !parse_double(tok[2], x[1]) ||
+            !parse_double(tok[3], x[2]) || !parse_double(tok[4], x[3]))
+          throw bad("expected 'add X Y Z V'");
+        mesher.add_constraint({x[0], x[1], x[2]}, x[3]);
+      } else if (op == "move") {
+        if (tok.size() != 5 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]) ||
+            !parse_double(tok[3], x[1]) || !parse_double(tok[4], x[2]))
+          throw bad("expected 'move I X Y Z'");
+        if (idx >= mesher.size()) throw bad("constraint index " + tok[1] + " out of range (" + std::to_string(mesher.size()) + " constraints)");
+        mesher.move_constraint(idx, {x[0], x[1], x[2]});
+      } else if (op == "remove") {
+        if (tok.size() != 2 || !parse_index(tok[1], idx)) throw bad("expected 'remove I'");
+        if (idx >= mesher.size()) throw bad("constraint index " + tok[1] + " out of range (" + std::to_string(mesher.size()) + " constraints)");
+        mesher.remove_constraint(idx);
+      } else if (op == "value") {
+        if (tok.size() != 3 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]))
+          throw bad("expected 'value I V'");
+        if (idx >= mesher.size()) throw bad("constraint index " + tok[1] + " out of range (" + std::to_string(mesher.size()) + " constraints)");
+        mesher.set_value(idx, x[0]);
+      } else {
+        throw bad("unknown edit '" + op + "' (add, move, remove, value, write)");
+      }
+      const double edit_ms = ms_since(t0);
+      const auto t1 = Clock::now();
+      const SurfaceMesh& m = mesher.surface();
+      const double extract_ms = ms_since(t1);
+      const MesherStats s = mesher.stats();
+      std::string text;
+      for (const auto& t : tok) text += (text.empty() ? "" : " ") + t;
+      if (text.size() > 28) text = text.substr(0, 25) + "...";
+      if (!quiet)
+        std::printf("%5zu %-28s %9zu %10zu %9.1f %9.1f %11.1f %9.1f\n", line, text.c_str(), m.vertices.size(),
+                    m.triangles.size(), s.edit_rbf_seconds * 1e3, edit_ms - s.edit_rbf_seconds * 1e3, extract_ms,
+                    edit_ms + extract_ms);
+    } catch (const ParseError&) {
+      throw;
+    } catch (const Error& e) {
+      throw ParseError(edits, line, e.what());
+    }
+  }
+  return 0;
+}
+
+}  // namespace vitri::cli

@@ -1,0 +1,140 @@
+#pragma once
+/// @file mesher.hpp
+/// vitri::Mesher, the public entry point: a variational implicit surface (RBF of constraint points) and
+/// its incremental Delaunay polygonization, kept up to date while constraints are added, moved, removed
+/// or change value (Crespin 2003, section 5). vitri::mesh_points() beside it does everything in one call.
+///
+///   vitri::Constraints c = ...;                 // f(points[i]) = values[i], f < 0 inside
+///   vitri::Mesher mesher(c);                    // fits the RBF, tetrahedralizes constraints + box
+///   mesher.refine(0.02 * mesher.diagonal());    // absolute precision (circumradius bound)
+///   Eigen::MatrixXd V, N; Eigen::MatrixXi F;
+///   mesher.mesh(V, F, N);                       // watertight, CCW seen from outside
+///   mesher.move_constraint(3, {0.1, 0.2, 0.3}); // edits the RBF, updates only what changed
+///   mesher.mesh(V, F, N);
+///
+/// Precision: the library takes absolute lengths (the circumradius bound of transverse tetrahedra); the
+/// CLI's relative precision is `P * diagonal()`.
+
+#include "vitri/core/box.hpp"
+#include "vitri/core/point.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+#include "vitri/polygonize/surface_mesh.hpp"
+#include "vitri/rbf/constraints.hpp"
+#include "vitri/rbf/rbf.hpp"
+
+#include <Eigen/Core>
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace vitri {
+
+/// Options of the Mesher.
+struct MesherOptions {
+  /// Refinement and extraction options (queue order, root finder, sampling, zero-vertex snapping).
+  PolygonizerOptions polygonizer;
+  /// Fit and edit options of the RBF.
+  RbfOptions rbf;
+  /// Normal constraints built by from_oriented_points() and from_mesh() (off-surface distance, ...).
+  ConstraintBuildOptions constraint_build;
+  /// The Delaunay domain is the bounding box of the constraints scaled by this factor (paper 3.2.2).
+  /// A constraint later added or moved outside it makes the Mesher rebuild with a new box.
+  double box_factor = 2.0;
+  /// After each edit, remove refinement vertices that no transverse tetrahedron touches any more, so
+  /// that a long editing session does not grow without bound.
+  bool collect_garbage = true;
+};
+
+/// Counters and timings (seconds). `polygonizer` holds the refinement/extraction numbers.
+struct MesherStats {
+  PolygonizerStats polygonizer;    ///< Delaunay and mesh counters, phase times of the last calls
+  std::size_t constraints = 0;     ///< current number of constraints
+  double fit_seconds = 0;          ///< RBF fit at construction (or last rebuild)
+  double edit_seconds = 0;         ///< last edit, total: RBF edit + Delaunay + re-evaluation + refinement
+  double edit_rbf_seconds = 0;     ///< last edit: RBF update
+  double edit_refine_seconds = 0;  ///< last edit: Delaunay update, re-evaluation, refinement, cleanup
+  std::size_t rebuilds = 0;        ///< edits that needed a new domain box (full rebuild)
+};
+
+/// Stateful mesher of one variational implicit surface. Not thread-safe. Movable, not copyable.
+class Mesher {
+ public:
+  /// Fits the RBF to the constraints and builds the initial tetrahedralization (constraints + the 8
+  /// corners of their bounding box enlarged by options.box_factor, plus the initial sampling).
+  /// Constraint vertices carry their constraint value exactly (f = 0 on on-surface constraints).
+  /// @throws as Rbf::fit (InvalidPoint for bad or duplicate constraints, NumericalError for a singular fit).
+  explicit Mesher(const Constraints& constraints, const MesherOptions& options = {});
+
+  /// Normal constraints from oriented points (constraints_from_oriented_points with
+  /// options.constraint_build: f = 0 on the points, +-d along the normals), then as above.
+  /// @param points   positions; @param normals one outward normal (any length > 0) per point.
+  static Mesher from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                                     const MesherOptions& options = {});
+  /// Normal constraints from a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3;
+  /// constraints_from_mesh), then as above. @throws InvalidArgument for an open or non-manifold mesh.
+  static Mesher from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options = {});
+
+  Mesher(Mesher&&) noexcept;
+  Mesher& operator=(Mesher&&) noexcept;
+  Mesher(const Mesher&) = delete;
+  Mesher& operator=(const Mesher&) = delete;
+  ~Mesher();
+
+  /// Refines until every transverse tetrahedron has circumradius <= precision (absolute). A smaller
+  /// precision than the previous call continues the refinement (levels of detail).
+  /// @return false when the progress callback cancelled. @throws InvalidArgument for precision <= 0.
+  bool refine(double precision, const ProgressCallback& progress = {});
+
+  /// The current mesh (extracted on demand, cached until the next refine or edit).
+  const SurfaceMesh& surface();
+  /// The current mesh as Eigen arrays: V #V x 3, F #F x 3 (CCW seen from outside), N #V x 3 unit
+  /// outward normals (gradient of f).
+  void mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N);
+
+  // ---- Dynamic editing: each edit updates the RBF, the Delaunay tree and the mesh -------------------
+  /// Appends the constraint f(p) = value (index size() - 1). @throws as Rbf::add_constraint.
+  std::size_t add_constraint(const Point3& p, double value);
+  /// Moves constraint i to p (keeps its value). @throws as Rbf::move_constraint.
+  void move_constraint(std::size_t i, const Point3& p);
+  /// Removes constraint i; later indices shift down by one. @throws as Rbf::remove_constraint.
+  void remove_constraint(std::size_t i);
+  /// Changes the value of constraint i. @throws as Rbf::set_value.
+  void set_value(std::size_t i, double value);
+
+  // ---- Queries ----------------------------------------------------------------------------------------
+  const Rbf& function() const { return *rbf_; }
+  const Constraints& constraints() const { return rbf_->constraints(); }
+  std::size_t size() const { return rbf_->size(); }
+  /// Diagonal of the bounding box of the current constraints (the unit of the CLI's precision).
+  double diagonal() const;
+  /// Absolute precision of the last refine() (infinity before the first).
+  double precision() const { return precision_; }
+  const Polygonizer& polygonizer() const { return *poly_; }
+  MesherStats stats() const;
+  const MesherOptions& options() const { return options_; }
+
+ private:
+  void build();
+  void after_edit(double rbf_seconds, double t_start);
+  bool inside_domain(const Point3& p) const;
+
+  MesherOptions options_;
+  std::unique_ptr<Rbf> rbf_;  // stable address: the polygonizer keeps a reference
+  std::unique_ptr<Polygonizer> poly_;
+  std::vector<VertexId> vertex_of_;  // Delaunay vertex of each constraint (kNoVertex: duplicate position)
+  double precision_;
+  SurfaceMesh mesh_;
+  bool mesh_valid_ = false;
+  MesherStats stats_;
+};
+
+/// One call: fits the RBF to the constraints, refines to `precision` (absolute) and extracts the mesh.
+/// @throws as Mesher::Mesher and Mesher::refine.
+SurfaceMesh mesh_points(const Constraints& constraints, double precision, const MesherOptions& options = {});
+
+/// One call, Eigen out: V #V x 3, F #F x 3, N #V x 3.
+void mesh_points(const Constraints& constraints, double precision, Eigen::MatrixXd& V, Eigen::MatrixXi& F,
+                 Eigen::MatrixXd& N, const MesherOptions& options = {});
+
+}  // namespace vitri

@@ -1,0 +1,181 @@
+// vitri::Mesher: the RBF and the polygonizer joined, with dynamic edits (Crespin 2003, section 5).
+//
+// An edit runs in this order:
+//   1. the RBF is edited in place (O(N^2) update of its factorization, never a refit);
+//   2. the constraint point is inserted / moved / removed in the Delaunay tree with its exact value
+//      (constraint vertices carry their constraint value, so on-surface ones are exactly 0);
+//   3. f is re-evaluated at every other Delaunay vertex in one batch (the RBF's support is global, so
+//      the surface may move anywhere), and only the tetrahedra around vertices whose sign flipped are
+//      reclassified (they became, or stopped being, transverse);
+//   4. refinement resumes at the current precision, on the queue this produced;
+//   5. refinement vertices that no transverse tetrahedron touches any more are removed (this never
+//      creates a transverse tetrahedron), so repeated edits do not accumulate Steiner points.
+// The mesh is extracted on demand afterwards.
+#include "vitri/mesher.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <utility>
+
+namespace vitri {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double now_seconds() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
+
+}  // namespace
+
+Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
+    : options_(options), rbf_(std::make_unique<Rbf>()), precision_(std::numeric_limits<double>::infinity()) {
+  if (!(options_.box_factor > 1.0) || !std::isfinite(options_.box_factor))
+    throw InvalidArgument("MesherOptions::box_factor must be > 1");
+  const double t0 = now_seconds();
+  rbf_->fit(constraints, options_.rbf);
+  stats_.fit_seconds = now_seconds() - t0;
+  build();
+}
+
+Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                                   const MesherOptions& options) {
+  return Mesher(constraints_from_oriented_points(points, normals, options.constraint_build), options);
+}
+
+Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options) {
+  return Mesher(constraints_from_mesh(V, F, options.constraint_build), options);
+}
+
+Mesher::Mesher(Mesher&&) noexcept = default;
+Mesher& Mesher::operator=(Mesher&&) noexcept = default;
+Mesher::~Mesher() = default;
+
+void Mesher::build() {
+  const Constraints& c = rbf_->constraints();
+  const Box3 domain = Polygonizer::domain_for(c.points, options_.box_factor);
+  poly_ = std::make_unique<Polygonizer>(*rbf_, domain, c.points, c.values, options_.polygonizer);
+  vertex_of_ = poly_->seed_vertices();
+  mesh_valid_ = false;
+}
+
+double Mesher::diagonal() const {
+  Box3 b;
+  for (const Point3& p : rbf_->constraints().points) b.extend(p);
+  return b.diagonal();
+}
+
+bool Mesher::inside_domain(const Point3& p) const {
+  const Box3& b = poly_->triangulation().box();
+  return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+}
+
+bool Mesher::refine(double precision, const ProgressCallback& progress) {
+  mesh_valid_ = false;
+  const bool done = poly_->refine(precision, progress);
+  precision_ = precision;
+  return done;
+}
+
+const SurfaceMesh& Mesher::surface() {
+  if (!mesh_valid_) {
+    mesh_ = poly_->extract();
+    mesh_valid_ = true;
+  }
+  return mesh_;
+}
+
+void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { to_eigen(surface(), V, F, &N); }
+
+void Mesher::after_edit(double rbf_seconds, double t_start) {
+  const double t1 = now_seconds();
+  poly_->function_changed();
+  if (std::isfinite(precision_)) poly_->refine(precision_);
+  if (options_.collect_garbage) poly_->collect_garbage();
+  mesh_valid_ = false;
+  stats_.edit_rbf_seconds = rbf_seconds;
+  stats_.edit_refine_seconds = now_seconds() - t1;
+  stats_.edit_seconds = now_seconds() - t_start;
+}
+
+std::size_t Mesher::add_constraint(const Point3& p, double value) {
+  const double t0 = now_seconds();
+  rbf_->add_constraint(p, value);  // validates p and value; throws before anything changes
+  const double t_rbf = now_seconds() - t0;
+  if (!inside_domain(p)) {
+    ++stats_.rebuilds;
+    build();
+    if (std::isfinite(precision_)) poly_->refine(precision_);
+    stats_.edit_rbf_seconds = t_rbf;
+    stats_.edit_seconds = now_seconds() - t0;
+    return rbf_->size() - 1;
+  }
+  vertex_of_.push_back(poly_->insert_vertex(p, value, VertexKind::Seed));
+  after_edit(t_rbf, t0);
+  return rbf_->size() - 1;
+}
+
+void Mesher::move_constraint(std::size_t i, const Point3& p) {
+  const double t0 = now_seconds();
+  rbf_->move_constraint(i, p);
+  const double t_rbf = now_seconds() - t0;
+  if (!inside_domain(p)) {
+    ++stats_.rebuilds;
+    build();
+    if (std::isfinite(precision_)) poly_->refine(precision_);
+    stats_.edit_rbf_seconds = t_rbf;
+    stats_.edit_seconds = now_seconds() - t0;
+    return;
+  }
+  const double value = rbf_->constraints().values[i];
+  const VertexId v = vertex_of_[i];
+  if (v != kNoVertex) {
+    if (!poly_->move_vertex(v, p, value)) {
+      // p duplicates another constraint's vertex: this constraint lives in the RBF only.
+      poly_->remove_vertex(v);
+      vertex_of_[i] = kNoVertex;
+    }
+  } else {
+    vertex_of_[i] = poly_->insert_vertex(p, value, VertexKind::Seed);
+  }
+  after_edit(t_rbf, t0);
+}
+
+void Mesher::remove_constraint(std::size_t i) {
+  const double t0 = now_seconds();
+  rbf_->remove_constraint(i);  // throws on a bad index or an impossible removal
+  const double t_rbf = now_seconds() - t0;
+  const VertexId v = vertex_of_[i];
+  vertex_of_.erase(vertex_of_.begin() + static_cast<std::ptrdiff_t>(i));
+  if (v != kNoVertex) poly_->remove_vertex(v);
+  after_edit(t_rbf, t0);
+}
+
+void Mesher::set_value(std::size_t i, double value) {
+  const double t0 = now_seconds();
+  rbf_->set_value(i, value);
+  const double t_rbf = now_seconds() - t0;
+  if (vertex_of_[i] != kNoVertex) poly_->set_vertex_value(vertex_of_[i], value);
+  after_edit(t_rbf, t0);
+}
+
+MesherStats Mesher::stats() const {
+  MesherStats s = stats_;
+  s.polygonizer = poly_->stats();
+  s.constraints = rbf_->size();
+  return s;
+}
+
+SurfaceMesh mesh_points(const Constraints& constraints, double precision, const MesherOptions& options) {
+  Mesher m(constraints, options);
+  m.refine(precision);
+  return m.surface();
+}
+
+void mesh_points(const Constraints& constraints, double precision, Eigen::MatrixXd& V, Eigen::MatrixXi& F,
+                 Eigen::MatrixXd& N, const MesherOptions& options) {
+  to_eigen(mesh_points(constraints, precision, options), V, F, &N);
+}
+
+}  // namespace vitri

@@ -2,7 +2,7 @@
 //
 // A brief explanation (details and a sketch in docs/delaunay.md):
 //
-// * Storage is flat. Tetrahedron t owns slots 4t..4t+3 of tv_ (vertices, internal point ids) and tn_
+// * Storage is flat. Tetrahedron t owns slots 8t..8t+3 of td_ (vertices, internal point ids) and 8t+4..8t+7
 //   (neighbour across the face opposite vertex i). Live tetrahedra are positively oriented. Flags tf_[t]
 //   say dead/live plus temporary marks used inside one operation.
 // * Start: the 8 box corners are cospherical; their Delaunay tetrahedralization under the symbolic
@@ -202,16 +202,15 @@ Triangulation::Triangulation(const Triangulation& o)
       vtet_(o.vtet_),
       vid_of_pid_(o.vid_of_pid_),
       pid_of_vid_(o.pid_of_vid_),
-      tv_(o.tv_),
-      tn_(o.tn_),
+      td_(o.td_),
       tf_(o.tf_),
+      hnb_(o.hnb_),
       ops_(o.ops_),
       num_live_vertices_(o.num_live_vertices_),
       num_live_tets_(o.num_live_tets_),
       free_head_(o.free_head_),
       last_tet_(o.last_tet_),
-      init_tv_(o.init_tv_),
-      init_tn_(o.init_tn_),
+      init_td_(o.init_td_),
       scratch_(std::make_unique<Scratch>()) {}
 
 Triangulation& Triangulation::operator=(const Triangulation& o) {
@@ -244,10 +243,9 @@ void Triangulation::init_corners() {
           if (empty) tets.push_back(t);
         }
   const std::size_t m = tets.size();
-  init_tv_.assign(4 * m, kNoVertex);
-  init_tn_.assign(4 * m, kNoTet);
+  init_td_.assign(8 * m, kNoTet);
   for (std::size_t t = 0; t < m; ++t)
-    for (int i = 0; i < 4; ++i) init_tv_[4 * t + i] = tets[t][i];
+    for (int i = 0; i < 4; ++i) init_td_[8 * t + i] = tets[t][std::size_t(i)];
   auto face = [&](std::size_t t, int i) {
     std::array<PointId, 3> f{};
     int k = 0;
@@ -260,22 +258,23 @@ void Triangulation::init_corners() {
     for (int i = 0; i < 4; ++i)
       for (std::size_t u = 0; u < m; ++u)
         for (int j = 0; j < 4 && u != t; ++j)
-          if (face(t, i) == face(u, j)) init_tn_[4 * t + i] = TetId(u);
+          if (face(t, i) == face(u, j)) init_td_[8 * t + 4 + std::size_t(i)] = TetId(u);
   reset_to_corners();
 }
 
 void Triangulation::reset_to_corners() {
-  const std::size_t m = init_tv_.size() / 4;
+  const std::size_t m = init_td_.size() / 8;
   pos_.resize(8);
   for (int k = 0; k < 8; ++k) pos_[k] = box_.corner(k);
   vtet_.assign(8, kNoTet);
   vid_of_pid_.clear();
   pid_of_vid_.clear();
-  tv_ = init_tv_;
-  tn_ = init_tn_;
+  td_ = init_td_;
   tf_.assign(m, 0);
+  hnb_.clear();
+  if (keep_history_) hnb_.assign(m, {kNoOffset, kNoOffset, kNoOffset, kNoOffset});
   for (std::size_t t = 0; t < m; ++t)
-    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * t + i]] = TetId(t);
+    for (std::size_t i = 0; i < 4; ++i) vtet_[td_[8 * t + i]] = TetId(t);
   ops_.clear();
   if (keep_history_) ops_.push_back({0, std::uint32_t(m), kNoVertex});
   num_live_vertices_ = 8;
@@ -321,12 +320,12 @@ TetId Triangulation::walk(const Point3& p, TetId t) const {
   for (;;) {
     rng = rng * 1664525u + 1013904223u;
     const int r = int(rng >> 30);
-    const std::size_t b = 4 * std::size_t(t);
-    const Point3* const P[4] = {&pos_[tv_[b]], &pos_[tv_[b + 1]], &pos_[tv_[b + 2]], &pos_[tv_[b + 3]]};
+    const std::size_t b = 8 * std::size_t(t);
+    const Point3* const P[4] = {&pos_[td_[b]], &pos_[td_[b + 1]], &pos_[td_[b + 2]], &pos_[td_[b + 3]]};
     TetId next = kNoTet;
     for (int k = 0; k < 4; ++k) {
       const int i = (r + k) & 3;
-      const TetId n = tn_[b + i];
+      const TetId n = td_[4 + b + i];
       if (n == kNoTet || n == prev) continue;
       if (orient_replace(P, i, p) == Sign::Negative) {
         next = n;
@@ -340,13 +339,56 @@ TetId Triangulation::walk(const Point3& p, TetId t) const {
 }
 
 bool Triangulation::in_op_tet(const Op& op, TetId s, const Point3& p) const {
-  const std::size_t b = 4 * std::size_t(s);
-  const Point3* const P[4] = {&pos_[tv_[b]], &pos_[tv_[b + 1]], &pos_[tv_[b + 2]], &pos_[tv_[b + 3]]};
+  const std::size_t b = 8 * std::size_t(s);
+  const Point3* const P[4] = {&pos_[td_[b]], &pos_[td_[b + 1]], &pos_[td_[b + 2]], &pos_[td_[b + 3]]};
   for (int i = 0; i < 4; ++i) {
-    if (tv_[b + i] == op.apex) continue;  // insertion: the face opposite the apex needs no test
+    if (td_[b + i] == op.apex) continue;  // insertion: the face opposite the apex needs no test
     if (orient_replace(P, i, p) == Sign::Negative) return false;
   }
   return true;
+}
+
+// One step down the history: the tetrahedron of the record that killed `dead` which contains p.
+TetId Triangulation::descend(TetId dead, const Point3& p, std::size_t* visited) const {
+  const std::uint32_t opi = td_[8 * std::size_t(dead) + 4];
+  const Op& op = ops_[opi];
+  const TetId hint = td_[8 * std::size_t(dead) + 5];
+  if (op.apex != kNoVertex && op.count < kNoOffset) {
+    // Walk around the apex with the creation-time adjacency: at s = (apex, F), p is in s when it is on
+    // the inner side of the three faces through the apex (the cavity is star-shaped from the apex).
+    TetId s = hint, prev = kNoTet;
+    std::uint32_t rng = 0x2545f491u ^ opi;
+    for (std::uint32_t steps = 0; steps < 4 * op.count + 8; ++steps) {
+      if (visited) ++*visited;
+      const std::size_t b = 8 * std::size_t(s);
+      const Point3* const P[4] = {&pos_[td_[b]], &pos_[td_[b + 1]], &pos_[td_[b + 2]], &pos_[td_[b + 3]]};
+      rng = rng * 1664525u + 1013904223u;
+      const int r = int(rng >> 30);
+      TetId next = kNoTet;
+      for (int k = 0; k < 4; ++k) {
+        const int j = (r + k) & 3;
+        const std::uint16_t off = hnb_[s][std::size_t(j)];
+        if (td_[b + std::size_t(j)] == op.apex || off == kNoOffset) continue;
+        const TetId n = op.first + off;
+        if (n == prev) continue;
+        if (orient_replace(P, j, p) == Sign::Negative) {
+          next = n;
+          break;
+        }
+      }
+      if (next == kNoTet) return s;
+      prev = s;
+      s = next;
+    }
+    // Not reached with exact predicates; fall through to the scan for safety.
+  }
+  for (std::uint32_t k = 0; k < op.count; ++k) {
+    const TetId s = op.first + (hint - op.first + k) % op.count;
+    if (visited) ++*visited;
+    if (in_op_tet(op, s, p)) return s;
+  }
+  throw std::logic_error("Triangulation::locate: history record " + std::to_string(opi) +
+                         " does not cover the point " + fmt_point(p));
 }
 
 TetId Triangulation::locate_history(const Point3& p) const {
@@ -355,23 +397,23 @@ TetId Triangulation::locate_history(const Point3& p) const {
   for (TetId s = root.first; s < root.first + root.count && t == kNoTet; ++s)
     if (in_op_tet(root, s, p)) t = s;
   if (t == kNoTet) throw std::logic_error("Triangulation::locate: point not in the root tetrahedra");
-  while (tf_[t] & kDead) {
-    const Op& op = ops_[tn_[4 * std::size_t(t)]];
-    const TetId hint = tn_[4 * std::size_t(t) + 1];
-    TetId found = kNoTet;
-    for (std::uint32_t k = 0; k < op.count; ++k) {
-      const TetId s = op.first + (hint - op.first + k) % op.count;
-      if (in_op_tet(op, s, p)) {
-        found = s;
-        break;
-      }
-    }
-    if (found == kNoTet)
-      throw std::logic_error("Triangulation::locate: history record " + std::to_string(tn_[4 * t]) +
-                             " does not cover the point " + fmt_point(p));
-    t = found;
-  }
+  while (tf_[t] & kDead) t = descend(t, p, nullptr);
   return t;
+}
+
+std::pair<std::size_t, std::size_t> Triangulation::history_path(const Point3& p) const {
+  check_point(p, 0);
+  if (!keep_history_) return {0, 0};
+  std::size_t levels = 0, visited = 0;
+  TetId t = kNoTet;
+  const Op& root = ops_[0];
+  for (TetId s = root.first; s < root.first + root.count && t == kNoTet; ++s, ++visited)
+    if (in_op_tet(root, s, p)) t = s;
+  while (tf_[t] & kDead) {
+    ++levels;
+    t = descend(t, p, &visited);
+  }
+  return {levels, visited};
 }
 
 TetId Triangulation::locate(const Point3& p) const {
@@ -384,14 +426,14 @@ TetId Triangulation::locate(const Point3& p) const {
 TetId Triangulation::alloc_tet() {
   if (!keep_history_ && free_head_ != kNoTet) {
     const TetId t = free_head_;
-    free_head_ = tn_[4 * std::size_t(t)];
+    free_head_ = td_[4 + 8 * std::size_t(t)];
     tf_[t] = 0;
     return t;
   }
   const TetId t = TetId(tf_.size());
-  grow_to(tv_, tv_.size() + 4);
-  grow_to(tn_, tn_.size() + 4);
+  grow_to(td_, td_.size() + 8);
   grow_to(tf_, tf_.size() + 1);
+  if (keep_history_) grow_to(hnb_, hnb_.size() + 1);
   tf_[t] = 0;
   return t;
 }
@@ -399,10 +441,10 @@ TetId Triangulation::alloc_tet() {
 void Triangulation::kill(TetId t, std::uint32_t op, TetId hint) {
   tf_[t] = kDead;
   if (keep_history_) {
-    tn_[4 * std::size_t(t)] = op;
-    tn_[4 * std::size_t(t) + 1] = hint;
+    td_[4 + 8 * std::size_t(t)] = op;
+    td_[4 + 8 * std::size_t(t) + 1] = hint;
   } else {
-    tn_[4 * std::size_t(t)] = free_head_;
+    td_[4 + 8 * std::size_t(t)] = free_head_;
     free_head_ = t;
   }
 }
@@ -448,7 +490,7 @@ bool Triangulation::grow_cavity(const Point3& p, TetId start, PointId& duplicate
   for (std::size_t k = 0; k < S.cavity.size(); ++k) {
     const TetId t = S.cavity[k];
     for (int i = 0; i < 4; ++i) {
-      const TetId n = tn_[4 * std::size_t(t) + i];
+      const TetId n = td_[4 + 8 * std::size_t(t) + i];
       if (n == kNoTet) {
         S.boundary.push_back({t, i});
         continue;
@@ -459,13 +501,13 @@ bool Triangulation::grow_cavity(const Point3& p, TetId start, PointId& duplicate
         S.boundary.push_back({t, i});
         continue;
       }
-      const std::size_t b = 4 * std::size_t(n);
-      const Point3& a0 = pos_[tv_[b]];
-      const Point3& a1 = pos_[tv_[b + 1]];
-      const Point3& a2 = pos_[tv_[b + 2]];
-      const Point3& a3 = pos_[tv_[b + 3]];
+      const std::size_t b = 8 * std::size_t(n);
+      const Point3& a0 = pos_[td_[b]];
+      const Point3& a1 = pos_[td_[b + 1]];
+      const Point3& a2 = pos_[td_[b + 2]];
+      const Point3& a3 = pos_[td_[b + 3]];
       if (p == a0 || p == a1 || p == a2 || p == a3) {
-        duplicate = tv_[b + (p == a0 ? 0 : p == a1 ? 1 : p == a2 ? 2 : 3)];
+        duplicate = td_[b + (p == a0 ? 0 : p == a1 ? 1 : p == a2 ? 2 : 3)];
         clear_cavity_marks();
         return false;
       }
@@ -493,7 +535,7 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
   Scratch& S = *scratch_;
   InsertResult res;
   for (int i = 0; i < 4; ++i) {
-    const PointId w = tv_[4 * std::size_t(start) + i];
+    const PointId w = td_[8 * std::size_t(start) + i];
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
   }
   PointId dup = kNoVertex;
@@ -505,7 +547,7 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
     PointId nearest = kNoVertex;
     for (TetId t : S.cavity)
       for (int i = 0; i < 4; ++i) {
-        const PointId w = tv_[4 * std::size_t(t) + i];
+        const PointId w = td_[8 * std::size_t(t) + i];
         const double d2 = squared_distance(pos_[w], p);
         if (d2 < best) {
           best = d2;
@@ -535,18 +577,18 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
   S.created.clear();
   for (const auto& bf : S.boundary) {
     const TetId s = alloc_tet();
-    const std::size_t bs = 4 * std::size_t(s), bt = 4 * std::size_t(bf.tet);
+    const std::size_t bs = 8 * std::size_t(s), bt = 8 * std::size_t(bf.tet);
     for (int j = 0; j < 4; ++j) {
-      tv_[bs + j] = tv_[bt + j];
-      tn_[bs + j] = kNoTet;
+      td_[bs + j] = td_[bt + j];
+      td_[4 + bs + j] = kNoTet;
     }
-    tv_[bs + bf.face] = q;
-    const TetId n = tn_[bt + bf.face];
-    tn_[bs + bf.face] = n;
+    td_[bs + bf.face] = q;
+    const TetId n = td_[4 + bt + bf.face];
+    td_[4 + bs + bf.face] = n;
     if (n != kNoTet)
       for (int k = 0; k < 4; ++k)
-        if (tn_[4 * std::size_t(n) + k] == bf.tet) tn_[4 * std::size_t(n) + k] = s;
-    tn_[bt + bf.face] = s;
+        if (td_[4 + 8 * std::size_t(n) + k] == bf.tet) td_[4 + 8 * std::size_t(n) + k] = s;
+    td_[4 + bt + bf.face] = s;
     S.created.push_back(s);
   }
   // Faces through q: rotate around the boundary edge through killed tetrahedra until the next boundary
@@ -561,27 +603,36 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
     const TetId s = S.created[k];
     const auto& bf = S.boundary[k];
     for (int j = 0; j < 4; ++j) {
-      if (j == bf.face || tn_[4 * std::size_t(s) + j] != kNoTet) continue;
+      if (j == bf.face || td_[4 + 8 * std::size_t(s) + j] != kNoTet) continue;
       TetId tc = bf.tet;
       int a = bf.face, b = j;
       TetId n;
       for (;;) {
-        n = tn_[4 * std::size_t(tc) + b];
+        n = td_[4 + 8 * std::size_t(tc) + b];
         if (!(tf_[n] & kMark)) break;
-        const PointId va = tv_[4 * std::size_t(tc) + a];
+        const PointId va = td_[8 * std::size_t(tc) + a];
         int ka = 0, kw = 0;
         for (int m = 0; m < 4; ++m) {
-          if (tv_[4 * std::size_t(n) + m] == va) ka = m;
-          if (tn_[4 * std::size_t(n) + m] == tc) kw = m;
+          if (td_[8 * std::size_t(n) + m] == va) ka = m;
+          if (td_[4 + 8 * std::size_t(n) + m] == tc) kw = m;
         }
         tc = n;
         a = kw;
         b = ka;
       }
-      tn_[4 * std::size_t(s) + j] = n;
-      tn_[4 * std::size_t(n) + a] = s;
+      td_[4 + 8 * std::size_t(s) + j] = n;
+      td_[4 + 8 * std::size_t(n) + a] = s;
     }
-    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * std::size_t(s) + i]] = s;
+    for (int i = 0; i < 4; ++i) vtet_[td_[8 * std::size_t(s) + i]] = s;
+  }
+  if (keep_history_) {
+    const bool small = S.created.size() < kNoOffset;
+    for (std::size_t k = 0; k < S.created.size(); ++k) {
+      const std::size_t s = S.created[k];
+      for (std::size_t j = 0; j < 4; ++j)
+        hnb_[s][j] = (!small || int(j) == S.boundary[k].face) ? kNoOffset
+                                                              : std::uint16_t(td_[8 * s + 4 + j] - first);
+    }
   }
   // Kill the cavity; in the history each killed tetrahedron points to this Op and to a new tetrahedron
   // built on one of its faces (where the descent is likely to continue).
@@ -591,7 +642,7 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
     TetId hint = first;
     if (keep_history_)
       for (int i = 0; i < 4; ++i)
-        if (tn_[4 * std::size_t(t) + i] >= first) hint = tn_[4 * std::size_t(t) + i];
+        if (td_[4 + 8 * std::size_t(t) + i] >= first) hint = td_[4 + 8 * std::size_t(t) + i];
     kill(t, op, hint);
   }
   for (TetId t : S.tested) tf_[t] &= std::uint8_t(~kTested);
@@ -622,10 +673,10 @@ InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, 
     throw InvalidArgument("Triangulation::insert_in_conflict: tetrahedron " + std::to_string(conflict) +
                           " is not live");
   if (changes) changes->clear();
-  const std::size_t b = 4 * std::size_t(conflict);
+  const std::size_t b = 8 * std::size_t(conflict);
   for (int i = 0; i < 4; ++i)
-    if (pos_[tv_[b + i]] == p) return {InsertStatus::TooClose, kNoVertex, vid(tv_[b + i])};
-  if (insphere_sos(pos_[tv_[b]], pos_[tv_[b + 1]], pos_[tv_[b + 2]], pos_[tv_[b + 3]], p) != Sign::Positive)
+    if (pos_[td_[b + i]] == p) return {InsertStatus::TooClose, kNoVertex, vid(td_[b + i])};
+  if (insphere_sos(pos_[td_[b]], pos_[td_[b + 1]], pos_[td_[b + 2]], pos_[td_[b + 3]], p) != Sign::Positive)
     throw InvalidArgument("Triangulation::insert_in_conflict: point " + fmt_point(p) +
                           " is not in conflict with tetrahedron " + std::to_string(conflict));
   return insert_at(p, conflict, min_distance, changes, kNoVertex);
@@ -640,8 +691,8 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
   if (points.empty()) return results;
   const std::vector<std::uint32_t> order = brio_order(points, box_);
   if (keep_history_) {  // about 27 tetrahedra are created per insertion of a uniform point
-    tv_.reserve(tv_.size() + 4 * 28 * points.size());
-    tn_.reserve(tn_.size() + 4 * 28 * points.size());
+    td_.reserve(td_.size() + 8 * 28 * points.size());
+    hnb_.reserve(hnb_.size() + 28 * points.size());
     tf_.reserve(tf_.size() + 28 * points.size());
     ops_.reserve(ops_.size() + points.size());
   }
@@ -671,10 +722,10 @@ void Triangulation::collect_star(PointId v) {
   tf_[t0] |= kMark;
   S.star.push_back(t0);
   for (std::size_t k = 0; k < S.star.size(); ++k) {
-    const std::size_t b = 4 * std::size_t(S.star[k]);
+    const std::size_t b = 8 * std::size_t(S.star[k]);
     for (int i = 0; i < 4; ++i) {
-      if (tv_[b + i] == v) continue;
-      const TetId n = tn_[b + i];
+      if (td_[b + i] == v) continue;
+      const TetId n = td_[4 + b + i];
       if (n == kNoTet || (tf_[n] & kMark)) continue;
       tf_[n] |= kMark;
       S.star.push_back(n);
@@ -705,15 +756,15 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   S.link.clear();
   S.link_faces.clear();
   for (TetId t : S.star) {
-    const std::size_t b = 4 * std::size_t(t);
+    const std::size_t b = 8 * std::size_t(t);
     int iv = 0;
     for (int i = 0; i < 4; ++i) {
-      if (tv_[b + i] == pv)
+      if (td_[b + i] == pv)
         iv = i;
       else
-        S.link.push_back(tv_[b + i]);
+        S.link.push_back(td_[b + i]);
     }
-    S.link_faces.push_back({face_key(tv_, b, iv, nullptr), t, kNoTet});
+    S.link_faces.push_back({face_key(td_, b, iv, nullptr), t, kNoTet});
   }
   std::sort(S.link.begin(), S.link.end());
   S.link.erase(std::unique(S.link.begin(), S.link.end()), S.link.end());
@@ -752,27 +803,27 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
 
   // Seed: the sub tetrahedron on v's side of the link face of the first star tetrahedron.
   const TetId t0 = S.star[0];
-  const std::size_t b0 = 4 * std::size_t(t0);
+  const std::size_t b0 = 8 * std::size_t(t0);
   int iv0 = 0;
   for (int i = 0; i < 4; ++i)
-    if (tv_[b0 + i] == pv) iv0 = i;
-  const Point3* const P0[4] = {&pos_[tv_[b0]], &pos_[tv_[b0 + 1]], &pos_[tv_[b0 + 2]], &pos_[tv_[b0 + 3]]};
+    if (td_[b0 + i] == pv) iv0 = i;
+  const Point3* const P0[4] = {&pos_[td_[b0]], &pos_[td_[b0 + 1]], &pos_[td_[b0 + 2]], &pos_[td_[b0 + 3]]};
   VertexId fs[3];
   for (int i = 0, k = 0; i < 4; ++i)
-    if (i != iv0) fs[k++] = sub_id(tv_[b0 + i]);
+    if (i != iv0) fs[k++] = sub_id(td_[b0 + i]);
   TetId seed = kNoTet;
   sub.collect_star(fs[0]);
   for (TetId st : sub.scratch_->star) {
-    const std::size_t bs = 4 * std::size_t(st);
+    const std::size_t bs = 8 * std::size_t(st);
     int found = 0, other = -1;
     for (int i = 0; i < 4; ++i) {
-      const PointId w = sub.tv_[bs + i];
+      const PointId w = sub.td_[bs + i];
       if (w == fs[0] || w == fs[1] || w == fs[2])
         ++found;
       else
         other = i;
     }
-    if (found == 3 && orient_replace(P0, iv0, sub.pos_[sub.tv_[bs + other]]) == Sign::Positive) seed = st;
+    if (found == 3 && orient_replace(P0, iv0, sub.pos_[sub.td_[bs + other]]) == Sign::Positive) seed = st;
   }
   for (TetId st : sub.scratch_->star) sub.tf_[st] &= std::uint8_t(~kMark);
   if (seed == kNoTet) throw std::logic_error("Triangulation::remove: no hole tetrahedron on a link face");
@@ -782,10 +833,10 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   S.inside.push_back(seed);
   sub.tf_[seed] |= kMark;
   for (std::size_t k = 0; k < S.inside.size(); ++k) {
-    const std::size_t bs = 4 * std::size_t(S.inside[k]);
+    const std::size_t bs = 8 * std::size_t(S.inside[k]);
     for (int j = 0; j < 4; ++j) {
-      if (find_face(face_key(sub.tv_, bs, j, &S.sub_to_main))) continue;
-      const TetId n = sub.tn_[bs + j];
+      if (find_face(face_key(sub.td_, bs, j, &S.sub_to_main))) continue;
+      const TetId n = sub.td_[4 + bs + j];
       if (n == kNoTet) throw std::logic_error("Triangulation::remove: hole leaks to the hull");
       if (sub.tf_[n] & kMark) continue;
       sub.tf_[n] |= kMark;
@@ -804,34 +855,34 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   S.sub_to_new.assign(sub.tf_.size(), kNoTet);
   for (TetId st : S.inside) {
     const TetId s = alloc_tet();
-    for (int j = 0; j < 4; ++j) tv_[4 * std::size_t(s) + j] = S.sub_to_main[sub.tv_[4 * std::size_t(st) + j]];
+    for (int j = 0; j < 4; ++j) td_[8 * std::size_t(s) + j] = S.sub_to_main[sub.td_[8 * std::size_t(st) + j]];
     S.sub_to_new[st] = s;
     S.created.push_back(s);
   }
   for (std::size_t k = 0; k < S.inside.size(); ++k) {
     const TetId st = S.inside[k], s = S.created[k];
-    const std::size_t bs = 4 * std::size_t(st);
+    const std::size_t bs = 8 * std::size_t(st);
     for (int j = 0; j < 4; ++j) {
-      Scratch::LinkFace* lf = find_face(face_key(sub.tv_, bs, j, &S.sub_to_main));
+      Scratch::LinkFace* lf = find_face(face_key(sub.td_, bs, j, &S.sub_to_main));
       TetId n;
       if (lf) {
-        const std::size_t bt = 4 * std::size_t(lf->star_tet);
+        const std::size_t bt = 8 * std::size_t(lf->star_tet);
         int iv = 0;
         for (int i = 0; i < 4; ++i)
-          if (tv_[bt + i] == pv) iv = i;
-        n = tn_[bt + iv];
+          if (td_[bt + i] == pv) iv = i;
+        n = td_[4 + bt + iv];
         if (n != kNoTet)
           for (int m = 0; m < 4; ++m)
-            if (tn_[4 * std::size_t(n) + m] == lf->star_tet) tn_[4 * std::size_t(n) + m] = s;
+            if (td_[4 + 8 * std::size_t(n) + m] == lf->star_tet) td_[4 + 8 * std::size_t(n) + m] = s;
         lf->new_tet = s;
       } else {
-        n = S.sub_to_new[sub.tn_[bs + j]];
+        n = S.sub_to_new[sub.td_[4 + bs + j]];
       }
-      tn_[4 * std::size_t(s) + j] = n;
+      td_[4 + 8 * std::size_t(s) + j] = n;
     }
   }
   for (TetId s : S.created)
-    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * std::size_t(s) + i]] = s;
+    for (int i = 0; i < 4; ++i) vtet_[td_[8 * std::size_t(s) + i]] = s;
   vtet_[pv] = kNoTet;
   --num_live_vertices_;
   const std::uint32_t op = std::uint32_t(ops_.size());
@@ -839,8 +890,8 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   for (TetId t : S.star) {
     int iv = 0;
     for (int i = 0; i < 4; ++i)
-      if (tv_[4 * std::size_t(t) + i] == pv) iv = i;
-    const Scratch::LinkFace* lf = find_face(face_key(tv_, 4 * std::size_t(t), iv, nullptr));
+      if (td_[8 * std::size_t(t) + i] == pv) iv = i;
+    const Scratch::LinkFace* lf = find_face(face_key(td_, 8 * std::size_t(t), iv, nullptr));
     kill(t, op, lf && lf->new_tet != kNoTet ? lf->new_tet : first);
   }
   num_live_tets_ = num_live_tets_ + S.created.size() - S.star.size();
@@ -863,7 +914,7 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
   };
   auto moved_points = [&](TetId t, const Point3* P[4]) {
     for (int i = 0; i < 4; ++i) {
-      const PointId w = tv_[4 * std::size_t(t) + i];
+      const PointId w = td_[8 * std::size_t(t) + i];
       P[i] = w == pv ? &p : &pos_[w];
     }
   };
@@ -882,11 +933,11 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
     const Point3* P[4];
     moved_points(t, P);
     for (int j = 0; j < 4; ++j) {
-      const TetId n = tn_[4 * std::size_t(t) + j];
+      const TetId n = td_[4 + 8 * std::size_t(t) + j];
       if (n == kNoTet || ((tf_[n] & kMark) && n < t)) continue;
       int k = 0;
-      while (tn_[4 * std::size_t(n) + k] != t) ++k;
-      const Point3& w = pos_[tv_[4 * std::size_t(n) + k]];
+      while (td_[4 + 8 * std::size_t(n) + k] != t) ++k;
+      const Point3& w = pos_[td_[8 * std::size_t(n) + k]];
       if (insphere_sos(*P[0], *P[1], *P[2], *P[3], w) != Sign::Negative) {
         unmark();
         return false;
@@ -899,7 +950,7 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
     PointId nearest = kNoVertex;
     for (TetId t : S.star)
       for (int i = 0; i < 4; ++i) {
-        const PointId w = tv_[4 * std::size_t(t) + i];
+        const PointId w = td_[8 * std::size_t(t) + i];
         if (w == pv) continue;
         const double d2 = squared_distance(pos_[w], p);
         if (d2 < best) {
@@ -936,8 +987,8 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
   for (TetId t : S.star) {
     const TetId s = alloc_tet();
     for (int j = 0; j < 4; ++j) {
-      const PointId w = tv_[4 * std::size_t(t) + j];
-      tv_[4 * std::size_t(s) + j] = w == pv ? np : w;
+      const PointId w = td_[8 * std::size_t(t) + j];
+      td_[8 * std::size_t(s) + j] = w == pv ? np : w;
     }
     S.created.push_back(s);
     S.old_to_new.emplace_back(t, s);
@@ -946,18 +997,18 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
   for (std::size_t k = 0; k < S.star.size(); ++k) {
     const TetId t = S.star[k], s = S.created[k];
     for (int j = 0; j < 4; ++j) {
-      TetId n = tn_[4 * std::size_t(t) + j];
+      TetId n = td_[4 + 8 * std::size_t(t) + j];
       if (n != kNoTet && (tf_[n] & kMark)) {
         n = std::lower_bound(S.old_to_new.begin(), S.old_to_new.end(), std::make_pair(n, TetId(0)))->second;
       } else if (n != kNoTet) {
         for (int m = 0; m < 4; ++m)
-          if (tn_[4 * std::size_t(n) + m] == t) tn_[4 * std::size_t(n) + m] = s;
+          if (td_[4 + 8 * std::size_t(n) + m] == t) td_[4 + 8 * std::size_t(n) + m] = s;
       }
-      tn_[4 * std::size_t(s) + j] = n;
+      td_[4 + 8 * std::size_t(s) + j] = n;
     }
   }
   for (TetId s : S.created)
-    for (int i = 0; i < 4; ++i) vtet_[tv_[4 * std::size_t(s) + i]] = s;
+    for (int i = 0; i < 4; ++i) vtet_[td_[8 * std::size_t(s) + i]] = s;
   if (np != pv) vtet_[pv] = kNoTet;
   const std::uint32_t op = std::uint32_t(ops_.size());
   record_op(first, std::uint32_t(S.created.size()), kNoVertex);
@@ -989,17 +1040,17 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   std::vector<PointId> candidates;
   for (TetId t : S.star) {
     tf_[t] &= std::uint8_t(~kMark);
-    for (int i = 0; i < 4; ++i) candidates.push_back(tv_[4 * std::size_t(t) + i]);
+    for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
   }
   const TetId start = keep_history_ ? locate_history(p) : walk(p, vtet_[pv]);
   for (int i = 0; i < 4; ++i) {
-    const PointId w = tv_[4 * std::size_t(start) + i];
+    const PointId w = td_[8 * std::size_t(start) + i];
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
   }
   PointId dup = kNoVertex;
   if (!grow_cavity(p, start, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
   for (TetId t : S.cavity)
-    for (int i = 0; i < 4; ++i) candidates.push_back(tv_[4 * std::size_t(t) + i]);
+    for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
   clear_cavity_marks();
   if (min_distance > 0.0) {
     double best = min_distance * min_distance;
@@ -1059,10 +1110,10 @@ std::vector<TetId> Triangulation::incident_tetrahedra(VertexId v) const {
   };
   out.push_back(vtet_[pv]);
   for (std::size_t k = 0; k < out.size(); ++k) {
-    const std::size_t b = 4 * std::size_t(out[k]);
+    const std::size_t b = 8 * std::size_t(out[k]);
     for (int i = 0; i < 4; ++i) {
-      if (tv_[b + i] == pv) continue;
-      const TetId n = tn_[b + i];
+      if (td_[b + i] == pv) continue;
+      const TetId n = td_[4 + b + i];
       if (n == kNoTet || visited(n)) continue;
       out.push_back(n);
       if (!seen.empty()) seen.insert(n);
@@ -1091,8 +1142,8 @@ std::size_t Triangulation::memory_live_bytes() const {
 
 std::size_t Triangulation::memory_total_bytes() const {
   std::size_t s = sizeof(*this) + bytes_of(pos_) + bytes_of(vtet_) + bytes_of(vid_of_pid_) +
-                  bytes_of(pid_of_vid_) + bytes_of(tv_) + bytes_of(tn_) + bytes_of(tf_) + bytes_of(ops_) +
-                  bytes_of(init_tv_) + bytes_of(init_tn_);
+                  bytes_of(pid_of_vid_) + bytes_of(td_) + bytes_of(hnb_) + bytes_of(tf_) + bytes_of(ops_) +
+                  bytes_of(init_td_);
   if (scratch_) {
     const Scratch& S = *scratch_;
     s += sizeof(Scratch) + bytes_of(S.cavity) + bytes_of(S.tested) + bytes_of(S.created) + bytes_of(S.star) +
@@ -1113,18 +1164,18 @@ void Triangulation::verify_topology() const {
     if (tf_[t] & kDead) continue;
     ++live;
     if (tf_[t] != 0) fail(T + std::to_string(t) + ": stale temporary flags");
-    const std::size_t b = 4 * std::size_t(t);
+    const std::size_t b = 8 * std::size_t(t);
     for (int i = 0; i < 4; ++i) {
-      const PointId w = tv_[b + i];
+      const PointId w = td_[b + i];
       if (w >= pos_.size()) fail(T + std::to_string(t) + ": vertex slot " + std::to_string(i) + " out of range");
       if (vtet_[w] == kNoTet) fail(T + std::to_string(t) + ": uses removed vertex " + std::to_string(vid(w)));
       for (int j = 0; j < i; ++j)
-        if (tv_[b + j] == w) fail(T + std::to_string(t) + ": repeated vertex");
+        if (td_[b + j] == w) fail(T + std::to_string(t) + ": repeated vertex");
     }
-    if (orient3d(pos_[tv_[b]], pos_[tv_[b + 1]], pos_[tv_[b + 2]], pos_[tv_[b + 3]]) != Sign::Positive)
+    if (orient3d(pos_[td_[b]], pos_[td_[b + 1]], pos_[td_[b + 2]], pos_[td_[b + 3]]) != Sign::Positive)
       fail(T + std::to_string(t) + " is not positively oriented");
     for (int i = 0; i < 4; ++i) {
-      const TetId n = tn_[b + i];
+      const TetId n = td_[4 + b + i];
       if (n == kNoTet) {
         // A hull face lies in a face of the box.
         bool on_box = false;
@@ -1132,7 +1183,7 @@ void Triangulation::verify_topology() const {
           for (double side : {box_.lo[std::size_t(axis)], box_.hi[std::size_t(axis)]}) {
             bool all = true;
             for (int j = 0; j < 4; ++j)
-              if (j != i && pos_[tv_[b + j]][std::size_t(axis)] != side) all = false;
+              if (j != i && pos_[td_[b + j]][std::size_t(axis)] != side) all = false;
             if (all) on_box = true;
           }
         if (!on_box) fail(T + std::to_string(t) + ": face " + std::to_string(i) + " has no neighbour but is not on the box");
@@ -1142,15 +1193,15 @@ void Triangulation::verify_topology() const {
         fail(T + std::to_string(t) + ": neighbour " + std::to_string(i) + " (" + std::to_string(n) + ") is not live");
       int back = -1;
       for (int k = 0; k < 4; ++k)
-        if (tn_[4 * std::size_t(n) + k] == t) back = k;
+        if (td_[4 + 8 * std::size_t(n) + k] == t) back = k;
       if (back < 0)
         fail(T + std::to_string(t) + ": neighbour " + std::to_string(n) + " across face " + std::to_string(i) +
              " does not point back");
       std::array<PointId, 3> f1{}, f2{};
       for (int j = 0, k = 0; j < 4; ++j)
-        if (j != i) f1[std::size_t(k++)] = tv_[b + j];
+        if (j != i) f1[std::size_t(k++)] = td_[b + j];
       for (int j = 0, k = 0; j < 4; ++j)
-        if (j != back) f2[std::size_t(k++)] = tv_[4 * std::size_t(n) + j];
+        if (j != back) f2[std::size_t(k++)] = td_[8 * std::size_t(n) + j];
       std::sort(f1.begin(), f1.end());
       std::sort(f2.begin(), f2.end());
       if (f1 != f2)
@@ -1169,7 +1220,7 @@ void Triangulation::verify_topology() const {
       fail("vertex " + std::to_string(vid(w)) + ": incident tetrahedron " + std::to_string(t) + " is not live");
     bool has = false;
     for (int i = 0; i < 4; ++i)
-      if (tv_[4 * std::size_t(t) + i] == w) has = true;
+      if (td_[8 * std::size_t(t) + i] == w) has = true;
     if (!has) fail("vertex " + std::to_string(vid(w)) + ": incident tetrahedron does not contain it");
     if (!pid_of_vid_.empty() && pid_of_vid_[vid_of_pid_[w]] != w)
       fail("vertex " + std::to_string(vid(w)) + ": id translation is inconsistent");
@@ -1184,15 +1235,15 @@ void Triangulation::verify_topology() const {
 void Triangulation::verify_delaunay() const {
   for (TetId t = 0; t < tf_.size(); ++t) {
     if (tf_[t] & kDead) continue;
-    const std::size_t b = 4 * std::size_t(t);
+    const std::size_t b = 8 * std::size_t(t);
     for (int i = 0; i < 4; ++i) {
-      const TetId n = tn_[b + i];
+      const TetId n = td_[4 + b + i];
       if (n == kNoTet) continue;
       int k = 0;
-      while (k < 4 && tn_[4 * std::size_t(n) + k] != t) ++k;
+      while (k < 4 && td_[4 + 8 * std::size_t(n) + k] != t) ++k;
       if (k == 4) throw std::logic_error("verify_delaunay: asymmetric neighbours (run verify_topology)");
-      const PointId w = tv_[4 * std::size_t(n) + k];
-      if (insphere_sos(pos_[tv_[b]], pos_[tv_[b + 1]], pos_[tv_[b + 2]], pos_[tv_[b + 3]], pos_[w]) !=
+      const PointId w = td_[8 * std::size_t(n) + k];
+      if (insphere_sos(pos_[td_[b]], pos_[td_[b + 1]], pos_[td_[b + 2]], pos_[td_[b + 3]], pos_[w]) !=
           Sign::Negative)
         throw std::logic_error("verify_delaunay: vertex " + std::to_string(vid(w)) + " of tetrahedron " +
                                std::to_string(n) + " is inside the (perturbed) circumsphere of tetrahedron " +

@@ -21,6 +21,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <utility>
 #include <vector>
 
 namespace vitri {
@@ -118,6 +119,10 @@ class Triangulation {
   /// A live tetrahedron containing p (closed); p must lie in the box. Uses the history DAG.
   TetId locate(const Point3& p) const;
 
+  /// Diagnostic: number of history records and of tetrahedra visited by the history descent of locate(p)
+  /// (both 0 without history).
+  std::pair<std::size_t, std::size_t> history_path(const Point3& p) const;
+
   const Box3& box() const { return box_; }
   bool keeps_history() const { return keep_history_; }
   std::size_t num_vertices() const { return num_live_vertices_; }  ///< live vertices, corners included
@@ -135,11 +140,11 @@ class Triangulation {
   /// t is a live tetrahedron (false for dead, recycled or out-of-range ids).
   bool is_live(TetId t) const { return t < tf_.size() && !(tf_[t] & kDead); }
   /// Vertex i (0..3) of tetrahedron t (live or dead).
-  VertexId tet_vertex(TetId t, int i) const { return vid(tv_[4 * std::size_t(t) + i]); }
+  VertexId tet_vertex(TetId t, int i) const { return vid(td_[8 * std::size_t(t) + i]); }
   /// Position of vertex i of t: point(tet_vertex(t, i)) without the id translation.
-  const Point3& tet_point(TetId t, int i) const { return pos_[tv_[4 * std::size_t(t) + i]]; }
+  const Point3& tet_point(TetId t, int i) const { return pos_[td_[8 * std::size_t(t) + i]]; }
   /// Across the face opposite vertex i; kNoTet on the hull. @pre is_live(t).
-  TetId tet_neighbor(TetId t, int i) const { return tn_[4 * std::size_t(t) + i]; }
+  TetId tet_neighbor(TetId t, int i) const { return td_[8 * std::size_t(t) + 4 + i]; }
   std::array<VertexId, 4> tet_vertices(TetId t) const {
     return {tet_vertex(t, 0), tet_vertex(t, 1), tet_vertex(t, 2), tet_vertex(t, 3)};
   }
@@ -193,6 +198,7 @@ class Triangulation {
   static constexpr std::uint8_t kDead = 1;      // tetrahedron is dead (or a free slot)
   static constexpr std::uint8_t kMark = 2;      // temporary: in the current cavity / star
   static constexpr std::uint8_t kTested = 4;    // temporary: tested, not in conflict
+  static constexpr std::uint16_t kNoOffset = 0xffff;
 
   PointId pid(VertexId v) const { return pid_of_vid_.empty() ? v : pid_of_vid_[v]; }
   VertexId vid(PointId p) const { return vid_of_pid_.empty() ? p : vid_of_pid_[p]; }
@@ -203,6 +209,7 @@ class Triangulation {
   TetId walk(const Point3& p, TetId start) const;
   TetId locate_history(const Point3& p) const;
   bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
+  TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
   TetId alloc_tet();
   void free_tet(TetId t);
   PointId alloc_point(const Point3& p, VertexId reuse_vid);
@@ -224,16 +231,20 @@ class Triangulation {
   std::vector<TetId> vtet_;            // by PointId: one incident live tetrahedron, kNoTet if not live
   std::vector<VertexId> vid_of_pid_;   // empty until the first move
   std::vector<PointId> pid_of_vid_;    // empty until the first move
-  std::vector<PointId> tv_;            // 4 per tetrahedron
-  std::vector<TetId> tn_;              // 4 per tetrahedron; dead: [0] history op, [1] hint
+  // 8 per tetrahedron t, one half cache line: td_[8t + i] vertex i (a PointId), td_[8t + 4 + i] the
+  // neighbour across the face opposite vertex i. Dead: td_[8t + 4] its history Op, td_[8t + 5] a hint.
+  std::vector<std::uint32_t> td_;
   std::vector<std::uint8_t> tf_;       // flags per tetrahedron
+  // History only: for a tetrahedron created by an insertion, its neighbours across the faces through the
+  // apex at creation time, as offsets in its Op's range (kNoOffset: none / range too large). Location
+  // walks around the apex with them instead of scanning the range.
+  std::vector<std::array<std::uint16_t, 4>> hnb_;
   std::vector<Op> ops_;                // history records (insertions, removals, moves)
   std::size_t num_live_vertices_ = 0;
   std::size_t num_live_tets_ = 0;
   TetId free_head_ = kNoTet;           // recycled slots (keep_history == false)
   TetId last_tet_ = 0;                 // a live tetrahedron near the last operation (walk start)
-  std::vector<PointId> init_tv_;       // the 8-corner triangulation, for reset_to_corners()
-  std::vector<TetId> init_tn_;
+  std::vector<std::uint32_t> init_td_; // the 8-corner triangulation, for reset_to_corners()
   std::unique_ptr<Scratch> scratch_;   // work buffers, never shared between copies
 };
 

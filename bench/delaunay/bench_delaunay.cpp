@@ -1,0 +1,328 @@
+// Delaunay tree vs CGAL's Delaunay_triangulation_3 (Epick), same points, same process.
+//
+//   bench_delaunay [--benchmark_filter=REGEX]
+//
+// Pairs of benchmarks vitri_X / cgal_X; at the end the ratio vitri / CGAL of every pair is printed.
+// - bulk/N: bulk build of N uniform points (vitri: insert_points with the history; CGAL: range insert,
+//   which sorts spatially too). bulk_nohist/N: vitri without history.
+// - grid/n: the n^3 integer grid (cospherical everywhere).
+// - insert1M: 10^4 single insertions at random locations into a 10^6-point triangulation (vitri:
+//   insert(), history location; CGAL: Fast_location, i.e. the Delaunay hierarchy, no hint).
+// - remove1M, move1M_small, move1M_far: 10^4 removals / moves in a 10^6-point triangulation (CGAL
+//   without the hierarchy, which only slows removal down).
+// Memory: counters bytes_per_vertex (heap growth measured with mallinfo2 around the build), and for vitri
+// live_B_per_v / total_B_per_v from memory_live_bytes() / memory_total_bytes().
+#include "vitri/delaunay/triangulation.hpp"
+
+#include <benchmark/benchmark.h>
+#include <malloc.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#ifdef VITRI_HAVE_CGAL
+#include <CGAL/Delaunay_triangulation_3.h>
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#endif
+
+namespace {
+
+using vitri::Point3;
+
+const vitri::Box3 kBox{{-0.5, -0.5, -0.5}, {1.5, 1.5, 1.5}};  // unit cube enlarged by 2
+
+std::vector<Point3> uniform(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<Point3> p(n);
+  for (auto& q : p) q = {u(rng), u(rng), u(rng)};
+  return p;
+}
+
+std::vector<Point3> grid(int n) {
+  std::vector<Point3> p;
+  p.reserve(std::size_t(n) * std::size_t(n) * std::size_t(n));
+  for (int x = 0; x < n; ++x)
+    for (int y = 0; y < n; ++y)
+      for (int z = 0; z < n; ++z) p.push_back({double(x), double(y), double(z)});
+  std::mt19937_64 rng(3);
+  std::shuffle(p.begin(), p.end(), rng);
+  return p;
+}
+
+std::size_t heap_bytes() { return mallinfo2().uordblks; }
+
+constexpr std::size_t kOps = 10000;
+constexpr std::size_t kBig = 1000000;
+
+#ifdef VITRI_HAVE_CGAL
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using CPoint = K::Point_3;
+using CDT = CGAL::Delaunay_triangulation_3<K>;
+using CDTFast = CGAL::Delaunay_triangulation_3<K, CGAL::Default, CGAL::Fast_location>;
+
+std::vector<CPoint> to_cgal(const std::vector<Point3>& p) {
+  std::vector<CPoint> c;
+  c.reserve(p.size());
+  for (const auto& q : p) c.emplace_back(q.x, q.y, q.z);
+  return c;
+}
+#endif
+
+// ---- bulk ----------------------------------------------------------------------------------------
+
+void vitri_bulk_impl(benchmark::State& state, bool history) {
+  const auto pts = uniform(std::size_t(state.range(0)), 1);
+  double live = 0, total = 0, heap = 0;
+  for (auto _ : state) {
+    const std::size_t h0 = heap_bytes();
+    vitri::Triangulation tr(kBox, vitri::TriangulationOptions{history});
+    tr.insert_points(pts);
+    heap = double(heap_bytes() - h0) / double(pts.size());
+    live = double(tr.memory_live_bytes()) / double(pts.size());
+    total = double(tr.memory_total_bytes()) / double(pts.size());
+    benchmark::DoNotOptimize(tr.num_tetrahedra());
+  }
+  state.counters["bytes_per_vertex"] = heap;
+  state.counters["live_B_per_v"] = live;
+  state.counters["total_B_per_v"] = total;
+}
+void vitri_bulk(benchmark::State& state) { vitri_bulk_impl(state, true); }
+void vitri_bulk_nohist(benchmark::State& state) { vitri_bulk_impl(state, false); }
+BENCHMARK(vitri_bulk)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(vitri_bulk_nohist)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+
+#ifdef VITRI_HAVE_CGAL
+void cgal_bulk(benchmark::State& state) {
+  const auto pts = to_cgal(uniform(std::size_t(state.range(0)), 1));
+  double heap = 0;
+  for (auto _ : state) {
+    const std::size_t h0 = heap_bytes();
+    CDT dt(pts.begin(), pts.end());
+    heap = double(heap_bytes() - h0) / double(pts.size());
+    benchmark::DoNotOptimize(dt.number_of_cells());
+  }
+  state.counters["bytes_per_vertex"] = heap;
+}
+BENCHMARK(cgal_bulk)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+#endif
+
+// ---- grid ----------------------------------------------------------------------------------------
+
+void vitri_grid(benchmark::State& state) {
+  const int n = int(state.range(0));
+  const auto pts = grid(n);
+  for (auto _ : state) {
+    vitri::Triangulation tr(vitri::Box3{{-1, -1, -1}, {double(n), double(n), double(n)}});
+    tr.insert_points(pts);
+    benchmark::DoNotOptimize(tr.num_tetrahedra());
+    state.counters["tets"] = double(tr.num_tetrahedra());
+  }
+}
+BENCHMARK(vitri_grid)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
+
+#ifdef VITRI_HAVE_CGAL
+void cgal_grid(benchmark::State& state) {
+  const int n = int(state.range(0));
+  const auto pts = to_cgal(grid(n));
+  for (auto _ : state) {
+    CDT dt(pts.begin(), pts.end());
+    benchmark::DoNotOptimize(dt.number_of_cells());
+    state.counters["tets"] = double(dt.number_of_finite_cells());
+  }
+}
+BENCHMARK(cgal_grid)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
+#endif
+
+// ---- dynamic operations in a 10^6-point triangulation -----------------------------------------------
+
+vitri::Triangulation& vitri_big() {
+  static std::unique_ptr<vitri::Triangulation> tr = [] {
+    auto t = std::make_unique<vitri::Triangulation>(kBox);
+    t->insert_points(uniform(kBig, 1));
+    return t;
+  }();
+  return *tr;
+}
+
+void vitri_insert1M(benchmark::State& state) {
+  auto& tr = vitri_big();
+  unsigned seed = 100;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto pts = uniform(kOps, seed++);
+    state.ResumeTiming();
+    for (const auto& p : pts) benchmark::DoNotOptimize(tr.insert(p).vertex);
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(kOps));
+}
+BENCHMARK(vitri_insert1M)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// Random live non-corner vertices.
+std::vector<vitri::VertexId> pick_vitri(const vitri::Triangulation& tr, std::size_t k, unsigned seed) {
+  std::vector<vitri::VertexId> all;
+  for (vitri::VertexId v = 8; v < tr.vertex_capacity(); ++v)
+    if (tr.is_vertex(v)) all.push_back(v);
+  std::mt19937_64 rng(seed);
+  std::shuffle(all.begin(), all.end(), rng);
+  all.resize(std::min(k, all.size()));
+  return all;
+}
+
+void vitri_remove1M(benchmark::State& state) {
+  auto& tr = vitri_big();
+  unsigned seed = 200;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto vs = pick_vitri(tr, kOps, seed++);
+    state.ResumeTiming();
+    for (auto v : vs) tr.remove(v);
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(kOps));
+}
+BENCHMARK(vitri_remove1M)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void vitri_move_impl(benchmark::State& state, bool small) {
+  auto& tr = vitri_big();
+  unsigned seed = small ? 300 : 400;
+  const double spacing = 1.0 / 100.0;  // mean spacing of 10^6 points in the unit cube
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto vs = pick_vitri(tr, kOps, seed);
+    std::mt19937_64 rng(seed++);
+    std::uniform_real_distribution<double> d(-0.1 * spacing, 0.1 * spacing), u(0.0, 1.0);
+    std::vector<Point3> to;
+    for (auto v : vs) to.push_back(small ? tr.point(v) + Point3{d(rng), d(rng), d(rng)} : Point3{u(rng), u(rng), u(rng)});
+    state.ResumeTiming();
+    for (std::size_t i = 0; i < vs.size(); ++i) benchmark::DoNotOptimize(tr.move(vs[i], to[i]).status);
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(kOps));
+}
+void vitri_move1M_small(benchmark::State& state) { vitri_move_impl(state, true); }
+void vitri_move1M_far(benchmark::State& state) { vitri_move_impl(state, false); }
+BENCHMARK(vitri_move1M_small)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(vitri_move1M_far)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+#ifdef VITRI_HAVE_CGAL
+CDTFast& cgal_big_fast() {
+  static std::unique_ptr<CDTFast> dt = [] {
+    const auto pts = to_cgal(uniform(kBig, 1));
+    return std::make_unique<CDTFast>(pts.begin(), pts.end());
+  }();
+  return *dt;
+}
+CDT& cgal_big() {
+  static std::unique_ptr<CDT> dt = [] {
+    const auto pts = to_cgal(uniform(kBig, 1));
+    return std::make_unique<CDT>(pts.begin(), pts.end());
+  }();
+  return *dt;
+}
+
+void cgal_insert1M(benchmark::State& state) {
+  auto& dt = cgal_big_fast();
+  unsigned seed = 100;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto pts = to_cgal(uniform(kOps, seed++));
+    state.ResumeTiming();
+    for (const auto& p : pts) benchmark::DoNotOptimize(dt.insert(p));
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(kOps));
+}
+BENCHMARK(cgal_insert1M)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+std::vector<CDT::Vertex_handle> pick_cgal(CDT& dt, std::size_t k, unsigned seed) {
+  std::vector<CDT::Vertex_handle> all;
+  for (auto v = dt.finite_vertices_begin(); v != dt.finite_vertices_end(); ++v) all.push_back(v);
+  std::mt19937_64 rng(seed);
+  std::shuffle(all.begin(), all.end(), rng);
+  all.resize(std::min(k, all.size()));
+  return all;
+}
+
+void cgal_remove1M(benchmark::State& state) {
+  auto& dt = cgal_big();
+  unsigned seed = 200;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto vs = pick_cgal(dt, kOps, seed++);
+    state.ResumeTiming();
+    for (auto v : vs) dt.remove(v);
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(kOps));
+}
+BENCHMARK(cgal_remove1M)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+void cgal_move_impl(benchmark::State& state, bool small) {
+  auto& dt = cgal_big();
+  unsigned seed = small ? 300 : 400;
+  const double spacing = 1.0 / 100.0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const auto vs = pick_cgal(dt, kOps, seed);
+    std::mt19937_64 rng(seed++);
+    std::uniform_real_distribution<double> d(-0.1 * spacing, 0.1 * spacing), u(0.0, 1.0);
+    std::vector<CPoint> to;
+    for (auto v : vs) {
+      const CPoint& p = v->point();
+      to.push_back(small ? CPoint(p.x() + d(rng), p.y() + d(rng), p.z() + d(rng)) : CPoint(u(rng), u(rng), u(rng)));
+    }
+    state.ResumeTiming();
+    for (std::size_t i = 0; i < vs.size(); ++i) benchmark::DoNotOptimize(dt.move(vs[i], to[i]));
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(kOps));
+}
+void cgal_move1M_small(benchmark::State& state) { cgal_move_impl(state, true); }
+void cgal_move1M_far(benchmark::State& state) { cgal_move_impl(state, false); }
+BENCHMARK(cgal_move1M_small)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(cgal_move1M_far)->Unit(benchmark::kMillisecond)->Iterations(3);
+#endif
+
+// Collects the times and prints vitri / CGAL ratios at the end.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const auto& r : runs) {
+      if (r.run_type == Run::RT_Aggregate && r.aggregate_name != "mean") continue;
+      std::string name = r.benchmark_name();
+      const auto agg = name.find("_mean");
+      if (agg != std::string::npos) name.erase(agg);
+      const auto it = name.find("/iterations");
+      if (it != std::string::npos) name.erase(it, name.find('/', it + 1) == std::string::npos ? std::string::npos : name.find('/', it + 1) - it);
+      times_[name] = r.GetAdjustedRealTime();
+    }
+    ConsoleReporter::ReportRuns(runs);
+  }
+  void print_ratios() const {
+    std::printf("\nratio vitri / CGAL (real time):\n");
+    for (const auto& [name, t] : times_) {
+      if (name.rfind("vitri_", 0) != 0) continue;
+      std::string key = name.substr(6);
+      const auto nh = key.find("_nohist");
+      if (nh != std::string::npos) key.erase(nh, 7);
+      const auto c = times_.find("cgal_" + key);
+      if (c == times_.end()) continue;
+      std::printf("  %-28s %8.3f\n", name.c_str(), t / c->second);
+    }
+  }
+
+ private:
+  std::map<std::string, double> times_;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  reporter.print_ratios();
+  benchmark::Shutdown();
+  return 0;
+}

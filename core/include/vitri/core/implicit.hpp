@@ -26,6 +26,13 @@ class ImplicitFunction {
   virtual void values(const Point3* points, std::size_t n, double* out) const {
     for (std::size_t i = 0; i < n; ++i) out[i] = value(points[i]);
   }
+
+  /// Batch evaluation with gradients: values[i] = f(points[i]), gradients[i] = grad f(points[i]) for
+  /// i < n. The default loops over value_gradient(); implementations override it with a vectorized or
+  /// threaded kernel (the polygonizer computes all mesh normals with one call).
+  virtual void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const {
+    for (std::size_t i = 0; i < n; ++i) values[i] = value_gradient(points[i], gradients[i]);
+  }
 };
 
 }  // namespace vitri

@@ -119,7 +119,7 @@ class Expansion {
   int sign() const { return size_ == 0 ? 0 : (data_[size_ - 1] > 0.0 ? 1 : -1); }
 
  private:
-  static constexpr int kInline = 32;
+  static constexpr int kInline = 64;
   double inline_[kInline];
   std::unique_ptr<double[]> heap_;
   double* data_ = inline_;

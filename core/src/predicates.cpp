@@ -23,6 +23,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace vitri {
 
@@ -47,6 +49,14 @@ constexpr int kOrient2dExponent = 500;
 /// Scales v[0..n) by one power of two so that max |v[i]| lies in [2^(target - 1), 2^target).
 /// Returns false when some value is not finite (the predicates then answer Zero: no precondition
 /// violation may crash or hit undefined behaviour).
+/// 2^k for -1022 <= k <= 1023, built from its bits (no libm call).
+double power_of_two(int k) {
+  const std::uint64_t bits = static_cast<std::uint64_t>(k + 1023) << 52;
+  double r;
+  std::memcpy(&r, &bits, sizeof r);
+  return r;
+}
+
 bool prescale(double* v, int n, int target) {
   double m = 0.0;
   for (int i = 0; i < n; ++i) {
@@ -54,11 +64,43 @@ bool prescale(double* v, int n, int target) {
     m = std::max(m, std::fabs(v[i]));
   }
   if (m == 0.0) return true;
-  const int k = target - 1 - std::ilogb(m);
-  if (k != 0)
-    for (int i = 0; i < n; ++i) v[i] = std::ldexp(v[i], k);
+  int k = target - 1 - std::ilogb(m);
+  // Multiply by 2^k in steps of at most 2^+-1000 (each factor a normal double): exact unless a value
+  // underflows, which the documented range excludes.
+  while (k != 0) {
+    const int step = std::max(-1000, std::min(1000, k));
+    const double f = power_of_two(step);
+    for (int i = 0; i < n; ++i) v[i] *= f;
+    k -= step;
+  }
   return true;
 }
+
+/// Double arithmetic that records whether every operation was exact (error-free transformations):
+/// when `exact` is still true at the end, the double result is the exact value. This is the cheap
+/// first stage of the fallback; it succeeds on grids and other inputs whose differences and products
+/// need few bits (exactly the degenerate inputs that Delaunay triangulations of grids produce).
+struct CheckedArithmetic {
+  bool exact = true;
+  double sub(double a, double b) {
+    double x, y;
+    two_diff(a, b, x, y);
+    exact = exact && y == 0.0;
+    return x;
+  }
+  double add(double a, double b) {
+    double x, y;
+    two_sum(a, b, x, y);
+    exact = exact && y == 0.0;
+    return x;
+  }
+  double mul(double a, double b) {
+    double x, y;
+    two_product(a, b, x, y);
+    exact = exact && y == 0.0;
+    return x;
+  }
+};
 
 Sign to_sign(int s) { return s > 0 ? Sign::Positive : (s < 0 ? Sign::Negative : Sign::Zero); }
 
@@ -69,6 +111,7 @@ void cross_minor(const Expansion& p, const Expansion& q, const Expansion& r, con
   expansion_product(p, q, t1);
   expansion_product(r, s, t2);
   expansion_sum(t1, t2, h, -1.0);
+  expansion_compress(h);
 }
 
 /// h = s1 * p1 * m1 + s2 * p2 * m2 + s3 * p3 * m3 (the signs s_i are +1 or -1), exactly.
@@ -87,12 +130,10 @@ void combine3(const Expansion& p1, const Expansion& m1, double s1, const Expansi
 
 }  // namespace
 
-Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
-#ifdef VITRI_PREDICATE_STATS
-  ++predicate_stats().orient3d_exact;
-#endif
-  double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
-  if (!prescale(v, 12, kOrient3dExponent)) return Sign::Zero;
+namespace {
+/// Stage 2 of orient3d_exact on the pre-scaled coordinates v (a, b, c, d): expansion arithmetic.
+/// Kept out of line so that stage 1 does not pay for the large stack frame.
+[[gnu::noinline]] Sign orient3d_expansion(const double* v) {
   // Rows u = b - a, v = c - a, w = d - a; columns x, y, z.
   Expansion m[3][3];
   for (int r = 0; r < 3; ++r)
@@ -107,13 +148,32 @@ Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
   combine3(u[0], m1, 1.0, u[1], m2, 1.0, u[2], m3, 1.0, det);
   return to_sign(det.sign());
 }
+}  // namespace
 
-Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
 #ifdef VITRI_PREDICATE_STATS
-  ++predicate_stats().insphere_exact;
+  ++predicate_stats().orient3d_exact;
 #endif
-  double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
-  if (!prescale(v, 15, kInsphereExponent)) return Sign::Zero;
+  double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+  if (!prescale(v, 12, kOrient3dExponent)) return Sign::Zero;
+  {
+    // Stage 1: the filter's expression, every operation checked for exactness.
+    CheckedArithmetic f;
+    double m[3][3];
+    for (int r = 0; r < 3; ++r)
+      for (int k = 0; k < 3; ++k) m[r][k] = f.sub(v[3 * (r + 1) + k], v[k]);
+    const double m1 = f.sub(f.mul(m[1][1], m[2][2]), f.mul(m[1][2], m[2][1]));
+    const double m2 = f.sub(f.mul(m[1][2], m[2][0]), f.mul(m[1][0], m[2][2]));
+    const double m3 = f.sub(f.mul(m[1][0], m[2][1]), f.mul(m[1][1], m[2][0]));
+    const double det = f.add(f.add(f.mul(m[0][0], m1), f.mul(m[0][1], m2)), f.mul(m[0][2], m3));
+    if (f.exact) return sign_of(det);
+  }
+  return orient3d_expansion(v);
+}
+
+namespace {
+/// Stage 2 of insphere_exact on the pre-scaled coordinates v (a, b, c, d, e): expansion arithmetic.
+[[gnu::noinline]] Sign insphere_expansion(const double* v) {
   // q[r][k] = coordinate k of (point r - e), r = a, b, c, d.
   Expansion q[4][3];
   for (int r = 0; r < 4; ++r)
@@ -145,6 +205,38 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
   expansion_sum(t[2], t[3], s2, -1.0);
   expansion_sum(s1, s2, det);
   return to_sign(det.sign());
+}
+}  // namespace
+
+Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+#ifdef VITRI_PREDICATE_STATS
+  ++predicate_stats().insphere_exact;
+#endif
+  double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
+  if (!prescale(v, 15, kInsphereExponent)) return Sign::Zero;
+  {
+    // Stage 1: the filter's expression, every operation checked for exactness.
+    CheckedArithmetic f;
+    double q[4][3];
+    for (int r = 0; r < 4; ++r)
+      for (int k = 0; k < 3; ++k) q[r][k] = f.sub(v[3 * r + k], v[12 + k]);
+    if (f.exact) {  // worth going on only with exact differences
+      auto minor2 = [&](int i, int j) { return f.sub(f.mul(q[i][0], q[j][1]), f.mul(q[j][0], q[i][1])); };
+      const double ab = minor2(0, 1), bc = minor2(1, 2), cd = minor2(2, 3), da = minor2(3, 0), ac = minor2(0, 2),
+                   bd = minor2(1, 3);
+      const double abc = f.add(f.sub(f.mul(q[0][2], bc), f.mul(q[1][2], ac)), f.mul(q[2][2], ab));
+      const double bcd = f.add(f.sub(f.mul(q[1][2], cd), f.mul(q[2][2], bd)), f.mul(q[3][2], bc));
+      const double cda = f.add(f.add(f.mul(q[2][2], da), f.mul(q[3][2], ac)), f.mul(q[0][2], cd));
+      const double dab = f.add(f.add(f.mul(q[3][2], ab), f.mul(q[0][2], bd)), f.mul(q[1][2], da));
+      double lift[4];
+      for (int r = 0; r < 4; ++r)
+        lift[r] = f.add(f.add(f.mul(q[r][0], q[r][0]), f.mul(q[r][1], q[r][1])), f.mul(q[r][2], q[r][2]));
+      const double det = f.add(f.sub(f.mul(lift[0], bcd), f.mul(lift[1], cda)),
+                               f.sub(f.mul(lift[2], dab), f.mul(lift[3], abc)));
+      if (f.exact) return sign_of(det);
+    }
+  }
+  return insphere_expansion(v);
 }
 
 Sign orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {

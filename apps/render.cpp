@@ -49,15 +49,21 @@ struct Screen {
   double x, y;
 };
 
-/// Twice the signed area of (a, b, p) in screen space, evaluated with (a, b) in a canonical order so
-/// that edge(a, b, p) == -edge(b, a, p) exactly.
-double edge(const Screen& a, const Screen& b, const Screen& p) {
-  const bool swap = a.x > b.x || (a.x == b.x && a.y > b.y);
-  const Screen& u = swap ? b : a;
-  const Screen& v = swap ? a : b;
-  const double e = (v.x - u.x) * (p.y - u.y) - (v.y - u.y) * (p.x - u.x);
-  return swap ? -e : e;
-}
+/// The edge function of the directed edge a -> b: twice the signed area of (a, b, p) in screen space.
+/// It is evaluated with (a, b) in a canonical order, so that Edge(a, b)(p) == -Edge(b, a)(p) exactly.
+struct Edge {
+  Screen u;
+  double dx, dy, sign;
+  Edge(const Screen& a, const Screen& b) {
+    const bool swap = a.x > b.x || (a.x == b.x && a.y > b.y);
+    u = swap ? b : a;
+    const Screen& v = swap ? a : b;
+    dx = v.x - u.x;
+    dy = v.y - u.y;
+    sign = swap ? -1.0 : 1.0;
+  }
+  double operator()(const Screen& p) const { return sign * (dx * (p.y - u.y) - dy * (p.x - u.x)); }
+};
 
 void check_options(const RenderOptions& o) {
   auto fail = [](const std::string& what) { throw InvalidArgument("render options: " + what); };
@@ -260,7 +266,8 @@ Image render_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Rend
     const double z[3] = {depth[id[0]], depth[id[1]], depth[id[2]]};
     if (cam.perspective && (z[0] <= cam.near || z[1] <= cam.near || z[2] <= cam.near)) continue;
     const Screen p[3] = {screen[id[0]], screen[id[1]], screen[id[2]]};
-    double area = edge(p[0], p[1], p[2]);
+    const Edge e0(p[1], p[2]), e1(p[2], p[0]), e2(p[0], p[1]);
+    double area = e2(p[2]);
     if (area == 0.0 || !std::isfinite(area)) continue;  // seen edge-on
     const double sign = area > 0 ? 1.0 : -1.0;
     area *= sign;
@@ -270,6 +277,17 @@ Image render_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Rend
     const Point3 centroid = (a + b + c) / 3.0;
     const bool front = dot(face_n, cam.perspective ? cam.eye - centroid : -1.0 * cam.forward) > 0.0;
     const Color base = front ? o.front : o.back;
+    // Flat shading: one colour per triangle, lit from its centroid (the headlight direction varies
+    // little across one triangle), so a sample costs a depth test and a store.
+    auto shade = [&](const Point3& normal, const Point3& at) {
+      const Point3 n = front ? normal : -1.0 * normal;
+      const Point3 light = cam.perspective ? normalized(cam.eye - at) : -1.0 * cam.forward;
+      const double lambert = std::max(0.0, dot(n, light));
+      const double highlight = o.specular * std::pow(lambert, o.shininess) * 255.0;
+      const double k = o.ambient + o.diffuse * lambert;
+      return Color{to_byte(base.r * k + highlight), to_byte(base.g * k + highlight), to_byte(base.b * k + highlight)};
+    };
+    const Color flat_color = shade(face_n, centroid);
     const double len[3] = {std::hypot(p[2].x - p[1].x, p[2].y - p[1].y), std::hypot(p[0].x - p[2].x, p[0].y - p[2].y),
                            std::hypot(p[1].x - p[0].x, p[1].y - p[0].y)};
 
@@ -280,7 +298,7 @@ Image render_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Rend
     for (int y = y0; y <= y1; ++y)
       for (int x = x0; x <= x1; ++x) {
         const Screen s{x + 0.5, y + 0.5};
-        const double w0 = sign * edge(p[1], p[2], s), w1 = sign * edge(p[2], p[0], s), w2 = sign * edge(p[0], p[1], s);
+        const double w0 = sign * e0(s), w1 = sign * e1(s), w2 = sign * e2(s);
         if (w0 < 0.0 || w1 < 0.0 || w2 < 0.0) continue;
         double mu[3] = {w0 / area, w1 / area, w2 / area};
         double zs;
@@ -300,19 +318,13 @@ Image render_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const Rend
           cbuf[k] = o.wire_color;
           continue;
         }
-        Point3 n = face_n;
-        if (o.shading == Shading::smooth) {
-          n = normalized(mu[0] * vnormal[id[0]] + mu[1] * vnormal[id[1]] + mu[2] * vnormal[id[2]]);
-          if (norm(n) == 0.0) n = face_n;
+        if (o.shading == Shading::flat) {
+          cbuf[k] = flat_color;
+          continue;
         }
-        if (!front) n = -1.0 * n;
-        const Point3 world = mu[0] * a + mu[1] * b + mu[2] * c;
-        const Point3 light = cam.perspective ? normalized(cam.eye - world) : -1.0 * cam.forward;
-        const double lambert = std::max(0.0, dot(n, light));
-        const double highlight = o.specular * std::pow(lambert, o.shininess) * 255.0;
-        const double shade = o.ambient + o.diffuse * lambert;
-        cbuf[k] = {to_byte(base.r * shade + highlight), to_byte(base.g * shade + highlight),
-                   to_byte(base.b * shade + highlight)};
+        Point3 n = normalized(mu[0] * vnormal[id[0]] + mu[1] * vnormal[id[1]] + mu[2] * vnormal[id[2]]);
+        if (norm(n) == 0.0) n = face_n;
+        cbuf[k] = shade(n, mu[0] * a + mu[1] * b + mu[2] * c);
       }
   }
 

@@ -147,7 +147,7 @@ class Rbf : public ImplicitFunction {
   /// out[i] = f(points[i]), i < n, threaded when large (options().threads).
   void values(const Point3* points, std::size_t n, double* out) const override;
   /// values[i] = f(points[i]) and gradients[i] = grad f(points[i]), i < n, threaded when large.
-  void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const;
+  void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const override;
 
   // ----- coefficients, in the caller's units -----
   /// RBF weights w_j of f (one per constraint, same numbering), for the caller's coordinates.

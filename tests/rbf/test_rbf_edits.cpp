@@ -151,3 +151,25 @@ TEST_CASE("rbf drift check refits when asked and keeps accuracy over many edits"
   CHECK(f.report().relative_residual <= 1e-9);
   CHECK(probe_difference(f, Rbf(c), 3) <= 1e-8);
 }
+
+TEST_CASE("rbf minimal sets and the FullLu solver's edits", "[rbf][edits]") {
+  Constraints c;
+  c.add({0, 0, 0}, -1), c.add({1, 0, 0}, 0.5), c.add({0, 2, 0}, 0.25), c.add({0, 0, 3}, 1);
+  Rbf f(c);  // N = 4: the reduced system is empty, f is the linear interpolant
+  for (std::size_t i = 0; i < 4; ++i) CHECK(f.value(c.points[i]) == Approx(c.values[i]).margin(1e-12));
+  for (double w : f.weights()) CHECK(w == 0.0);
+  vitri::RbfOptions lu;
+  lu.solver = vitri::RbfSolver::FullLu;
+  Rbf g(c, lu);
+  f.add_constraint({0.3, 0.3, 0.3}, 2.0);
+  g.add_constraint({0.3, 0.3, 0.3}, 2.0);
+  f.move_constraint(0, {-0.5, 0.1, 0.2});
+  g.move_constraint(0, {-0.5, 0.1, 0.2});
+  f.set_value(2, -3.0);
+  g.set_value(2, -3.0);
+  f.remove_constraint(1);
+  g.remove_constraint(1);
+  REQUIRE(f.size() == 4);
+  CHECK(g.size() == 4);
+  CHECK(probe_difference(f, g, 9) <= 1e-9);
+}

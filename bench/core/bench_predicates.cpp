@@ -105,13 +105,16 @@ void run(benchmark::State& state, const Dataset& d, F f) {
   state.SetItemsProcessed(static_cast<std::int64_t>(state.iterations() * kTuples));
 }
 
-int sgn(double x) { return (x > 0) - (x < 0); }
+int sgn(double x) {
+  return (x > 0) - (x < 0);
+}
 
 void BM_orient3d_plain(benchmark::State& s, Input in) {
   run(s, orient_data(in), [](const Point3* p) { return sgn(vitri::orient3d_fast(p[0], p[1], p[2], p[3])); });
 }
 void BM_orient3d_filtered(benchmark::State& s, Input in) {
-  run(s, orient_data(in), [](const Point3* p) { return vitri::to_int(vitri::orient3d(p[0], p[1], p[2], p[3])); });
+  run(s, orient_data(in),
+      [](const Point3* p) { return vitri::to_int(vitri::orient3d(p[0], p[1], p[2], p[3])); });
 }
 void BM_insphere_plain(benchmark::State& s, Input in) {
   run(s, sphere_data(in),
@@ -188,7 +191,8 @@ void check_agreement_with_cgal() {
     for (std::size_t i = 0; i < kTuples; ++i) {
       const Point3* p = &od.pts[5 * i];
       const KP* q = &oc[5 * i];
-      mismatches += vitri::to_int(vitri::orient3d(p[0], p[1], p[2], p[3])) != static_cast<int>(o(q[0], q[1], q[2], q[3]));
+      mismatches += vitri::to_int(vitri::orient3d(p[0], p[1], p[2], p[3])) !=
+                    static_cast<int>(o(q[0], q[1], q[2], q[3]));
       const Point3* r = &sd.pts[5 * i];
       const KP* t = &sc[5 * i];
       mismatches += vitri::to_int(vitri::insphere(r[0], r[1], r[2], r[3], r[4])) !=
@@ -232,9 +236,9 @@ class RatioReporter : public benchmark::ConsoleReporter {
 
 }  // namespace
 
-#define VITRI_BENCH_INPUTS(fn)                                          \
-  BENCHMARK_CAPTURE(fn, random, Input::Random);                         \
-  BENCHMARK_CAPTURE(fn, near_degenerate, Input::NearDegenerate);        \
+#define VITRI_BENCH_INPUTS(fn)                                   \
+  BENCHMARK_CAPTURE(fn, random, Input::Random);                  \
+  BENCHMARK_CAPTURE(fn, near_degenerate, Input::NearDegenerate); \
   BENCHMARK_CAPTURE(fn, grid, Input::Grid)
 
 VITRI_BENCH_INPUTS(BM_orient3d_plain);

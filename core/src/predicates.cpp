@@ -102,7 +102,9 @@ struct CheckedArithmetic {
   }
 };
 
-Sign to_sign(int s) { return s > 0 ? Sign::Positive : (s < 0 ? Sign::Negative : Sign::Zero); }
+Sign to_sign(int s) {
+  return s > 0 ? Sign::Positive : (s < 0 ? Sign::Negative : Sign::Zero);
+}
 
 /// h = p * q - r * s, exactly.
 void cross_minor(const Expansion& p, const Expansion& q, const Expansion& r, const Expansion& s,
@@ -115,9 +117,8 @@ void cross_minor(const Expansion& p, const Expansion& q, const Expansion& r, con
 }
 
 /// h = s1 * p1 * m1 + s2 * p2 * m2 + s3 * p3 * m3 (the signs s_i are +1 or -1), exactly.
-void combine3(const Expansion& p1, const Expansion& m1, double s1, const Expansion& p2,
-              const Expansion& m2, double s2, const Expansion& p3, const Expansion& m3, double s3,
-              Expansion& h) {
+void combine3(const Expansion& p1, const Expansion& m1, double s1, const Expansion& p2, const Expansion& m2,
+              double s2, const Expansion& p3, const Expansion& m3, double s3, Expansion& h) {
   Expansion t1, t2, t3, zero, acc1, acc2;
   expansion_product(p1, m1, t1);
   expansion_product(p2, m2, t2);
@@ -194,7 +195,8 @@ namespace {
   combine3(q[3][2], ab, 1.0, q[0][2], bd, 1.0, q[1][2], da, 1.0, dab);
   // Lifts |p - e|^2.
   Expansion lift[4];
-  for (int r = 0; r < 4; ++r) combine3(q[r][0], q[r][0], 1.0, q[r][1], q[r][1], 1.0, q[r][2], q[r][2], 1.0, lift[r]);
+  for (int r = 0; r < 4; ++r)
+    combine3(q[r][0], q[r][0], 1.0, q[r][1], q[r][1], 1.0, q[r][2], q[r][2], 1.0, lift[r]);
   // det = (alift * bcd - blift * cda) + (clift * dab - dlift * abc).
   Expansion t[4], s1, s2, det;
   expansion_product(lift[0], bcd, t[0]);
@@ -222,8 +224,8 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
       for (int k = 0; k < 3; ++k) q[r][k] = f.sub(v[3 * r + k], v[12 + k]);
     if (f.exact) {  // worth going on only with exact differences
       auto minor2 = [&](int i, int j) { return f.sub(f.mul(q[i][0], q[j][1]), f.mul(q[j][0], q[i][1])); };
-      const double ab = minor2(0, 1), bc = minor2(1, 2), cd = minor2(2, 3), da = minor2(3, 0), ac = minor2(0, 2),
-                   bd = minor2(1, 3);
+      const double ab = minor2(0, 1), bc = minor2(1, 2), cd = minor2(2, 3), da = minor2(3, 0),
+                   ac = minor2(0, 2), bd = minor2(1, 3);
       const double abc = f.add(f.sub(f.mul(q[0][2], bc), f.mul(q[1][2], ac)), f.mul(q[2][2], ab));
       const double bcd = f.add(f.sub(f.mul(q[1][2], cd), f.mul(q[2][2], bd)), f.mul(q[3][2], bc));
       const double cda = f.add(f.add(f.mul(q[2][2], da), f.mul(q[3][2], ac)), f.mul(q[0][2], cd));

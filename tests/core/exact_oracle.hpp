@@ -23,7 +23,8 @@ class BigInt {
   BigInt() = default;
   BigInt(long long v) {  // NOLINT: implicit on purpose, for readable formulas
     neg_ = v < 0;
-    unsigned long long m = neg_ ? 0ULL - static_cast<unsigned long long>(v) : static_cast<unsigned long long>(v);
+    unsigned long long m =
+        neg_ ? 0ULL - static_cast<unsigned long long>(v) : static_cast<unsigned long long>(v);
     while (m) {
       mag_.push_back(static_cast<std::uint32_t>(m & 0xffffffffULL));
       m >>= 32;
@@ -113,7 +114,8 @@ class BigInt {
     std::vector<std::uint32_t> r(std::max(a.size(), b.size()) + 1, 0u);
     std::uint64_t carry = 0;
     for (std::size_t i = 0; i + 1 < r.size(); ++i) {
-      const std::uint64_t cur = (i < a.size() ? a[i] : 0u) + static_cast<std::uint64_t>(i < b.size() ? b[i] : 0u) + carry;
+      const std::uint64_t cur =
+          (i < a.size() ? a[i] : 0u) + static_cast<std::uint64_t>(i < b.size() ? b[i] : 0u) + carry;
       r[i] = static_cast<std::uint32_t>(cur & 0xffffffffULL);
       carry = cur >> 32;
     }
@@ -149,7 +151,7 @@ inline std::vector<BigInt> exact_integers(const std::vector<double>& xs) {
   int kmin = 1 << 20;
   for (std::size_t i = 0; i < xs.size(); ++i) {
     int e = 0;
-    const double f = std::frexp(xs[i], &e);  // xs[i] = f * 2^e, 0.5 <= |f| < 1
+    const double f = std::frexp(xs[i], &e);               // xs[i] = f * 2^e, 0.5 <= |f| < 1
     mant[i] = static_cast<long long>(std::ldexp(f, 53));  // exact: |f| * 2^53 < 2^53 is an integer
     expo[i] = e - 53;
     if (xs[i] != 0.0) kmin = std::min(kmin, expo[i]);
@@ -162,7 +164,8 @@ inline std::vector<BigInt> exact_integers(const std::vector<double>& xs) {
 
 /// Determinant of a 3x3 / 4x4 matrix of big integers (Leibniz / Laplace along the first row).
 inline BigInt det3(const BigInt m[3][3]) {
-  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+         m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
          m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
 inline BigInt det4(const BigInt m[4][4]) {
@@ -183,7 +186,8 @@ inline int oracle_orient3d(const Point3& a, const Point3& b, const Point3& c, co
   const auto v = exact_integers({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z});
   BigInt m[3][3];
   for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) m[r][k] = v[static_cast<std::size_t>(3 * (r + 1) + k)] - v[static_cast<std::size_t>(k)];
+    for (int k = 0; k < 3; ++k)
+      m[r][k] = v[static_cast<std::size_t>(3 * (r + 1) + k)] - v[static_cast<std::size_t>(k)];
   return det3(m).sign();
 }
 
@@ -199,7 +203,8 @@ inline int oracle_orient2d(const Point3& a, const Point3& b, const Point3& c, in
 inline int lifted_sign(const std::vector<BigInt>& v, const BigInt lift[5]) {
   BigInt m[4][4];
   for (int r = 0; r < 4; ++r) {
-    for (int k = 0; k < 3; ++k) m[r][k] = v[static_cast<std::size_t>(3 * r + k)] - v[static_cast<std::size_t>(12 + k)];
+    for (int k = 0; k < 3; ++k)
+      m[r][k] = v[static_cast<std::size_t>(3 * r + k)] - v[static_cast<std::size_t>(12 + k)];
     m[r][3] = lift[r] - lift[4];
   }
   return -det4(m).sign();
@@ -207,7 +212,8 @@ inline int lifted_sign(const std::vector<BigInt>& v, const BigInt lift[5]) {
 
 /// Exact insphere sign: -det[[p - e, |p|^2 - |e|^2]] over p = a, b, c, d (equal to the translated form
 /// in predicates.hpp by column operations).
-inline int oracle_insphere(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+inline int oracle_insphere(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                           const Point3& e) {
   const auto v = exact_integers({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z});
   BigInt lift[5];
   for (int p = 0; p < 5; ++p) {

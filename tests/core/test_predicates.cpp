@@ -31,12 +31,17 @@ __extension__ typedef __int128 Int128;
 // Differences are below 2^21, so orient3d < 6 * 2^63 and insphere < 4 * 3 * 2^42 * 6 * 2^63 < 2^112:
 // both fit in a signed 128-bit integer.
 
-Int128 to_i(double x) { return static_cast<Int128>(static_cast<long long>(x)); }
+Int128 to_i(double x) {
+  return static_cast<Int128>(static_cast<long long>(x));
+}
 
-int sign_i(Int128 v) { return v > 0 ? 1 : (v < 0 ? -1 : 0); }
+int sign_i(Int128 v) {
+  return v > 0 ? 1 : (v < 0 ? -1 : 0);
+}
 
 Int128 det3_i(const Int128 m[3][3]) {
-  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
+  return m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1]) -
+         m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0]) +
          m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
 }
 
@@ -85,7 +90,9 @@ Point3 random_point(std::mt19937_64& rng, double lo, double hi) {
   return {dist(rng), dist(rng), dist(rng)};
 }
 
-Point3 scaled(const Point3& p, double s) { return {p.x * s, p.y * s, p.z * s}; }
+Point3 scaled(const Point3& p, double s) {
+  return {p.x * s, p.y * s, p.z * s};
+}
 
 // One-ulp neighbours of a point along each axis and direction.
 std::vector<Point3> ulp_neighbours(const Point3& p, int steps) {
@@ -126,7 +133,8 @@ void check_orient3d_oracle(const Point3& a, const Point3& b, const Point3& c, co
   REQUIRE(to_int(orient3d(a, b, c, d)) == vitri::test::oracle_orient3d(a, b, c, d));
 }
 
-void check_insphere_oracle(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
+void check_insphere_oracle(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                           const Point3& e) {
   INFO("e=(" << e.x << "," << e.y << "," << e.z << ")");
   REQUIRE(to_int(insphere(a, b, c, d, e)) == vitri::test::oracle_insphere(a, b, c, d, e));
 }
@@ -176,8 +184,8 @@ TEST_CASE("orient3d equals the 128-bit integer oracle on random 2^20 grid points
   std::mt19937_64 rng(20240601);
   for (const long long w : {2LL, 8LL, 1LL << 20}) {  // small grids: many exact zeros; large: generic
     for (int i = 0; i < 20000; ++i) {
-      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w), c = random_grid_point(rng, w),
-                   d = random_grid_point(rng, w);
+      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w),
+                   c = random_grid_point(rng, w), d = random_grid_point(rng, w);
       REQUIRE(to_int(orient3d(a, b, c, d)) == orient3d_i128(a, b, c, d));
     }
   }
@@ -205,8 +213,9 @@ TEST_CASE("insphere equals the 128-bit integer oracle on random 2^20 grid points
   std::mt19937_64 rng(99);
   for (const long long w : {1LL, 2LL, 4LL, 1LL << 20}) {
     for (int i = 0; i < 20000; ++i) {
-      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w), c = random_grid_point(rng, w),
-                   d = random_grid_point(rng, w), e = random_grid_point(rng, w);
+      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w),
+                   c = random_grid_point(rng, w), d = random_grid_point(rng, w),
+                   e = random_grid_point(rng, w);
       REQUIRE(to_int(insphere(a, b, c, d, e)) == insphere_i128(a, b, c, d, e));
     }
   }
@@ -235,8 +244,8 @@ TEST_CASE("insphere equals the 128-bit oracle on near-cospherical 2^20 grid poin
   for (int i = 0; i < 20000; ++i) {
     const Point3 center{static_cast<double>(coord(rng)), static_cast<double>(coord(rng)),
                         static_cast<double>(coord(rng))};
-    const Point3 a = center + sphere[pick(rng)], b = center + sphere[pick(rng)], c = center + sphere[pick(rng)],
-                 d = center + sphere[pick(rng)];
+    const Point3 a = center + sphere[pick(rng)], b = center + sphere[pick(rng)],
+                 c = center + sphere[pick(rng)], d = center + sphere[pick(rng)];
     Point3 e = center + sphere[pick(rng)];
     e.x += static_cast<double>(nudge(rng));
     const int expected = insphere_i128(a, b, c, d, e);
@@ -250,7 +259,8 @@ TEST_CASE("orient2d equals the 128-bit integer oracle on random grid points", "[
   std::mt19937_64 rng(5);
   for (const long long w : {2LL, 1LL << 20}) {
     for (int n = 0; n < 20000; ++n) {
-      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w), c = random_grid_point(rng, w);
+      const Point3 a = random_grid_point(rng, w), b = random_grid_point(rng, w),
+                   c = random_grid_point(rng, w);
       const int i = static_cast<int>(n % 3), j = (i + 1 + static_cast<int>((n / 3) % 2)) % 3;
       const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
       const Int128 det = (to_i(b[si]) - to_i(a[si])) * (to_i(c[sj]) - to_i(a[sj])) -
@@ -335,7 +345,8 @@ TEST_CASE("degenerate: huge coordinates (1e100 scale)", "[predicates][degenerate
   // Near the top of the double range.
   const double top = 1e300;
   CHECK(orient3d({0, 0, 0}, {top, 0, 0}, {0, top, 0}, {0, 0, top}) == Sign::Positive);
-  CHECK(orient3d({-top, -top, -top}, {top, -top, -top}, {-top, top, -top}, {-top, -top, top}) == Sign::Positive);
+  CHECK(orient3d({-top, -top, -top}, {top, -top, -top}, {-top, top, -top}, {-top, -top, top}) ==
+        Sign::Positive);
 }
 
 TEST_CASE("degenerate: tiny coordinates (1e-100 scale)", "[predicates][degenerate]") {
@@ -441,7 +452,8 @@ TEST_CASE("degenerate: coplanar points", "[predicates][degenerate]") {
   // The plane 0.5 x - 0.25 y + z = 1, with dyadic points exactly on it.
   auto on_plane = [](double x, double y) { return Point3{x, y, 1.0 - 0.5 * x + 0.25 * y}; };
   CHECK(orient3d(on_plane(0, 0), on_plane(4, 1), on_plane(-2, 3), on_plane(1.5, -6)) == Sign::Zero);
-  CHECK(insphere(on_plane(0, 0), on_plane(4, 1), on_plane(-2, 3), on_plane(1.5, -6), on_plane(7, 7)) == Sign::Zero);
+  CHECK(insphere(on_plane(0, 0), on_plane(4, 1), on_plane(-2, 3), on_plane(1.5, -6), on_plane(7, 7)) ==
+        Sign::Zero);
   // A flat, cocircular (a, b, c, d) (a square) and e off the plane: the lifted points span only 3
   // dimensions, Zero again.
   CHECK(insphere(a, b, d, c, {1, 1, 5}) == Sign::Zero);
@@ -483,7 +495,8 @@ TEST_CASE("degenerate: the 8 corners of a cube are cospherical", "[predicates][d
 // ---------------------------------------------------------------------------------------------------
 // The symbolic perturbation
 
-TEST_CASE("insphere_sos never answers Zero and agrees with insphere on degenerate grids", "[predicates][sos]") {
+TEST_CASE("insphere_sos never answers Zero and agrees with insphere on degenerate grids",
+          "[predicates][sos]") {
   std::mt19937_64 rng(18);
   int degenerate = 0;
   for (int i = 0; i < 20000; ++i) {
@@ -499,8 +512,10 @@ TEST_CASE("insphere_sos never answers Zero and agrees with insphere on degenerat
     } else {
       ++degenerate;
       REQUIRE(to_int(sos) == vitri::test::oracle_insphere_sos(a, b, c, d, e));
-      if (orient3d(a, b, c, d) == Sign::Positive) REQUIRE(sos == cgal_rule(a, b, c, d, e));
-      else REQUIRE(sos == -cgal_rule(b, a, c, d, e));
+      if (orient3d(a, b, c, d) == Sign::Positive)
+        REQUIRE(sos == cgal_rule(a, b, c, d, e));
+      else
+        REQUIRE(sos == -cgal_rule(b, a, c, d, e));
     }
   }
   CHECK(degenerate > 500);
@@ -515,16 +530,20 @@ TEST_CASE("insphere_sos is antisymmetric under permutations of its arguments", "
     for (auto& q : p) q = random_grid_point(rng, 1);
     bool distinct = true;
     for (int s = 0; s < 5; ++s)
-      for (int t = s + 1; t < 5; ++t) distinct = distinct && p[static_cast<std::size_t>(s)] != p[static_cast<std::size_t>(t)];
+      for (int t = s + 1; t < 5; ++t)
+        distinct = distinct && p[static_cast<std::size_t>(s)] != p[static_cast<std::size_t>(t)];
     if (!distinct || orient3d(p[0], p[1], p[2], p[3]) == Sign::Zero) continue;
     const Sign ref = insphere_sos(p[0], p[1], p[2], p[3], p[4]);
     std::array<int, 5> perm = {0, 1, 2, 3, 4};
     do {
-      const auto& q = [&](int k) -> const Point3& { return p[static_cast<std::size_t>(perm[static_cast<std::size_t>(k)])]; };
+      const auto& q = [&](int k) -> const Point3& {
+        return p[static_cast<std::size_t>(perm[static_cast<std::size_t>(k)])];
+      };
       if (orient3d(q(0), q(1), q(2), q(3)) == Sign::Zero) continue;
       int inversions = 0;
       for (int s = 0; s < 5; ++s)
-        for (int t = s + 1; t < 5; ++t) inversions += perm[static_cast<std::size_t>(s)] > perm[static_cast<std::size_t>(t)];
+        for (int t = s + 1; t < 5; ++t)
+          inversions += perm[static_cast<std::size_t>(s)] > perm[static_cast<std::size_t>(t)];
       const Sign expected = inversions % 2 == 0 ? ref : -ref;
       REQUIRE(insphere_sos(q(0), q(1), q(2), q(3), q(4)) == expected);
       ++checked;

@@ -5,9 +5,9 @@
 /// Every predicate returns the exact sign of its determinant for every finite double input within the
 /// range documented in docs/predicates.md (in short: no restriction on magnitude, as long as the
 /// binary exponents of the largest and the smallest non-zero |coordinate| of one call differ by at most
-/// 336 for insphere, 600 for orient3d, 932 for orient2d). A certified semi-static floating-point filter, inline below, answers almost
-/// every call on non-degenerate input; the rest fall back to exact expansion arithmetic
-/// (core/src/predicates.cpp). The error bounds are derived in docs/predicates.md.
+/// 336 for insphere, 600 for orient3d, 932 for orient2d). A certified semi-static floating-point filter,
+/// inline below, answers almost every call on non-degenerate input; the rest fall back to exact expansion
+/// arithmetic (core/src/predicates.cpp). The error bounds are derived in docs/predicates.md.
 ///
 /// Conventions (stated once, tested in tests/core/test_predicates.cpp, same as CGAL's):
 /// - orient3d(a, b, c, d) is POSITIVE when (a, b, c, d) is a positively oriented tetrahedron,
@@ -39,9 +39,15 @@ namespace vitri {
 /// The sign of a predicate. Values are -1, 0, +1 so that they multiply like signs.
 enum class Sign : int { Negative = -1, Zero = 0, Positive = 1 };
 
-constexpr Sign operator-(Sign s) { return static_cast<Sign>(-static_cast<int>(s)); }
-constexpr Sign operator*(Sign a, Sign b) { return static_cast<Sign>(static_cast<int>(a) * static_cast<int>(b)); }
-constexpr int to_int(Sign s) { return static_cast<int>(s); }
+constexpr Sign operator-(Sign s) {
+  return static_cast<Sign>(-static_cast<int>(s));
+}
+constexpr Sign operator*(Sign a, Sign b) {
+  return static_cast<Sign>(static_cast<int>(a) * static_cast<int>(b));
+}
+constexpr int to_int(Sign s) {
+  return static_cast<int>(s);
+}
 
 /// Counters of how often the predicates ran and how often the exact fallback ran. Thread-local.
 struct PredicateStats {
@@ -108,8 +114,12 @@ inline double max2(double a, double b) {
   return a > b ? a : b;
 #endif
 }
-inline double max3(double a, double b, double c) { return max2(max2(a, b), c); }
-inline double max4(double a, double b, double c, double d) { return max2(max2(a, b), max2(c, d)); }
+inline double max3(double a, double b, double c) {
+  return max2(max2(a, b), c);
+}
+inline double max4(double a, double b, double c, double d) {
+  return max2(max2(a, b), max2(c, d));
+}
 inline double min2(double a, double b) {
 #if defined(__SSE2__) && defined(__GNUC__)
   __asm__("minsd %1, %0" : "+x"(a) : "x"(b));
@@ -120,9 +130,13 @@ inline double min2(double a, double b) {
   return a < b ? a : b;
 #endif
 }
-inline double min3(double a, double b, double c) { return min2(min2(a, b), c); }
+inline double min3(double a, double b, double c) {
+  return min2(min2(a, b), c);
+}
 /// Branch-free: the sign of a random determinant is unpredictable.
-inline Sign sign_of(double x) { return static_cast<Sign>(static_cast<int>(x > 0.0) - static_cast<int>(x < 0.0)); }
+inline Sign sign_of(double x) {
+  return static_cast<Sign>(static_cast<int>(x > 0.0) - static_cast<int>(x < 0.0));
+}
 
 /// True when the filtered value `det` certifiably has the sign of the exact determinant: |det| exceeds
 /// the error bound `eps`, no intermediate overflowed (det finite; an infinity never turns finite
@@ -162,8 +176,8 @@ inline Sign orient3d(const Point3& a, const Point3& b, const Point3& c, const Po
   const __m128d ut = _mm_mul_pd(uxy, _mm_shuffle_pd(t, t, 1));
   const double det = (_mm_cvtsd_f64(ut) - _mm_cvtsd_f64(_mm_unpackhi_pd(ut, ut))) + uz * m3;
   const __m128d abs_mask = _mm_castsi128_pd(_mm_set1_epi64x(0x7fffffffffffffffLL));
-  const __m128d mxy = _mm_max_pd(_mm_max_pd(_mm_and_pd(uxy, abs_mask), _mm_and_pd(vxy, abs_mask)),
-                                 _mm_and_pd(wxy, abs_mask));
+  const __m128d mxy =
+      _mm_max_pd(_mm_max_pd(_mm_and_pd(uxy, abs_mask), _mm_and_pd(vxy, abs_mask)), _mm_and_pd(wxy, abs_mask));
   const double mx = _mm_cvtsd_f64(mxy), my = _mm_cvtsd_f64(_mm_unpackhi_pd(mxy, mxy));
   const double mz = detail::max3(std::fabs(uz), std::fabs(vz), std::fabs(wz));
 #else

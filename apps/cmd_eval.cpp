@@ -32,12 +32,16 @@ double parse_number(const std::string& flag, const std::string& s) {
 Constraints constraints_of_input(const std::string& path, const ConstraintBuildOptions& opt) {
   const Input in = read_input(path);
   switch (in.kind) {
-    case InputKind::Constraints: return Constraints{in.constraints.points, in.constraints.values};
-    case InputKind::OrientedPoints: return constraints_from_oriented_points(in.points.points, in.points.normals, opt);
+    case InputKind::Constraints:
+      return Constraints{in.constraints.points, in.constraints.values};
+    case InputKind::OrientedPoints:
+      return constraints_from_oriented_points(in.points.points, in.points.normals, opt);
     case InputKind::Points:
-      throw InvalidArgument(path + ": points without normals (3 columns) do not define an inside and an outside; "
-                                   "give x y z nx ny nz, a .xyzv constraint file or a closed mesh");
-    case InputKind::Mesh: return constraints_from_mesh(in.mesh.V, in.mesh.F, opt);
+      throw InvalidArgument(path +
+                            ": points without normals (3 columns) do not define an inside and an outside; "
+                            "give x y z nx ny nz, a .xyzv constraint file or a closed mesh");
+    case InputKind::Mesh:
+      return constraints_from_mesh(in.mesh.V, in.mesh.F, opt);
   }
   throw InvalidArgument(path + ": unsupported input");
 }
@@ -51,14 +55,19 @@ int run_eval(const Args& args) {
       if (i + 1 >= args.size()) throw InvalidArgument(a + " needs a value");
       return args[++i];
     };
-    if (a == "--at") query = value();
-    else if (a == "--offset") opt.offset = parse_number(a, value());
-    else if (a == "--max-constraints") opt.max_constraints = static_cast<std::size_t>(parse_number(a, value()));
-    else if (a == "--seed") opt.seed = static_cast<std::uint64_t>(parse_number(a, value()));
+    if (a == "--at")
+      query = value();
+    else if (a == "--offset")
+      opt.offset = parse_number(a, value());
+    else if (a == "--max-constraints")
+      opt.max_constraints = static_cast<std::size_t>(parse_number(a, value()));
+    else if (a == "--seed")
+      opt.seed = static_cast<std::uint64_t>(parse_number(a, value()));
     else if (!a.empty() && a[0] == '-') {
       std::cerr << "vitri eval: unknown option '" << a << "'\n";
       return 2;
-    } else if (input.empty()) input = a;
+    } else if (input.empty())
+      input = a;
     else {
       std::cerr << "vitri eval: unexpected argument '" << a << "'\n";
       return 2;
@@ -75,23 +84,25 @@ int run_eval(const Args& args) {
   std::vector<double> v(q.points.size());
   std::vector<Point3> g(q.points.size());
   f.values_gradients(q.points.data(), q.points.size(), v.data(), g.data());
-  for (std::size_t i = 0; i < v.size(); ++i) std::printf("%.17g %.17g %.17g %.17g\n", v[i], g[i].x, g[i].y, g[i].z);
+  for (std::size_t i = 0; i < v.size(); ++i)
+    std::printf("%.17g %.17g %.17g %.17g\n", v[i], g[i].x, g[i].y, g[i].z);
   return std::fflush(stdout) == 0 ? 0 : 1;
 }
 
 const char* eval_usage() {
-  return
-    "usage: vitri eval INPUT --at QUERY.xyz [--offset F] [--max-constraints N] [--seed S]\n"
-    "\n"
-    "Fits the variational implicit function of INPUT and prints 'f gx gy gz' (value and gradient, %.17g)\n"
-    "for each point of QUERY.xyz (3 or 6 columns; only positions are used), one line per point.\n"
-    "f < 0 inside, f > 0 outside.\n"
-    "\n"
-    "INPUT: constraints .xyzv (x y z value), oriented points .pwn / 6-column .xyz, or a closed mesh\n"
-    "       .off / .obj / .ply (vertex normals area-weighted, oriented outwards).\n"
-    "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal (0.01)\n"
-    "  --max-constraints N  subsample points / vertices to at most N constraints (0: all)\n"
-    "  --seed S             seed of the subsampling (1)\n";
+  return "usage: vitri eval INPUT --at QUERY.xyz [--offset F] [--max-constraints N] [--seed S]\n"
+         "\n"
+         "Fits the variational implicit function of INPUT and prints 'f gx gy gz' (value and gradient, "
+         "%.17g)\n"
+         "for each point of QUERY.xyz (3 or 6 columns; only positions are used), one line per point.\n"
+         "f < 0 inside, f > 0 outside.\n"
+         "\n"
+         "INPUT: constraints .xyzv (x y z value), oriented points .pwn / 6-column .xyz, or a closed mesh\n"
+         "       .off / .obj / .ply (vertex normals area-weighted, oriented outwards).\n"
+         "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal "
+         "(0.01)\n"
+         "  --max-constraints N  subsample points / vertices to at most N constraints (0: all)\n"
+         "  --seed S             seed of the subsampling (1)\n";
 }
 
 }  // namespace vitri::cli

@@ -34,7 +34,13 @@ void BM_FitCholesky(benchmark::State& state) {
   state.counters["N"] = static_cast<double>(c.size());
   state.counters["residual"] = residual;
 }
-BENCHMARK(BM_FitCholesky)->Arg(200)->Arg(1500)->Arg(3000)->Arg(6000)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_FitCholesky)
+    ->Arg(200)
+    ->Arg(1500)
+    ->Arg(3000)
+    ->Arg(6000)
+    ->Unit(benchmark::kMillisecond)
+    ->Iterations(3);
 
 void BM_FitPartialPivLU(benchmark::State& state) {
   const auto& c = constraints(static_cast<std::size_t>(state.range(0)));

@@ -57,7 +57,9 @@ std::string num(double v) {
   return buf;
 }
 
-bool has_normals(const TriangleMesh& m) { return m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0; }
+bool has_normals(const TriangleMesh& m) {
+  return m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0;
+}
 
 void check_mesh_shape(const TriangleMesh& m, const std::string& path) {
   if (m.V.cols() != 3 || m.F.cols() != 3) throw InvalidArgument(path + ": mesh V and F must have 3 columns");
@@ -77,7 +79,8 @@ void add_polygon(std::vector<int>& tris, const std::vector<int>& poly) {
   }
 }
 
-TriangleMesh make_mesh(const std::vector<double>& v, const std::vector<int>& t, const std::vector<double>& n) {
+TriangleMesh make_mesh(const std::vector<double>& v, const std::vector<int>& t,
+                       const std::vector<double>& n) {
   TriangleMesh m;
   const auto nv = static_cast<Eigen::Index>(v.size() / 3), nt = static_cast<Eigen::Index>(t.size() / 3);
   m.V.resize(nv, 3);
@@ -99,7 +102,9 @@ TriangleMesh make_mesh(const std::vector<double>& v, const std::vector<int>& t, 
 // Number of lines left after the scanner position (an upper bound of the records a text can hold).
 std::size_t lines_left(std::string_view text, std::size_t offset) {
   if (offset >= text.size()) return 0;
-  return static_cast<std::size_t>(std::count(text.begin() + static_cast<std::ptrdiff_t>(offset), text.end(), '\n')) + 1;
+  return static_cast<std::size_t>(
+             std::count(text.begin() + static_cast<std::ptrdiff_t>(offset), text.end(), '\n')) +
+         1;
 }
 
 }  // namespace
@@ -127,15 +132,17 @@ PointValues parse_xyzv(std::string_view text, const std::string& name) {
   return c;
 }
 
-PointValues read_xyzv(const std::string& path) { return parse_xyzv(io_detail::slurp(path), path); }
+PointValues read_xyzv(const std::string& path) {
+  return parse_xyzv(io_detail::slurp(path), path);
+}
 
 void write_xyzv(const std::string& path, const PointValues& c) {
   if (c.points.size() != c.values.size()) throw InvalidArgument(path + ": points and values differ in count");
   auto out = open_out(path);
   out << "# x y z value\n";
   for (std::size_t i = 0; i < c.points.size(); ++i)
-    out << num(c.points[i].x) << ' ' << num(c.points[i].y) << ' ' << num(c.points[i].z) << ' ' << num(c.values[i])
-        << '\n';
+    out << num(c.points[i].x) << ' ' << num(c.points[i].y) << ' ' << num(c.points[i].z) << ' '
+        << num(c.values[i]) << '\n';
   finish_out(out, path);
 }
 
@@ -155,19 +162,23 @@ OrientedPoints parse_points(std::string_view text, const std::string& name, bool
     }
     first = false;
     if (columns == 0) {
-      if (nt != 3 && nt != 6) s.fail("expected 3 (x y z) or 6 (x y z nx ny nz) numbers, got " + std::to_string(nt));
-      if (require_normals && nt != 6) s.fail("expected 6 numbers 'x y z nx ny nz' (points with normals), got 3");
+      if (nt != 3 && nt != 6)
+        s.fail("expected 3 (x y z) or 6 (x y z nx ny nz) numbers, got " + std::to_string(nt));
+      if (require_normals && nt != 6)
+        s.fail("expected 6 numbers 'x y z nx ny nz' (points with normals), got 3");
       columns = nt;
     } else if (nt != columns) {
-      s.fail("expected " + std::to_string(columns) + " numbers like the previous lines, got " + std::to_string(nt));
+      s.fail("expected " + std::to_string(columns) + " numbers like the previous lines, got " +
+             std::to_string(nt));
     }
     p.points.push_back({s.number(0), s.number(1), s.number(2)});
     if (columns == 6) p.normals.push_back({s.number(3), s.number(4), s.number(5)});
   }
   if (p.points.empty()) throw ParseError(name, 0, "no point in file");
   if (declared >= 0 && static_cast<std::size_t>(declared) != p.points.size())
-    throw ParseError(name, 1, "header declares " + std::to_string(declared) + " points, file has " +
-                                  std::to_string(p.points.size()));
+    throw ParseError(name, 1,
+                     "header declares " + std::to_string(declared) + " points, file has " +
+                         std::to_string(p.points.size()));
   return p;
 }
 
@@ -198,13 +209,18 @@ TriangleMesh parse_off(std::string_view text, const std::string& name) {
     if (k.size() >= 3 && k.substr(k.size() - 3) == "OFF") {
       const std::string_view prefix = k.substr(0, k.size() - 3);
       for (char c : prefix) {
-        if (c == 'C') colors = true;
-        else if (c == 'N') normals = true;
-        else s.fail("unsupported OFF variant '" + std::string(key) + "' (OFF, COFF, NOFF, CNOFF are supported)");
+        if (c == 'C')
+          colors = true;
+        else if (c == 'N')
+          normals = true;
+        else
+          s.fail("unsupported OFF variant '" + std::string(key) + "' (OFF, COFF, NOFF, CNOFF are supported)");
       }
-      if (key.substr(0, 2) == "ST") s.fail("texture-coordinate OFF ('" + std::string(key) + "') is not supported");
+      if (key.substr(0, 2) == "ST")
+        s.fail("texture-coordinate OFF ('" + std::string(key) + "') is not supported");
     } else {
-      s.fail("not an OFF file: expected the keyword OFF, COFF, NOFF or CNOFF, got '" + std::string(key) + "'");
+      s.fail("not an OFF file: expected the keyword OFF, COFF, NOFF or CNOFF, got '" + std::string(key) +
+             "'");
     }
   }
   (void)colors;
@@ -223,7 +239,8 @@ TriangleMesh parse_off(std::string_view text, const std::string& name) {
   v.reserve(static_cast<std::size_t>(3 * nv));
   if (normals) n.reserve(static_cast<std::size_t>(3 * nv));
   for (long long i = 0; i < nv; ++i) {
-    if (!s.next_data_line()) s.fail("file ends after " + std::to_string(i) + " of " + std::to_string(nv) + " vertices");
+    if (!s.next_data_line())
+      s.fail("file ends after " + std::to_string(i) + " of " + std::to_string(nv) + " vertices");
     const std::size_t need = normals ? 6 : 3;
     if (s.tokens().size() < need)
       s.fail("vertex " + std::to_string(i) + ": expected " + std::to_string(need) + " numbers, got " +
@@ -235,9 +252,11 @@ TriangleMesh parse_off(std::string_view text, const std::string& name) {
   std::vector<int> tris, poly;
   tris.reserve(static_cast<std::size_t>(3 * nf));
   for (long long f = 0; f < nf; ++f) {
-    if (!s.next_data_line()) s.fail("file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
+    if (!s.next_data_line())
+      s.fail("file ends after " + std::to_string(f) + " of " + std::to_string(nf) + " faces");
     const long long k = s.integer(0, 0, kMaxIndex);
-    if (k < 3) s.fail("face " + std::to_string(f) + " has " + std::to_string(k) + " vertices (at least 3 needed)");
+    if (k < 3)
+      s.fail("face " + std::to_string(f) + " has " + std::to_string(k) + " vertices (at least 3 needed)");
     if (s.tokens().size() < static_cast<std::size_t>(k) + 1)
       s.fail("face " + std::to_string(f) + ": expected " + std::to_string(k) + " vertex indices, got " +
              std::to_string(s.tokens().size() - 1));
@@ -266,7 +285,8 @@ TriangleMesh parse_obj(std::string_view text, const std::string& name) {
   while (s.next_data_line()) {
     const auto& t = s.tokens();
     if (t[0] == "v") {
-      if (t.size() < 4) s.fail("vertex: expected 'v x y z', got " + std::to_string(t.size() - 1) + " numbers");
+      if (t.size() < 4)
+        s.fail("vertex: expected 'v x y z', got " + std::to_string(t.size() - 1) + " numbers");
       for (std::size_t k = 1; k <= 3; ++k) v.push_back(s.number(k));
     } else if (t[0] == "vn") {
       if (t.size() < 4) s.fail("normal: expected 'vn x y z'");
@@ -283,8 +303,8 @@ TriangleMesh parse_obj(std::string_view text, const std::string& name) {
           const long long raw = s.parse_integer(part, -kMaxIndex, kMaxIndex);
           const long long idx = raw < 0 ? count + raw : raw - 1;
           if (raw == 0 || idx < 0 || idx >= count)
-            s.fail(std::string(what) + " index " + std::to_string(raw) + " out of range (" + std::to_string(count) +
-                   " defined so far)");
+            s.fail(std::string(what) + " index " + std::to_string(raw) + " out of range (" +
+                   std::to_string(count) + " defined so far)");
           return idx;
         };
         const long long vi = resolve(tok.substr(0, slash), nv, "vertex");
@@ -297,7 +317,8 @@ TriangleMesh parse_obj(std::string_view text, const std::string& name) {
         if (ni >= 0) {
           any_normal_ref = true;
           long long& cur = normal_of[static_cast<std::size_t>(vi)];
-          if (cur == -1) cur = ni;
+          if (cur == -1)
+            cur = ni;
           else if (cur != ni && cur != -2) {
             // Same vertex, two normal indices: keep only if the vectors are equal.
             const auto a = static_cast<std::size_t>(3 * cur), b = static_cast<std::size_t>(3 * ni);
@@ -347,7 +368,8 @@ void write_off(const std::string& path, const TriangleMesh& m) {
     if (n) out << ' ' << num(m.N(i, 0)) << ' ' << num(m.N(i, 1)) << ' ' << num(m.N(i, 2));
     out << '\n';
   }
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) out << "3 " << m.F(f, 0) << ' ' << m.F(f, 1) << ' ' << m.F(f, 2) << '\n';
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    out << "3 " << m.F(f, 0) << ' ' << m.F(f, 1) << ' ' << m.F(f, 2) << '\n';
   finish_out(out, path);
 }
 

@@ -41,18 +41,24 @@ struct PlyElement {
 std::size_t type_size(PlyType t) {
   switch (t) {
     case PlyType::I8:
-    case PlyType::U8: return 1;
+    case PlyType::U8:
+      return 1;
     case PlyType::I16:
-    case PlyType::U16: return 2;
+    case PlyType::U16:
+      return 2;
     case PlyType::I32:
     case PlyType::U32:
-    case PlyType::F32: return 4;
-    case PlyType::F64: return 8;
+    case PlyType::F32:
+      return 4;
+    case PlyType::F64:
+      return 8;
   }
   return 1;
 }
 
-bool is_integer(PlyType t) { return t != PlyType::F32 && t != PlyType::F64; }
+bool is_integer(PlyType t) {
+  return t != PlyType::F32 && t != PlyType::F64;
+}
 
 PlyType parse_type(const LineScanner& s, std::string_view t) {
   if (t == "char" || t == "int8") return PlyType::I8;
@@ -82,21 +88,48 @@ class BinaryReader {
   double read(PlyType t, const char* what, std::size_t index) {
     const std::size_t n = type_size(t);
     if (pos_ + n > bytes_.size())
-      throw ParseError(name_, 0, std::string("binary PLY truncated in ") + what + " " + std::to_string(index) +
-                                     " at byte offset " + std::to_string(pos_));
+      throw ParseError(name_, 0,
+                       std::string("binary PLY truncated in ") + what + " " + std::to_string(index) +
+                           " at byte offset " + std::to_string(pos_));
     unsigned char b[8];
     std::memcpy(b, bytes_.data() + pos_, n);
     if (swap_) std::reverse(b, b + n);
     pos_ += n;
     switch (t) {
-      case PlyType::I8: return static_cast<double>(static_cast<std::int8_t>(b[0]));
-      case PlyType::U8: return static_cast<double>(b[0]);
-      case PlyType::I16: { std::int16_t v; std::memcpy(&v, b, 2); return v; }
-      case PlyType::U16: { std::uint16_t v; std::memcpy(&v, b, 2); return v; }
-      case PlyType::I32: { std::int32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::U32: { std::uint32_t v; std::memcpy(&v, b, 4); return v; }
-      case PlyType::F32: { float v; std::memcpy(&v, b, 4); return static_cast<double>(v); }
-      case PlyType::F64: { double v; std::memcpy(&v, b, 8); return v; }
+      case PlyType::I8:
+        return static_cast<double>(static_cast<std::int8_t>(b[0]));
+      case PlyType::U8:
+        return static_cast<double>(b[0]);
+      case PlyType::I16: {
+        std::int16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case PlyType::U16: {
+        std::uint16_t v;
+        std::memcpy(&v, b, 2);
+        return v;
+      }
+      case PlyType::I32: {
+        std::int32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::U32: {
+        std::uint32_t v;
+        std::memcpy(&v, b, 4);
+        return v;
+      }
+      case PlyType::F32: {
+        float v;
+        std::memcpy(&v, b, 4);
+        return static_cast<double>(v);
+      }
+      case PlyType::F64: {
+        double v;
+        std::memcpy(&v, b, 8);
+        return v;
+      }
     }
     return 0;
   }
@@ -121,7 +154,8 @@ std::size_t min_record_size(const PlyElement& e) {
 
 TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
   LineScanner s(bytes, name, /*comments=*/false);
-  if (!s.next_data_line() || s.tokens()[0] != "ply") throw ParseError(name, 1, "not a PLY file (missing 'ply')");
+  if (!s.next_data_line() || s.tokens()[0] != "ply")
+    throw ParseError(name, 1, "not a PLY file (missing 'ply')");
   bool binary = false, have_format = false;
   std::vector<PlyElement> elements;
   for (;;) {
@@ -131,10 +165,14 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
     if (t[0] == "comment" || t[0] == "obj_info") continue;
     if (t[0] == "format") {
       if (t.size() < 2) s.fail("format line without a format");
-      if (t[1] == "ascii") binary = false;
-      else if (t[1] == "binary_little_endian") binary = true;
-      else if (t[1] == "binary_big_endian") s.fail("binary_big_endian PLY is not supported (convert to ascii or little endian)");
-      else s.fail("unknown PLY format '" + std::string(t[1]) + "'");
+      if (t[1] == "ascii")
+        binary = false;
+      else if (t[1] == "binary_little_endian")
+        binary = true;
+      else if (t[1] == "binary_big_endian")
+        s.fail("binary_big_endian PLY is not supported (convert to ascii or little endian)");
+      else
+        s.fail("unknown PLY format '" + std::string(t[1]) + "'");
       have_format = true;
     } else if (t[0] == "element") {
       if (t.size() != 3) s.fail("expected 'element NAME COUNT'");
@@ -188,7 +226,8 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
   const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
   if (fe) {
     for (std::size_t k = 0; k < fe->props.size(); ++k)
-      if (fe->props[k].is_list && (fe->props[k].name == "vertex_indices" || fe->props[k].name == "vertex_index"))
+      if (fe->props[k].is_list &&
+          (fe->props[k].name == "vertex_indices" || fe->props[k].name == "vertex_index"))
         ilist = static_cast<int>(k);
     if (ilist < 0) throw ParseError(name, fe->header_line, "face element lacks a vertex_indices list");
     if (!is_integer(fe->props[static_cast<std::size_t>(ilist)].type))
@@ -202,14 +241,16 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
     std::size_t need = 0;
     for (const auto& e : elements) need += e.count * min_record_size(e);
     if (need > bytes.size() - std::min(bytes.size(), s.offset()))
-      throw ParseError(name, 0, "binary PLY: element counts need at least " + std::to_string(need) +
-                                    " bytes, file has " + std::to_string(bytes.size() - s.offset()) + " (truncated?)");
+      throw ParseError(name, 0,
+                       "binary PLY: element counts need at least " + std::to_string(need) +
+                           " bytes, file has " + std::to_string(bytes.size() - s.offset()) + " (truncated?)");
   } else {
     std::size_t lines = 0;
     for (std::size_t i = s.offset(); i < bytes.size(); ++i) lines += bytes[i] == '\n';
     if (total_records > lines + 1)
-      throw ParseError(name, s.line(), "element counts (" + std::to_string(total_records) +
-                                           " records) exceed the lines left in the file (truncated?)");
+      throw ParseError(name, s.line(),
+                       "element counts (" + std::to_string(total_records) +
+                           " records) exceed the lines left in the file (truncated?)");
   }
 
   std::vector<double> v, n;
@@ -225,7 +266,8 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
       poly.clear();
       if (!binary) {
         if (!s.next_data_line())
-          s.fail("file ends in element '" + e.name + "' after " + std::to_string(r) + " of " + std::to_string(e.count));
+          s.fail("file ends in element '" + e.name + "' after " + std::to_string(r) + " of " +
+                 std::to_string(e.count));
       }
       std::size_t tok = 0;
       auto next_value = [&](PlyType t, bool integer_only) -> double {
@@ -234,7 +276,8 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
           s.fail(e.name + " " + std::to_string(r) + ": expected more values on the line");
         const std::string_view tk = s.tokens()[tok++];
         if (integer_only || is_integer(t))
-          return static_cast<double>(s.parse_integer(tk, std::numeric_limits<int>::min(), std::numeric_limits<unsigned>::max()));
+          return static_cast<double>(
+              s.parse_integer(tk, std::numeric_limits<int>::min(), std::numeric_limits<unsigned>::max()));
         return s.parse_double(tk);
       };
       for (std::size_t k = 0; k < e.props.size(); ++k) {
@@ -245,19 +288,22 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
         }
         const double cnt = next_value(p.count_type, true);
         if (cnt < 0 || cnt > 1e6)
-          throw ParseError(name, binary ? 0 : s.line(), e.name + " " + std::to_string(r) + ": invalid list length " +
-                                                            std::to_string(static_cast<long long>(cnt)));
+          throw ParseError(name, binary ? 0 : s.line(),
+                           e.name + " " + std::to_string(r) + ": invalid list length " +
+                               std::to_string(static_cast<long long>(cnt)));
         const auto c = static_cast<std::size_t>(cnt);
         if (binary && c * type_size(p.type) > br.left())
-          throw ParseError(name, 0, e.name + " " + std::to_string(r) + ": list of " + std::to_string(c) +
-                                        " items runs past the end of the file");
+          throw ParseError(name, 0,
+                           e.name + " " + std::to_string(r) + ": list of " + std::to_string(c) +
+                               " items runs past the end of the file");
         for (std::size_t j = 0; j < c; ++j) {
           const double val = next_value(p.type, false);
           if (is_f && static_cast<int>(k) == ilist) {
             if (val < 0 || val >= static_cast<double>(ve->count))
               throw ParseError(name, binary ? 0 : s.line(),
-                               "face " + std::to_string(r) + ": vertex index " + std::to_string(static_cast<long long>(val)) +
-                                   " out of range (" + std::to_string(ve->count) + " vertices)");
+                               "face " + std::to_string(r) + ": vertex index " +
+                                   std::to_string(static_cast<long long>(val)) + " out of range (" +
+                                   std::to_string(ve->count) + " vertices)");
             poly.push_back(static_cast<int>(val));
           }
         }
@@ -269,15 +315,17 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
         for (int k : {ix, iy, iz}) {
           const double x = rec[static_cast<std::size_t>(k)];
           if (!std::isfinite(x))
-            throw ParseError(name, binary ? 0 : s.line(), "vertex " + std::to_string(r) + ": non-finite coordinate");
+            throw ParseError(name, binary ? 0 : s.line(),
+                             "vertex " + std::to_string(r) + ": non-finite coordinate");
           v.push_back(x);
         }
         if (normals)
           for (int k : {inx, iny, inz}) n.push_back(rec[static_cast<std::size_t>(k)]);
       } else if (is_f) {
         if (poly.size() < 3)
-          throw ParseError(name, binary ? 0 : s.line(), "face " + std::to_string(r) + " has " +
-                                                            std::to_string(poly.size()) + " vertices (at least 3 needed)");
+          throw ParseError(name, binary ? 0 : s.line(),
+                           "face " + std::to_string(r) + " has " + std::to_string(poly.size()) +
+                               " vertices (at least 3 needed)");
         for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
           tris.push_back(poly[0]);
           tris.push_back(poly[k]);
@@ -290,8 +338,10 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
   const auto nv = static_cast<Eigen::Index>(v.size() / 3), nt = static_cast<Eigen::Index>(tris.size() / 3);
   m.V = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(v.data(), nv, 3);
   m.F = Eigen::Map<const Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>>(tris.data(), nt, 3);
-  if (normals) m.N = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(n.data(), nv, 3);
-  else m.N.resize(0, 3);
+  if (normals)
+    m.N = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(n.data(), nv, 3);
+  else
+    m.N.resize(0, 3);
   return m;
 }
 

@@ -48,8 +48,9 @@ class LineScanner {
 
   /// Token i as a finite double.
   double number(std::size_t i) const {
-    if (i >= tokens_.size()) fail("expected a number in column " + std::to_string(i + 1) + ", line has " +
-                                  std::to_string(tokens_.size()) + " tokens");
+    if (i >= tokens_.size())
+      fail("expected a number in column " + std::to_string(i + 1) + ", line has " +
+           std::to_string(tokens_.size()) + " tokens");
     return parse_double(tokens_[i]);
   }
 
@@ -78,7 +79,8 @@ class LineScanner {
     const auto r = std::from_chars(b, e, v);
     if (r.ec != std::errc() || r.ptr != e) fail("not an integer: '" + std::string(t) + "'");
     if (v < lo || v > hi)
-      fail("integer " + std::to_string(v) + " out of range [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+      fail("integer " + std::to_string(v) + " out of range [" + std::to_string(lo) + ", " +
+           std::to_string(hi) + "]");
     return v;
   }
 

@@ -13,12 +13,12 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
-#include <array>
 #include <map>
-#include <tuple>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -76,14 +76,17 @@ class PointGrid {
 
 }  // namespace
 
-Constraints constraints_from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
+                                             const std::vector<Point3>& normals,
                                              const ConstraintBuildOptions& opt) {
   if (points.empty()) throw InvalidArgument("no points to build constraints from");
   if (normals.empty())
-    throw InvalidArgument("points without normals: an inside and an outside cannot be told apart "
-                          "(give oriented points, .pwn or 6-column .xyz, or a closed mesh)");
+    throw InvalidArgument(
+        "points without normals: an inside and an outside cannot be told apart "
+        "(give oriented points, .pwn or 6-column .xyz, or a closed mesh)");
   if (normals.size() != points.size())
-    throw InvalidArgument(std::to_string(points.size()) + " points but " + std::to_string(normals.size()) + " normals");
+    throw InvalidArgument(std::to_string(points.size()) + " points but " + std::to_string(normals.size()) +
+                          " normals");
   if (!(opt.offset > 0) || !std::isfinite(opt.offset))
     throw InvalidArgument("constraint offset must be a positive fraction of the diagonal");
   // Validate and merge exact duplicates (first kept).
@@ -120,7 +123,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points, 
   {
     std::map<std::tuple<double, double, double>, bool> seen;
     for (std::size_t i = 0; i < points.size(); ++i)
-      if (seen.emplace(std::make_tuple(points[i].x, points[i].y, points[i].z), true).second) surf.push_back(points[i]);
+      if (seen.emplace(std::make_tuple(points[i].x, points[i].y, points[i].z), true).second)
+        surf.push_back(points[i]);
   }
   PointGrid grid(surf, d0);
   Constraints c;
@@ -128,12 +132,13 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points, 
   for (std::size_t i : keep) {
     const Point3 n = normals[i] / norm(normals[i]);
     for (int side : {+1, -1}) {
-      if ((side > 0 && opt.sides == OffSurface::Inside) || (side < 0 && opt.sides == OffSurface::Outside)) continue;
+      if ((side > 0 && opt.sides == OffSurface::Inside) || (side < 0 && opt.sides == OffSurface::Outside))
+        continue;
       double d = d0;
       for (int tries = 0; tries < 5; ++tries, d *= 0.5) {
         const Point3 q = points[i] + (side * d) * n;
         // Too close to another surface point: the constraint would contradict that part of the surface.
-        if (!grid.any_within(q, 0.999 * d, static_cast<std::size_t>(-1)  /* p_i itself is at distance d */)) {
+        if (!grid.any_within(q, 0.999 * d, static_cast<std::size_t>(-1) /* p_i itself is at distance d */)) {
           c.add(q, side * d);
           break;
         }
@@ -150,20 +155,24 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k)
       if (F(f, k) < 0 || F(f, k) >= nv)
-        throw InvalidArgument("mesh triangle " + std::to_string(f) + ": vertex index " + std::to_string(F(f, k)) +
-                              " out of range (" + std::to_string(nv) + " vertices)");
+        throw InvalidArgument("mesh triangle " + std::to_string(f) + ": vertex index " +
+                              std::to_string(F(f, k)) + " out of range (" + std::to_string(nv) +
+                              " vertices)");
     if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2))
       throw InvalidArgument("mesh triangle " + std::to_string(f) + " repeats a vertex");
   }
   // Every undirected edge must be used by exactly two triangles, once in each direction.
   std::unordered_map<std::uint64_t, int> directed;
-  auto key = [](int a, int b) { return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b); };
+  auto key = [](int a, int b) {
+    return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+  };
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = F(f, k), b = F(f, (k + 1) % 3);
       if (++directed[key(a, b)] > 1)
-        throw InvalidArgument("mesh is not a consistently oriented closed manifold: edge (" + std::to_string(a) + ", " +
-                              std::to_string(b) + ") is used twice in the same direction (flipped triangle or "
+        throw InvalidArgument("mesh is not a consistently oriented closed manifold: edge (" +
+                              std::to_string(a) + ", " + std::to_string(b) +
+                              ") is used twice in the same direction (flipped triangle or "
                               "non-manifold edge)");
     }
   std::size_t boundary = 0;
@@ -178,9 +187,10 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
     }
   }
   if (boundary)
-    throw InvalidArgument("mesh has a boundary: edge (" + std::to_string(ba) + ", " + std::to_string(bb) +
-                          ") belongs to a single triangle (" + std::to_string(boundary) +
-                          " boundary edges); the inside is undefined: close the mesh or give oriented points");
+    throw InvalidArgument(
+        "mesh has a boundary: edge (" + std::to_string(ba) + ", " + std::to_string(bb) +
+        ") belongs to a single triangle (" + std::to_string(boundary) +
+        " boundary edges); the inside is undefined: close the mesh or give oriented points");
   Eigen::MatrixXd N = Eigen::MatrixXd::Zero(nv, 3);
   double volume6 = 0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {

@@ -54,7 +54,9 @@ namespace {
 
 constexpr std::size_t kNoSlot = std::numeric_limits<std::size_t>::max();
 
-double cube(double r) { return r * r * r; }
+double cube(double r) {
+  return r * r * r;
+}
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -64,14 +66,17 @@ std::string fmt(double v) {
 }
 
 // The linear-polynomial basis of scaled point x: [1, x, y, z].
-Eigen::Vector4d poly_row(const Point3& x) { return {1.0, x.x, x.y, x.z}; }
+Eigen::Vector4d poly_row(const Point3& x) {
+  return {1.0, x.x, x.y, x.z};
+}
 
 }  // namespace
 
 Constraints Constraints::from_matrix(const Eigen::Ref<const Eigen::MatrixXd>& positions,
                                      const Eigen::Ref<const Eigen::VectorXd>& values) {
   if (positions.cols() != 3)
-    throw InvalidArgument("constraint positions must have 3 columns, got " + std::to_string(positions.cols()));
+    throw InvalidArgument("constraint positions must have 3 columns, got " +
+                          std::to_string(positions.cols()));
   if (positions.rows() != values.size())
     throw InvalidArgument("constraint positions and values differ in count (" +
                           std::to_string(positions.rows()) + " vs " + std::to_string(values.size()) + ")");
@@ -114,7 +119,9 @@ struct Rbf::Impl {
   // ---------- geometry helpers ----------
   Point3 scaled(const Point3& p) const { return (p - center) / scale; }
   // The polynomial part at a scaled point (one expression shared by every evaluation path).
-  double poly_at(double x, double y, double z) const { return poly(0) + (poly(1) * x + poly(2) * y + poly(3) * z); }
+  double poly_at(double x, double y, double z) const {
+    return poly(0) + (poly(1) * x + poly(2) * y + poly(3) * z);
+  }
   Point3 pos(std::size_t i) const { return {cx[i], cy[i], cz[i]}; }
   double kernel(std::size_t i, std::size_t j) const { return cube(distance(pos(i), pos(j))); }
 
@@ -182,8 +189,9 @@ struct Rbf::Impl {
                             std::to_string(c.values.size()) + " values");
     for (std::size_t i = 0; i < c.size(); ++i) check_finite(c.points[i], c.values[i], i);
     if (c.size() < 4)
-      throw InvalidArgument("at least 4 non-coplanar constraints are needed to fix the linear polynomial, got " +
-                            std::to_string(c.size()));
+      throw InvalidArgument(
+          "at least 4 non-coplanar constraints are needed to fix the linear polynomial, got " +
+          std::to_string(c.size()));
     if (std::all_of(c.values.begin(), c.values.end(), [](double v) { return v == 0.0; }))
       throw InvalidArgument("all " + std::to_string(c.size()) +
                             " constraint values are zero: the interpolant would be f = 0 everywhere "
@@ -210,7 +218,8 @@ struct Rbf::Impl {
     std::array<std::size_t, 4> a{};
     a[0] = argmax([&](std::size_t i) { return squared_distance(pos(i), g); });
     a[1] = argmax([&](std::size_t i) { return squared_distance(pos(i), pos(a[0])); });
-    a[2] = argmax([&](std::size_t i) { return squared_norm(cross(pos(a[1]) - pos(a[0]), pos(i) - pos(a[0]))); });
+    a[2] =
+        argmax([&](std::size_t i) { return squared_norm(cross(pos(a[1]) - pos(a[0]), pos(i) - pos(a[0]))); });
     auto vol = [&](const std::array<std::size_t, 4>& t) {
       return std::abs(dot(cross(pos(t[1]) - pos(t[0]), pos(t[2]) - pos(t[0])), pos(t[3]) - pos(t[0])));
     };
@@ -234,7 +243,8 @@ struct Rbf::Impl {
       throw NumericalError("the " + std::to_string(N) +
                            " constraints are coplanar (or collinear): the linear polynomial is undetermined; "
                            "at least 4 non-coplanar constraints are needed (plane of constraints " +
-                           std::to_string(a[0]) + ", " + std::to_string(a[1]) + ", " + std::to_string(a[2]) + ")");
+                           std::to_string(a[0]) + ", " + std::to_string(a[1]) + ", " + std::to_string(a[2]) +
+                           ")");
     }
     anchor = a;
   }
@@ -250,7 +260,8 @@ struct Rbf::Impl {
     gg.resize(N);
     Eigen::Matrix4d aaa;
     for (int k = 0; k < 4; ++k)
-      for (int l = 0; l < 4; ++l) aaa(k, l) = kernel(anchor[static_cast<std::size_t>(k)], anchor[static_cast<std::size_t>(l)]);
+      for (int l = 0; l < 4; ++l)
+        aaa(k, l) = kernel(anchor[static_cast<std::size_t>(k)], anchor[static_cast<std::size_t>(l)]);
     for (std::size_t i = 0; i < N; ++i) basis_row(i, aaa);
     // Anchors: exact unit coordinates (b_{a_k} is never used, but lam enters the weights of anchors).
     for (int k = 0; k < 4; ++k) {
@@ -263,7 +274,8 @@ struct Rbf::Impl {
   Eigen::Matrix4d anchor_kernel() const {
     Eigen::Matrix4d aaa;
     for (int k = 0; k < 4; ++k)
-      for (int l = 0; l < 4; ++l) aaa(k, l) = kernel(anchor[static_cast<std::size_t>(k)], anchor[static_cast<std::size_t>(l)]);
+      for (int l = 0; l < 4; ++l)
+        aaa(k, l) = kernel(anchor[static_cast<std::size_t>(k)], anchor[static_cast<std::size_t>(l)]);
     return aaa;
   }
 
@@ -330,8 +342,7 @@ struct Rbf::Impl {
     for (std::size_t i = 0; i < N; ++i) q[3 * i] = cx[i], q[3 * i + 1] = cy[i], q[3 * i + 2] = cz[i];
     sums(q.data(), N, f.data(), nullptr);
     std::vector<double> r(N);
-    for (std::size_t i = 0; i < N; ++i)
-      r[i] = cons.values[i] - (f[i] + poly_at(cx[i], cy[i], cz[i]));
+    for (std::size_t i = 0; i < N; ++i) r[i] = cons.values[i] - (f[i] + poly_at(cx[i], cy[i], cz[i]));
     return r;
   }
 
@@ -360,8 +371,8 @@ struct Rbf::Impl {
       const std::size_t b = k * chunk, e = std::min(m, b + chunk);
       if (b >= e) break;
       pool.emplace_back([&, b, e] {
-        ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), nn, q + 3 * b, static_cast<long>(e - b), f + b,
-                     g ? g + 3 * b : nullptr);
+        ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), nn, q + 3 * b, static_cast<long>(e - b),
+                     f + b, g ? g + 3 * b : nullptr);
       });
     }
     for (auto& th : pool) th.join();
@@ -412,13 +423,13 @@ struct Rbf::Impl {
       sz += w[i] * cz[i];
       aw += std::abs(w[i]);
     }
-    rep.side_condition_residual = aw > 0 ? (std::abs(sw) + std::abs(sx) + std::abs(sy) + std::abs(sz)) / aw : 0.0;
+    rep.side_condition_residual =
+        aw > 0 ? (std::abs(sw) + std::abs(sx) + std::abs(sy) + std::abs(sz)) / aw : 0.0;
     rep.warning = rel > opt.warn_residual || rep.condition_estimate > opt.warn_condition;
     rep.message.clear();
     if (rep.warning) {
       rep.message = "unreliable fit: relative residual " + fmt(rel) + ", condition estimate " +
-                    fmt(rep.condition_estimate) +
-                    " (near-duplicate constraints or very uneven spacing?)";
+                    fmt(rep.condition_estimate) + " (near-duplicate constraints or very uneven spacing?)";
     }
   }
 
@@ -479,7 +490,8 @@ struct Rbf::Impl {
     n = order.size();
     if (static_cast<std::size_t>(L.rows()) < n || static_cast<std::size_t>(L.rows()) > 2 * n + 64) {
       L.resize(0, 0);
-      L = Eigen::MatrixXd(static_cast<Eigen::Index>(n + n / 8 + 16), static_cast<Eigen::Index>(n + n / 8 + 16));
+      L = Eigen::MatrixXd(static_cast<Eigen::Index>(n + n / 8 + 16),
+                          static_cast<Eigen::Index>(n + n / 8 + 16));
     }
     const auto m = static_cast<Eigen::Index>(n);
     // Fill the lower triangle of K (column-major: column s, rows t >= s) and its 1-norm.
@@ -495,7 +507,8 @@ struct Rbf::Impl {
       }
     }
     const double knorm = n ? *std::max_element(colsum.begin(), colsum.end()) : 0.0;
-    if (!rbf_detail::dense_ops().cholesky_inplace(L.data(), static_cast<long>(m), static_cast<long>(L.rows())))
+    if (!rbf_detail::dense_ops().cholesky_inplace(L.data(), static_cast<long>(m),
+                                                  static_cast<long>(L.rows())))
       throw NumericalError("the reduced RBF system of " + std::to_string(N) +
                            " constraints is not numerically positive definite (near-duplicate or degenerate "
                            "constraints?)");
@@ -616,8 +629,9 @@ struct Rbf::Impl {
       if (v > best) best = v, s = t;
     }
     if (s == kNoSlot || best < 1e-9)
-      throw InvalidArgument("the remaining constraints would be coplanar: the linear polynomial would be "
-                            "undetermined");
+      throw InvalidArgument(
+          "the remaining constraints would be coplanar: the linear polynomial would be "
+          "undetermined");
     const std::size_t j = order[s];
     const double ljk = lam[j](k);
     Eigen::VectorXd t(static_cast<Eigen::Index>(n));
@@ -629,7 +643,7 @@ struct Rbf::Impl {
     // R = L^T: R(r, c) = L(c, r) = a[r * ld + c] (row r of R is column r of L).
     auto R = [&](std::size_t r, std::size_t c) -> double& { return a[r * ld + c]; };
     std::vector<double> wv(s + 1);
-    for (std::size_t c = 0; c <= s; ++c) wv[c] = R(c, s);  // l = row s of L = column s of R
+    for (std::size_t c = 0; c <= s; ++c) wv[c] = R(c, s);       // l = row s of L = column s of R
     for (std::size_t r = 0; r + 1 < n; ++r) R(r + 1, r) = 0.0;  // subdiagonal scratch
     auto rotate = [&](std::size_t r, double c, double sn, std::size_t from) {
       for (std::size_t col = from; col < n; ++col) {
@@ -703,12 +717,14 @@ struct Rbf::Impl {
       const double d = distance(cons.points[j], p);
       if (d <= tol_abs) {
         if (d == 0.0 && cons.values[j] != v)
-          throw InvalidPoint(index, "duplicate of constraint " + std::to_string(j) + " with a different value (" +
-                                        fmt(cons.values[j]) + " vs " + fmt(v) + ")");
+          throw InvalidPoint(index, "duplicate of constraint " + std::to_string(j) +
+                                        " with a different value (" + fmt(cons.values[j]) + " vs " + fmt(v) +
+                                        ")");
         if (d == 0.0)
-          throw InvalidPoint(index, "duplicate of constraint " + std::to_string(j) + " (same position and value)");
-        throw InvalidPoint(index, "nearly coincides with constraint " + std::to_string(j) + " (distance " + fmt(d) +
-                                      " <= tolerance " + fmt(tol_abs) + ")");
+          throw InvalidPoint(index,
+                             "duplicate of constraint " + std::to_string(j) + " (same position and value)");
+        throw InvalidPoint(index, "nearly coincides with constraint " + std::to_string(j) + " (distance " +
+                                      fmt(d) + " <= tolerance " + fmt(tol_abs) + ")");
       }
     }
   }
@@ -720,7 +736,9 @@ struct Rbf::Impl {
 
 // ------------------------------------------------------------------------------------------------
 Rbf::Rbf() : impl_(std::make_unique<Impl>()) {}
-Rbf::Rbf(const Constraints& constraints, const RbfOptions& options) : Rbf() { fit(constraints, options); }
+Rbf::Rbf(const Constraints& constraints, const RbfOptions& options) : Rbf() {
+  fit(constraints, options);
+}
 Rbf::~Rbf() = default;
 Rbf::Rbf(const Rbf& o) : impl_(std::make_unique<Impl>(*o.impl_)) {}
 Rbf& Rbf::operator=(const Rbf& o) {
@@ -742,13 +760,27 @@ const FitReport& Rbf::fit(const Constraints& constraints, const RbfOptions& opti
   return impl_->rep;
 }
 
-bool Rbf::fitted() const { return impl_->fitted; }
-std::size_t Rbf::size() const { return impl_->cons.size(); }
-const Constraints& Rbf::constraints() const { return impl_->cons; }
-const RbfOptions& Rbf::options() const { return impl_->opt; }
-const FitReport& Rbf::report() const { return impl_->rep; }
-std::size_t Rbf::edits_since_fit() const { return impl_->edits; }
-std::size_t Rbf::refits_by_edits() const { return impl_->refits; }
+bool Rbf::fitted() const {
+  return impl_->fitted;
+}
+std::size_t Rbf::size() const {
+  return impl_->cons.size();
+}
+const Constraints& Rbf::constraints() const {
+  return impl_->cons;
+}
+const RbfOptions& Rbf::options() const {
+  return impl_->opt;
+}
+const FitReport& Rbf::report() const {
+  return impl_->rep;
+}
+std::size_t Rbf::edits_since_fit() const {
+  return impl_->edits;
+}
+std::size_t Rbf::refits_by_edits() const {
+  return impl_->refits;
+}
 
 double Rbf::value(const Point3& p) const {
   impl_->require_fitted();
@@ -756,8 +788,8 @@ double Rbf::value(const Point3& p) const {
   const Point3 s = m.scaled(p);
   const double q[3] = {s.x, s.y, s.z};
   double f = 0;
-  rbf_detail::dense_ops().rbf_sums(m.cx.data(), m.cy.data(), m.cz.data(), m.w.data(), static_cast<long>(m.cx.size()),
-                                   q, 1, &f, nullptr);
+  rbf_detail::dense_ops().rbf_sums(m.cx.data(), m.cy.data(), m.cz.data(), m.w.data(),
+                                   static_cast<long>(m.cx.size()), q, 1, &f, nullptr);
   return f + m.poly_at(s.x, s.y, s.z);
 }
 
@@ -776,8 +808,7 @@ void Rbf::values(const Point3* points, std::size_t n, double* out) const {
     q[3 * i] = s.x, q[3 * i + 1] = s.y, q[3 * i + 2] = s.z;
   }
   m.sums(q.data(), n, out, nullptr);
-  for (std::size_t i = 0; i < n; ++i)
-    out[i] += m.poly_at(q[3 * i], q[3 * i + 1], q[3 * i + 2]);
+  for (std::size_t i = 0; i < n; ++i) out[i] += m.poly_at(q[3 * i], q[3 * i + 1], q[3 * i + 2]);
 }
 
 void Rbf::values_gradients(const Point3* points, std::size_t n, double* vals, Point3* gradients) const {
@@ -836,8 +867,9 @@ void Rbf::add_constraint(const Point3& p, double value) {
     m.cons.points.pop_back(), m.cons.values.pop_back();
     m.cx.pop_back(), m.cy.pop_back(), m.cz.pop_back(), m.w.pop_back();
     m.lam.pop_back(), m.aa.pop_back(), m.gg.pop_back();
-    throw InvalidPoint(i, "adding this constraint makes the RBF system numerically singular (too close to "
-                          "other constraints?)");
+    throw InvalidPoint(i,
+                       "adding this constraint makes the RBF system numerically singular (too close to "
+                       "other constraints?)");
   }
   m.slot_of.push_back(m.n - 1);
   m.after_edit();
@@ -854,7 +886,8 @@ void Rbf::remove_constraint(std::size_t i) {
   bool nonzero = false;
   for (std::size_t j = 0; j < N && !nonzero; ++j) nonzero = j != i && m.cons.values[j] != 0.0;
   if (!nonzero)
-    throw InvalidArgument("cannot remove constraint " + std::to_string(i) + ": all remaining values would be zero");
+    throw InvalidArgument("cannot remove constraint " + std::to_string(i) +
+                          ": all remaining values would be zero");
   if (m.opt.solver == RbfSolver::FullLu) {
     Constraints c = m.cons;
     c.points.erase(c.points.begin() + static_cast<std::ptrdiff_t>(i));
@@ -902,8 +935,9 @@ void Rbf::move_constraint(std::size_t i, const Point3& p) {
     m.load_positions();
     m.factor_from_scratch();
     m.solve_weights(2);
-    throw InvalidPoint(i, "moving this constraint makes the RBF system numerically singular (too close to "
-                          "other constraints?)");
+    throw InvalidPoint(i,
+                       "moving this constraint makes the RBF system numerically singular (too close to "
+                       "other constraints?)");
   }
   m.rebuild_slots();
   m.after_edit();
@@ -918,7 +952,8 @@ void Rbf::set_value(std::size_t i, double value) {
   if (value == 0.0) {
     bool nonzero = false;
     for (std::size_t j = 0; j < N && !nonzero; ++j) nonzero = j != i && m.cons.values[j] != 0.0;
-    if (!nonzero) throw InvalidArgument("setting value " + std::to_string(i) + " to 0 would make all values zero");
+    if (!nonzero)
+      throw InvalidArgument("setting value " + std::to_string(i) + " to 0 would make all values zero");
   }
   m.cons.values[i] = value;
   if (m.opt.solver == RbfSolver::FullLu) {

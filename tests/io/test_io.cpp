@@ -5,8 +5,8 @@
 
 #include <catch2/catch.hpp>
 
-#include <cstdio>
 #include <dirent.h>
+#include <cstdio>
 #include <fstream>
 #include <random>
 #include <string>
@@ -15,7 +15,9 @@ using namespace vitri;
 
 namespace {
 
-std::string tmp(const std::string& name) { return std::string("vitri_test_io_") + name; }
+std::string tmp(const std::string& name) {
+  return std::string("vitri_test_io_") + name;
+}
 
 TriangleMesh tetra(bool normals) {
   TriangleMesh m;
@@ -33,11 +35,16 @@ TriangleMesh tetra(bool normals) {
 // Parses `text` with the reader of extension `ext` and returns the ParseError line (or 0 if it parsed).
 std::size_t error_line(const std::string& text, const std::string& ext) {
   try {
-    if (ext == "off") parse_off(text, "t.off");
-    else if (ext == "obj") parse_obj(text, "t.obj");
-    else if (ext == "ply") parse_ply(text, "t.ply");
-    else if (ext == "xyzv") parse_xyzv(text, "t.xyzv");
-    else parse_points(text, "t.xyz");
+    if (ext == "off")
+      parse_off(text, "t.off");
+    else if (ext == "obj")
+      parse_obj(text, "t.obj");
+    else if (ext == "ply")
+      parse_ply(text, "t.ply");
+    else if (ext == "xyzv")
+      parse_xyzv(text, "t.xyzv");
+    else
+      parse_points(text, "t.xyz");
   } catch (const ParseError& e) {
     return e.line();
   }
@@ -122,7 +129,8 @@ TEST_CASE("io reads the bundled models", "[io][data]") {
 }
 
 TEST_CASE("io text variants: comments, header counts, NOFF, polygons, OBJ index forms, PLY extras", "[io]") {
-  const TriangleMesh a = parse_off("# c\nOFF 4 2 0 # counts here\n0 0 0\n1 0 0\n\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 2 1\n");
+  const TriangleMesh a =
+      parse_off("# c\nOFF 4 2 0 # counts here\n0 0 0\n1 0 0\n\n1 1 0\n0 1 0\n4 0 1 2 3\n3 0 2 1\n");
   CHECK(a.V.rows() == 4);
   CHECK(a.F.rows() == 3);  // the quad is fan-triangulated
   CHECK(a.F.row(1) == Eigen::RowVector3i(0, 2, 3));
@@ -137,13 +145,16 @@ TEST_CASE("io text variants: comments, header counts, NOFF, polygons, OBJ index 
   REQUIRE(o.N.rows() == 4);  // every vertex referenced with the single normal 1
   CHECK(o.N(3, 2) == -1.0);
   // Vertices 1 and 2 referenced with two different normals: per-vertex normals are dropped.
-  const TriangleMesh o2 = parse_obj("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 -1\nvn 0 0 1\n"
-                                    "f 1//1 3//1 2//1\nf 1//2 2//2 4//2\n");
+  const TriangleMesh o2 = parse_obj(
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvn 0 0 -1\nvn 0 0 1\n"
+      "f 1//1 3//1 2//1\nf 1//2 2//2 4//2\n");
   CHECK(o2.N.rows() == 0);
   const TriangleMesh p = parse_ply(
-      "ply\nformat ascii 1.0\ncomment x\nelement vertex 3\nproperty float x\nproperty uchar red\nproperty float y\n"
+      "ply\nformat ascii 1.0\ncomment x\nelement vertex 3\nproperty float x\nproperty uchar red\nproperty "
+      "float y\n"
       "property float z\nelement face 1\nproperty uchar flags\nproperty list uchar int vertex_index\n"
-      "element edge 1\nproperty int a\nproperty int b\nend_header\n0 9 0 0\n1 9 0 0\n0 9 1 0\n7 3 0 1 2\n0 1\n");
+      "element edge 1\nproperty int a\nproperty int b\nend_header\n0 9 0 0\n1 9 0 0\n0 9 1 0\n7 3 0 1 2\n0 "
+      "1\n");
   CHECK(p.V.rows() == 3);
   CHECK(p.V(2, 1) == 1.0);
   CHECK(p.F.row(0) == Eigen::RowVector3i(0, 1, 2));
@@ -157,9 +168,10 @@ TEST_CASE("io errors name the file and the line", "[io][errors]") {
   CHECK(error_line("v 0 0 0\nv 1 0 0\n\nf 1 2 3\n", "obj") == 4);
   CHECK(error_line("1 2 3 4\n\n# c\n1 2 3\n", "xyzv") == 4);
   CHECK(error_line("1 2 3 4 5 6\n1 2 3\n", "xyz") == 2);
-  CHECK(error_line("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
-                   "end_header\n0 0 q\n",
-                   "ply") == 8);
+  CHECK(error_line(
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\n"
+            "end_header\n0 0 q\n",
+            "ply") == 8);
   try {
     parse_off("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 9\n", "model.off");
     FAIL("no exception");
@@ -180,7 +192,8 @@ TEST_CASE("io writers and readers refuse impossible requests", "[io][errors]") {
   PointValues pv{{{0, 0, 0}}, {}};
   CHECK_THROWS_AS(write_xyzv(tmp("bad.xyzv"), pv), InvalidArgument);
   std::remove(tmp("bad.obj").c_str());
-  CHECK_THROWS_WITH(parse_ply("ply\nformat binary_big_endian 1.0\nend_header\n", "b.ply"), Catch::Contains("big_endian"));
+  CHECK_THROWS_WITH(parse_ply("ply\nformat binary_big_endian 1.0\nend_header\n", "b.ply"),
+                    Catch::Contains("big_endian"));
   CHECK_THROWS_WITH(parse_points("1 2 3\n", "p.pwn", true), Catch::Contains("6 numbers"));
   CHECK_THROWS_WITH(parse_obj("", "e.obj"), Catch::Contains("no vertex"));
 }

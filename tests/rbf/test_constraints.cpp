@@ -86,7 +86,8 @@ TEST_CASE("constraints from oriented points: values, offsets, subsampling", "[rb
   }
 }
 
-TEST_CASE("constraints: a thin slab shrinks the offset instead of crossing to the other side", "[rbf][constraints]") {
+TEST_CASE("constraints: a thin slab shrinks the offset instead of crossing to the other side",
+          "[rbf][constraints]") {
   // Two parallel 5x5 grids 0.02 apart, normals pointing away from each other; d = 1% of ~1.4 > 0.01.
   std::vector<Point3> p, n;
   for (int i = 0; i < 5; ++i)
@@ -114,16 +115,19 @@ TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary an
   const Eigen::MatrixXi G = F.rowwise().reverse();
   const Eigen::MatrixXd M = closed_mesh_vertex_normals(V, G);
   CHECK(M.isApprox(N));
-  CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, F.topRows(3)), Catch::Contains("boundary") && Catch::Contains("edge (1, 2)"));
+  CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, F.topRows(3)),
+                    Catch::Contains("boundary") && Catch::Contains("edge (1, 2)"));
   Eigen::MatrixXi H = F;
   H.row(0) << 0, 1, 2;
   CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, H), Catch::Contains("same direction"));
   const TriangleMesh pig = read_mesh(kData + "/pig.off");
-  CHECK_THROWS_WITH(constraints_from_mesh(pig.V, pig.F), Catch::Contains("boundary") && Catch::Contains("edge ("));
+  CHECK_THROWS_WITH(constraints_from_mesh(pig.V, pig.F),
+                    Catch::Contains("boundary") && Catch::Contains("edge ("));
 }
 
 TEST_CASE("rbf on real models: ~0 on the surface, < 0 inside, > 0 outside", "[rbf][data]") {
-  const std::string name = GENERATE(std::string("hand.off"), std::string("bunny.off"), std::string("cactus.off"));
+  const std::string name =
+      GENERATE(std::string("hand.off"), std::string("bunny.off"), std::string("cactus.off"));
   INFO(name);
   const TriangleMesh m = read_mesh(kData + "/" + name);
   ConstraintBuildOptions opt;
@@ -162,7 +166,8 @@ TEST_CASE("rbf on sphere926.pwn: a sphere, negative at its center", "[rbf][data]
   double rmean = 0;
   for (const auto& p : in.points.points) rmean += distance(p, center);
   rmean /= static_cast<double>(in.points.points.size());
-  for (const auto& p : in.points.points) CHECK(std::abs(f.value(p)) <= 1e-2 * rmean);  // most points are not constraints
+  for (const auto& p : in.points.points)
+    CHECK(std::abs(f.value(p)) <= 1e-2 * rmean);  // most points are not constraints
   CHECK(f.value(center + Point3{3 * rmean, 0, 0}) > 0);
   Point3 g;
   f.value_gradient(in.points.points[0], g);

@@ -42,7 +42,8 @@ TEST_CASE("rbf interpolates random constraints to 1e-9 relative", "[rbf]") {
   CHECK_FALSE(rep.warning);
   CHECK(rep.condition_estimate >= 1.0);
   const double hmax = max_abs(c.values);
-  for (std::size_t i = 0; i < c.size(); ++i) CHECK(std::abs(f.value(c.points[i]) - c.values[i]) <= 1e-9 * hmax);
+  for (std::size_t i = 0; i < c.size(); ++i)
+    CHECK(std::abs(f.value(c.points[i]) - c.values[i]) <= 1e-9 * hmax);
 }
 
 TEST_CASE("rbf reproduces a linear function exactly", "[rbf]") {
@@ -84,7 +85,8 @@ TEST_CASE("rbf gradient matches central differences; batch equals single-point",
     const double v = f.value_gradient(p, g);
     CHECK(v == f.value(p));
     const Point3 ex{h, 0, 0}, ey{0, h, 0}, ez{0, 0, h};
-    const Point3 fd{(f.value(p + ex) - f.value(p - ex)) / (2 * h), (f.value(p + ey) - f.value(p - ey)) / (2 * h),
+    const Point3 fd{(f.value(p + ex) - f.value(p - ex)) / (2 * h),
+                    (f.value(p + ey) - f.value(p - ey)) / (2 * h),
                     (f.value(p + ez) - f.value(p - ez)) / (2 * h)};
     const double scale = 1 + vitri::norm(g);
     CHECK(vitri::norm(fd - g) <= 1e-5 * scale);  // rounding of f(p +- h) dominates
@@ -188,7 +190,8 @@ TEST_CASE("rbf rejects bad input with the constraint index", "[rbf][errors]") {
     }
   }
   SECTION("NaN and infinity") {
-    const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+    const double nan = std::numeric_limits<double>::quiet_NaN(),
+                 inf = std::numeric_limits<double>::infinity();
     Constraints a = good, b = good, d = good;
     a.points[4].y = nan;
     b.values[8] = inf;
@@ -227,7 +230,8 @@ TEST_CASE("rbf nearly coincident constraints: rejected, interpolated, or reporte
     const auto& rep = f.report();
     if (!rep.warning) {
       CHECK(rep.relative_residual <= 1e-9);
-      for (std::size_t i = 0; i < c.size(); ++i) CHECK(f.value(c.points[i]) == Approx(c.values[i]).margin(1e-8));
+      for (std::size_t i = 0; i < c.size(); ++i)
+        CHECK(f.value(c.points[i]) == Approx(c.values[i]).margin(1e-8));
     } else {
       CHECK_FALSE(rep.message.empty());
     }

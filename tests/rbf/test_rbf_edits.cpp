@@ -120,7 +120,8 @@ TEST_CASE("rbf edit errors leave the function unchanged", "[rbf][edits][errors]"
 
   // Down to 4 constraints, then no further; coplanar remainders are refused.
   Constraints sq;
-  sq.add({0, 0, 0}, 1), sq.add({1, 0, 0}, -1), sq.add({0, 1, 0}, 1), sq.add({1, 1, 0}, 2), sq.add({0, 0, 1}, 3);
+  sq.add({0, 0, 0}, 1), sq.add({1, 0, 0}, -1), sq.add({0, 1, 0}, 1), sq.add({1, 1, 0}, 2),
+      sq.add({0, 0, 1}, 3);
   Rbf h(sq);
   CHECK_THROWS_WITH(h.remove_constraint(4), Catch::Contains("coplanar"));
   CHECK(h.size() == 5);

@@ -42,7 +42,8 @@ struct ConstraintBuildOptions {
 /// @throws InvalidPoint (index of the point) for non-finite data or a zero normal; InvalidArgument for
 ///         mismatched sizes, an empty input or a missing normal array (points alone do not define an
 ///         inside and an outside).
-Constraints constraints_from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
+                                             const std::vector<Point3>& normals,
                                              const ConstraintBuildOptions& options = {});
 
 /// Area-weighted vertex normals of a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3),

@@ -60,7 +60,8 @@ struct RbfOptions {
   double duplicate_tolerance = 1e-6;
   /// Relative residual max_i |f(c_i) - h_i| / max_i |h_i| above which the fit is flagged unreliable
   /// (FitReport::warning). Rounding in the sum of N weighted kernels bounds what any solver reaches:
-  /// about 1e-10 for random sets of a few hundred points, 5e-9 (1500) to 5e-8 (6000) on surface data. The fit throws NumericalError when it is above `fail_residual`.
+  /// about 1e-10 for random sets of a few hundred points, 5e-9 (1500) to 5e-8 (6000) on surface data. The fit
+  /// throws NumericalError when it is above `fail_residual`.
   double warn_residual = 1e-7;
   /// See warn_residual. Also the threshold of the drift check after edits (which refits first).
   double fail_residual = 1e-4;
@@ -147,7 +148,8 @@ class Rbf : public ImplicitFunction {
   /// out[i] = f(points[i]), i < n, threaded when large (options().threads).
   void values(const Point3* points, std::size_t n, double* out) const override;
   /// values[i] = f(points[i]) and gradients[i] = grad f(points[i]), i < n, threaded when large.
-  void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const override;
+  void values_gradients(const Point3* points, std::size_t n, double* values,
+                        Point3* gradients) const override;
 
   // ----- coefficients, in the caller's units -----
   /// RBF weights w_j of f (one per constraint, same numbering), for the caller's coordinates.

@@ -18,6 +18,8 @@
 ///   oriented tetrahedron the sign flips. In general it is the sign of
 ///   -det[[a-e, |a-e|^2], [b-e, |b-e|^2], [c-e, |c-e|^2], [d-e, |d-e|^2]] (4x4, rows), which is
 ///   antisymmetric in its five arguments.
+/// - Non-finite coordinates (NaN, infinity) violate the preconditions; the predicates then answer Zero
+///   (never crash, no undefined behaviour). Callers validate their points on input.
 ///
 /// @note The inline filters are safe under FMA contraction (contraction only removes roundings, which
 /// keeps the derived bounds valid); the exact fallback lives in the library's translation unit, which is

@@ -2,7 +2,8 @@
 //
 //   bench_delaunay [--benchmark_filter=REGEX]
 //
-// Pairs of benchmarks vitri_X / cgal_X; at the end the ratio vitri / CGAL of every pair is printed.
+// Pairs of benchmarks vitri_X / cgal_X; at the end the ratio vitri / CGAL of every pair is printed
+// (CPU time, which is robust to other load on the machine; everything is single-threaded).
 // - bulk/N: bulk build of N uniform points (vitri: insert_points with the history; CGAL: range insert,
 //   which sorts spatially too). bulk_nohist/N: vitri without history.
 // - grid/n: the n^3 integer grid (cospherical everywhere).
@@ -55,7 +56,11 @@ std::vector<Point3> grid(int n) {
   return p;
 }
 
-std::size_t heap_bytes() { return mallinfo2().uordblks; }
+// Heap in use: small blocks (uordblks) plus mmap-ed large blocks (hblkhd).
+std::size_t heap_bytes() {
+  const auto m = mallinfo2();
+  return m.uordblks + m.hblkhd;
+}
 
 constexpr std::size_t kOps = 10000;
 constexpr std::size_t kBig = 1000000;
@@ -295,12 +300,12 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if (agg != std::string::npos) name.erase(agg);
       const auto it = name.find("/iterations");
       if (it != std::string::npos) name.erase(it, name.find('/', it + 1) == std::string::npos ? std::string::npos : name.find('/', it + 1) - it);
-      times_[name] = r.GetAdjustedRealTime();
+      times_[name] = {r.GetAdjustedCPUTime(), r.GetAdjustedRealTime()};
     }
     ConsoleReporter::ReportRuns(runs);
   }
   void print_ratios() const {
-    std::printf("\nratio vitri / CGAL (real time):\n");
+    std::printf("\nratio vitri / CGAL (CPU time; real time in parentheses):\n");
     for (const auto& [name, t] : times_) {
       if (name.rfind("vitri_", 0) != 0) continue;
       std::string key = name.substr(6);
@@ -308,12 +313,12 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if (nh != std::string::npos) key.erase(nh, 7);
       const auto c = times_.find("cgal_" + key);
       if (c == times_.end()) continue;
-      std::printf("  %-28s %8.3f\n", name.c_str(), t / c->second);
+      std::printf("  %-34s %8.3f  (%.3f)\n", name.c_str(), t.first / c->second.first, t.second / c->second.second);
     }
   }
 
  private:
-  std::map<std::string, double> times_;
+  std::map<std::string, std::pair<double, double>> times_;
 };
 
 }  // namespace

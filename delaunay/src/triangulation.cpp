@@ -85,13 +85,11 @@ std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   for (std::uint32_t q = m; q > 1; q >>= 1) {
     const std::uint32_t p = q - 1;
     for (int i = 0; i < 3; ++i) {
-      if (X[i] & q) {
-        X[0] ^= p;
-      } else {
-        const std::uint32_t t = (X[0] ^ X[i]) & p;
-        X[0] ^= t;
-        X[i] ^= t;
-      }
+      // Branch-free form of: if (X[i] & q) X[0] ^= p; else swap the low bits of X[0] and X[i].
+      const std::uint32_t set = 0u - std::uint32_t((X[i] & q) != 0);
+      const std::uint32_t t = (X[0] ^ X[i]) & p & ~set;
+      X[0] ^= (p & set) | t;
+      X[i] ^= t;
     }
   }
   for (int i = 1; i < 3; ++i) X[i] ^= X[i - 1];
@@ -172,6 +170,7 @@ struct Triangulation::Scratch {
   std::vector<VertexId> link_sub; // their ids in `sub`
   std::vector<PointId> sub_to_main;
   std::vector<LinkFace> link_faces;
+  std::vector<std::uint32_t> face_hash;  // open addressing: 1 + index into link_faces, 0 = empty
   std::vector<TetId> inside, sub_to_new;
   std::vector<std::pair<TetId, TetId>> old_to_new;
   std::unique_ptr<Triangulation> sub;  // small triangulation used by remove()
@@ -336,6 +335,31 @@ TetId Triangulation::walk(const Point3& p, TetId t) const {
     prev = t;
     t = next;
   }
+}
+
+TetId Triangulation::walk_limited(const Point3& p, TetId t, std::size_t max_steps) const {
+  TetId prev = kNoTet;
+  std::uint32_t rng = 0x9e3779b9u ^ t;
+  for (std::size_t step = 0; step < max_steps; ++step) {
+    rng = rng * 1664525u + 1013904223u;
+    const int r = int(rng >> 30);
+    const std::size_t b = 8 * std::size_t(t);
+    const Point3* const P[4] = {&pos_[td_[b]], &pos_[td_[b + 1]], &pos_[td_[b + 2]], &pos_[td_[b + 3]]};
+    TetId next = kNoTet;
+    for (int k = 0; k < 4; ++k) {
+      const int i = (r + k) & 3;
+      const TetId n = td_[4 + b + i];
+      if (n == kNoTet || n == prev) continue;
+      if (orient_replace(P, i, p) == Sign::Negative) {
+        next = n;
+        break;
+      }
+    }
+    if (next == kNoTet) return t;
+    prev = t;
+    t = next;
+  }
+  return kNoTet;
 }
 
 bool Triangulation::in_op_tet(const Op& op, TetId s, const Point3& p) const {
@@ -585,9 +609,12 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
     td_[bs + bf.face] = q;
     const TetId n = td_[4 + bt + bf.face];
     td_[4 + bs + bf.face] = n;
-    if (n != kNoTet)
-      for (int k = 0; k < 4; ++k)
-        if (td_[4 + 8 * std::size_t(n) + k] == bf.tet) td_[4 + 8 * std::size_t(n) + k] = s;
+    if (n != kNoTet) {
+      const std::size_t bn = 4 + 8 * std::size_t(n);
+      std::size_t k = 0;
+      for (std::size_t m = 1; m < 4; ++m) k = td_[bn + m] == bf.tet ? m : k;
+      td_[bn + k] = s;
+    }
     td_[4 + bt + bf.face] = s;
     S.created.push_back(s);
   }
@@ -599,11 +626,12 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
   //         \    /|                  index a (vertex tc[a]) is the one shared with s.
   //          \  / |
   //        e0 *---* b
+  // Each link is computed from both sides (no "already linked" test: it would be a 50/50 branch).
+  static constexpr int kOther[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
   for (std::size_t k = 0; k < S.created.size(); ++k) {
     const TetId s = S.created[k];
     const auto& bf = S.boundary[k];
-    for (int j = 0; j < 4; ++j) {
-      if (j == bf.face || td_[4 + 8 * std::size_t(s) + j] != kNoTet) continue;
+    for (int j : kOther[bf.face]) {
       TetId tc = bf.tet;
       int a = bf.face, b = j;
       TetId n;
@@ -612,16 +640,16 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
         if (!(tf_[n] & kMark)) break;
         const PointId va = td_[8 * std::size_t(tc) + a];
         int ka = 0, kw = 0;
-        for (int m = 0; m < 4; ++m) {
-          if (td_[8 * std::size_t(n) + m] == va) ka = m;
-          if (td_[4 + 8 * std::size_t(n) + m] == tc) kw = m;
+        for (int m = 1; m < 4; ++m) {
+          ka = td_[8 * std::size_t(n) + m] == va ? m : ka;
+          kw = td_[4 + 8 * std::size_t(n) + m] == tc ? m : kw;
         }
         tc = n;
         a = kw;
         b = ka;
       }
       td_[4 + 8 * std::size_t(s) + j] = n;
-      td_[4 + 8 * std::size_t(n) + a] = s;
+      (void)a;
     }
     for (int i = 0; i < 4; ++i) vtet_[td_[8 * std::size_t(s) + i]] = s;
   }
@@ -641,8 +669,10 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
   for (TetId t : S.cavity) {
     TetId hint = first;
     if (keep_history_)
-      for (int i = 0; i < 4; ++i)
-        if (td_[4 + 8 * std::size_t(t) + i] >= first) hint = td_[4 + 8 * std::size_t(t) + i];
+      for (int i = 0; i < 4; ++i) {
+        const TetId n = td_[4 + 8 * std::size_t(t) + i];
+        hint = n >= first ? n : hint;
+      }
     kill(t, op, hint);
   }
   for (TetId t : S.tested) tf_[t] &= std::uint8_t(~kTested);
@@ -690,10 +720,11 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
   std::vector<InsertResult> results(points.size());
   if (points.empty()) return results;
   const std::vector<std::uint32_t> order = brio_order(points, box_);
-  if (keep_history_) {  // about 27 tetrahedra are created per insertion of a uniform point
-    td_.reserve(td_.size() + 8 * 28 * points.size());
-    hnb_.reserve(hnb_.size() + 28 * points.size());
-    tf_.reserve(tf_.size() + 28 * points.size());
+  if (keep_history_) {  // about 28 tetrahedra are created per insertion of a uniform point
+    const std::size_t extra = 29 * points.size() + points.size() / 2;
+    td_.reserve(td_.size() + 8 * extra);
+    hnb_.reserve(hnb_.size() + extra);
+    tf_.reserve(tf_.size() + extra);
     ops_.reserve(ops_.size() + points.size());
   }
   pos_.reserve(pos_.size() + points.size());
@@ -749,7 +780,9 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
     std::size_t k = 0;
     for (std::size_t j = 0; j < 4; ++j)
       if (int(j) != skip) f[k++] = map ? (*map)[tv[b + j]] : tv[b + j];
-    std::sort(f.begin(), f.end());
+    if (f[0] > f[1]) std::swap(f[0], f[1]);
+    if (f[1] > f[2]) std::swap(f[1], f[2]);
+    if (f[0] > f[1]) std::swap(f[0], f[1]);
     return f;
   };
   // Link vertices and link faces (the face of each star tetrahedron opposite v).
@@ -768,12 +801,25 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   }
   std::sort(S.link.begin(), S.link.end());
   S.link.erase(std::unique(S.link.begin(), S.link.end()), S.link.end());
-  auto face_less = [](const Scratch::LinkFace& x, const Scratch::LinkFace& y) { return x.key < y.key; };
-  std::sort(S.link_faces.begin(), S.link_faces.end(), face_less);
+  std::size_t hsize = 16;
+  while (hsize < 4 * S.link_faces.size()) hsize *= 2;
+  const std::size_t hmask = hsize - 1;
+  S.face_hash.assign(hsize, 0);
+  auto hash = [hmask](const std::array<PointId, 3>& k) {
+    return (std::size_t(k[0]) * 73856093u ^ std::size_t(k[1]) * 19349663u ^ std::size_t(k[2]) * 83492791u) &
+           hmask;
+  };
+  for (std::size_t i = 0; i < S.link_faces.size(); ++i) {
+    std::size_t h = hash(S.link_faces[i].key);
+    while (S.face_hash[h]) h = (h + 1) & hmask;
+    S.face_hash[h] = std::uint32_t(i + 1);
+  }
   auto find_face = [&](const std::array<PointId, 3>& key) -> Scratch::LinkFace* {
-    auto it = std::lower_bound(S.link_faces.begin(), S.link_faces.end(), Scratch::LinkFace{key, 0, 0},
-                               face_less);
-    return (it != S.link_faces.end() && it->key == key) ? &*it : nullptr;
+    for (std::size_t h = hash(key); S.face_hash[h]; h = (h + 1) & hmask) {
+      Scratch::LinkFace& f = S.link_faces[S.face_hash[h] - 1];
+      if (f.key == key) return &f;
+    }
+    return nullptr;
   };
 
   // The perturbed DT of the link vertices plus the corners, in the same box.
@@ -1042,7 +1088,9 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
     tf_[t] &= std::uint8_t(~kMark);
     for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
   }
-  const TetId start = keep_history_ ? locate_history(p) : walk(p, vtet_[pv]);
+  // A short walk from v finds p after a small move; a far move uses the history.
+  TetId start = walk_limited(p, vtet_[pv], 64);
+  if (start == kNoTet) start = keep_history_ ? locate_history(p) : walk(p, vtet_[pv]);
   for (int i = 0; i < 4; ++i) {
     const PointId w = td_[8 * std::size_t(start) + i];
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
@@ -1068,7 +1116,8 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
 
   ChangeSet removal, insertion;
   remove_impl(v, changes ? &removal : nullptr);
-  const TetId t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
+  TetId t = walk_limited(p, last_tet_, 64);
+  if (t == kNoTet) t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
   result = insert_at(p, t, 0.0, changes ? &insertion : nullptr, v);
   if (result.status != InsertStatus::Inserted)
     throw std::logic_error("Triangulation::move: reinsertion rejected after the proximity check");

@@ -207,6 +207,7 @@ class Triangulation {
   void check_point(const Point3& p, std::size_t index) const;
   void check_vertex(VertexId v, const char* what) const;
   TetId walk(const Point3& p, TetId start) const;
+  TetId walk_limited(const Point3& p, TetId start, std::size_t max_steps) const;
   TetId locate_history(const Point3& p) const;
   bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
   TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;

@@ -507,8 +507,8 @@ struct Rbf::Impl {
       }
     }
     const double knorm = n ? *std::max_element(colsum.begin(), colsum.end()) : 0.0;
-    if (!rbf_detail::dense_ops().cholesky_inplace(L.data(), static_cast<long>(m),
-                                                  static_cast<long>(L.rows())))
+    const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+    if (!rbf_detail::cholesky_parallel(L.data(), static_cast<long>(m), static_cast<long>(L.rows()), threads))
       throw NumericalError("the reduced RBF system of " + std::to_string(N) +
                            " constraints is not numerically positive definite (near-duplicate or degenerate "
                            "constraints?)");

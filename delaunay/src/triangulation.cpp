@@ -726,6 +726,12 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
     hnb_.reserve(hnb_.size() + extra);
     tf_.reserve(tf_.size() + extra);
     ops_.reserve(ops_.size() + points.size());
+  } else {  // about 6.8 live tetrahedra per uniform point; freed slots are recycled
+    const std::size_t extra = 6 * points.size() + points.size() * 9 / 10 + 64;
+    if (tf_.size() + extra > tf_.capacity()) {
+      td_.reserve(td_.size() + 8 * extra);
+      tf_.reserve(tf_.size() + extra);
+    }
   }
   pos_.reserve(pos_.size() + points.size());
   vtet_.reserve(vtet_.size() + points.size());

@@ -590,3 +590,19 @@ TEST_CASE("delaunay: copies are independent") {
   CHECK(a.is_vertex(20));
   CHECK_FALSE(b.is_vertex(20));
 }
+
+TEST_CASE("delaunay: bulk insertion reports the net change of the batch") {
+  for (bool history : {true, false}) {
+    Triangulation tr(kUnitBox, TriangulationOptions{history});
+    tr.insert_points(uniform_points(100, 91));
+    const auto before = tr.live_tetrahedra();
+    ChangeSet ch;
+    tr.insert_points(uniform_points(200, 92), 0.0, &ch);
+    check(tr);
+    std::set<TetId> expect(before.begin(), before.end());
+    for (TetId t : ch.killed) REQUIRE(expect.erase(t) == 1);  // killed were live before
+    for (TetId t : ch.created) REQUIRE(expect.insert(t).second);
+    const auto after = tr.live_tetrahedra();
+    CHECK(expect == std::set<TetId>(after.begin(), after.end()));
+  }
+}

@@ -5,6 +5,7 @@
 #include "vitri/core/error.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -138,12 +139,33 @@ int run_tetrahedralize(const Args& args) {
   }
   Triangulation tr(box, TriangulationOptions{false});
 
+  // Exact duplicates: the first occurrence in the file wins (the bulk insertion order is spatial).
+  std::vector<std::size_t> first(n);
+  {
+    std::vector<std::size_t> order;  // finite points only: NaN breaks the ordering
+    for (std::size_t i = 0; i < n; ++i) {
+      first[i] = i;
+      if (is_finite(in[i].p)) order.push_back(i);
+    }
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+      if (in[a].p != in[b].p) return lex_less(in[a].p, in[b].p);
+      return a < b;
+    });
+    for (std::size_t k = 0; k < order.size(); ++k)
+      first[order[k]] = (k > 0 && in[order[k]].p == in[order[k - 1]].p) ? first[order[k - 1]] : order[k];
+  }
   // Points the triangulation would refuse are reported here, the others inserted in bulk.
   std::vector<Point3> pts;
   std::vector<std::size_t> index;  // input index of pts[k]
   std::size_t rejected = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Point3& p = in[i].p;
+    if (first[i] != i && is_finite(p)) {
+      std::cerr << input << ":" << in[i].line << ": point " << i << " rejected: duplicate of point " << first[i]
+                << " (line " << in[first[i]].line << ")\n";
+      ++rejected;
+      continue;
+    }
     const bool inside = p.x > box.lo.x && p.x < box.hi.x && p.y > box.lo.y && p.y < box.hi.y &&
                         p.z > box.lo.z && p.z < box.hi.z;
     if (!is_finite(p) || !inside) {

@@ -116,6 +116,9 @@ TEST_CASE("cli tetrahedralize: explicit box, rejected points reported with their
   f << "0.5 0.5 0.5 0 0 1\n";  // line 45: extra columns ignored
   pts.push_back({0.5, 0.5, 0.5});
   accepted.push_back(true);
+  f << "nan 0.5 0.5\n";  // line 46: non-finite
+  pts.push_back({0.25, 0.5, 0.5});  // placeholder position, never referenced
+  accepted.push_back(false);
   f.close();
 
   std::string err;
@@ -123,6 +126,7 @@ TEST_CASE("cli tetrahedralize: explicit box, rejected points reported with their
   REQUIRE(run(kDir + "/tetra_in.xyz -o " + out + " --box 0 0 0 1 1 1", err) == 0);
   CHECK(err.find("tetra_in.xyz:43: point 40 rejected: duplicate of point 5 (line 8)") != std::string::npos);
   CHECK(err.find("tetra_in.xyz:44: point 41 rejected: not strictly inside the box") != std::string::npos);
+  CHECK(err.find("tetra_in.xyz:46: point 43 rejected: non-finite coordinates") != std::string::npos);
   check_output(out, Box3{{0, 0, 0}, {1, 1, 1}}, pts, accepted);
 }
 

@@ -212,7 +212,6 @@ class Triangulation {
   bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
   TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
   TetId alloc_tet();
-  void free_tet(TetId t);
   PointId alloc_point(const Point3& p, VertexId reuse_vid);
   bool grow_cavity(const Point3& p, TetId start, PointId& duplicate);
   void clear_cavity_marks();

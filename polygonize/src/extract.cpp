@@ -25,7 +25,6 @@
 // which is the standard strictly-classified marching tetrahedra result (a manifold, never flat).
 #include "vitri/core/error.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
-#include "parallel.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -43,6 +42,10 @@ constexpr double kMinT = 1e-6;  // crossings stay at least this fraction of the 
 
 // Even permutations (i, j, k, l) starting with each lone vertex i.
 constexpr int kLone[4][4] = {{0, 1, 2, 3}, {1, 0, 3, 2}, {2, 3, 0, 1}, {3, 2, 1, 0}};
+
+inline std::uint64_t edge_key(VertexId a, VertexId b) {
+  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+}
 
 struct CrossedEdge {
   VertexId pos;  // endpoint with f >= 0
@@ -64,8 +67,7 @@ SurfaceMesh Polygonizer::extract() {
   tris.reserve(tets.size());
   auto edge_of = [&](VertexId a, VertexId b) -> std::uint32_t {
     // a, b of opposite classes; order the key, remember which is positive.
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-    const auto it = edge_index.try_emplace(key, static_cast<std::uint32_t>(edges.size()));
+    const auto it = edge_index.try_emplace(edge_key(a, b), static_cast<std::uint32_t>(edges.size()));
     if (it.second) {
       if (is_negative_value(a))
         edges.push_back({b, a});
@@ -122,27 +124,38 @@ SurfaceMesh Polygonizer::extract() {
       if (options_.placement == VertexPlacement::RootFinding) roots.push_back(static_cast<std::uint32_t>(e));
     }
   }
+  std::unordered_map<std::uint64_t, RootCacheEntry> next_cache;
   if (!roots.empty()) {
     // Illinois: bracket [a, b] with g(a) > 0 > g(b) (g(a) may be halved), lockstep over all edges.
+    // Stop when |g| <= tol (f(pos) - f(neg)) (position error ~ tol x edge length for a smooth f), or
+    // when the bracket or the step is below tol. An edge met by the previous extraction, with the same
+    // endpoints and the same positive end, starts from its previous root (warm start): after an edit
+    // that barely changed f there, one evaluation accepts it.
     const std::size_t nr = roots.size();
-    std::vector<double> a(nr, 0.0), b(nr, 1.0), ga(nr), gb(nr), last(nr, -1.0);
+    std::vector<double> a(nr, 0.0), b(nr, 1.0), ga(nr), gb(nr), last(nr, -1.0), gtol(nr), guess(nr, -1.0);
     std::vector<signed char> side(nr, 0);
+    const double tol = options_.root_tolerance;
     for (std::size_t i = 0; i < nr; ++i) {
-      ga[i] = values_[edges[roots[i]].pos];
-      gb[i] = values_[edges[roots[i]].neg];
+      const CrossedEdge& e = edges[roots[i]];
+      ga[i] = values_[e.pos];
+      gb[i] = values_[e.neg];
+      gtol[i] = tol * (ga[i] - gb[i]);
+      const auto it = root_cache_.find(edge_key(e.pos, e.neg));
+      if (it != root_cache_.end() && it->second.pos == e.pos && !moved_[e.pos] && !moved_[e.neg])
+        guess[i] = it->second.t;
     }
     std::vector<std::uint32_t> active(nr);
     for (std::size_t i = 0; i < nr; ++i) active[i] = static_cast<std::uint32_t>(i);
     std::vector<Point3> pts;
     std::vector<double> val;
     std::vector<double> tcur(nr);
-    const double tol = options_.root_tolerance;
     for (int it = 0; it < options_.max_root_iterations && !active.empty(); ++it) {
       pts.resize(active.size());
       val.resize(active.size());
       for (std::size_t k = 0; k < active.size(); ++k) {
         const std::uint32_t i = active[k];
         double t = a[i] + (b[i] - a[i]) * (ga[i] / (ga[i] - gb[i]));
+        if (it == 0 && guess[i] > 0.0 && guess[i] < 1.0) t = guess[i];
         if (!(t > a[i] && t < b[i])) t = 0.5 * (a[i] + b[i]);  // safeguard (underflow, rounding)
         tcur[i] = t;
         const Point3& pp = tri_.point(edges[roots[i]].pos);
@@ -155,21 +168,21 @@ SurfaceMesh Polygonizer::extract() {
       for (std::size_t k = 0; k < active.size(); ++k) {
         const std::uint32_t i = active[k];
         const double t = tcur[i], g = val[k];
-        bool done = false;
-        if (g == 0.0 || std::isnan(g)) {
-          done = true;  // exact root (or a NaN: keep the current estimate, still inside the bracket)
-        } else if (g > 0.0) {
-          a[i] = t;
-          ga[i] = g;
-          if (side[i] == 1) gb[i] *= 0.5;
-          side[i] = 1;
-        } else {
-          b[i] = t;
-          gb[i] = g;
-          if (side[i] == -1) ga[i] *= 0.5;
-          side[i] = -1;
+        bool done = std::abs(g) <= gtol[i] || std::isnan(g);  // NaN: keep the estimate (inside the bracket)
+        if (!done) {
+          if (g > 0.0) {
+            a[i] = t;
+            ga[i] = g;
+            if (side[i] == 1) gb[i] *= 0.5;
+            side[i] = 1;
+          } else {
+            b[i] = t;
+            gb[i] = g;
+            if (side[i] == -1) ga[i] *= 0.5;
+            side[i] = -1;
+          }
+          if (b[i] - a[i] <= tol || std::abs(t - last[i]) <= 0.5 * tol) done = true;
         }
-        if (b[i] - a[i] <= tol || std::abs(t - last[i]) <= 0.5 * tol) done = true;
         last[i] = t;
         const double tc = std::clamp(t, kMinT, 1.0 - kMinT);
         const Point3& pp = tri_.point(edges[roots[i]].pos);
@@ -178,7 +191,14 @@ SurfaceMesh Polygonizer::extract() {
       }
       active.resize(keep);
     }
+    next_cache.reserve(nr);
+    for (std::size_t i = 0; i < nr; ++i) {
+      const CrossedEdge& e = edges[roots[i]];
+      next_cache.emplace(edge_key(e.pos, e.neg), RootCacheEntry{std::clamp(last[i], kMinT, 1.0 - kMinT), e.pos});
+    }
   }
+  root_cache_.swap(next_cache);
+  std::fill(moved_.begin(), moved_.end(), std::uint8_t{0});
 
   // ---- 3. Triangles (quads split along the shorter diagonal) ----------------------------------------------
   for (const auto& q : quads) {
@@ -309,14 +329,15 @@ SurfaceMesh Polygonizer::extract() {
     mesh.triangles.push_back(out);
   }
   mesh.normals.resize(mesh.vertices.size());
-  detail::parallel_for(mesh.vertices.size(), options_.threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      Point3 g;
-      f_.value_gradient(mesh.vertices[i], g);
+  {
+    // One batch call (vectorized / threaded by the function when it overrides values_gradients).
+    std::vector<double> unused(mesh.vertices.size());
+    f_.values_gradients(mesh.vertices.data(), mesh.vertices.size(), unused.data(), mesh.normals.data());
+    for (Point3& g : mesh.normals) {
       const double n = norm(g);
-      mesh.normals[i] = (n > 0.0 && std::isfinite(n)) ? g / n : Point3{0.0, 0.0, 0.0};
+      g = (n > 0.0 && std::isfinite(n)) ? g / n : Point3{0.0, 0.0, 0.0};
     }
-  });
+  }
   stats_.function_evaluations += mesh.vertices.size();
   stats_.gradient_evaluations += mesh.vertices.size();
   // A vanishing gradient (critical point on the surface): fall back to the area-weighted face normal.

@@ -53,13 +53,6 @@ bool strictly_inside(const Box3& b, const Point3& p) {
   return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
 }
 
-/// The point of the box shrunk by a relative margin 1e-9 that is nearest to p.
-Point3 clamp_inside(const Box3& b, const Point3& p) {
-  const Point3 m = 1e-9 * b.extent();
-  return {std::clamp(p.x, b.lo.x + m.x, b.hi.x - m.x), std::clamp(p.y, b.lo.y + m.y, b.hi.y - m.y),
-          std::clamp(p.z, b.lo.z + m.z, b.hi.z - m.z)};
-}
-
 std::string describe(const Point3& p) {
   std::ostringstream s;
   s.precision(17);
@@ -148,6 +141,7 @@ void Polygonizer::grow_vertex_arrays() {
   kind_.resize(cap, static_cast<std::uint8_t>(VertexKind::Refinement));
   fixed_.resize(cap, 0);
   tcount_.resize(cap, 0);
+  moved_.resize(cap, 0);
 }
 
 void Polygonizer::grow_tet_arrays() {
@@ -260,33 +254,49 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
   changes_.clear();
   InsertResult r;
   if (is_finite(c) && strictly_inside(box, c)) {
-    r = tri_.insert_in_conflict(c, t, min_distance, &changes_);
-  } else {
-    // Fallback 1: the point of the (slightly shrunk) box nearest to the circumcenter. It lies in or
-    // very near the circumball (the tetrahedron is in the box), not necessarily in conflict with t:
-    // insert it with point location.
-    ++stats_.boundary_fallbacks;
-    const auto v = tri_.tet_vertices(t);
-    const Point3 q = is_finite(c) ? clamp_inside(box, c)
-                                  : 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
-    r = tri_.insert(q, min_distance, &changes_);
-    if (r.status != InsertStatus::Inserted) {
-      // Fallback 2: the midpoint of the longest edge, pulled 10% towards the centroid: a point of the
-      // interior of t, hence strictly inside the box and strictly inside the circumball (in conflict).
-      double best = -1.0;
-      Point3 m;
-      const Point3 g = 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
-      for (int i = 0; i < 4; ++i)
-        for (int j = i + 1; j < 4; ++j) {
-          const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
-          if (d > best) {
-            best = d;
-            m = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
-          }
-        }
-      if (!strictly_inside(box, m)) m = g;  // rounding put it on a face (t is very flat there)
+    try {
+      r = tri_.insert_in_conflict(c, t, min_distance, &changes_);
+    } catch (const InvalidArgument&) {
+      // The rounded circumcenter of a nearly flat tetrahedron can fall just outside its exact
+      // circumsphere: insert it with point location instead (same proximity rule).
       changes_.clear();
-      if (strictly_inside(box, m)) r = tri_.insert_in_conflict(m, t, min_distance, &changes_);
+      r = tri_.insert(c, min_distance, &changes_);
+    }
+  } else {
+    // The circumcenter is outside the box. A tetrahedron with a face on the box hull has its
+    // circumradius bounded below by that face (only corners lie on the hull): it cannot be refined,
+    // and inserting points towards the face would only pile them up there. It is dropped.
+    ++stats_.boundary_fallbacks;
+    for (int i = 0; i < 4; ++i)
+      if (tri_.tet_neighbor(t, i) == kNoTet) {
+        if (kind == VertexKind::Refinement) ++stats_.rejected;
+        return false;
+      }
+    // Otherwise: the midpoint of the longest edge pulled 10% towards the centroid, a point of the
+    // interior of t, hence strictly inside the box and the circumball (in conflict), subject to the
+    // same proximity rule.
+    const auto v = tri_.tet_vertices(t);
+    double best = -1.0;
+    Point3 m;
+    const Point3 g = 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
+        if (d > best) {
+          best = d;
+          m = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
+        }
+      }
+    if (!strictly_inside(box, m)) m = g;  // rounding put it on a face (t is very flat there)
+    r.status = InsertStatus::TooClose;
+    if (strictly_inside(box, m)) {
+      try {
+        r = tri_.insert_in_conflict(m, t, min_distance, &changes_);
+      } catch (const InvalidArgument&) {
+        // t is so flat that the rounded m left its circumsphere: locate it instead.
+        changes_.clear();
+        r = tri_.insert(m, min_distance, &changes_);
+      }
     }
   }
   if (r.status != InsertStatus::Inserted) {
@@ -442,6 +452,7 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
     if (r.status != InsertStatus::Inserted) return false;
   }
   grow_tet_arrays();
+  moved_[v] = 1;
   if (value) {
     values_[v] = *value;
     fixed_[v] = 1;

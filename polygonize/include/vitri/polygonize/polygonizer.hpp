@@ -29,6 +29,7 @@
 #include <functional>
 #include <optional>
 #include <queue>
+#include <unordered_map>
 #include <utility>
 #include <vector>
 
@@ -69,7 +70,9 @@ struct PolygonizerOptions {
   double min_distance_fraction = 0.25;
   /// Mesh vertex placement on crossed edges.
   VertexPlacement placement = VertexPlacement::RootFinding;
-  /// Root finder stops when the bracket is shorter than this fraction of the edge length.
+  /// Root finder tolerance, relative to the edge: it stops when |f| <= root_tolerance x (f(+end) -
+  /// f(-end)) (position error about this fraction of the edge for a smooth f) or when the bracket is
+  /// shorter than this fraction of the edge.
   double root_tolerance = 1e-4;
   /// Root finder iteration cap per edge (each iteration is one function evaluation, batched).
   int max_root_iterations = 16;
@@ -79,8 +82,6 @@ struct PolygonizerOptions {
   bool snap_zero_vertices = true;
   /// Fraction of the edge length, from the zero vertex, at which a non-snapped crossing is placed.
   double zero_offset = 0.05;
-  /// Threads for gradient (normal) evaluation in extract(); 0 = hardware concurrency.
-  unsigned threads = 0;
 };
 
 /// Counters and timings. Times in seconds; counters cumulative since construction unless stated.
@@ -93,7 +94,7 @@ struct PolygonizerStats {
   std::size_t root_evaluations = 0;     ///< of which by the root finder
   std::size_t gradient_evaluations = 0; ///< of which for normals
   std::size_t insertions = 0;           ///< Delaunay insertions by refinement and sampling
-  std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box replaced by a fallback point
+  std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box (hull tetrahedra dropped, others split inside)
   std::size_t rejected = 0;             ///< refine(): points rejected by proximity (tetrahedron dropped)
   std::size_t removed_steiner = 0;      ///< refinement vertices removed by collect_garbage()
   std::size_t zero_snapped = 0;         ///< last extract(): zero vertices used as mesh vertices
@@ -220,6 +221,14 @@ class Polygonizer {
   std::priority_queue<std::pair<double, TetId>> heap_;
   ChangeSet changes_;
   PolygonizerStats stats_;
+  // Roots found by the last extract(), per crossed edge (key: ordered vertex pair), to warm-start the
+  // next one; moved_ marks vertices moved since (their edges start cold).
+  struct RootCacheEntry {
+    double t;      // parameter from the positive end
+    VertexId pos;  // the positive end when it was found
+  };
+  std::unordered_map<std::uint64_t, RootCacheEntry> root_cache_;
+  std::vector<std::uint8_t> moved_;
 };
 
 }  // namespace vitri

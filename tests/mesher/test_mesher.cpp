@@ -1,0 +1,214 @@
+// Tests of vitri::Mesher: real models through the RBF (topology, closeness to the input), levels of
+// detail, dynamic edits (watertight, on the edited surface, close to a fresh mesh, bounded growth).
+#include <catch2/catch.hpp>
+
+#include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
+#include "vitri/mesher.hpp"
+#include "vitri/polygonize/mesh_metrics.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+
+using namespace vitri;
+
+namespace {
+
+const std::string kData = VITRI_DATA_DIR;
+
+MeshMetrics metrics_of(const SurfaceMesh& m) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  to_eigen(m, V, F);
+  return compute_mesh_metrics(V, F);
+}
+
+void require_closed(const SurfaceMesh& m) {
+  const MeshMetrics mm = metrics_of(m);
+  INFO("V " << mm.vertices << " F " << mm.triangles << " boundary " << mm.boundary_edges << " nonmanifold e/v "
+            << mm.non_manifold_edges << "/" << mm.non_manifold_vertices << " inconsistent " << mm.inconsistent_edges
+            << " degenerate " << mm.degenerate_triangles << " zero-area " << mm.zero_area_triangles
+            << " duplicates " << mm.duplicate_vertices);
+  REQUIRE(mm.closed_manifold());
+  REQUIRE(mm.signed_volume > 0.0);
+}
+
+/// Largest first-order distance |f| / |grad f| of the mesh vertices to the surface of f.
+double max_surface_distance(const SurfaceMesh& m, const ImplicitFunction& f) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  to_eigen(m, V, F);
+  return surface_distance(V, f).max;
+}
+
+/// A small model at the paper's Table 2 scale (25 constraints): the center of an ellipsoid (index 0,
+/// value -0.5), 18 points of its surface (value 0) and 6 points outside it on the axes (value +1), which
+/// keep f positive far away so that the surface stays well inside the domain box.
+Constraints small_model() {
+  Constraints c;
+  c.add({0.0, 0.0, 0.0}, -0.5);
+  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < 18; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / 18.0, r = std::sqrt(1.0 - z * z), phi = golden * i;
+    c.add({1.0 * r * std::cos(phi), 0.8 * r * std::sin(phi), 0.6 * z}, 0.0);
+  }
+  for (int k = 0; k < 3; ++k)
+    for (const double s : {-2.0, 2.0}) {
+      Point3 p{0.0, 0.0, 0.0};
+      p[static_cast<std::size_t>(k)] = s;
+      c.add(p, 1.0);
+    }
+  return c;
+}
+
+}  // namespace
+
+TEST_CASE("real models: watertight 2-manifold with the model's Euler characteristic", "[mesher]") {
+  struct Case {
+    const char* file;
+    std::size_t max_constraints;  // subsampled to keep the sanitizer run short
+    double precision;             // relative to the diagonal
+    long long euler;
+  };
+  // Stated precisions: at these the RBF surface of each model has the model's topology (elephant needs
+  // ~1500 surface points; with 500 the fitted surface itself grows extra handles).
+  const Case c = GENERATE(Case{"hand.off", 1500, 0.03, 2}, Case{"bunny.off", 1500, 0.03, 2},
+                          Case{"knot1.off", 1500, 0.03, 0}, Case{"elephant.off", 4500, 0.02, -4});
+  INFO(c.file);
+  const TriangleMesh in = read_mesh(kData + "/" + c.file);
+  MesherOptions o;
+  o.constraint_build.max_constraints = c.max_constraints;
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  const double precision = c.precision * mesher.diagonal();
+  REQUIRE(mesher.refine(precision));
+  const SurfaceMesh& m = mesher.surface();
+  require_closed(m);
+  const MeshMetrics mm = metrics_of(m);
+  REQUIRE(mm.euler_characteristic == c.euler);
+  REQUIRE(mm.components == 1);
+  // The vertices are on the fitted surface: root-finder vertices to 1e-4 of an edge, the crossings of
+  // zero vertices that could not be collapsed at 5% of an edge (edges < 2 precision); the on-surface
+  // constraints are near the mesh.
+  REQUIRE(max_surface_distance(m, mesher.function()) <= 0.1 * precision);
+  const MeshDistance md(m);
+  double worst = 0.0;
+  const Constraints& cs = mesher.constraints();
+  for (std::size_t i = 0; i < cs.size(); ++i)
+    if (cs.values[i] == 0.0) worst = std::max(worst, md.distance(cs.points[i]));
+  REQUIRE(worst <= precision);
+  // Every on-surface constraint whose crossings could be collapsed is a mesh vertex exactly.
+  REQUIRE(mesher.stats().polygonizer.zero_snapped > 0);
+}
+
+TEST_CASE("levels of detail: more vertices at each level, each watertight", "[mesher]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.constraint_build.max_constraints = 1500;
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  std::size_t last = 0;
+  for (const double p : {0.06, 0.04, 0.03}) {
+    REQUIRE(mesher.refine(p * mesher.diagonal()));
+    const SurfaceMesh& m = mesher.surface();
+    require_closed(m);
+    REQUIRE(metrics_of(m).euler_characteristic == 0);
+    REQUIRE(m.vertices.size() > last);
+    last = m.vertices.size();
+  }
+}
+
+TEST_CASE("one-call mesh_points equals the stateful mesher", "[mesher]") {
+  const Constraints c = small_model();
+  Eigen::MatrixXd V, N;
+  Eigen::MatrixXi F;
+  mesh_points(c, 0.05, V, F, N);
+  Mesher m(c);
+  m.refine(0.05);
+  REQUIRE(V.rows() == static_cast<Eigen::Index>(m.surface().vertices.size()));
+  REQUIRE(F.rows() == static_cast<Eigen::Index>(m.surface().triangles.size()));
+  REQUIRE(N.rows() == V.rows());
+  const MeshMetrics mm = compute_mesh_metrics(V, F);
+  REQUIRE(mm.closed_manifold());
+  REQUIRE(mm.euler_characteristic == 2);
+}
+
+TEST_CASE("scripted edits: watertight, on the edited surface, close to a fresh mesh", "[mesher]") {
+  const double precision = 0.05;
+  Mesher mesher(small_model());
+  REQUIRE(mesher.refine(precision));
+  require_closed(mesher.surface());
+  auto check = [&](const char* what) {
+    INFO(what);
+    const SurfaceMesh& m = mesher.surface();
+    require_closed(m);
+    REQUIRE(max_surface_distance(m, mesher.function()) <= 0.1 * precision);
+    for (const TetId t : mesher.polygonizer().transverse_tetrahedra())
+      REQUIRE(mesher.polygonizer().triangulation().circumradius(t) <= precision);
+    Mesher fresh(mesher.constraints());
+    fresh.refine(precision);
+    REQUIRE(hausdorff_distance(m, fresh.surface()) <= precision);
+  };
+  mesher.move_constraint(3, {1.2, 0.2, 0.1});
+  check("move");
+  mesher.add_constraint({0.0, 0.0, 0.9}, 0.0);
+  check("add");
+  mesher.set_value(0, -0.8);
+  check("value");
+  mesher.remove_constraint(7);
+  check("remove");
+  REQUIRE(mesher.size() == 25);
+  mesher.polygonizer().triangulation().verify_topology();
+}
+
+TEST_CASE("100 random edits: vertex count stays within 1.5x of a fresh mesh", "[mesher]") {
+  const double precision = 0.06;
+  Mesher mesher(small_model());
+  REQUIRE(mesher.refine(precision));
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int e = 0; e < 100; ++e) {
+    const std::size_t n = mesher.size();
+    const int kind = static_cast<int>(rng() % 4);
+    // A random surface constraint (|value| < 0.5; index 0 is the center, the +1 points are outside).
+    std::size_t i = 0;
+    do i = 1 + rng() % (n - 1);
+    while (std::abs(mesher.constraints().values[i]) >= 0.5);
+    if (kind == 0 || n <= 20) {  // move it a little
+      const Point3 p = mesher.constraints().points[i];
+      mesher.move_constraint(i, {p.x + 0.1 * u(rng), p.y + 0.1 * u(rng), p.z + 0.1 * u(rng)});
+    } else if (kind == 1 && n < 30) {  // add a surface point of the ellipsoid
+      const Point3 d{u(rng), u(rng), u(rng)};
+      const double len = norm(d) + 1e-3;
+      mesher.add_constraint({d.x / len, 0.8 * d.y / len, 0.6 * d.z / len}, 0.0);
+    } else if (kind == 2 && n > 20) {
+      mesher.remove_constraint(i);
+    } else {  // nudge its value
+      mesher.set_value(i, 0.02 * u(rng));
+    }
+  }
+  const SurfaceMesh& m = mesher.surface();
+  require_closed(m);
+  Mesher fresh(mesher.constraints());
+  fresh.refine(precision);
+  INFO("edited: " << mesher.stats().polygonizer.vertices << " Delaunay vertices, fresh: "
+                  << fresh.stats().polygonizer.vertices);
+  REQUIRE(static_cast<double>(mesher.stats().polygonizer.vertices) <=
+          1.5 * static_cast<double>(fresh.stats().polygonizer.vertices));
+  REQUIRE(hausdorff_distance(m, fresh.surface()) <= precision);
+  mesher.polygonizer().triangulation().verify_topology();
+}
+
+TEST_CASE("mesher errors", "[mesher]") {
+  Mesher mesher(small_model());
+  REQUIRE_THROWS_AS(mesher.refine(0.0), InvalidArgument);
+  REQUIRE_THROWS_AS(mesher.move_constraint(100, {0, 0, 0}), InvalidPoint);
+  REQUIRE_THROWS_AS(mesher.add_constraint({std::nan(""), 0, 0}, 0.0), InvalidPoint);
+  // Nothing changed after the failed edits.
+  REQUIRE(mesher.size() == 25);
+  REQUIRE(mesher.refine(0.1));
+  require_closed(mesher.surface());
+  MesherOptions o;
+  o.box_factor = 1.0;
+  REQUIRE_THROWS_AS(Mesher(small_model(), o), InvalidArgument);
+}

@@ -65,17 +65,16 @@ Constraints small_model() {
 
 }  // namespace
 
-TEST_CASE("real models: watertight 2-manifold with the model's Euler characteristic", "[mesher]") {
-  struct Case {
-    const char* file;
-    std::size_t max_constraints;  // subsampled to keep the sanitizer run short
-    double precision;             // relative to the diagonal
-    long long euler;
-  };
-  // Stated precisions: at these the RBF surface of each model has the model's topology (elephant needs
-  // ~1500 surface points; with 500 the fitted surface itself grows extra handles).
-  const Case c = GENERATE(Case{"hand.off", 1500, 0.03, 2}, Case{"bunny.off", 1500, 0.03, 2},
-                          Case{"knot1.off", 1500, 0.03, 0}, Case{"elephant.off", 4500, 0.02, -4});
+namespace {
+
+struct ModelCase {
+  const char* file;
+  std::size_t max_constraints;  // subsampled to keep the sanitizer run short
+  double precision;             // relative to the diagonal
+  long long euler;
+};
+
+void check_model(const ModelCase& c) {
   INFO(c.file);
   const TriangleMesh in = read_mesh(kData + "/" + c.file);
   MesherOptions o;
@@ -100,6 +99,21 @@ TEST_CASE("real models: watertight 2-manifold with the model's Euler characteris
   REQUIRE(worst <= precision);
   // Every on-surface constraint whose crossings could be collapsed is a mesh vertex exactly.
   REQUIRE(mesher.stats().polygonizer.zero_snapped > 0);
+}
+
+}  // namespace
+
+// Stated precisions: at these the RBF surface of each model has the model's topology.
+TEST_CASE("real models: watertight 2-manifold with the model's Euler characteristic", "[mesher]") {
+  check_model(GENERATE(ModelCase{"hand.off", 1500, 0.03, 2}, ModelCase{"bunny.off", 1500, 0.03, 2},
+                       ModelCase{"knot1.off", 1500, 0.03, 0}));
+}
+
+// Elephant (genus 3) needs ~1500 surface points (4500 constraints): with fewer, the fitted surface itself
+// grows extra handles. The O(N^3) fit takes ~150 s under the sanitizers, so this case is hidden from the
+// default run; run it with `test_mesher "[slow]"` (about 5 s in Release).
+TEST_CASE("real model elephant: genus 3 (Euler characteristic -4)", "[.][slow][mesher]") {
+  check_model(ModelCase{"elephant.off", 4500, 0.02, -4});
 }
 
 TEST_CASE("levels of detail: more vertices at each level, each watertight", "[mesher]") {

@@ -46,12 +46,14 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <functional>
 #include <iostream>
 #include <map>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -66,14 +68,18 @@ using viz::RenderOptions;
 // Small helpers
 
 using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
+}
 
 std::string fmt(const char* format, double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, format, v);
   return buf;
 }
-std::string ms(double seconds) { return fmt("%.0f ms", 1e3 * seconds); }
+std::string ms(double seconds) {
+  return fmt("%.0f ms", 1e3 * seconds);
+}
 
 /// An indexed triangle mesh: V #V x 3, F #F x 3.
 struct Mesh {
@@ -88,7 +94,9 @@ Mesh to_mesh(const SurfaceMesh& s) {
   return m;
 }
 
-std::string data_path(const std::string& file) { return std::string(VITRI_DATA_DIR) + "/" + file; }
+std::string data_path(const std::string& file) {
+  return std::string(VITRI_DATA_DIR) + "/" + file;
+}
 
 Box3 box_of(const std::vector<Point3>& points) {
   Box3 b;
@@ -111,7 +119,8 @@ void add_marker(Mesh& m, const Point3& p, double radius) {
   for (int i = 0; i < 6; ++i)
     m.V.row(v0 + i) << p.x + radius * d[i][0], p.y + radius * d[i][1], p.z + radius * d[i][2];
   // Outward faces of the octahedron are (x, y, z) with an even permutation of signs; written reversed.
-  const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  const int faces[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                           {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
   for (int i = 0; i < 8; ++i)
     m.F.row(f0 + i) << static_cast<int>(v0) + faces[i][0], static_cast<int>(v0) + faces[i][2],
         static_cast<int>(v0) + faces[i][1];
@@ -185,9 +194,15 @@ Constraints blob23() {
   Constraints c;
   for (double sx : {-1.0, 1.0}) {
     const Point3 ctr{0.8 * sx, 0, 0};
-    const Point3 dirs[9] = {{sx, 0, 0},           {0, 1, 0},           {0, -1, 0},          {0, 0, 1},
-                            {0, 0, -1},           {0.5 * sx, 0.6, 0.6}, {0.5 * sx, -0.6, 0.6},
-                            {0.5 * sx, 0.6, -0.6}, {0.5 * sx, -0.6, -0.6}};
+    const Point3 dirs[9] = {{sx, 0, 0},
+                            {0, 1, 0},
+                            {0, -1, 0},
+                            {0, 0, 1},
+                            {0, 0, -1},
+                            {0.5 * sx, 0.6, 0.6},
+                            {0.5 * sx, -0.6, 0.6},
+                            {0.5 * sx, 0.6, -0.6},
+                            {0.5 * sx, -0.6, -0.6}};
     for (const Point3& d : dirs) c.add(ctr + d / norm(d), 0.0);
   }
   c.add({0, 0.75, 0}, 0.0);
@@ -260,7 +275,8 @@ std::pair<double, Mesh> match_vertices(const std::function<Mesh(double)>& run, d
       const auto& a = pts[pts.size() - 2];
       const auto& b = pts.back();
       if (std::abs(b.first - a.first) > 1e-12) s = (b.second - a.second) / (b.first - a.first);
-      if (!(s * slope > 0) || std::abs(s) < 0.3 * std::abs(slope) || std::abs(s) > 3 * std::abs(slope)) s = slope;
+      if (!(s * slope > 0) || std::abs(s) < 0.3 * std::abs(slope) || std::abs(s) > 3 * std::abs(slope))
+        s = slope;
     }
     p = std::exp(std::log(p) + (std::log(target) - std::log(n)) / s);
   }
@@ -337,7 +353,8 @@ std::string figures_2_and_4(const Context& ctx) {
     const Mesh shell = transverse_shell(mesher.polygonizer());
     const Image under = viz::render_mesh(surf.V, surf.F, surf_o);
     const Image over = viz::render_mesh(shell.V, shell.F, shell_o);
-    const std::string label = k == 0 ? "step 0 (initial)" : "step " + std::to_string(k) + ", P = " + fmt("%.3g", p) + " diag";
+    const std::string label =
+        k == 0 ? "step 0 (initial)" : "step " + std::to_string(k) + ", P = " + fmt("%.3g", p) + " diag";
     tets.push_back(viz::add_caption(overlay(over, under, 0.55, o.background),
                                     label + ": " + std::to_string(st.vertices) + " vertices, " +
                                         std::to_string(st.transverse) + " transverse tets",
@@ -345,9 +362,9 @@ std::string figures_2_and_4(const Context& ctx) {
     RenderOptions mo2 = o;
     mo2.wireframe = true;
     meshes.push_back(tile(surf, mo2, label + ": " + std::to_string(surf.vertices()) + " mesh vertices"));
-    rows << "| " << k << " | " << (k == 0 ? std::string("- (initial)") : fmt("%.3g", p)) << " | " << st.vertices
-         << " | " << st.transverse << " | " << surf.vertices() << " | " << surf.F.rows() << " | " << ms(step_s)
-         << (k == 0 ? " (fit + initial tetrahedralization + extract)" : "") << " |\n";
+    rows << "| " << k << " | " << (k == 0 ? std::string("- (initial)") : fmt("%.3g", p)) << " | "
+         << st.vertices << " | " << st.transverse << " | " << surf.vertices() << " | " << surf.F.rows()
+         << " | " << ms(step_s) << (k == 0 ? " (fit + initial tetrahedralization + extract)" : "") << " |\n";
   }
   std::ostringstream md;
   md << "## Figure 2: transverse tetrahedra after 0, 1, 2, 3 refinement steps\n\n"
@@ -358,13 +375,16 @@ std::string figures_2_and_4(const Context& ctx) {
         "constraint points and the 8 corners of the constraints' box enlarged by 2, as in the paper). "
         "**Step 0** is that initial state; **step k** is `refine(P_k)`: circumcenters of transverse "
         "tetrahedra are inserted until every transverse tetrahedron has circumradius <= P_k, with P_1 = "
-     << kFirstPrecision << " x "
+     << kFirstPrecision
+     << " x "
         "the diagonal of the constraints' box (diagonal "
      << fmt("%.3f", diag)
      << ") and P_k halved at each step; each step continues the previous tetrahedralization. Drawn: the "
         "boundary of the union of the transverse tetrahedra (light blue, with its edges), 55% opaque over "
-        "the extracted surface (orange); all four at the same scale (the frame is the constraints' box "
-        "x 1.3, so the first, huge tetrahedra reaching to the box corners are cut off by the image border). "
+        "the extracted surface (orange); all four at the same scale. At step 0 every transverse tetrahedron "
+        "joins an inside "
+        "constraint to three on-surface constraints (value 0, on the surface), so the surface runs along "
+        "the outer faces of the shell and the two coincide. "
         "The paper's Figure 2 had 18, 68, 223 and 889 vertices.\n\n"
      << rows.str() << "\n";
   md << "## Figure 4: the meshes of the four states of Figure 2 (levels of detail)\n\n"
@@ -381,7 +401,8 @@ std::string figures_2_and_4(const Context& ctx) {
 struct TwoResolutions {
   Mesh meshes[2];
   double precision[2] = {0, 0};  // relative to the diagonal
-  double total_s[2] = {0, 0}, fit_s[2] = {0, 0}, build_s[2] = {0, 0}, refine_s[2] = {0, 0}, extract_s[2] = {0, 0};
+  double total_s[2] = {0, 0}, fit_s[2] = {0, 0}, build_s[2] = {0, 0}, refine_s[2] = {0, 0},
+         extract_s[2] = {0, 0};
   long long chi[2] = {0, 0};
   bool closed[2] = {false, false};
 };
@@ -392,9 +413,9 @@ TwoResolutions two_resolutions(const Constraints& c, const Rbf& rbf, const doubl
   const double diag = box_of(c.points).diagonal();
   for (int k = 0; k < 2; ++k) {
     const double guess = 0.1 * diag * std::sqrt(200.0 / targets[k]);
-    const double p =
-        match_vertices([&](double q) { return vitri_mesh(rbf, c, q, mo.polygonizer); }, guess, -2.0, targets[k], 8)
-            .first;
+    const double p = match_vertices([&](double q) { return vitri_mesh(rbf, c, q, mo.polygonizer); }, guess,
+                                    -2.0, targets[k], 8)
+                         .first;
     const auto t0 = Clock::now();
     Mesher mesher(c, mo);
     const auto t1 = Clock::now();
@@ -414,16 +435,19 @@ TwoResolutions two_resolutions(const Constraints& c, const Rbf& rbf, const doubl
   return r;
 }
 
-std::string two_resolution_table(const TwoResolutions& r, const double (&paper_v)[2], const double (&paper_s)[2]) {
+std::string two_resolution_table(const TwoResolutions& r, const double (&paper_v)[2],
+                                 const double (&paper_s)[2]) {
   std::ostringstream t;
-  t << "| | precision (x diagonal) | vertices (paper) | vertices | triangles | Euler char. | closed manifold | "
+  t << "| | precision (x diagonal) | vertices (paper) | vertices | triangles | Euler char. | closed manifold "
+       "| "
        "total time (paper) | total time | of which fit / initial tetrahedralization and sampling / refine / "
        "extract |\n|---|---|---|---|---|---|---|---|---|---|\n";
   for (int k = 0; k < 2; ++k)
-    t << "| (" << static_cast<char>('a' + k) << ") | " << fmt("%.4f", r.precision[k]) << " | " << paper_v[k] << " | "
-      << r.meshes[k].vertices() << " | " << r.meshes[k].F.rows() << " | " << r.chi[k] << " | "
-      << (r.closed[k] ? "yes" : "no") << " | " << fmt("%.2f s", paper_s[k]) << " | " << ms(r.total_s[k]) << " | "
-      << ms(r.fit_s[k]) << " / " << ms(r.build_s[k]) << " / " << ms(r.refine_s[k]) << " / " << ms(r.extract_s[k]) << " |\n";
+    t << "| (" << static_cast<char>('a' + k) << ") | " << fmt("%.4f", r.precision[k]) << " | " << paper_v[k]
+      << " | " << r.meshes[k].vertices() << " | " << r.meshes[k].F.rows() << " | " << r.chi[k] << " | "
+      << (r.closed[k] ? "yes" : "no") << " | " << fmt("%.2f s", paper_s[k]) << " | " << ms(r.total_s[k])
+      << " | " << ms(r.fit_s[k]) << " / " << ms(r.build_s[k]) << " / " << ms(r.refine_s[k]) << " / "
+      << ms(r.extract_s[k]) << " |\n";
   return t.str();
 }
 
@@ -458,7 +482,8 @@ std::string figure_6(const Context& ctx) {
         "normals, one off-surface constraint inside each (`OffSurface::Inside`): 200 constraints, "
         "`torus200()` as in the benchmark. (With `OffSurface::Outside` no constraint is negative, since "
         "on-surface values 0 count as positive, and the default sampling lattice, coarser than the tube, "
-        "finds no inside vertex: the mesh is empty. Inside constraints seed the inside.) Each resolution is a fresh `vitri::Mesher` (fit, initial "
+        "finds no inside vertex: the mesh is empty. Inside constraints seed the inside.) Each resolution is "
+        "a fresh `vitri::Mesher` (fit, initial "
         "tetrahedralization with the sampling lattice, refinement, extraction; times are wall clock of that "
         "whole run); the precision was searched on a pre-fitted RBF to land near the paper's vertex counts. "
         "The paper's times are on a 500 MHz Pentium III.\n\n"
@@ -479,8 +504,7 @@ std::string figure_7(Context& ctx, const Constraints& c, const Rbf& rbf) {
   o.margin = 0.02;
   std::ostringstream md;
   md << "## Figure 7: hand at two resolutions\n\n"
-     << save(ctx, two_panels(r, o, "hand"), "fig7-hand.png")
-     << "`data/hand.off` turned into " << c.size()
+     << save(ctx, two_panels(r, o, "hand"), "fig7-hand.png") << "`data/hand.off` turned into " << c.size()
      << " normal constraints (`constraints_from_mesh`, `max_constraints = 1500`: 500 surface points "
         "subsampled with seed 1, each with an inside and an outside constraint at 0.01 x the diagonal), "
         "the paper's fist had about 1500 constraints. Each resolution is a fresh `vitri::Mesher` as in "
@@ -531,15 +555,16 @@ std::string figure_8(const Context& ctx) {
     const double vitri_s = seconds_since(b);
     const MeshMetrics vmet = compute_mesh_metrics(vm.V, vm.F);
     if (gmet.components != vmet.components || gmet.euler_characteristic != vmet.euler_characteristic)
-      grid_wrong.push_back(std::to_string(n) + " cells (" + std::to_string(gmet.components) +
-                           " component(s), Euler characteristic " + std::to_string(gmet.euler_characteristic) + ")");
+      grid_wrong.push_back(std::to_string(n) + " cells (" + std::to_string(gmet.components) + " component" +
+                           (gmet.components == 1 ? "" : "s") + ", chi " +
+                           std::to_string(gmet.euler_characteristic) + ")");
     if (vitri_min == 0) vitri_min = static_cast<std::size_t>(vm.vertices());
     top.push_back(tile(gm, ow,
                        "grid " + std::to_string(n) + " cells: " + std::to_string(gm.vertices()) + " v, chi " +
                            std::to_string(gmet.euler_characteristic)));
-    bottom.push_back(tile(vm, ow,
-                          "vitri: " + std::to_string(vm.vertices()) + " v, chi " +
-                              std::to_string(vmet.euler_characteristic)));
+    bottom.push_back(tile(
+        vm, ow,
+        "vitri: " + std::to_string(vm.vertices()) + " v, chi " + std::to_string(vmet.euler_characteristic)));
     t << "| " << n << " | " << gm.vertices() << " | " << gmet.components << " | " << gmet.euler_characteristic
       << " | " << ms(grid_s) << " | " << fmt("%.4f", p / diag) << " | " << vm.vertices() << " | "
       << vmet.components << " | " << vmet.euler_characteristic << " | " << ms(vitri_s) << " |\n";
@@ -548,26 +573,29 @@ std::string figure_8(const Context& ctx) {
   tiles.insert(tiles.end(), bottom.begin(), bottom.end());
   std::ostringstream md;
   md << "## Figure 8: the grid baseline at low resolution next to vitri\n\n"
-     << save(ctx, viz::compose_grid(tiles, 3), "fig8-grid-vs-vitri.png")
-     << "The RBF of `data/knot1.off` (" << c.size()
-     << " normal constraints, fit " << ms(fit_s)
+     << save(ctx, viz::compose_grid(tiles, 3), "fig8-grid-vs-vitri.png") << "The RBF of `data/knot1.off` ("
+     << c.size() << " normal constraints, fit " << ms(fit_s)
      << "), a trefoil knot whose tube is thin compared with the cells of a coarse grid. Top: "
         "`polygonize_grid` (marching tetrahedra on a uniform grid over the constraints' box x 1.3, the "
         "baseline of the paper's section 4.3) with 10, 16 and 24 cells along the longest side. Bottom: "
         "vitri (a fresh polygonization as the Mesher builds it) with the precision searched so that its "
-        "vertex count is close to the grid mesh above it (except at the coarsest grid: vitri's search stops at "
+        "vertex count is close to the grid mesh above it; both times exclude the shared RBF fit (except at "
+        "the coarsest grid: vitri's search stops at "
      << vitri_min
      << " vertices, its meshes cannot get much coarser because the 1500 constraint points are all vertices "
         "of the tetrahedralization). Captions: vertices and Euler characteristic (chi; a knotted tube is a "
         "torus, chi = 0). A grid cell larger than the gap between two strands of the tube, or than the tube "
         "itself, either fuses the strands (extra handles: chi < 0) or cuts the tube. "
-     << (grid_wrong.empty() ? std::string("In this run the grid's topology matched vitri's at every resolution.")
-                            : "In this run the grid's topology is wrong at " + [&] {
-                                std::string j;
-                                for (std::size_t i = 0; i < grid_wrong.size(); ++i)
-                                  j += (i ? (i + 1 == grid_wrong.size() ? " and " : ", ") : "") + grid_wrong[i];
-                                return j;
-                              }() + ".")
+     << (grid_wrong.empty()
+             ? std::string("In this run the grid's topology matched vitri's at every resolution.")
+             : "In this run the grid's topology is wrong at " +
+                   [&] {
+                     std::string j;
+                     for (std::size_t i = 0; i < grid_wrong.size(); ++i)
+                       j += (i ? (i + 1 == grid_wrong.size() ? " and " : ", ") : "") + grid_wrong[i];
+                     return j;
+                   }() +
+                   ".")
      << " vitri's tetrahedralization contains the inside constraint points, so every part of the tube is "
         "found from the start and refinement only adds detail. The paper's Figure 8 showed the baseline's "
         "defects on its test model (46, 164, 488 and 1770 vertices).\n\n"
@@ -597,9 +625,10 @@ std::string figure_9(const Context& ctx) {
   const double initial_s = seconds_since(t0);
   // Constraint 0 is the tip of the left lobe (-1.8, 0, 0), constraint 1 the top of the left lobe
   // (-0.8, 1, 0); the waist has radius 0.75.
-  const Edit edits[3] = {{0, {-2.3, 0, 0}, "move constraint 0 (left tip) from (-1.8, 0, 0) to (-2.3, 0, 0)"},
-                         {1, {-0.8, 1.4, 0}, "move constraint 1 (left top) from (-0.8, 1, 0) to (-0.8, 1.4, 0)"},
-                         {-1, {0, 0.95, 0}, "add the constraint f(0, 0.95, 0) = 0 above the waist"}};
+  const Edit edits[3] = {
+      {0, {-2.3, 0, 0}, "move constraint 0 (left tip) from (-1.8, 0, 0) to (-2.3, 0, 0)"},
+      {1, {-0.8, 1.4, 0}, "move constraint 1 (left top) from (-0.8, 1, 0) to (-0.8, 1.4, 0)"},
+      {-1, {0, 0.95, 0}, "add the constraint f(0, 0.95, 0) = 0 above the waist"}};
   RenderOptions o = base_options(300, 200);
   o.azimuth = 5;
   o.elevation = 15;
@@ -650,7 +679,8 @@ std::string figure_9(const Context& ctx) {
      << t.str()
      << "\nThe benchmark's Tables 2 and 3 time three insertions of points 0.05 to 0.2 outside the surface; "
         "their bumps are too small to see at this size, so this figure makes larger edits. A zero-valued "
-        "constraint added far outside the surface, such as (2.1, 0, 0), does not pull a bump out of the blob: "
+        "constraint added far outside the surface, such as (2.1, 0, 0), does not pull a bump out of the "
+        "blob: "
         "the RBF passes through 0 there and is negative beyond it, so the new surface is a separate sheet "
         "(right for the function, not a modelling edit). Moving an existing constraint, or adding one close "
         "to the surface, deforms the blob as a user expects.\n\n";
@@ -658,10 +688,17 @@ std::string figure_9(const Context& ctx) {
 }
 
 /// The histogram plot: from bench_compare's --hist CSV when given, otherwise vitri and grid only.
+/// Fixed series colours, so that a plot without CGAL keeps the colours of the full one.
+Color series_color(const std::string& name) {
+  if (name == "vitri") return {45, 95, 165};
+  if (name == "CGAL") return {215, 95, 20};
+  return {85, 160, 45};  // grid
+}
+
 std::string histogram(const Context& ctx, const Constraints& hand_c) {
   const int bin_deg = 3, bins = 60 / bin_deg;
   std::vector<viz::PlotSeries> series;
-  std::string source;
+  std::string source, sizes;
   if (!ctx.hist_csv.empty()) {
     // Columns: surface,target,contender,bin_lo_deg,bin_hi_deg,count,fraction (1-degree bins).
     std::ifstream in(ctx.hist_csv);
@@ -681,7 +718,7 @@ std::string histogram(const Context& ctx, const Constraints& hand_c) {
       v[static_cast<std::size_t>(std::min(bins - 1, lo / bin_deg))] += std::stod(f[5]);
     }
     const std::pair<const char*, const char*> wanted[3] = {
-        {"vitri-fifo-root", "vitri"}, {"cgal", "CGAL surface mesher"}, {"grid", "grid marching tetrahedra"}};
+        {"vitri-fifo-root", "vitri"}, {"cgal", "CGAL"}, {"grid", "grid"}};
     for (const auto& [key, name] : wanted) {
       auto it = counts.find(key);
       if (it == counts.end()) continue;
@@ -689,10 +726,14 @@ std::string histogram(const Context& ctx, const Constraints& hand_c) {
       for (double x : it->second) total += x;
       std::vector<double> share = it->second;
       for (double& x : share) x /= std::max(1.0, total);
-      series.push_back({name + std::string(" (") + std::to_string(static_cast<long long>(total)) + " tris)", share, {}});
+      series.push_back({name, share, series_color(name)});
+      sizes += std::string(sizes.empty() ? "" : ", ") + name + " " +
+               std::to_string(static_cast<long long>(total)) + " triangles";
     }
-    source = "read from `" + ctx.hist_csv + "` (written by `bench_compare --hist`: hand, ~10k vertices, every "
-             "contender on the same RBF)";
+    source = "read from `" + ctx.hist_csv +
+             "`, written by `bench_compare --hist` (hand, ~10k vertices, every "
+             "contender on the same RBF; vitri is the FIFO queue with root-found vertices; " +
+             sizes + ")";
   } else {
     const double target = static_cast<double>(ctx.hand_high.vertices());
     const Box3 box = box_of(hand_c.points).scaled(1.3);
@@ -705,15 +746,24 @@ std::string histogram(const Context& ctx, const Constraints& hand_c) {
                           },
                           60.0, 2.0, target, 6, true)
                           .second;
-    const std::pair<const Mesh*, std::string> ms_[2] = {{&ctx.hand_high, "vitri"}, {&grid, "grid marching tetrahedra"}};
-    for (const auto& [m, name] : ms_) {
+    const std::pair<const Mesh*, std::string> meshes[2] = {{&ctx.hand_high, "vitri"}, {&grid, "grid"}};
+    for (const auto& [m, name] : meshes) {
       const std::vector<double> a = triangle_min_angles(m->V, m->F);
-      series.push_back({name + " (" + std::to_string(m->vertices()) + " v)", viz::histogram_shares(a, 0.0, 60.0, bins), {}});
+      series.push_back({name, viz::histogram_shares(a, 0.0, 60.0, bins), series_color(name)});
+      sizes += std::string(sizes.empty() ? "" : ", ") + name + " " + std::to_string(m->vertices()) +
+               " vertices / " + std::to_string(m->F.rows()) + " triangles";
     }
-    source = "computed here for vitri (the Figure 7 (b) hand mesh) and the grid polygonizer on the same RBF "
-             "(box x 1.3, cells searched to match the vertex count). CGAL is missing: it is only built in "
-             "bench/; to add it run `bench_compare --surfaces hand --no-paper --hist hist.csv` and "
-             "`vitri_figures docs/figures --hist hist.csv`";
+    source =
+        "computed here for vitri (the Figure 7 (b) hand mesh) and the grid polygonizer on the same RBF "
+        "(marching tetrahedra on a uniform grid over the constraints' box x 1.3, cells searched to match the "
+        "vertex count; " +
+        sizes +
+        "). **CGAL is missing** from this run: CGAL is only linked into "
+        "bench/. To add it, build the benchmarks and run `./build-release/bench/compare/bench_compare "
+        "--quick --no-paper --surfaces hand --hist docs/figures/hist-hand-10k.csv`, then "
+        "`./build-release/tools/figures/vitri_figures docs/figures --hist docs/figures/hist-hand-10k.csv` "
+        "(the CSV's 1-degree bins are summed into the plot's bins; its RBF has up to 2400 constraints, "
+        "so the vitri series then comes from the benchmark's run, not from Figure 7)";
   }
   viz::HistogramPlotOptions po;
   po.width = 640;
@@ -729,6 +779,22 @@ std::string histogram(const Context& ctx, const Constraints& hand_c) {
      << "-degree bin (an equilateral triangle has 60 degrees; slivers pile up at the left). Data " << source
      << ".\n\n";
   return md.str();
+}
+
+/// "<CPU model>, N hardware threads, <UTC date>" for the gallery's footer (Linux /proc; "unknown CPU"
+/// elsewhere).
+std::string machine() {
+  std::string cpu = "unknown CPU";
+  std::ifstream in("/proc/cpuinfo");
+  for (std::string line; std::getline(in, line);)
+    if (line.rfind("model name", 0) == 0 && line.find(':') != std::string::npos) {
+      cpu = line.substr(line.find(':') + 2);
+      break;
+    }
+  char date[32] = "unknown date";
+  const std::time_t now = std::time(nullptr);
+  if (const std::tm* tm = std::gmtime(&now)) std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", tm);
+  return cpu + ", " + std::to_string(std::thread::hardware_concurrency()) + " hardware threads, " + date;
 }
 
 int run(int argc, char** argv) {
@@ -777,8 +843,8 @@ int run(int argc, char** argv) {
         "```\n\n"
         "Source: `tools/figures/make_figures.cpp`. Renderer: `apps/render.hpp` (flat shading, headlight, "
         "perspective; front faces blue-grey, back faces red: a hole or a flipped triangle shows red). Times "
-        "are wall clock on the machine of the run (see the footer), single process; vertex counts are "
-        "deterministic.\n\n";
+        "are wall clock on the machine of the run (see the footer; the RBF's batch evaluation uses the "
+        "library's default threads), so they vary from run to run; vertex counts are deterministic.\n\n";
   md << figures_2_and_4(ctx);
   md << figure_6(ctx);
   const Constraints hand_c = mesh_constraints("hand.off", 1500);
@@ -788,7 +854,8 @@ int run(int argc, char** argv) {
   md << figure_8(ctx);
   md << figure_9(ctx);
   md << histogram(ctx, hand_c);
-  md << "---\nGenerated by `vitri_figures` in " << fmt("%.1f", seconds_since(start)) << " s.\n";
+  md << "---\nGenerated by `vitri_figures` in " << fmt("%.1f", seconds_since(start)) << " s on " << machine()
+     << ".\n";
   std::ofstream out(gallery);
   if (!out) throw Error("cannot write " + gallery);
   out << md.str();

@@ -47,6 +47,7 @@
 #include <cmath>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <iostream>
@@ -820,22 +821,23 @@ int run(int argc, char** argv) {
     std::cerr << "vitri_figures: missing OUTDIR (try --help)\n";
     return 2;
   }
-  while (ctx.out_dir.size() > 1 && ctx.out_dir.back() == '/') ctx.out_dir.pop_back();
-  const std::size_t slash = ctx.out_dir.find_last_of('/');
-  const std::string base = slash == std::string::npos ? ctx.out_dir : ctx.out_dir.substr(slash + 1);
-  if (gallery.empty()) {
-    gallery = (slash == std::string::npos ? std::string(".") : ctx.out_dir.substr(0, slash)) + "/gallery.md";
-    ctx.link_dir = base + "/";
-  } else {
-    ctx.link_dir = ctx.out_dir + "/";  // relative to the working directory: adjust by hand if needed
-  }
+  namespace fs = std::filesystem;
+  fs::path out_path = fs::absolute(ctx.out_dir).lexically_normal();
+  if (out_path.filename().empty()) out_path = out_path.parent_path();  // "docs/figures/"
+  fs::create_directories(out_path);
+  if (gallery.empty()) gallery = (out_path.parent_path() / "gallery.md").string();
+  // Image links relative to the gallery's folder.
+  ctx.link_dir =
+      out_path.lexically_relative(fs::absolute(gallery).lexically_normal().parent_path()).generic_string() +
+      "/";
 
   const auto start = Clock::now();
   std::ostringstream md;
   md << "# Gallery\n\n"
         "Pictures of what vitri produces, in the order of the paper's figures (Crespin 2003), next to the "
         "uniform-grid baseline, with the numbers measured in the run that drew them. Regenerate every "
-        "picture and this page (it is written by the program; do not edit it by hand):\n\n"
+        "picture and this page (it is written by the program; do not edit it by hand; like `vitri render`, "
+        "it needs stb_image_write from libstb-dev):\n\n"
         "```sh\n"
         "cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release\n"
         "cmake --build build-release --target vitri_figures && ./build-release/tools/figures/vitri_figures "

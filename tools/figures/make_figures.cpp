@@ -856,6 +856,10 @@ int run(int argc, char** argv) {
     std::cerr << "vitri_figures: missing OUTDIR (try --help)\n";
     return 2;
   }
+  if (!ctx.hist_csv.empty() && !std::ifstream(ctx.hist_csv)) {  // fail before minutes of work, not after
+    std::cerr << "vitri_figures: cannot open " << ctx.hist_csv << "\n";
+    return 1;
+  }
   namespace fs = std::filesystem;
   fs::path out_path = fs::absolute(ctx.out_dir).lexically_normal();
   if (out_path.filename().empty()) out_path = out_path.parent_path();  // "docs/figures/"

@@ -692,8 +692,9 @@ std::string figure_9(const Context& ctx) {
         "tetrahedra whose signs changed and refines them; the mesh is then extracted. Times are the update "
         "plus the extraction.\n\n"
      << t.str()
-     << "\nThe benchmark's Tables 2 and 3 time three insertions of points 0.05 to 0.2 outside the surface; "
-        "their bumps are too small to see at this size, so this figure makes larger edits. A zero-valued "
+     << "\nThe benchmark's Tables 2 and 3 time three insertions of constraint points "
+        "close to the surface (see bench/compare/compare.cpp, `paper_dynamic`), which make small bumps; "
+        "this figure makes larger edits so that the change is easy to see. A zero-valued "
         "constraint added far outside the surface, such as (2.1, 0, 0), does not pull a bump out of the "
         "blob: "
         "the RBF passes through 0 there and is negative beyond it, so the new surface is a separate sheet "

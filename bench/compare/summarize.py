@@ -30,12 +30,15 @@ for target in sorted({int(r["target"]) for r in rows}):
                       f"{yn(r['manifold'])} | {r['euler']} | {float(r['min_angle']):.2f} | "
                       f"{100 * float(r['share_below_10']):.1f}% | {100 * float(r['share_below_20']):.1f}% | "
                       f"{float(r['dist_mean']):.1e} | {float(r['dist_max']):.1e} | {float(r['ratio_vitri_over_this']):.3f} |")
-print("\n#### Time ratio vitri (FIFO, root-found) / contender, geometric mean over the surfaces (wall)\n")
-print("| target | " + " | ".join(order[1:]) + " |")
-print("|---|" + "---|" * (len(order) - 1))
+print("\n#### Time ratio vitri (FIFO, root-found) / contender: geometric mean over the surfaces (wall)\n")
+print("| target | surfaces | " + " | ".join(order[1:]) + " |")
+print("|---|---|" + "---|" * (len(order) - 1))
+groups = [("analytic", lambda s: s in ("sphere", "torus")), ("RBF", lambda s: s not in ("sphere", "torus"))]
 for target in sorted({int(r["target"]) for r in rows}):
-    cells = []
-    for c in order[1:]:
-        v = [float(r["ratio_vitri_over_this"]) for r in rows if int(r["target"]) == target and r["contender"] == c]
-        cells.append(f"{math.exp(sum(map(math.log, v)) / len(v)):.3f} ({len(v)} surfaces)" if v else "-")
-    print(f"| {target} | " + " | ".join(cells) + " |")
+    for gname, g in groups:
+        cells = []
+        for c in order[1:]:
+            v = [float(r["ratio_vitri_over_this"]) for r in rows
+                 if int(r["target"]) == target and r["contender"] == c and g(r["surface"])]
+            cells.append(f"{math.exp(sum(map(math.log, v)) / len(v)):.3f} (n={len(v)})" if v else "-")
+        print(f"| {target} | {gname} | " + " | ".join(cells) + " |")

@@ -328,19 +328,25 @@ Run run_cgal(const Surface& s, double radius_bound) {
 /// Secant search on log(vertices) vs log(param): vertices ~ param^slope. Runs `run(param)` until the
 /// vertex count is within `tolerance` of the target or `max_runs` runs were made; returns the run
 /// closest to the target. `guess` is the first parameter; `slope_guess` the expected exponent.
-/// `integer` rounds the parameter (grid cells).
+/// `integer` rounds the parameter (grid cells). Once the target is bracketed, a secant step that leaves
+/// the bracket (or repeats a parameter) is replaced by the log-midpoint of the bracket: the count is a
+/// step function of the parameter, and the secant alone can oscillate around a jump.
 Run search(const std::function<Run(double)>& run, double guess, double slope_guess, std::size_t target,
            double tolerance, int max_runs, bool integer = false) {
   std::vector<std::pair<double, double>> pts;  // (log param, log vertices)
+  const double lt = std::log(static_cast<double>(target));
   Run best;
   double best_err = 1e300;
   double p = guess;
   int runs = 0;
+  auto seen = [&](double q) {
+    for (const auto& pt : pts)
+      if (std::abs(pt.first - std::log(q)) < 1e-12) return true;
+    return false;
+  };
   for (; runs < max_runs; ++runs) {
     if (integer) p = std::max(2.0, std::round(p));
-    bool seen = false;
-    for (const auto& q : pts) seen = seen || std::abs(q.first - std::log(p)) < 1e-12;
-    if (seen) break;
+    if (seen(p)) break;
     Run r = run(p);
     if (std::getenv("VITRI_COMPARE_DEBUG"))
       std::fprintf(stderr, "search: param %.6g -> %zu vertices\n", p, vertices_of(r));
@@ -349,7 +355,7 @@ Run search(const std::function<Run(double)>& run, double guess, double slope_gue
       continue;
     }
     const double n = static_cast<double>(vertices_of(r));
-    const double err = std::abs(std::log(n / static_cast<double>(target)));
+    const double err = std::abs(std::log(n) - lt);
     pts.emplace_back(std::log(p), std::log(n));
     if (err < best_err) {
       best_err = err;
@@ -368,7 +374,21 @@ Run search(const std::function<Run(double)>& run, double guess, double slope_gue
       if (!(std::abs(slope) > 0.5 * std::abs(slope_guess)) || std::abs(slope) > 2 * std::abs(slope_guess))
         slope = slope_guess;
     }
-    p = std::exp(pts.back().first + (std::log(static_cast<double>(target)) - pts.back().second) / slope);
+    double next = pts.back().first + (lt - pts.back().second) / slope;  // log param
+    // bracket: the closest runs below and above the target
+    const std::pair<double, double>* below = nullptr;
+    const std::pair<double, double>* above = nullptr;
+    for (const auto& pt : pts) {
+      if (pt.second < lt && (!below || pt.second > below->second)) below = &pt;
+      if (pt.second > lt && (!above || pt.second < above->second)) above = &pt;
+    }
+    if (below && above) {
+      const double lo = std::min(below->first, above->first), hi = std::max(below->first, above->first);
+      double q = std::exp(next);
+      if (integer) q = std::max(2.0, std::round(q));
+      if (!(next > lo && next < hi) || seen(q)) next = 0.5 * (lo + hi);
+    }
+    p = std::exp(next);
   }
   best.search_runs = runs;
   return best;
@@ -505,7 +525,7 @@ void compare(const Options& opt) {
         double guess = 0.1 * diag * std::sqrt(200.0 / tgt);  // first guess; refined by the search
         if (last_vitri.count(key)) guess = last_vitri[key].first * std::sqrt(last_vitri[key].second / tgt);
         Run root = search([&](double p) { return run_vitri(s, order, VertexPlacement::RootFinding, p); }, guess,
-                          -2.0, target, 0.05, 6);
+                          -2.0, target, 0.05, 8);
         last_vitri[key] = {root.param, static_cast<double>(vertices_of(root))};
         Run lin = run_vitri(s, order, VertexPlacement::Linear, root.param);
         runs.push_back(std::move(root));

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Markdown tables for docs/benchmarks.md from bench_compare's --csv output (one table per target size,
+"""Markdown tables (param: vitri's absolute precision, CGAL's radius bound, the grid's cells) for docs/benchmarks.md from bench_compare's --csv output (one table per target size,
 then the geometric mean over surfaces of vitri's time ratio to each contender).
 Usage: bench/compare/summarize.py bench/compare/results/compare.csv"""
 import csv
@@ -12,9 +12,9 @@ yn = lambda s: "yes" if s == "1" else "**no**"
 order = ["vitri-fifo-root", "vitri-fifo-linear", "vitri-largest-root", "vitri-largest-linear", "grid", "cgal"]
 for target in sorted({int(r["target"]) for r in rows}):
     print(f"\n#### About {target} vertices\n")
-    print("| surface | contender | V | F | mesh s (wall) | mesh s (CPU) | evals/V | watertight | manifold | chi "
+    print("| surface | contender | param | V | F | mesh s (wall) | mesh s (CPU) | evals/V | watertight | manifold | chi "
           "| min angle | < 10 deg | < 20 deg | dist mean | dist max | vitri/this |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     sel = [r for r in rows if int(r["target"]) == target]
     surfaces = []
     for r in sel:
@@ -25,7 +25,7 @@ for target in sorted({int(r["target"]) for r in rows}):
             for r in sel:
                 if r["surface"] != s or r["contender"] != c:
                     continue
-                print(f"| {s} | {c} | {r['vertices']} | {r['triangles']} | {float(r['mesh_s']):.3f} | "
+                print(f"| {s} | {c} | {r['param_name']} {float(r['param']):.4g} | {r['vertices']} | {r['triangles']} | {float(r['mesh_s']):.3f} | "
                       f"{float(r['mesh_cpu_s']):.3f} | {float(r['evals_per_vertex']):.1f} | {yn(r['watertight'])} | "
                       f"{yn(r['manifold'])} | {r['euler']} | {float(r['min_angle']):.2f} | "
                       f"{100 * float(r['share_below_10']):.1f}% | {100 * float(r['share_below_20']):.1f}% | "

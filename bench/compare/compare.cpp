@@ -7,32 +7,40 @@
 // sphere926.pwn (constraints_from_oriented_points), capped at kRbfConstraints constraints. The one fitted
 // Rbf object is what every contender evaluates; each contender sees it through a counting wrapper.
 //
-// Contenders, each tuned to the target vertex count (about 2k, 10k, 50k output vertices):
+// Contenders, each tuned to the target vertex count (about 2k, 10k, 50k output vertices) by search():
+// a secant step on log(vertices) vs log(parameter), bisection in log space once the target is bracketed
+// (the count is a step function of the parameter, not even monotone for vitri on sphere926); tolerance
+// 5% (vitri, grid) or 10% (CGAL); the reported run is the search run closest to the target.
 //   vitri    Polygonizer exactly as vitri::Mesher builds it (constraints as seeds with their values,
 //            domain = constraint box x 2), FIFO and largest-first queues x root-found and linear vertices.
-//            The precision is found by a log-log secant search on the vertex count (per queue order; the
-//            two placements share the tetrahedralization, hence the count).
+//            The precision is searched per queue order (the two placements share the tetrahedralization,
+//            hence the count). The analytic torus gets 8 seeds on its core circle (the default sampling
+//            lattice is coarser than its tube).
 //   cgal     CGAL::make_surface_mesh, Surface_mesh_default_triangulation_3, Implicit_surface_3 wrapping
 //            the same function (f < 0 inside, which is CGAL's convention too), bounding sphere centred at
 //            an inside point and containing the surface, error bound 1e-3 (CGAL's default),
-//            Surface_mesh_default_criteria_3(30 degrees, radius r, distance r / 4) with r found by a
-//            secant search on the vertex count; CGAL::Manifold_tag (closed manifold output).
+//            Surface_mesh_default_criteria_3(30 degrees, radius r, distance r / 4), r searched;
+//            CGAL::Manifold_tag (closed manifold output).
 //   grid     polygonize_grid (marching tetrahedra on a uniform grid, Kuhn split) over the box of the
-//            surface enlarged by 1.6 (the RBF zero sets bulge out of the constraints' box), cells along the longest side found by a secant search.
+//            surface enlarged by 1.6 (--grid-box; with 1.1 the hand's RBF zero set leaves the box and the
+//            mesh is open), cells along the longest side searched.
 //
-// Timing: wall clock (steady_clock) of one full run, fit excluded (reported separately: the same fit
-// serves every contender). Each reported run is a fresh, complete run (search runs included: the reported
-// one is the run closest to the target). ratio = vitri (FIFO, root-found) mesh time / contender mesh time
-// (below 1: vitri is faster).
+// Timing: wall clock (steady_clock) and process CPU time of one full run, fit excluded (reported
+// separately: the same fit serves every contender). Each reported run is a fresh, complete run.
+// ratio = vitri (FIFO, root-found) mesh wall time / contender mesh wall time (below 1: vitri is faster).
 //
 // Usage: bench_compare [--quick] [--full] [--csv PATH] [--hist PATH] [--meshes DIR] [--no-paper]
-//                      [--no-compare] [--surfaces name,name,...] [--threads N]
+//                      [--no-compare] [--surfaces name,name,...] [--threads N] [--grid-box F]
 //   --quick     only the ~2k and ~10k targets
-//   --full      also run CGAL at ~50k on the RBF surfaces (minutes each; skipped by default)
-//   --csv       one row per (surface, target, contender) run
+//   --full      also run CGAL at ~50k on the RBF surfaces (about 40 s per run; skipped by default)
+//   --csv       one row per (surface, target, contender) run (columns: see write_csv)
 //   --hist      min-angle histograms (1-degree bins) of every contender on hand at ~10k
 //   --meshes    writes the hand ~10k meshes of every contender as OFF files into DIR
+//   --surfaces  subset of sphere, torus, hand, bunny, knot1, sphere926
 //   --threads   threads of the RBF batch evaluation (0 = all cores, the library default)
+//   --grid-box  box enlargement of the grid contender (default 1.6)
+// VITRI_COMPARE_DEBUG=1 in the environment prints every search step to stderr.
+// bench/compare/run_compare.sh builds this in Release and writes bench/compare/results/.
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/core/implicit.hpp"
@@ -422,8 +430,9 @@ void print_rows(const std::vector<Row>& rows) {
   std::cout << "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const Row& r : rows) {
     if (!r.run.ok) {
-      std::cout << "| " << r.surface << " | " << r.target << " | " << r.run.contender << " | " << r.run.note
-                << " |||||||||||||||\n";
+      std::cout << "| " << r.surface << " | " << r.target << " | " << r.run.contender << " | " << r.run.note << " |";
+      for (int k = 0; k < 16; ++k) std::cout << " |";  // the 16 empty measurement cells
+      std::cout << '\n';
       continue;
     }
     const double nv = static_cast<double>(r.m.vertices);

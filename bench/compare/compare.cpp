@@ -860,7 +860,7 @@ int main(int argc, char** argv) {
       opt.threads = static_cast<unsigned>(std::stoul(next()));
     } else {
       std::cerr << "usage: bench_compare [--quick] [--full] [--csv PATH] [--hist PATH] [--meshes DIR] "
-                   "[--no-paper] [--no-compare] [--surfaces a,b] [--threads N]\n";
+                   "[--no-paper] [--no-compare] [--surfaces a,b] [--threads N] [--grid-box F]\n";
       return a == "--help" || a == "-h" ? 0 : 2;
     }
   }

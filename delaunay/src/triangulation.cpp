@@ -173,6 +173,16 @@ struct Triangulation::Scratch {
   std::vector<std::uint32_t> face_hash;  // open addressing: 1 + index into link_faces, 0 = empty
   std::vector<TetId> inside, sub_to_new;
   std::vector<std::pair<TetId, TetId>> old_to_new;
+  // Edge table of link_around_apex(): key = the two vertex ids (smaller in the high half), side = the
+  // two (created index, face) pairs as 4k + j, valid when stamp == edge_stamp.
+  struct EdgeSlot {
+    std::uint64_t key = 0;
+    std::uint32_t stamp = 0;
+    std::uint32_t side[2] = {0, 0};
+  };
+  std::vector<EdgeSlot> edges;
+  std::uint32_t edge_stamp = 0;
+  std::vector<std::uint32_t> edge_used;
   std::unique_ptr<Triangulation> sub;  // small triangulation used by remove()
 };
 
@@ -462,6 +472,27 @@ TetId Triangulation::alloc_tet() {
   return t;
 }
 
+// n new slots (recycled ones first without the history) appended to `out` (cleared); returns the first
+// id, which with the history is the start of a contiguous range.
+TetId Triangulation::alloc_tets(std::size_t n, std::vector<TetId>& out) {
+  out.resize(n);
+  std::size_t k = 0;
+  if (!keep_history_)
+    for (; k < n && free_head_ != kNoTet; ++k) {
+      const TetId t = free_head_;
+      free_head_ = td_[4 + 8 * std::size_t(t)];
+      tf_[t] = 0;
+      out[k] = t;
+    }
+  const TetId base = TetId(tf_.size());
+  const std::size_t rest = n - k;
+  grow_to(td_, td_.size() + 8 * rest);
+  grow_to(tf_, tf_.size() + rest);  // zero flags: live
+  if (keep_history_) grow_to(hnb_, hnb_.size() + rest);
+  for (std::size_t i = 0; k < n; ++k, ++i) out[k] = base + TetId(i);
+  return n ? out[0] : base;
+}
+
 void Triangulation::kill(TetId t, std::uint32_t op, TetId hint) {
   tf_[t] = kDead;
   if (keep_history_) {
@@ -504,7 +535,10 @@ void Triangulation::record_op(TetId first, std::uint32_t count, PointId apex) {
 
 // ---- Insertion -------------------------------------------------------------------------------------
 
-bool Triangulation::grow_cavity(const Point3& p, TetId start, PointId& duplicate) {
+// start_contains: p lies in the closed tetrahedron `start` and is none of its vertices (checked by the
+// caller), hence p is no vertex of the triangulation (closed tetrahedra meet only in common faces) and
+// the duplicate test per tested tetrahedron is skipped.
+bool Triangulation::grow_cavity(const Point3& p, TetId start, bool start_contains, PointId& duplicate) {
   Scratch& S = *scratch_;
   S.cavity.clear();
   S.boundary.clear();
@@ -530,7 +564,7 @@ bool Triangulation::grow_cavity(const Point3& p, TetId start, PointId& duplicate
       const Point3& a1 = pos_[td_[b + 1]];
       const Point3& a2 = pos_[td_[b + 2]];
       const Point3& a3 = pos_[td_[b + 3]];
-      if (p == a0 || p == a1 || p == a2 || p == a3) {
+      if (!start_contains && (p == a0 || p == a1 || p == a2 || p == a3)) {
         duplicate = td_[b + (p == a0 ? 0 : p == a1 ? 1 : p == a2 ? 2 : 3)];
         clear_cavity_marks();
         return false;
@@ -554,8 +588,87 @@ void Triangulation::clear_cavity_marks() {
   for (TetId t : S.tested) tf_[t] &= std::uint8_t(~kTested);
 }
 
-InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_distance, ChangeSet* changes,
-                                      VertexId reuse_vid) {
+// Links the new tetrahedra S.created[k] (apex q at index S.boundary[k].face) across their faces through q.
+// The cavity boundary is a triangulated sphere seen from q, so each of its edges {a, b} lies in exactly two
+// boundary faces, and the faces (q, a, b) of the two tetrahedra built on them are glued together. A small
+// open-addressing table keyed by the edge collects both sides (first pass), then links them (second pass);
+// the table is never cleared, entries of an older insertion have an older stamp. Branch-free except for the
+// (short) probe sequence: the "first or second side" decision would be a 50/50 branch.
+//
+//          q                    new tetrahedra s1 = (q, a, b, c) and s2 = (q, b, a, d) on the boundary
+//         /|\                   faces (a, b, c) and (b, a, d): the face (q, a, b) is shared, found by
+//        / | \                  the key {a, b} of their common boundary edge.
+//       c--a--d
+//          b
+void Triangulation::link_around_apex(PointId q) {
+  Scratch& S = *scratch_;
+  (void)q;
+  const std::size_t nb = S.created.size();
+  std::size_t size = 64;
+  while (size < 3 * nb) size *= 2;
+  if (S.edges.size() < size) {
+    S.edges.assign(size, Scratch::EdgeSlot{});
+    S.edge_stamp = 0;
+  }
+  if (++S.edge_stamp == 0) {  // wrapped: forget all stamps
+    for (auto& e : S.edges) e.stamp = 0;
+    S.edge_stamp = 1;
+  }
+  const std::uint32_t stamp = S.edge_stamp;
+  int bits = 0;
+  while ((std::size_t(1) << bits) < S.edges.size()) ++bits;
+  const std::size_t mask = S.edges.size() - 1;
+  Scratch::EdgeSlot* const E = S.edges.data();
+  S.edge_used.resize(3 * nb / 2 + 1);
+  std::uint32_t* const used = S.edge_used.data();
+  std::size_t nused = 0;
+  // kEdge[f][j]: the two indices other than f (the apex) and j (the face through the apex).
+  static constexpr std::uint8_t kEdge[4][4][2] = {{{0, 0}, {2, 3}, {1, 3}, {1, 2}},
+                                                  {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
+                                                  {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
+                                                  {{1, 2}, {0, 2}, {0, 1}, {0, 0}}};
+  for (std::size_t k = 0; k < nb; ++k) {
+    const std::size_t bs = 8 * std::size_t(S.created[k]);
+    const int f = S.boundary[k].face;
+    for (int j = 0; j < 4; ++j) {
+      if (j == f) continue;
+      const std::uint32_t a = td_[bs + kEdge[f][j][0]], b = td_[bs + kEdge[f][j][1]];
+      const std::uint64_t key = a < b ? (std::uint64_t(a) << 32 | b) : (std::uint64_t(b) << 32 | a);
+      std::size_t h = std::size_t((key * 0x9E3779B97F4A7C15ull) >> (64 - bits));
+      while (E[h].stamp == stamp && E[h].key != key) h = (h + 1) & mask;
+      Scratch::EdgeSlot& e = E[h];
+      const bool fresh = e.stamp != stamp;
+      const std::uint32_t c = fresh ? 0u : 1u;
+      e.key = key;
+      e.stamp = stamp;
+      e.side[c] = std::uint32_t(4 * k + std::size_t(j));
+      used[nused] = std::uint32_t(h);
+      nused += fresh;
+    }
+  }
+  const bool offsets = keep_history_ && nb < kNoOffset;
+  for (std::size_t u = 0; u < nused; ++u) {
+    const Scratch::EdgeSlot& e = E[used[u]];
+    const std::size_t k0 = e.side[0] >> 2, k1 = e.side[1] >> 2;
+    const std::size_t j0 = e.side[0] & 3, j1 = e.side[1] & 3;
+    const TetId s0 = S.created[k0], s1 = S.created[k1];
+    td_[4 + 8 * std::size_t(s0) + j0] = s1;
+    td_[4 + 8 * std::size_t(s1) + j1] = s0;
+    if (offsets) {
+      hnb_[s0][j0] = std::uint16_t(k1);
+      hnb_[s1][j1] = std::uint16_t(k0);
+    }
+  }
+  if (keep_history_)
+    for (std::size_t k = 0; k < nb; ++k) {
+      auto& o = hnb_[S.created[k]];
+      o[std::size_t(S.boundary[k].face)] = kNoOffset;
+      if (!offsets) o = {kNoOffset, kNoOffset, kNoOffset, kNoOffset};
+    }
+}
+
+InsertResult Triangulation::insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
+                                      ChangeSet* changes, VertexId reuse_vid) {
   Scratch& S = *scratch_;
   InsertResult res;
   for (int i = 0; i < 4; ++i) {
@@ -563,7 +676,7 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
   }
   PointId dup = kNoVertex;
-  if (!grow_cavity(p, start, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
+  if (!grow_cavity(p, start, start_contains, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
 
   if (min_distance > 0.0) {
     // The nearest vertex of p is a Delaunay neighbour of p, hence a vertex of the cavity.
@@ -596,72 +709,28 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, double min_d
   }
 
   // One new tetrahedron per boundary face: q replaces the killed tetrahedron's vertex opposite the face.
-  // The killed tetrahedron's slot for that face is overwritten with the new id (used by the rotation).
-  const TetId first = TetId(tf_.size());
-  S.created.clear();
-  for (const auto& bf : S.boundary) {
-    const TetId s = alloc_tet();
+  // The killed tetrahedron's slot for that face is overwritten with the new id (the hint of kill()).
+  const std::size_t nb = S.boundary.size();
+  const TetId first = alloc_tets(nb, S.created);
+  for (std::size_t k = 0; k < nb; ++k) {
+    const auto& bf = S.boundary[k];
+    const TetId s = S.created[k];
     const std::size_t bs = 8 * std::size_t(s), bt = 8 * std::size_t(bf.tet);
-    for (int j = 0; j < 4; ++j) {
-      td_[bs + j] = td_[bt + j];
-      td_[4 + bs + j] = kNoTet;
-    }
+    for (int j = 0; j < 4; ++j) td_[bs + j] = td_[bt + j];
     td_[bs + bf.face] = q;
     const TetId n = td_[4 + bt + bf.face];
     td_[4 + bs + bf.face] = n;
     if (n != kNoTet) {
       const std::size_t bn = 4 + 8 * std::size_t(n);
-      std::size_t k = 0;
-      for (std::size_t m = 1; m < 4; ++m) k = td_[bn + m] == bf.tet ? m : k;
-      td_[bn + k] = s;
+      std::size_t m = 0;
+      for (std::size_t i = 1; i < 4; ++i) m = td_[bn + i] == bf.tet ? i : m;
+      td_[bn + m] = s;
     }
     td_[4 + bt + bf.face] = s;
-    S.created.push_back(s);
   }
-  // Faces through q: rotate around the boundary edge through killed tetrahedra until the next boundary
-  // face; the new tetrahedron there is the neighbour.
-  //
-  //        killed tc                 across face b of tc: killed n? continue around edge e = tc \ {a, b}
-  //      a *------* e1               otherwise n is the new tetrahedron on (tc, b); its face opposite
-  //         \    /|                  index a (vertex tc[a]) is the one shared with s.
-  //          \  / |
-  //        e0 *---* b
-  // Each link is computed from both sides (no "already linked" test: it would be a 50/50 branch).
-  static constexpr int kOther[4][3] = {{1, 2, 3}, {0, 2, 3}, {0, 1, 3}, {0, 1, 2}};
-  for (std::size_t k = 0; k < S.created.size(); ++k) {
-    const TetId s = S.created[k];
-    const auto& bf = S.boundary[k];
-    for (int j : kOther[bf.face]) {
-      TetId tc = bf.tet;
-      int a = bf.face, b = j;
-      TetId n;
-      for (;;) {
-        n = td_[4 + 8 * std::size_t(tc) + b];
-        if (!(tf_[n] & kMark)) break;
-        const PointId va = td_[8 * std::size_t(tc) + a];
-        int ka = 0, kw = 0;
-        for (int m = 1; m < 4; ++m) {
-          ka = td_[8 * std::size_t(n) + m] == va ? m : ka;
-          kw = td_[4 + 8 * std::size_t(n) + m] == tc ? m : kw;
-        }
-        tc = n;
-        a = kw;
-        b = ka;
-      }
-      td_[4 + 8 * std::size_t(s) + j] = n;
-      (void)a;
-    }
+  link_around_apex(q);
+  for (TetId s : S.created)
     for (int i = 0; i < 4; ++i) vtet_[td_[8 * std::size_t(s) + i]] = s;
-  }
-  if (keep_history_) {
-    const bool small = S.created.size() < kNoOffset;
-    for (std::size_t k = 0; k < S.created.size(); ++k) {
-      const std::size_t s = S.created[k];
-      for (std::size_t j = 0; j < 4; ++j)
-        hnb_[s][j] = (!small || int(j) == S.boundary[k].face) ? kNoOffset
-                                                              : std::uint16_t(td_[8 * s + 4 + j] - first);
-    }
-  }
   // Kill the cavity; in the history each killed tetrahedron points to this Op and to a new tetrahedron
   // built on one of its faces (where the descent is likely to continue).
   const std::uint32_t op = std::uint32_t(ops_.size());
@@ -692,7 +761,7 @@ InsertResult Triangulation::insert(const Point3& p, double min_distance, ChangeS
   check_min_distance(min_distance);
   if (changes) changes->clear();
   const TetId t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
-  return insert_at(p, t, min_distance, changes, kNoVertex);
+  return insert_at(p, t, true, min_distance, changes, kNoVertex);
 }
 
 InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, double min_distance,
@@ -709,7 +778,7 @@ InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, 
   if (insphere_sos(pos_[td_[b]], pos_[td_[b + 1]], pos_[td_[b + 2]], pos_[td_[b + 3]], p) != Sign::Positive)
     throw InvalidArgument("Triangulation::insert_in_conflict: point " + fmt_point(p) +
                           " is not in conflict with tetrahedron " + std::to_string(conflict));
-  return insert_at(p, conflict, min_distance, changes, kNoVertex);
+  return insert_at(p, conflict, false, min_distance, changes, kNoVertex);
 }
 
 std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>& points, double min_distance,
@@ -740,7 +809,7 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
   for (std::uint32_t i : order) {
     const TetId t = walk(points[i], last_tet_);
     one.clear();
-    results[i] = insert_at(points[i], t, min_distance, changes ? &one : nullptr, kNoVertex);
+    results[i] = insert_at(points[i], t, true, min_distance, changes ? &one : nullptr, kNoVertex);
     if (changes) {
       for (TetId k : one.killed) events.emplace_back(k, false);
       for (TetId c : one.created) events.emplace_back(c, true);
@@ -843,7 +912,7 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
       S.link_sub[k] = w;
       continue;
     }
-    const InsertResult r = sub.insert_at(pos_[w], sub.walk(pos_[w], sub.last_tet_), 0.0, nullptr, kNoVertex);
+    const InsertResult r = sub.insert_at(pos_[w], sub.walk(pos_[w], sub.last_tet_), true, 0.0, nullptr, kNoVertex);
     if (r.status != InsertStatus::Inserted || r.vertex != S.sub_to_main.size())
       throw std::logic_error("Triangulation::remove: link vertex rejected by the hole triangulation");
     S.link_sub[k] = r.vertex;
@@ -1102,7 +1171,7 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
   }
   PointId dup = kNoVertex;
-  if (!grow_cavity(p, start, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
+  if (!grow_cavity(p, start, true, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
   for (TetId t : S.cavity)
     for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
   clear_cavity_marks();
@@ -1124,7 +1193,7 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   remove_impl(v, changes ? &removal : nullptr);
   TetId t = walk_limited(p, last_tet_, 64);
   if (t == kNoTet) t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
-  result = insert_at(p, t, 0.0, changes ? &insertion : nullptr, v);
+  result = insert_at(p, t, true, 0.0, changes ? &insertion : nullptr, v);
   if (result.status != InsertStatus::Inserted)
     throw std::logic_error("Triangulation::move: reinsertion rejected after the proximity check");
   if (changes) {

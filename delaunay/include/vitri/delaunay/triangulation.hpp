@@ -212,11 +212,13 @@ class Triangulation {
   bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
   TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
   TetId alloc_tet();
+  TetId alloc_tets(std::size_t n, std::vector<TetId>& out);
   PointId alloc_point(const Point3& p, VertexId reuse_vid);
-  bool grow_cavity(const Point3& p, TetId start, PointId& duplicate);
+  bool grow_cavity(const Point3& p, TetId start, bool start_contains, PointId& duplicate);
+  void link_around_apex(PointId q);
   void clear_cavity_marks();
-  InsertResult insert_at(const Point3& p, TetId start, double min_distance, ChangeSet* changes,
-                         VertexId reuse_vid);
+  InsertResult insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
+                         ChangeSet* changes, VertexId reuse_vid);
   void collect_star(PointId v);
   void remove_impl(VertexId v, ChangeSet* changes);
   bool try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,

@@ -606,3 +606,41 @@ TEST_CASE("delaunay: bulk insertion reports the net change of the batch") {
     CHECK(expect == std::set<TetId>(after.begin(), after.end()));
   }
 }
+
+TEST_CASE("delaunay: huge cavities and stars (the centre of points near a sphere)") {
+  // Inserting the centre kills nearly every tetrahedron: its cavity has ~1200 boundary vertices, more
+  // than the direct-addressed edge table of the linking takes, so the hashed fallback runs; removing it
+  // again fills a hole of the same size; moving it far and back exercises both in a move.
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> g(0.0, 1.0);
+  std::vector<Point3> pts;
+  for (int i = 0; i < 1200; ++i) {
+    const Point3 d{g(rng), g(rng), g(rng)};
+    pts.push_back(Point3{0.5, 0.5, 0.5} + (0.3 / norm(d)) * d);
+  }
+  for (bool history : {true, false}) {
+    Triangulation tr(kUnitBox, TriangulationOptions{history});
+    tr.insert_points(pts);
+    auto quads = [&tr] {
+      std::set<std::array<VertexId, 4>> q;
+      tr.for_each_tetrahedron([&](TetId t) {
+        auto v = tr.tet_vertices(t);
+        std::sort(v.begin(), v.end());
+        q.insert(v);
+      });
+      return q;
+    };
+    const auto before = quads();
+    ChangeSet ch;
+    const InsertResult c = tr.insert({0.5, 0.5, 0.5}, 0.0, &ch);
+    REQUIRE(c.status == InsertStatus::Inserted);
+    CHECK(ch.created.size() > 2000);
+    check(tr);
+    tr.move(c.vertex, {0.51, 0.49, 0.5});
+    check(tr);
+    tr.remove(c.vertex);
+    check(tr);
+    CHECK(quads() == before);
+    if (history) CHECK(tr.locate({0.5, 0.5, 0.5}) != kNoTet);
+  }
+}

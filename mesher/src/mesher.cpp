@@ -9,7 +9,9 @@
 //      reclassified (they became, or stopped being, transverse);
 //   4. refinement resumes at the current precision, on the queue this produced;
 //   5. refinement vertices that no transverse tetrahedron touches any more are removed (this never
-//      creates a transverse tetrahedron), so repeated edits do not accumulate Steiner points.
+//      creates a transverse tetrahedron), so repeated edits do not accumulate Steiner points; in
+//      batches, once they exceed MesherOptions::garbage_fraction of the vertices (removal is the
+//      costliest part of a small update, and a vertex left by one edit often serves the next).
 // The mesh is extracted on demand afterwards.
 #include "vitri/mesher.hpp"
 
@@ -33,6 +35,8 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
     : options_(options), rbf_(std::make_unique<Rbf>()), precision_(std::numeric_limits<double>::infinity()) {
   if (!(options_.box_factor > 1.0) || !std::isfinite(options_.box_factor))
     throw InvalidArgument("MesherOptions::box_factor must be > 1");
+  if (!(options_.garbage_fraction >= 0.0) || !std::isfinite(options_.garbage_fraction))
+    throw InvalidArgument("MesherOptions::garbage_fraction must be >= 0");
   const double t0 = now_seconds();
   rbf_->fit(constraints, options_.rbf);
   stats_.fit_seconds = now_seconds() - t0;
@@ -92,7 +96,7 @@ void Mesher::after_edit(double rbf_seconds, double t_start) {
   const double t1 = now_seconds();
   poly_->function_changed();
   if (std::isfinite(precision_)) poly_->refine(precision_);
-  if (options_.collect_garbage) poly_->collect_garbage();
+  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction);
   mesh_valid_ = false;
   stats_.edit_rbf_seconds = rbf_seconds;
   stats_.edit_refine_seconds = now_seconds() - t1;

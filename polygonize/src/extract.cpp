@@ -12,7 +12,8 @@
 //         quad (e_ac, e_ad, e_bd, e_bc) faces the positive side
 //
 // Vertex placement: Illinois regula falsi on each crossed edge, all edges in lockstep so that each
-// iteration is one batch call of f. The result is clamped strictly inside the edge, so no two mesh
+// iteration is one batch call of f (value and gradient: the gradient at the accepted point is the
+// vertex normal, so most normals cost no evaluation of their own). The result is clamped strictly inside the edge, so no two mesh
 // vertices coincide and no triangle is flat.
 //
 // Zero-valued Delaunay vertices (constraint points): the true surface passes through such a vertex z,
@@ -111,6 +112,12 @@ SurfaceMesh Polygonizer::extract() {
   // ---- 2. Vertex placement --------------------------------------------------------------------------------
   const std::size_t ne = edges.size();
   std::vector<Point3> pos(ne);
+  // Gradient of f at pos[e] when the root finder evaluated f exactly there (it asks for value and
+  // gradient together, which costs about as much as the value alone for the RBF): the normal then
+  // needs no evaluation of its own. After an edit most edges are accepted at their first (warm-started)
+  // evaluation, so this removes about half of the evaluations of an update's extraction.
+  std::vector<Point3> grad(ne);
+  std::vector<std::uint8_t> has_grad(ne, 0);
   std::vector<std::uint32_t> roots;  // edges to solve
   for (std::size_t e = 0; e < ne; ++e) {
     const Point3& pp = tri_.point(edges[e].pos);
@@ -146,12 +153,13 @@ SurfaceMesh Polygonizer::extract() {
     }
     std::vector<std::uint32_t> active(nr);
     for (std::size_t i = 0; i < nr; ++i) active[i] = static_cast<std::uint32_t>(i);
-    std::vector<Point3> pts;
+    std::vector<Point3> pts, gval;
     std::vector<double> val;
     std::vector<double> tcur(nr);
     for (int it = 0; it < options_.max_root_iterations && !active.empty(); ++it) {
       pts.resize(active.size());
       val.resize(active.size());
+      gval.resize(active.size());
       for (std::size_t k = 0; k < active.size(); ++k) {
         const std::uint32_t i = active[k];
         double t = a[i] + (b[i] - a[i]) * (ga[i] / (ga[i] - gb[i]));
@@ -161,7 +169,7 @@ SurfaceMesh Polygonizer::extract() {
         const Point3& pp = tri_.point(edges[roots[i]].pos);
         pts[k] = pp + t * (tri_.point(edges[roots[i]].neg) - pp);
       }
-      f_.values(pts.data(), pts.size(), val.data());
+      f_.values_gradients(pts.data(), pts.size(), val.data(), gval.data());
       stats_.function_evaluations += pts.size();
       stats_.root_evaluations += pts.size();
       std::size_t keep = 0;
@@ -187,6 +195,8 @@ SurfaceMesh Polygonizer::extract() {
         const double tc = std::clamp(t, kMinT, 1.0 - kMinT);
         const Point3& pp = tri_.point(edges[roots[i]].pos);
         pos[roots[i]] = pp + tc * (tri_.point(edges[roots[i]].neg) - pp);
+        grad[roots[i]] = gval[k];
+        has_grad[roots[i]] = tc == t ? 1 : 0;  // the last evaluation was at the mesh vertex itself
         if (!done) active[keep++] = i;
       }
       active.resize(keep);
@@ -298,6 +308,7 @@ SurfaceMesh Polygonizer::extract() {
       if (ok) {
         const std::uint32_t r = zero_edges[s];
         pos[r] = zp;
+        has_grad[r] = 0;
         for (std::size_t k = s; k < e_end; ++k) rep[zero_edges[k]] = r;
         for (const std::uint32_t t : keep_tris)
           for (int i = 0; i < 3; ++i)
@@ -314,6 +325,7 @@ SurfaceMesh Polygonizer::extract() {
   // ---- 5. Compact, normals from the gradient --------------------------------------------------------------
   SurfaceMesh mesh;
   std::vector<std::uint32_t> index(ne, kDead);
+  std::vector<std::uint32_t> source;  // mesh vertex -> edge
   mesh.triangles.reserve(tris.size());
   for (const auto& t : tris) {
     if (t[0] == kDead) continue;
@@ -323,6 +335,7 @@ SurfaceMesh Polygonizer::extract() {
       if (slot == kDead) {
         slot = static_cast<std::uint32_t>(mesh.vertices.size());
         mesh.vertices.push_back(pos[t[i]]);
+        source.push_back(t[i]);
       }
       out[i] = slot;
     }
@@ -330,16 +343,27 @@ SurfaceMesh Polygonizer::extract() {
   }
   mesh.normals.resize(mesh.vertices.size());
   {
-    // One batch call (vectorized / threaded by the function when it overrides values_gradients).
-    std::vector<double> unused(mesh.vertices.size());
-    f_.values_gradients(mesh.vertices.data(), mesh.vertices.size(), unused.data(), mesh.normals.data());
-    for (Point3& g : mesh.normals) {
-      const double n = norm(g);
-      g = (n > 0.0 && std::isfinite(n)) ? g / n : Point3{0.0, 0.0, 0.0};
+    // Gradients from the root finder where it evaluated f at the vertex itself; one batch call for the
+    // others (zero vertices, offset crossings, linear placement, clamped roots).
+    std::vector<std::uint32_t> missing;
+    for (std::size_t i = 0; i < mesh.vertices.size(); ++i) {
+      if (has_grad[source[i]])
+        mesh.normals[i] = grad[source[i]];
+      else
+        missing.push_back(static_cast<std::uint32_t>(i));
     }
+    std::vector<Point3> at(missing.size()), g(missing.size());
+    std::vector<double> unused(missing.size());
+    for (std::size_t k = 0; k < missing.size(); ++k) at[k] = mesh.vertices[missing[k]];
+    f_.values_gradients(at.data(), at.size(), unused.data(), g.data());
+    for (std::size_t k = 0; k < missing.size(); ++k) mesh.normals[missing[k]] = g[k];
+    for (Point3& n : mesh.normals) {
+      const double l = norm(n);
+      n = (l > 0.0 && std::isfinite(l)) ? n / l : Point3{0.0, 0.0, 0.0};
+    }
+    stats_.function_evaluations += missing.size();
+    stats_.gradient_evaluations += missing.size();
   }
-  stats_.function_evaluations += mesh.vertices.size();
-  stats_.gradient_evaluations += mesh.vertices.size();
   // A vanishing gradient (critical point on the surface): fall back to the area-weighted face normal.
   bool need_faces = false;
   for (const Point3& n : mesh.normals) need_faces = need_faces || (n.x == 0.0 && n.y == 0.0 && n.z == 0.0);

@@ -3,9 +3,10 @@
 // A brief explanation. The Delaunay tetrahedralization starts from the 8 corners of the domain box and
 // the seed points. An initial *sampling* lattice (cell centers, covering radius r_s) is inserted too, so
 // that every component of {f < 0} or {f > 0} containing a ball of radius r_s holds a vertex of its sign
-// and shows up as a sign change, whether or not a seed lies on it. From then on only *transverse*
-// tetrahedra (vertex signs differ; sign(0) = +) are refined: while the queue holds a transverse
-// tetrahedron whose circumradius exceeds the precision, its circumcenter is inserted with
+// and shows up as a sign change, whether or not a seed lies on it. From then on only *active*
+// tetrahedra are refined: the transverse ones (vertex signs differ; sign(0) = +) and the stars of lone
+// zeros (zero-valued vertices that no transverse tetrahedron touches, see below). While the queue holds
+// an active tetrahedron whose circumradius exceeds the precision, its circumcenter is inserted with
 // insert_in_conflict() (the tetrahedron itself is in conflict, so no point location is needed).
 //
 // The transverse set is maintained from the Delaunay change sets: killed tetrahedra leave it, created
@@ -51,6 +52,22 @@ inline bool is_negative(double v) { return v < 0.0; }
 /// The Delaunay tree accepts points strictly inside its box only (the corners alone are on the hull).
 bool strictly_inside(const Box3& b, const Point3& p) {
   return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+}
+
+/// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
+/// removal swaps the last element in. @pre x is not listed (on) or listed (off).
+void set_listed(std::vector<std::uint32_t>& list, std::vector<std::uint32_t>& pos, std::uint32_t x, bool on) {
+  if (on) {
+    pos[x] = static_cast<std::uint32_t>(list.size());
+    list.push_back(x);
+  } else {
+    const std::uint32_t i = pos[x];
+    const std::uint32_t last = list.back();
+    list[i] = last;
+    pos[last] = i;
+    list.pop_back();
+    pos[x] = kNotListed;
+  }
 }
 
 std::string describe(const Point3& p) {
@@ -120,7 +137,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
     kind_[v] = static_cast<std::uint8_t>(VertexKind::Seed);
     seed_vertices_[i] = v;
     if (!seed_values.empty() && !std::isnan(seed_values[i])) {
-      values_[v] = seed_values[i];
+      set_value(v, seed_values[i]);
       fixed_[v] = 1;
     } else {
       pending_.push_back(v);
@@ -130,6 +147,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
   evaluate_pending();
   grow_tet_arrays();
   tri_.for_each_tetrahedron([this](TetId t) { classify(t, false); });
+  settle_zeros({});
   stats_.init_seconds = seconds_since(t0);
 }
 
@@ -142,6 +160,7 @@ void Polygonizer::grow_vertex_arrays() {
   fixed_.resize(cap, 0);
   tcount_.resize(cap, 0);
   moved_.resize(cap, 0);
+  lpos_.resize(cap, kNotListed);
 }
 
 void Polygonizer::grow_tet_arrays() {
@@ -169,7 +188,7 @@ void Polygonizer::evaluate_pending() {
   stats_.vertex_evaluations += pts.size();
   for (std::size_t i = 0; i < ids.size(); ++i) {
     if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
-    values_[ids[i]] = out[i];
+    set_value(ids[i], out[i]);
   }
 }
 
@@ -184,19 +203,65 @@ void Polygonizer::set_transverse(TetId t, bool on) {
   const bool listed = tpos_[t] != kNotListed;
   if (on == listed) return;
   const auto v = tri_.tet_vertices(t);
+  set_listed(tlist_, tpos_, t, on);
   if (on) {
-    tpos_[t] = static_cast<std::uint32_t>(tlist_.size());
-    tlist_.push_back(t);
-    for (const VertexId u : v) ++tcount_[u];
+    for (const VertexId u : v)
+      if (tcount_[u]++ == 0 && lpos_[u] != kNotListed) set_lonely(u, false);  // no longer a lone zero
   } else {
-    const std::uint32_t i = tpos_[t];
-    const TetId last = tlist_.back();
-    tlist_[i] = last;
-    tpos_[last] = i;
-    tlist_.pop_back();
-    tpos_[t] = kNotListed;
-    for (const VertexId u : v) --tcount_[u];
+    for (const VertexId u : v)  // the vertex may have become a lone zero (decided after the batch)
+      if (--tcount_[u] == 0 && values_[u] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(u);
   }
+}
+
+// ---- Lone zeros ----------------------------------------------------------------------------------------
+// A zero-valued vertex z with no transverse tetrahedron around it: the surface passes through z, but no
+// vertex shows its negative side yet (e.g. a zero constraint added away from the current surface, or
+// on-surface constraints of a thin part with only outside constraints). Its star is *active*: refined
+// like transverse tetrahedra, never meshed. A circumcenter inserted for a tetrahedron of the star is
+// joined to z by an edge (z is on the boundary of the cavity), so as soon as one of them is negative,
+// z has a crossed edge, stops being lone, and ordinary refinement follows the new sign change.
+// The set is kept from the events that can change it: a value becoming or leaving 0 (set_value), the
+// transverse count of a zero vertex dropping to 0 (set_transverse), tetrahedra created around a lone zero
+// (settle_zeros); no scan.
+
+void Polygonizer::set_value(VertexId v, double value) {
+  values_[v] = value;
+  if ((value == 0.0 && options_.refine_lone_zeros) || lpos_[v] != kNotListed) zcheck_.push_back(v);
+}
+
+void Polygonizer::set_lonely(VertexId v, bool on) {
+  if (on != (lpos_[v] != kNotListed)) set_listed(lonely_, lpos_, v, on);
+}
+
+bool Polygonizer::touches_lonely(TetId t) const {
+  for (const VertexId u : tri_.tet_vertices(t))
+    if (lpos_[u] != kNotListed) return true;
+  return false;
+}
+
+bool Polygonizer::is_active(TetId t) const {
+  if (!tri_.is_live(t)) return false;
+  return (t < tpos_.size() && tpos_[t] != kNotListed) || touches_lonely(t);
+}
+
+void Polygonizer::push_if_big(TetId t) {
+  if (!std::isfinite(precision_)) return;  // before the first refine(): nothing is queued
+  radius_[t] = tri_.circumradius(t);
+  if (radius_[t] > precision_) push(t);
+}
+
+void Polygonizer::settle_zeros(const std::vector<TetId>& created) {
+  for (const VertexId u : zcheck_) {
+    const bool lone = tri_.is_vertex(u) && values_[u] == 0.0 && tcount_[u] == 0;
+    if (lone == (lpos_[u] != kNotListed)) continue;
+    set_lonely(u, lone);
+    if (lone)
+      for (const TetId t : tri_.incident_tetrahedra(u)) push_if_big(t);
+  }
+  zcheck_.clear();
+  if (lonely_.empty()) return;
+  for (const TetId t : created)
+    if (tri_.is_live(t) && tpos_[t] == kNotListed && touches_lonely(t)) push_if_big(t);
 }
 
 void Polygonizer::on_killed(const ChangeSet& cs) {
@@ -216,6 +281,7 @@ void Polygonizer::classify(TetId t, bool requeue) {
 void Polygonizer::classify_created(std::vector<TetId>& created) {
   grow_tet_arrays();
   for (const TetId t : created) classify(t, false);
+  settle_zeros(created);
   created.clear();
 }
 
@@ -357,6 +423,8 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   clear_queue();
   for (const TetId t : tlist_)
     if (radius_[t] > precision) push(t);
+  for (const VertexId z : lonely_)
+    for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
   std::vector<TetId> created, retry;
   RefineProgress info;
   bool completed = true;
@@ -365,16 +433,18 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
     for (std::size_t i = 0; i < n; ++i) {
       TetId t;
       if (!pop(t)) break;
-      if (!tri_.is_live(t) || tpos_[t] == kNotListed || radius_[t] <= precision) continue;
+      if (!is_active(t) || radius_[t] <= precision) continue;
+      const bool lone_star = tpos_[t] == kNotListed;
       if (insert_refinement_point(t, dmin, VertexKind::Refinement, created)) {
         ++info.inserted;
+        if (lone_star) ++stats_.lone_zero_insertions;
         if (tri_.is_live(t)) retry.push_back(t);
       }
     }
     evaluate_pending();
     classify_created(created);
     for (const TetId t : retry)
-      if (tri_.is_live(t) && tpos_[t] != kNotListed) push(t);
+      if (is_active(t)) push(t);
     retry.clear();
     if (progress) {
       info.vertices = tri_.num_vertices();
@@ -413,7 +483,7 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
   kind_[v] = static_cast<std::uint8_t>(kind);
   tcount_[v] = 0;
   if (value) {
-    values_[v] = *value;
+    set_value(v, *value);
     fixed_[v] = 1;
   } else {
     fixed_[v] = 0;
@@ -428,6 +498,7 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
 
 void Polygonizer::remove_vertex(VertexId v) {
   if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("remove_vertex: not a removable vertex");
+  set_lonely(v, false);
   changes_.clear();
   tri_.remove(v, &changes_);
   on_killed(changes_);
@@ -454,7 +525,7 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
   grow_tet_arrays();
   moved_[v] = 1;
   if (value) {
-    values_[v] = *value;
+    set_value(v, *value);
     fixed_[v] = 1;
   } else if (!fixed_[v]) {
     pending_.push_back(v);
@@ -464,16 +535,23 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
   std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
   classify_created(created);
   // Tetrahedra around v that the move kept alive changed shape: re-measure and re-queue them.
-  for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, true);
+  // The star of a lone zero v is re-queued too (settle_zeros only sees the created tetrahedra).
+  for (const TetId t : tri_.incident_tetrahedra(v)) {
+    classify(t, true);
+    if (lpos_[v] != kNotListed) push_if_big(t);
+  }
+  if (values_[v] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(v);
+  settle_zeros({});
   return true;
 }
 
 void Polygonizer::set_vertex_value(VertexId v, double value) {
   if (!tri_.is_vertex(v)) throw InvalidArgument("set_vertex_value: not a vertex");
   if (!std::isfinite(value)) throw InvalidArgument("set_vertex_value: value is not finite");
-  values_[v] = value;
+  set_value(v, value);
   fixed_[v] = 1;
   for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, false);
+  settle_zeros({});
 }
 
 void Polygonizer::function_changed() {
@@ -495,7 +573,7 @@ void Polygonizer::function_changed() {
     if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
     const VertexId v = ids[i];
     const bool flip = is_negative(out[i]) != is_negative(values_[v]);
-    values_[v] = out[i];
+    set_value(v, out[i]);
     if (flip) {
       const auto inc = tri_.incident_tetrahedra(v);
       touched.insert(touched.end(), inc.begin(), inc.end());
@@ -504,15 +582,28 @@ void Polygonizer::function_changed() {
   std::sort(touched.begin(), touched.end());
   touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
   for (const TetId t : touched) classify(t, false);
+  settle_zeros({});
   stats_.update_seconds = seconds_since(t0);
 }
 
-std::size_t Polygonizer::collect_garbage() {
+std::size_t Polygonizer::collect_garbage(double min_fraction) {
   std::size_t removed = 0;
   const std::size_t cap = tri_.vertex_capacity();
+  if (min_fraction > 0.0) {
+    std::size_t candidates = 0;
+    for (VertexId v = 8; v < cap; ++v)
+      candidates += kind_[v] == static_cast<std::uint8_t>(VertexKind::Refinement) && tcount_[v] == 0 &&
+                    tri_.is_vertex(v);
+    if (static_cast<double>(candidates) <= min_fraction * static_cast<double>(tri_.num_vertices())) return 0;
+  }
   for (VertexId v = 8; v < cap; ++v) {
     if (kind_[v] != static_cast<std::uint8_t>(VertexKind::Refinement) || tcount_[v] != 0 || !tri_.is_vertex(v))
       continue;
+    // Keep the refinement of the stars of lone zeros (they are active; removing would redo it).
+    if (lpos_[v] != kNotListed) continue;
+    bool serves = false;
+    for (const TetId t : tri_.incident_tetrahedra(v)) serves = serves || touches_lonely(t);
+    if (serves) continue;
     remove_vertex(v);
     ++removed;
   }
@@ -525,6 +616,7 @@ PolygonizerStats Polygonizer::stats() const {
   s.vertices = tri_.num_vertices();
   s.tetrahedra = tri_.num_tetrahedra();
   s.transverse = tlist_.size();
+  s.lone_zeros = lonely_.size();
   return s;
 }
 

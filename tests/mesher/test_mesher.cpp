@@ -74,10 +74,9 @@ struct ModelCase {
   long long euler;
 };
 
-void check_model(const ModelCase& c) {
+void check_model_with(const ModelCase& c, MesherOptions o) {
   INFO(c.file);
   const TriangleMesh in = read_mesh(kData + "/" + c.file);
-  MesherOptions o;
   o.constraint_build.max_constraints = c.max_constraints;
   Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
   const double precision = c.precision * mesher.diagonal();
@@ -100,6 +99,8 @@ void check_model(const ModelCase& c) {
   // Every on-surface constraint whose crossings could be collapsed is a mesh vertex exactly.
   REQUIRE(mesher.stats().polygonizer.zero_snapped > 0);
 }
+
+void check_model(const ModelCase& c) { check_model_with(c, {}); }
 
 }  // namespace
 
@@ -225,4 +226,81 @@ TEST_CASE("mesher errors", "[mesher]") {
   MesherOptions o;
   o.box_factor = 1.0;
   REQUIRE_THROWS_AS(Mesher(small_model(), o), InvalidArgument);
+}
+
+namespace {
+
+/// Oriented points of a torus (major radius R, tube radius r) on an nu x nv grid, outward normals.
+void torus_points(double R, double r, int nu, int nv, std::vector<Point3>& p, std::vector<Point3>& n) {
+  const double pi = 3.14159265358979323846;
+  for (int i = 0; i < nu; ++i)
+    for (int j = 0; j < nv; ++j) {
+      const double u = 2 * pi * (i + 0.5 * (j % 2)) / nu, v = 2 * pi * j / nv;
+      n.push_back({std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v)});
+      p.push_back({(R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)});
+    }
+}
+
+}  // namespace
+
+// Lone zeros (docs/polygonize.md), bug (a): a zero constraint added away from the surface. The RBF
+// surface passes through the point and encloses a small region f < 0 next to it, but no vertex is
+// negative there: under the plain rule nothing is transverse and the mesh ignores the point.
+TEST_CASE("lone zeros: a zero constraint added well outside the surface gets its own surface", "[mesher]") {
+  const double precision = 0.05;
+  const Point3 p{0.0, 1.2, 0.8};  // the ellipsoid reaches y = 0.8 and z = 0.6; a +1 constraint is at y = 2
+  for (const bool lone : {true, false}) {
+    INFO("refine_lone_zeros " << lone);
+    MesherOptions o;
+    o.polygonizer.refine_lone_zeros = lone;
+    Mesher mesher(small_model(), o);
+    REQUIRE(mesher.refine(precision));
+    REQUIRE(metrics_of(mesher.surface()).components == 1);
+    REQUIRE(MeshDistance(mesher.surface()).distance(p) > 0.3);
+    mesher.add_constraint(p, 0.0);
+    const SurfaceMesh& m = mesher.surface();
+    const double d = MeshDistance(m).distance(p);
+    if (lone) {
+      require_closed(m);
+      REQUIRE(metrics_of(m).components == 2);
+      REQUIRE(d <= precision);
+      REQUIRE(max_surface_distance(m, mesher.function()) <= 0.1 * precision);
+      REQUIRE(mesher.stats().polygonizer.lone_zeros == 0);
+    } else {
+      REQUIRE(d > 0.3);  // the bug this rule fixes
+    }
+  }
+}
+
+// Bug (b): only outside off-surface constraints on a tube thinner than the sampling lattice: no vertex
+// is negative at the start, every on-surface constraint is a lone zero.
+TEST_CASE("lone zeros: thin torus with outside constraints only is a closed genus-1 mesh", "[mesher]") {
+  std::vector<Point3> p, n;
+  torus_points(1.0, 0.08, 40, 8, p, n);
+  MesherOptions o;
+  o.constraint_build.sides = OffSurface::Outside;
+  Mesher mesher = Mesher::from_oriented_points(p, n, o);
+  REQUIRE(mesher.polygonizer().transverse_tetrahedra().empty());  // precondition: nothing negative
+  const double precision = 0.02 * mesher.diagonal();
+  REQUIRE(mesher.refine(precision));
+  const SurfaceMesh& m = mesher.surface();
+  require_closed(m);
+  const MeshMetrics mm = metrics_of(m);
+  REQUIRE(mm.euler_characteristic == 0);
+  REQUIRE(mm.components == 1);
+  const MeshDistance md(m);
+  for (const Point3& q : p) REQUIRE(md.distance(q) <= precision);
+
+  MesherOptions plain = o;
+  plain.polygonizer.refine_lone_zeros = false;
+  Mesher old = Mesher::from_oriented_points(p, n, plain);
+  REQUIRE(old.refine(precision));
+  REQUIRE(old.surface().triangles.empty());  // the bug this rule fixes
+}
+
+// hand.off with one outside constraint per vertex (~2400 constraints, the benchmark's setting of issue 5).
+TEST_CASE("lone zeros: hand.off with outside constraints only has the hand's topology", "[mesher]") {
+  MesherOptions o;
+  o.constraint_build.sides = OffSurface::Outside;
+  check_model_with(ModelCase{"hand.off", 0, 0.03, 2}, o);
 }

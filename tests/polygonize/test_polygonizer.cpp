@@ -332,3 +332,75 @@ TEST_CASE("MeshDistance matches brute force", "[surface_mesh]") {
   REQUIRE(point_triangle_distance({0, 0, 1}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}) == Approx(1.0));
   REQUIRE(point_triangle_distance({2, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}) == Approx(1.0));
 }
+
+// Lone zeros (docs/polygonize.md): a zero-valued vertex that no transverse tetrahedron touches has its
+// star refined, so a surface known only through zero-valued seeds is found even when no vertex is on its
+// negative side. Here: a thin torus (tube radius 0.06) far thinner than the sampling lattice (covering
+// radius 0.69), seeds on its surface with the exact value 0. Under the plain rule nothing is transverse.
+TEST_CASE("lone zeros: a thin torus known only by zero-valued seeds on it is found", "[polygonizer]") {
+  const double R = 1.0, r = 0.06;
+  const TorusFunction f({0.0, 0.0, 0.0}, R, r);
+  std::vector<Point3> seeds;
+  for (int i = 0; i < 24; ++i)
+    for (int j = 0; j < 3; ++j) {
+      const double u = 2 * 3.14159265358979323846 * (i + 0.37) / 24, v = 2 * 3.14159265358979323846 * j / 3;
+      seeds.push_back({(R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)});
+    }
+  const std::vector<double> zeros(seeds.size(), 0.0);
+  const double precision = 0.03;
+  SECTION("lone-zero refinement finds it: closed genus 1 within the precision") {
+    Polygonizer poly(f, kCube, seeds, zeros);
+    // Precondition of the test: no vertex is inside the tube, every seed is a lone zero.
+    REQUIRE(poly.transverse_tetrahedra().empty());
+    REQUIRE(poly.stats().lone_zeros == seeds.size());
+    REQUIRE(poly.refine(precision));
+    const SurfaceMesh m = poly.extract();
+    require_closed(m, 0, 1);
+    REQUIRE(poly.stats().lone_zeros == 0);
+    REQUIRE(poly.stats().lone_zero_insertions > 0);
+    const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
+    REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
+    // Every seed is on (or next to) the mesh.
+    const MeshDistance md(m);
+    for (const Point3& s : seeds) REQUIRE(md.distance(s) <= precision);
+    // Invariant: lone zeros are exactly the zero vertices without a transverse tetrahedron.
+    for (const TetId t : poly.transverse_tetrahedra()) REQUIRE(poly.is_active(t));
+  }
+  SECTION("the plain rule (refine_lone_zeros = false) finds nothing") {
+    PolygonizerOptions o;
+    o.refine_lone_zeros = false;
+    Polygonizer poly(f, kCube, seeds, zeros, o);
+    REQUIRE(poly.refine(precision));
+    REQUIRE(poly.extract().triangles.empty());
+    REQUIRE(poly.stats().lone_zeros == 0);
+  }
+}
+
+// A lone zero whose surface has no negative side (f >= 0 around it, here a zero seed placed where f > 0
+// is given the value 0): its star is refined to the precision and then refinement stops (termination),
+// nothing is meshed, and the star's refinement is not garbage-collected (it stays active).
+TEST_CASE("lone zeros: a zero vertex without a negative side terminates and meshes nothing", "[polygonizer]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 0.5);
+  const std::vector<Point3> seeds = {{1.3, 0.2, -0.1}};
+  Polygonizer poly(f, kCube, seeds, {0.0});
+  REQUIRE(poly.refine(0.1));
+  REQUIRE(poly.stats().lone_zeros == 1);
+  REQUIRE(poly.stats().lone_zero_insertions > 0);
+  const VertexId z = poly.seed_vertices()[0];
+  for (const TetId t : poly.triangulation().incident_tetrahedra(z)) {
+    REQUIRE(poly.is_active(t));
+    REQUIRE_FALSE(poly.is_transverse(t));
+    REQUIRE(poly.triangulation().circumradius(t) <= 0.1);
+  }
+  require_closed(poly.extract(), 2, 1);  // the sphere alone
+  std::set<VertexId> star;
+  for (const TetId t : poly.triangulation().incident_tetrahedra(z))
+    for (const VertexId u : poly.triangulation().tet_vertices(t))
+      if (poly.vertex_kind(u) == VertexKind::Refinement) star.insert(u);
+  REQUIRE(!star.empty());
+  poly.collect_garbage();
+  for (const VertexId u : star) REQUIRE(poly.triangulation().is_vertex(u));
+  const std::size_t before = poly.stats().vertices;
+  REQUIRE(poly.refine(0.1));  // nothing left to do
+  REQUIRE(poly.stats().vertices == before);
+}

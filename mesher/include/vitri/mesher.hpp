@@ -44,6 +44,11 @@ struct MesherOptions {
   /// After each edit, remove refinement vertices that no transverse tetrahedron touches any more, so
   /// that a long editing session does not grow without bound.
   bool collect_garbage = true;
+  /// Collect only when such vertices exceed this fraction of the Delaunay vertices (removals are the
+  /// most expensive part of a small update, and vertices left by one edit often serve the next one).
+  /// 0: after every edit. The Delaunay vertex count then stays within about (1 + this) of a session
+  /// that collects after every edit.
+  double garbage_fraction = 0.1;
 };
 
 /// Counters and timings (seconds). `polygonizer` holds the refinement/extraction numbers.

@@ -11,8 +11,12 @@
 /// tetrahedralization (levels of detail); a mesh can be extracted at any moment.
 ///
 /// Sign rule: a vertex value of exactly 0 counts as positive ("sign(0) = +"), so every vertex is
-/// strictly classified and marching tetrahedra is the standard two-case table. See docs/polygonize.md
-/// for how zero-valued vertices are placed on the mesh and for the termination argument.
+/// strictly classified and marching tetrahedra is the standard two-case table. A zero-valued vertex
+/// that no transverse tetrahedron touches (a *lone zero*: the surface passes through it but no vertex
+/// shows the negative side yet) makes its star *active*: those tetrahedra are refined like transverse
+/// ones (circumradius > precision) but never meshed, so that refinement around the point discovers the
+/// negative side. See docs/polygonize.md for the placement of zero-valued vertices on the mesh and for
+/// the termination argument.
 ///
 /// @note The function is held by reference and must outlive the Polygonizer. When the function
 /// changes (dynamic editing), call function_changed().
@@ -82,6 +86,12 @@ struct PolygonizerOptions {
   bool snap_zero_vertices = true;
   /// Fraction of the edge length, from the zero vertex, at which a non-snapped crossing is placed.
   double zero_offset = 0.05;
+  /// Lone zeros: refine the star of every zero-valued vertex that no transverse tetrahedron touches
+  /// (circumradius > precision), so that the surface through it is found even when no vertex is on its
+  /// negative side yet (a zero constraint added away from the surface; a thin part with only outside
+  /// constraints). false restores the plain rule (only transverse tetrahedra are refined). See
+  /// docs/polygonize.md.
+  bool refine_lone_zeros = true;
 };
 
 /// Counters and timings. Times in seconds; counters cumulative since construction unless stated.
@@ -91,14 +101,16 @@ struct PolygonizerStats {
   std::size_t transverse = 0;           ///< live transverse tetrahedra
   std::size_t function_evaluations = 0; ///< calls of f (value or gradient), all phases
   std::size_t vertex_evaluations = 0;   ///< of which at Delaunay vertices
-  std::size_t root_evaluations = 0;     ///< of which by the root finder
-  std::size_t gradient_evaluations = 0; ///< of which for normals
+  std::size_t root_evaluations = 0;     ///< of which by the root finder (value + gradient: the normal)
+  std::size_t gradient_evaluations = 0; ///< of which for normals not given by the root finder
   std::size_t insertions = 0;           ///< Delaunay insertions by refinement and sampling
   std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box (hull tetrahedra dropped, others split inside)
   std::size_t rejected = 0;             ///< refine(): points rejected by proximity (tetrahedron dropped)
   std::size_t removed_steiner = 0;      ///< refinement vertices removed by collect_garbage()
   std::size_t zero_snapped = 0;         ///< last extract(): zero vertices used as mesh vertices
   std::size_t zero_offset = 0;          ///< last extract(): zero vertices whose crossings stayed offset
+  std::size_t lone_zeros = 0;           ///< current zero-valued vertices touched by no transverse tetrahedron
+  std::size_t lone_zero_insertions = 0; ///< refinement points inserted for the stars of lone zeros
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
   double refine_seconds = 0;            ///< last refine() call
   double extract_seconds = 0;           ///< last extract() call
@@ -137,8 +149,9 @@ class Polygonizer {
   /// @throws InvalidArgument when points is empty or factor <= 1; InvalidPoint(i) when point i is not finite.
   static Box3 domain_for(const std::vector<Point3>& points, double factor = 2.0);
 
-  /// Refines until every transverse tetrahedron has circumradius <= precision (except the rare ones
-  /// whose refinement point was rejected, counted in stats().rejected). Continues the current
+  /// Refines until every active tetrahedron (transverse, or in the star of a lone zero) has
+  /// circumradius <= precision (except the rare ones whose refinement point was rejected, counted in
+  /// stats().rejected). Continues the current
   /// tetrahedralization: calling it with a smaller precision refines further (level of detail).
   /// @return false when the callback cancelled. @throws InvalidArgument when precision <= 0 or NaN.
   bool refine(double precision, const ProgressCallback& progress = {});
@@ -167,8 +180,12 @@ class Polygonizer {
   /// reclassifies only the tetrahedra around vertices whose sign changed. Call refine() afterwards.
   void function_changed();
   /// Removes Refinement vertices that no transverse tetrahedron touches (they no longer serve the
-  /// surface). Removing such a vertex never creates a transverse tetrahedron. Returns how many.
-  std::size_t collect_garbage();
+  /// surface; those in the star of a lone zero are kept). Removing such a vertex never creates a
+  /// transverse tetrahedron. Returns how many.
+  /// @param min_fraction  do nothing (return 0) unless such vertices are more than this fraction of the
+  ///        live vertices: removals are expensive, and vertices left by one edit often serve the next
+  ///        one (a constraint moved back and forth), so a session can collect in batches. 0: always.
+  std::size_t collect_garbage(double min_fraction = 0.0);
 
   // ---- Queries ---------------------------------------------------------------------------------------
   const Triangulation& triangulation() const { return tri_; }
@@ -182,6 +199,11 @@ class Polygonizer {
   const std::vector<TetId>& transverse_tetrahedra() const { return tlist_; }
   /// True when tetrahedron t is live and its vertex signs differ (sign(0) = +).
   bool is_transverse(TetId t) const;
+  /// True when tetrahedron t is live and refined by refine(): transverse, or incident to a lone zero
+  /// (a zero-valued vertex that no transverse tetrahedron touches).
+  bool is_active(TetId t) const;
+  /// Zero-valued vertices that no transverse tetrahedron touches (unordered); their stars are refined.
+  const std::vector<VertexId>& lone_zero_vertices() const { return lonely_; }
   /// The precision of the last refine() call (infinity before the first).
   double precision() const { return precision_; }
   /// Counters and timings (vertices/tetrahedra/transverse are current).
@@ -203,6 +225,11 @@ class Polygonizer {
   void sample(double radius);
   bool insert_refinement_point(TetId t, double min_distance, VertexKind kind, std::vector<TetId>& created);
   void classify_created(std::vector<TetId>& created);
+  void set_value(VertexId v, double value);
+  void set_lonely(VertexId v, bool on);
+  void push_if_big(TetId t);
+  void settle_zeros(const std::vector<TetId>& created);
+  bool touches_lonely(TetId t) const;
 
   const ImplicitFunction& f_;
   PolygonizerOptions options_;
@@ -214,7 +241,10 @@ class Polygonizer {
   std::vector<std::uint32_t> tcount_;   // per vertex: incident transverse tetrahedra
   std::vector<std::uint32_t> tpos_;     // per tet: index in tlist_, or kNotListed
   std::vector<TetId> tlist_;            // live transverse tetrahedra
-  std::vector<double> radius_;          // per tet: circumradius, valid while listed
+  std::vector<double> radius_;          // per tet: circumradius, valid while listed or queued
+  std::vector<std::uint32_t> lpos_;     // per vertex: index in lonely_, or kNotListed
+  std::vector<VertexId> lonely_;        // lone zeros: value 0, tcount_ 0 (their stars are active)
+  std::vector<VertexId> zcheck_;        // zero vertices whose loneliness may have changed (settle_zeros)
   std::vector<VertexId> pending_;       // vertices waiting for their value (batch)
   std::vector<VertexId> seed_vertices_;
   std::deque<TetId> fifo_;

@@ -21,6 +21,7 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj --precision P [--precision P2 ...] [--edits SCRIPT]\n"
+    "                  [--sides both|inside|outside] [--offset D] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -47,10 +48,17 @@ const char* const kUsage =
     "                       and print the update time of each edit.\n"
     "  --offset D           off-surface constraint distance for points/meshes, fraction of the\n"
     "                       diagonal (default 0.01)\n"
+    "  --sides S            off-surface constraints per point for points/meshes: both (default; +D\n"
+    "                       outside and -D inside, 3 constraints per point), outside or inside (2 per\n"
+    "                       point: fewer constraints, a faster fit). Ignored for .xyzv input.\n"
     "  -q, --quiet          no table, no progress\n"
     "\n"
     "Prints, per level: vertices, triangles, refinement and extraction times, and the running total\n"
-    "(the paper's Table 1). Exit status: 0 ok, 1 bad input, 2 usage error.\n";
+    "(the paper's Table 1). A bad edit line is reported with its line number; index I out of range is\n"
+    "bad input.\n"
+    "Exit status: 0 ok, 1 bad input (unreadable or malformed file, bad edit line, singular fit),\n"
+    "2 usage error (unknown option, missing or bad argument, e.g. a precision <= 0 or NaN),\n"
+    "3 internal error.\n";
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
@@ -140,8 +148,15 @@ int run_mesh(const Args& args) {
       if (!value(edits)) return usage_error("--edits needs a path");
     } else if (a == "--offset") {
       double d;
-      if (!value(v) || !parse_double(v, d) || !(d > 0.0)) return usage_error("--offset needs a positive number");
+      if (!value(v) || !parse_double(v, d) || !(d > 0.0) || !std::isfinite(d))
+        return usage_error("--offset needs a positive number");
       options.constraint_build.offset = d;
+    } else if (a == "--sides") {
+      if (!value(v)) return usage_error("--sides needs both, inside or outside");
+      if (v == "both") options.constraint_build.sides = OffSurface::Both;
+      else if (v == "inside") options.constraint_build.sides = OffSurface::Inside;
+      else if (v == "outside") options.constraint_build.sides = OffSurface::Outside;
+      else return usage_error("--sides must be both, inside or outside, got '" + v + "'");
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (!a.empty() && a[0] == '-') {

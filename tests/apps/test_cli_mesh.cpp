@@ -1,0 +1,238 @@
+// `vitri mesh`: runs the real binary on small inputs. Every mesh it writes is read back and must be a
+// closed, outward 2-manifold of the right topology; levels of detail go to OUT-k with growing vertex
+// counts; an edit script runs and reports each edit; bad input exits with 1 and usage errors with 2, each
+// with a message on stderr (the edit line's number for a bad script line).
+#include "vitri/io/io.hpp"
+#include "vitri/polygonize/mesh_metrics.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+const std::string kDir = VITRI_TEST_WORK_DIR;
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+bool exists(const std::string& path) {
+  return std::ifstream(path).good();
+}
+
+// Runs `vitri mesh ARGS`, capturing stdout and stderr; returns the exit code.
+int run(const std::string& args, std::string& out, std::string& err) {
+  const std::string o = kDir + "/mesh_stdout.txt", e = kDir + "/mesh_stderr.txt";
+  const int rc = std::system((std::string(VITRI_CLI) + " mesh " + args + " > " + o + " 2> " + e).c_str());
+  out = slurp(o);
+  err = slurp(e);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+/// The 25-constraint model of the mesher tests (paper's Table 2 scale): the center of an ellipsoid
+/// (index 0, value -0.5), 18 points of its surface (value 0), 6 points outside on the axes (value +1).
+std::string write_small_model() {
+  const std::string path = kDir + "/mesh_small.xyzv";
+  std::ofstream c(path);
+  c.precision(17);
+  c << "# ellipsoid: center, 18 surface points, 6 outside points\n0 0 0 -0.5\n";
+  const double pi = 3.14159265358979323846, golden = pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < 18; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / 18.0, r = std::sqrt(1.0 - z * z), phi = golden * i;
+    c << r * std::cos(phi) << ' ' << 0.8 * r * std::sin(phi) << ' ' << 0.6 * z << " 0\n";
+  }
+  for (int k = 0; k < 3; ++k)
+    for (const double s : {-2.0, 2.0})
+      c << (k == 0 ? s : 0.0) << ' ' << (k == 1 ? s : 0.0) << ' ' << (k == 2 ? s : 0.0) << " 1\n";
+  return path;
+}
+
+/// Reads a mesh the CLI wrote and checks it is a closed, outward 2-manifold with Euler characteristic
+/// `euler`; returns its vertex count.
+long check_mesh(const std::string& path, long long euler = 2) {
+  INFO(path);
+  REQUIRE(exists(path));
+  const TriangleMesh m = read_mesh(path);
+  const MeshMetrics mm = compute_mesh_metrics(m.V, m.F);
+  REQUIRE(mm.closed_manifold());
+  REQUIRE(mm.euler_characteristic == euler);
+  REQUIRE(mm.signed_volume > 0.0);
+  return static_cast<long>(m.V.rows());
+}
+
+}  // namespace
+
+TEST_CASE("vitri mesh: one precision writes OUT itself", "[cli][mesh]") {
+  const std::string in = write_small_model(), out = kDir + "/mesh_one.obj";
+  std::remove(out.c_str());
+  std::remove((kDir + "/mesh_one-0.obj").c_str());
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --precision 0.05", o, e) == 0);
+  INFO(o << e);
+  REQUIRE(check_mesh(out) > 100);
+  REQUIRE_FALSE(exists(kDir + "/mesh_one-0.obj"));
+  REQUIRE(o.find("25 constraints") != std::string::npos);  // the Table 1 header
+  REQUIRE(o.find("extract ms") != std::string::npos);
+}
+
+TEST_CASE("vitri mesh: several precisions write OUT-k with growing vertex counts", "[cli][mesh]") {
+  const std::string in = write_small_model(), out = kDir + "/mesh_lod.obj";
+  for (int k = 0; k < 3; ++k) std::remove((kDir + "/mesh_lod-" + std::to_string(k) + ".obj").c_str());
+  std::remove(out.c_str());
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --precision 0.12 --precision 0.06 --precision 0.03", o, e) == 0);
+  INFO(o << e);
+  long last = 0;
+  for (int k = 0; k < 3; ++k) {
+    const long n = check_mesh(kDir + "/mesh_lod-" + std::to_string(k) + ".obj");
+    REQUIRE(n > last);
+    last = n;
+  }
+  REQUIRE_FALSE(exists(out));
+}
+
+TEST_CASE("vitri mesh: .ply and .off outputs hold the same mesh as .obj", "[cli][mesh]") {
+  const std::string in = write_small_model();
+  std::string o, e;
+  long n[3];
+  const char* ext[3] = {"obj", "ply", "off"};
+  for (int i = 0; i < 3; ++i) {
+    const std::string out = kDir + "/mesh_fmt." + ext[i];
+    std::remove(out.c_str());
+    REQUIRE(run(in + " -o " + out + " --precision 0.06 -q", o, e) == 0);
+    REQUIRE(o.empty());  // --quiet
+    n[i] = check_mesh(out);
+  }
+  REQUIRE(n[0] == n[1]);
+  REQUIRE(n[0] == n[2]);
+}
+
+TEST_CASE("vitri mesh: an edit script runs, reports each edit and writes meshes", "[cli][mesh]") {
+  const std::string in = write_small_model(), out = kDir + "/mesh_edit.obj",
+                    script = kDir + "/mesh_edits.txt";
+  const std::string w1 = kDir + "/mesh_edit_w1.off", w2 = kDir + "/mesh_edit_w2.obj";
+  std::remove(w1.c_str());
+  std::remove(w2.c_str());
+  {
+    std::ofstream s(script);
+    s << "# a comment line\n"
+         "move 3 1.1 0.2 0.1\n"
+         "add 0 0 0.75 0   # a surface point pulled out\n"
+         "\n"
+         "write "
+      << w1
+      << "\n"
+         "value 0 -0.8\n"
+         "remove 7\n"
+         "write "
+      << w2 << "\n";
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --precision 0.06 --edits " + script, o, e) == 0);
+  INFO(o << e);
+  check_mesh(out);
+  check_mesh(w1);
+  check_mesh(w2);
+  // One report line per edit, starting with its script line number, with the update times.
+  for (const char* line : {"\n    2 move 3", "\n    3 add 0 0 0.75 0", "\n    6 value 0 -0.8",
+                           "\n    7 remove 7", "\n    5 write", "\n    8 write"})
+    REQUIRE(o.find(line) != std::string::npos);
+  REQUIRE(o.find("rbf ms") != std::string::npos);
+  REQUIRE(o.find("total ms") != std::string::npos);
+}
+
+TEST_CASE("vitri mesh --sides: outside/inside/both build 2 or 3 constraints per point", "[cli][mesh]") {
+  // 64 oriented points on the unit sphere (Fibonacci spiral), outward normals.
+  const std::string in = kDir + "/mesh_sphere.pwn";
+  {
+    std::ofstream p(in);
+    p.precision(17);
+    const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+    for (int i = 0; i < 64; ++i) {
+      const double z = 1.0 - 2.0 * (i + 0.5) / 64.0, r = std::sqrt(1.0 - z * z), phi = golden * i;
+      const double x = r * std::cos(phi), y = r * std::sin(phi);
+      p << x << ' ' << y << ' ' << z << ' ' << x << ' ' << y << ' ' << z << '\n';
+    }
+  }
+  std::string o, e;
+  const struct {
+    const char* sides;
+    const char* count;
+  } cases[] = {{"both", "192 constraints"}, {"outside", "128 constraints"}, {"inside", "128 constraints"}};
+  for (const auto& c : cases) {
+    INFO(c.sides);
+    const std::string out = kDir + "/mesh_sides_" + c.sides + ".obj";
+    std::remove(out.c_str());
+    REQUIRE(run(in + " -o " + out + " --precision 0.05 --sides " + c.sides, o, e) == 0);
+    INFO(o << e);
+    REQUIRE(o.find(c.count) != std::string::npos);
+    check_mesh(out);
+  }
+  REQUIRE(run(in + " -o " + kDir + "/mesh_sides_bad.obj --precision 0.05 --sides middle", o, e) == 2);
+  REQUIRE(e.find("--sides") != std::string::npos);
+}
+
+TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why on stderr", "[cli][mesh]") {
+  const std::string in = write_small_model(), out = kDir + "/mesh_err.obj";
+  std::string o, e;
+  SECTION("missing input file") {
+    REQUIRE(run(kDir + "/no_such_file.xyzv -o " + out + " --precision 0.1", o, e) == 1);
+    REQUIRE(e.find("no_such_file.xyzv") != std::string::npos);
+  }
+  SECTION("malformed input names the line") {
+    const std::string bad = kDir + "/mesh_bad.xyzv";
+    std::ofstream(bad) << "0 0 0 -1\n1 0 0 0\n0 1 zero 0\n0 0 1 0\n";
+    REQUIRE(run(bad + " -o " + out + " --precision 0.1", o, e) == 1);
+    REQUIRE(e.find("mesh_bad.xyzv:3") != std::string::npos);
+  }
+  SECTION("bad precision: 0, negative, NaN, not a number, missing") {
+    for (const char* p : {"0", "-0.1", "nan", "abc"}) {
+      INFO(p);
+      REQUIRE(run(in + " -o " + out + " --precision " + p, o, e) == 2);
+      REQUIRE(e.find("--precision") != std::string::npos);
+    }
+    REQUIRE(run(in + " -o " + out, o, e) == 2);
+    REQUIRE(e.find("--precision") != std::string::npos);
+  }
+  SECTION("unknown option, missing output, bad output extension") {
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --frobnicate", o, e) == 2);
+    REQUIRE(e.find("--frobnicate") != std::string::npos);
+    REQUIRE(run(in + " --precision 0.1", o, e) == 2);
+    REQUIRE(run(in + " -o " + kDir + "/mesh_err.stl --precision 0.1", o, e) == 2);
+    REQUIRE(e.find(".stl") != std::string::npos);
+  }
+  SECTION("bad edit line, with its line number") {
+    const std::string script = kDir + "/mesh_bad_edits.txt";
+    std::ofstream(script) << "# fine\nmove 1 0.9 0 0\nmove 2 0.5\n";
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + script, o, e) == 1);
+    REQUIRE(e.find("mesh_bad_edits.txt:3") != std::string::npos);
+    std::ofstream(script) << "twist 1 2\n";
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + script, o, e) == 1);
+    REQUIRE(e.find("mesh_bad_edits.txt:1") != std::string::npos);
+    REQUIRE(e.find("twist") != std::string::npos);
+  }
+  SECTION("constraint index out of range") {
+    const std::string script = kDir + "/mesh_range_edits.txt";
+    std::ofstream(script) << "remove 3\nvalue 25 0.5\n";  // 25 constraints: 0..24
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + script, o, e) == 1);
+    REQUIRE(e.find("mesh_range_edits.txt:2") != std::string::npos);
+    REQUIRE(e.find("out of range") != std::string::npos);
+  }
+  SECTION("missing edit script") {
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + kDir + "/no_such_script.txt", o, e) == 1);
+    REQUIRE(e.find("no_such_script.txt") != std::string::npos);
+  }
+}

@@ -11,9 +11,10 @@
 //       pair a, b negative, c, d positive, (a, b, c, d) even:
 //         quad (e_ac, e_ad, e_bd, e_bc) faces the positive side
 //
-// Vertex placement: Illinois regula falsi on each crossed edge, all edges in lockstep so that each
-// iteration is one batch call of f (value and gradient: the gradient at the accepted point is the
-// vertex normal, so most normals cost no evaluation of their own). The result is clamped strictly inside the edge, so no two mesh
+// Vertex placement: Illinois regula falsi on each crossed edge, with Newton steps (from the gradient)
+// while they stay inside the bracket, all edges in lockstep so that each iteration is one batch call of
+// f (value and gradient: the gradient at the accepted point is the vertex normal, so most normals cost
+// no evaluation of their own). The result is clamped strictly inside the edge, so no two mesh
 // vertices coincide and no triangle is flat.
 //
 // Zero-valued Delaunay vertices (constraint points): the true surface passes through such a vertex z,
@@ -155,7 +156,7 @@ SurfaceMesh Polygonizer::extract() {
     for (std::size_t i = 0; i < nr; ++i) active[i] = static_cast<std::uint32_t>(i);
     std::vector<Point3> pts, gval;
     std::vector<double> val;
-    std::vector<double> tcur(nr);
+    std::vector<double> tcur(nr), newton(nr, -1.0);
     for (int it = 0; it < options_.max_root_iterations && !active.empty(); ++it) {
       pts.resize(active.size());
       val.resize(active.size());
@@ -163,6 +164,7 @@ SurfaceMesh Polygonizer::extract() {
       for (std::size_t k = 0; k < active.size(); ++k) {
         const std::uint32_t i = active[k];
         double t = a[i] + (b[i] - a[i]) * (ga[i] / (ga[i] - gb[i]));
+        if (newton[i] > a[i] && newton[i] < b[i]) t = newton[i];
         if (it == 0 && guess[i] > 0.0 && guess[i] < 1.0) t = guess[i];
         if (!(t > a[i] && t < b[i])) t = 0.5 * (a[i] + b[i]);  // safeguard (underflow, rounding)
         tcur[i] = t;
@@ -190,6 +192,12 @@ SurfaceMesh Polygonizer::extract() {
             side[i] = -1;
           }
           if (b[i] - a[i] <= tol || std::abs(t - last[i]) <= 0.5 * tol) done = true;
+          // Next point: the Newton step from t (the gradient came with the value) when it stays inside
+          // the bracket, else the Illinois step. Near a simple root Newton converges quadratically, so an
+          // edge usually needs one evaluation after the first; the bracket keeps it safe.
+          const Point3& p0 = tri_.point(edges[roots[i]].pos);
+          const double slope = dot(gval[k], tri_.point(edges[roots[i]].neg) - p0);  // df/dt
+          newton[i] = slope < 0.0 && std::isfinite(slope) ? t - g / slope : -1.0;
         }
         last[i] = t;
         const double tc = std::clamp(t, kMinT, 1.0 - kMinT);

@@ -270,6 +270,28 @@ TEST_CASE("dynamic function: re-evaluation, local reclassification, garbage coll
   REQUIRE(static_cast<double>(poly.stats().vertices) <= 1.5 * static_cast<double>(fresh.stats().vertices));
   REQUIRE(hausdorff_distance(poly.extract(), fresh.extract()) <= precision);
   poly.triangulation().verify_topology();
+
+  SECTION("collect_garbage(min_fraction) waits until the garbage exceeds that fraction") {
+    f.c = {-0.4, 0.3, 0.2};
+    f.r = 0.5;  // shrinks: many refinement vertices stop serving
+    poly.function_changed();
+    REQUIRE(poly.refine(precision));
+    std::size_t garbage = 0;  // refinement vertices no transverse tetrahedron touches
+    std::vector<std::uint8_t> touched(poly.triangulation().vertex_capacity(), 0);
+    for (const TetId t : poly.transverse_tetrahedra())
+      for (const VertexId u : poly.triangulation().tet_vertices(t)) touched[u] = 1;
+    for (VertexId v = 8; v < touched.size(); ++v)
+      garbage += poly.triangulation().is_vertex(v) && poly.vertex_kind(v) == VertexKind::Refinement && !touched[v];
+    const double share = static_cast<double>(garbage) / static_cast<double>(poly.stats().vertices);
+    INFO("garbage " << garbage << " of " << poly.stats().vertices);
+    REQUIRE(share > 0.05);
+    const std::size_t before = poly.stats().vertices;
+    REQUIRE(poly.collect_garbage(share + 0.01) == 0);  // below the threshold: nothing happens
+    REQUIRE(poly.stats().vertices == before);
+    REQUIRE(poly.collect_garbage(share - 0.01) == garbage);  // above it: all of them go
+    REQUIRE(poly.stats().vertices == before - garbage);
+    require_closed(poly.extract(), 2, 1);
+  }
 }
 
 TEST_CASE("bad input is rejected with a clear error", "[polygonizer]") {

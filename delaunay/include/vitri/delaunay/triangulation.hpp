@@ -199,6 +199,9 @@ class Triangulation {
   static constexpr std::uint8_t kMark = 2;      // temporary: in the current cavity / star
   static constexpr std::uint8_t kTested = 4;    // temporary: tested, not in conflict
   static constexpr std::uint16_t kNoOffset = 0xffff;
+  // Removal: stars with at most this many link vertices are filled by gift wrapping (O(link^2)
+  // predicates), larger ones through a scratch triangulation of the link.
+  static constexpr std::size_t kMaxWrapLink = 64;
 
   PointId pid(VertexId v) const { return pid_of_vid_.empty() ? v : pid_of_vid_[v]; }
   VertexId vid(PointId p) const { return vid_of_pid_.empty() ? p : vid_of_pid_[p]; }
@@ -221,6 +224,7 @@ class Triangulation {
                          ChangeSet* changes, VertexId reuse_vid);
   void collect_star(PointId v);
   void remove_impl(VertexId v, ChangeSet* changes);
+  void fill_hole_by_wrapping(PointId pv, ChangeSet* changes);
   bool try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,
                          ChangeSet* changes);
   void record_op(TetId first, std::uint32_t count, PointId apex);

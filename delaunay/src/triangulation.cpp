@@ -1416,29 +1416,30 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   InsertResult result;
   if (try_move_in_place(v, p, min_distance, result, changes)) return result;
 
-  // Before changing anything, find the nearest vertex of p among the others. It is a Delaunay neighbour
-  // of p in DT(S \ v + p): either a vertex of p's cavity in DT(S), or (when the edge appears only once v
-  // is gone) a link vertex of v.
-  Scratch& S = *scratch_;
-  collect_star(pv);
-  std::vector<PointId> candidates;
-  for (TetId t : S.star) {
-    tf_[t] &= std::uint8_t(~kMark);
-    for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
-  }
-  // A short walk from v finds p after a small move; a far move uses the history.
+  // Before changing anything, reject p when it is too close to another vertex. A short walk from v finds
+  // p after a small move; a far move uses the history. An exact duplicate of p is a vertex of the closed
+  // tetrahedron containing p (and not v: p differs from v's position).
   TetId start = walk_limited(p, vtet_[pv], 64);
   if (start == kNoTet) start = keep_history_ ? locate_history(p) : walk(p, vtet_[pv]);
   for (int i = 0; i < 4; ++i) {
     const PointId w = td_[8 * std::size_t(start) + i];
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
   }
-  PointId dup = kNoVertex;
-  if (!grow_cavity(p, start, true, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
-  for (TetId t : S.cavity)
-    for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
-  clear_cavity_marks();
   if (min_distance > 0.0) {
+    // The nearest other vertex of p is a Delaunay neighbour of p in DT(S \ v + p): either a vertex of
+    // p's cavity in DT(S), or (when the edge appears only once v is gone) a link vertex of v.
+    Scratch& S = *scratch_;
+    collect_star(pv);
+    std::vector<PointId> candidates;
+    for (TetId t : S.star) {
+      tf_[t] &= std::uint8_t(~kMark);
+      for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
+    }
+    PointId dup = kNoVertex;
+    if (!grow_cavity(p, start, true, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
+    for (TetId t : S.cavity)
+      for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
+    clear_cavity_marks();
     double best = min_distance * min_distance;
     PointId nearest = kNoVertex;
     for (PointId w : candidates) {

@@ -1189,13 +1189,19 @@ void Triangulation::fill_hole_by_wrapping(PointId pv, ChangeSet* changes) {
     if (S.wfront[fi].filler != kNoTet) continue;
     const Scratch::WrapFace f = S.wfront[fi];
     const Point3* P[4] = {&pos[f.arr[0]], &pos[f.arr[1]], &pos[f.arr[2]], &pos[f.arr[3]]};
-    // Best apex among the link vertices on the hole side of f.
+    // Best apex among the link vertices on the hole side of f. (a, b, c): the face oriented so that
+    // orient3d(a, b, c, x) = orient3d(arr with x in the slot); it is called as orient3d(a, x, b, c) (an even
+    // permutation, same sign), whose inlined filter then computes the minors of b - a, c - a once per face.
+    static constexpr int kFace[4][3] = {{2, 1, 3}, {0, 2, 3}, {1, 0, 3}, {0, 1, 2}};
+    const Point3& fa = *P[kFace[f.slot][0]];
+    const Point3& fb = *P[kFace[f.slot][1]];
+    const Point3& fc = *P[kFace[f.slot][2]];
     PointId best = kNoVertex;
     const PointId f0 = f.key[0], f1 = f.key[1], f2 = f.key[2];
     for (PointId w : S.link) {
       // The face's own vertices would give exact zeros (the filter's slow path).
       if ((w == f0) | (w == f1) | (w == f2)) continue;
-      if (orient_replace(P, f.slot, pos[w]) != Sign::Positive) continue;
+      if (orient3d(fa, pos[w], fb, fc) != Sign::Positive) continue;
       if (best != kNoVertex && insphere_sos(*P[0], *P[1], *P[2], *P[3], pos[w]) != Sign::Positive) continue;
       best = w;
       P[f.slot] = &pos[w];

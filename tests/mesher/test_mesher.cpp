@@ -266,6 +266,19 @@ TEST_CASE("lone zeros: a zero constraint added well outside the surface gets its
       REQUIRE(d <= precision);
       REQUIRE(max_surface_distance(m, mesher.function()) <= 0.1 * precision);
       REQUIRE(mesher.stats().polygonizer.lone_zeros == 0);
+      // Kept under edits: moved to the other side, the new surface follows it; removed, it goes away.
+      const std::size_t last = mesher.size() - 1;
+      const Point3 q{0.1, -1.2, 0.8};
+      mesher.move_constraint(last, q);
+      require_closed(mesher.surface());
+      REQUIRE(MeshDistance(mesher.surface()).distance(q) <= precision);
+      REQUIRE(MeshDistance(mesher.surface()).distance(p) > 0.3);
+      mesher.remove_constraint(last);
+      require_closed(mesher.surface());
+      REQUIRE(metrics_of(mesher.surface()).components == 1);
+      REQUIRE(MeshDistance(mesher.surface()).distance(q) > 0.3);
+      REQUIRE(mesher.stats().polygonizer.lone_zeros == 0);
+      mesher.polygonizer().triangulation().verify_topology();
     } else {
       REQUIRE(d > 0.3);  // the bug this rule fixes
     }

@@ -294,7 +294,7 @@ void Triangulation::reset_to_corners() {
   vtet_.assign(8, kNoTet);
   vid_of_pid_.clear();
   pid_of_vid_.clear();
-  td_ = init_td_;
+  td_.assign(init_td_.begin(), init_td_.end());
   tf_.assign(m, 0);
   hnb_.clear();
   if (keep_history_) hnb_.assign(m, {kNoOffset, kNoOffset, kNoOffset, kNoOffset});
@@ -483,7 +483,10 @@ TetId Triangulation::alloc_tet() {
   const TetId t = TetId(tf_.size());
   grow_to(td_, td_.size() + 8);
   grow_to(tf_, tf_.size() + 1);
-  if (keep_history_) grow_to(hnb_, hnb_.size() + 1);
+  if (keep_history_) {
+    grow_to(hnb_, hnb_.size() + 1);
+    hnb_[t] = {kNoOffset, kNoOffset, kNoOffset, kNoOffset};
+  }
   tf_[t] = 0;
   return t;
 }
@@ -502,10 +505,15 @@ TetId Triangulation::alloc_tets(std::size_t n, std::vector<TetId>& out) {
     }
   const TetId base = TetId(tf_.size());
   const std::size_t rest = n - k;
-  grow_to(td_, td_.size() + 8 * rest);
-  grow_to(tf_, tf_.size() + rest);  // zero flags: live
+  grow_to(td_, td_.size() + 8 * rest);  // written by the caller
+  grow_to(tf_, tf_.size() + rest);
   if (keep_history_) grow_to(hnb_, hnb_.size() + rest);
-  for (std::size_t i = 0; k < n; ++k, ++i) out[k] = base + TetId(i);
+  for (std::size_t i = 0; k < n; ++k, ++i) {
+    const TetId t = base + TetId(i);
+    out[k] = t;
+    tf_[t] = 0;  // live
+    if (keep_history_) hnb_[t] = {kNoOffset, kNoOffset, kNoOffset, kNoOffset};
+  }
   return n ? out[0] : base;
 }
 
@@ -926,7 +934,7 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   Scratch& S = *scratch_;
   const PointId pv = pid(v);
   collect_star(pv);
-  auto face_key = [](const std::vector<PointId>& tv, const std::size_t b, int skip,
+  auto face_key = [](const auto& tv, const std::size_t b, int skip,
                      const std::vector<PointId>* map) {
     std::array<PointId, 3> f{};
     std::size_t k = 0;

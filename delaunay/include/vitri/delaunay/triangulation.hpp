@@ -15,16 +15,98 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <memory>
+#include <new>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
 namespace vitri {
+
+namespace detail {
+
+/// Growable array of a trivially copyable T on malloc/realloc, for the tetrahedron arrays: growing a large
+/// block lets realloc move its pages (mremap) instead of copying hundreds of megabytes, as std::vector
+/// does. resize(n) leaves new elements uninitialized; resize(n, value) and assign fill them.
+template <class T>
+class PodArray {
+  static_assert(std::is_trivially_copyable<T>::value, "PodArray holds trivially copyable types");
+
+ public:
+  using value_type = T;
+  PodArray() = default;
+  PodArray(const PodArray& o) { assign(o.begin(), o.end()); }
+  PodArray(PodArray&& o) noexcept : p_(o.p_), n_(o.n_), cap_(o.cap_) {
+    o.p_ = nullptr;
+    o.n_ = o.cap_ = 0;
+  }
+  PodArray& operator=(const PodArray& o) {
+    if (this != &o) assign(o.begin(), o.end());
+    return *this;
+  }
+  PodArray& operator=(PodArray&& o) noexcept {
+    std::swap(p_, o.p_);
+    std::swap(n_, o.n_);
+    std::swap(cap_, o.cap_);
+    return *this;
+  }
+  ~PodArray() { std::free(p_); }
+
+  T& operator[](std::size_t i) { return p_[i]; }
+  const T& operator[](std::size_t i) const { return p_[i]; }
+  T* data() { return p_; }
+  const T* data() const { return p_; }
+  T* begin() { return p_; }
+  T* end() { return p_ + n_; }
+  const T* begin() const { return p_; }
+  const T* end() const { return p_ + n_; }
+  std::size_t size() const { return n_; }
+  std::size_t capacity() const { return cap_; }
+  bool empty() const { return n_ == 0; }
+  void clear() { n_ = 0; }
+  void reserve(std::size_t n) {
+    if (n <= cap_) return;
+    void* q = std::realloc(static_cast<void*>(p_), n * sizeof(T));
+    if (!q) throw std::bad_alloc();
+    p_ = static_cast<T*>(q);
+    cap_ = n;
+  }
+  void resize(std::size_t n) {
+    reserve(n);
+    n_ = n;
+  }
+  void resize(std::size_t n, const T& value) {
+    reserve(n);
+    for (std::size_t i = n_; i < n; ++i) p_[i] = value;
+    n_ = n;
+  }
+  void assign(std::size_t n, const T& value) {
+    n_ = 0;
+    resize(n, value);
+  }
+  template <class It>
+  void assign(It first, It last) {
+    const std::size_t n = std::size_t(last - first);
+    n_ = 0;
+    reserve(n);
+    std::copy(first, last, p_);
+    n_ = n;
+  }
+
+ private:
+  T* p_ = nullptr;
+  std::size_t n_ = 0;
+  std::size_t cap_ = 0;
+};
+
+}  // namespace detail
 
 using VertexId = std::uint32_t;  ///< Stable id of a vertex; never reused after removal.
 using TetId = std::uint32_t;     ///< Id of a tetrahedron (live or in the history).
@@ -239,12 +321,12 @@ class Triangulation {
   std::vector<PointId> pid_of_vid_;    // empty until the first move
   // 8 per tetrahedron t, one half cache line: td_[8t + i] vertex i (a PointId), td_[8t + 4 + i] the
   // neighbour across the face opposite vertex i. Dead: td_[8t + 4] its history Op, td_[8t + 5] a hint.
-  std::vector<std::uint32_t> td_;
-  std::vector<std::uint8_t> tf_;       // flags per tetrahedron
+  detail::PodArray<std::uint32_t> td_;
+  detail::PodArray<std::uint8_t> tf_;  // flags per tetrahedron
   // History only: for a tetrahedron created by an insertion, its neighbours across the faces through the
   // apex at creation time, as offsets in its Op's range (kNoOffset: none / range too large). Location
   // walks around the apex with them instead of scanning the range.
-  std::vector<std::array<std::uint16_t, 4>> hnb_;
+  detail::PodArray<std::array<std::uint16_t, 4>> hnb_;
   std::vector<Op> ops_;                // history records (insertions, removals, moves)
   std::size_t num_live_vertices_ = 0;
   std::size_t num_live_tets_ = 0;

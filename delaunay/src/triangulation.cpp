@@ -11,8 +11,8 @@
 // * Insertion (Bowyer-Watson): from one tetrahedron in conflict with p, grow the cavity (all tetrahedra
 //   whose perturbed circumsphere contains p) by adjacency; it is star-shaped from p. Then build one new
 //   tetrahedron per boundary face of the cavity (p replaces the vertex of the killed tetrahedron
-//   opposite that face, which keeps the orientation) and link the new ones around each boundary edge by
-//   rotating through the killed tetrahedra.
+//   opposite that face, which keeps the orientation) and glue the new ones by the edges of the cavity
+//   boundary, through a table indexed by directed edges in local vertex numbers (link_around_apex).
 // * History (containment DAG): each operation records the contiguous id range of the tetrahedra it
 //   created (Op). Those cover exactly the region of the tetrahedra it killed, and each killed tetrahedron
 //   stores the index of its Op (plus a hint) in its freed neighbour slots. Location descends from the root:
@@ -22,9 +22,10 @@
 //   containment test is used. The sequence of tetrahedra containing a fixed point changes O(log n) times
 //   in expectation for a random insertion order (backward analysis), which bounds the descent.
 // * Removal: the hole is the star of v. The tetrahedra filling it in DT(S \ v) are Delaunay for the link
-//   vertices plus the 8 corners (all in S \ v), so they are exactly the tetrahedra of the perturbed
-//   DT(link + corners), built in a small scratch Triangulation over the same box, that lie inside the
-//   hole. They are found by a flood fill from a link face that stops at link faces.
+//   vertices (all in S \ v), so they are exactly the tetrahedra of the perturbed DT(link) inside the hole:
+//   found by gift wrapping from the link faces (fill_hole_by_wrapping). For stars with more than
+//   kMaxWrapLink link vertices: the tetrahedra of DT(link + corners), built in a small scratch
+//   Triangulation over the same box, that a flood fill from a link face reaches without crossing one.
 // * Move: if every tetrahedron of the star stays positive and every face of the star stays locally
 //   Delaunay at the new position, the star is rebuilt with the same combinatorics; otherwise remove then
 //   insert. Positions are immutable (the history refers to them): a moved vertex gets a new internal
@@ -1550,7 +1551,9 @@ std::size_t Triangulation::memory_total_bytes() const {
     const Scratch& S = *scratch_;
     s += sizeof(Scratch) + bytes_of(S.cavity) + bytes_of(S.tested) + bytes_of(S.created) + bytes_of(S.star) +
          bytes_of(S.boundary) + bytes_of(S.link) + bytes_of(S.link_sub) + bytes_of(S.sub_to_main) +
-         bytes_of(S.link_faces) + bytes_of(S.inside) + bytes_of(S.sub_to_new) + bytes_of(S.old_to_new);
+         bytes_of(S.link_faces) + bytes_of(S.inside) + bytes_of(S.sub_to_new) + bytes_of(S.old_to_new) +
+         bytes_of(S.face_hash) + bytes_of(S.edges) + bytes_of(S.edge_used) + bytes_of(S.local) +
+         bytes_of(S.dir_edge) + bytes_of(S.wfront) + bytes_of(S.wtets);
     if (S.sub) s += S.sub->memory_total_bytes();
   }
   return s;

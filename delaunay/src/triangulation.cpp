@@ -46,25 +46,7 @@
 #include <unordered_set>
 #include <utility>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace vitri {
-
-void detail::advise_huge_pages(void* p, std::size_t bytes) {
-#if defined(__linux__) && defined(MADV_HUGEPAGE)
-  constexpr std::size_t kHuge = std::size_t(2) << 20;
-  if (bytes < 2 * kHuge) return;
-  const std::uintptr_t a = reinterpret_cast<std::uintptr_t>(p);
-  const std::uintptr_t lo = (a + kHuge - 1) & ~std::uintptr_t(kHuge - 1);
-  const std::uintptr_t hi = (a + bytes) & ~std::uintptr_t(kHuge - 1);
-  if (hi > lo) (void)madvise(reinterpret_cast<void*>(lo), hi - lo, MADV_HUGEPAGE);  // advisory only
-#else
-  (void)p;
-  (void)bytes;
-#endif
-}
 
 namespace {
 

@@ -32,11 +32,6 @@ namespace vitri {
 
 namespace detail {
 
-/// Asks the kernel for transparent huge pages on the 2 MiB-aligned part of [p, p + bytes) (Linux, where THP
-/// is often in "madvise" mode; a no-op elsewhere and for blocks under 4 MiB). Random access into the
-/// history arrays (hundreds of MiB) then misses the TLB far less, and first touches fault 2 MiB at a time.
-void advise_huge_pages(void* p, std::size_t bytes);
-
 /// Growable array of a trivially copyable T on malloc/realloc, for the tetrahedron arrays: growing a large
 /// block lets realloc move its pages (mremap) instead of copying hundreds of megabytes, as std::vector
 /// does. resize(n) leaves new elements uninitialized; resize(n, value) and assign fill them.
@@ -82,7 +77,6 @@ class PodArray {
     if (!q) throw std::bad_alloc();
     p_ = static_cast<T*>(q);
     cap_ = n;
-    advise_huge_pages(q, n * sizeof(T));
   }
   void resize(std::size_t n) {
     reserve(n);

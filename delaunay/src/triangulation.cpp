@@ -187,7 +187,7 @@ struct Triangulation::Scratch {
     std::array<PointId, 3> key;  // sorted vertices
     PointId arr[4];              // template: positive once arr[slot] is a vertex on the unfilled side
     int slot;
-    std::uint32_t owner;         // other side: kLinkBit | link face (= star) index, or 4 * new + face
+    std::uint32_t owner;            // other side: kLinkBit | link face (= star) index, or 4 * new + face
     std::uint32_t filler = kNoTet;  // new tetrahedron index on the unfilled side, kNoTet while pending
   };
   struct WrapTet {
@@ -935,8 +935,7 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   Scratch& S = *scratch_;
   const PointId pv = pid(v);
   collect_star(pv);
-  auto face_key = [](const auto& tv, const std::size_t b, int skip,
-                     const std::vector<PointId>* map) {
+  auto face_key = [](const auto& tv, const std::size_t b, int skip, const std::vector<PointId>* map) {
     std::array<PointId, 3> f{};
     std::size_t k = 0;
     for (std::size_t j = 0; j < 4; ++j)
@@ -1002,7 +1001,8 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
       S.link_sub[k] = w;
       continue;
     }
-    const InsertResult r = sub.insert_at(pos_[w], sub.walk(pos_[w], sub.last_tet_), true, 0.0, nullptr, kNoVertex);
+    const InsertResult r =
+        sub.insert_at(pos_[w], sub.walk(pos_[w], sub.last_tet_), true, 0.0, nullptr, kNoVertex);
     if (r.status != InsertStatus::Inserted || r.vertex != S.sub_to_main.size())
       throw std::logic_error("Triangulation::remove: link vertex rejected by the hole triangulation");
     S.link_sub[k] = r.vertex;
@@ -1170,7 +1170,8 @@ void Triangulation::fill_hole_by_wrapping(PointId pv, ChangeSet* changes) {
   // Open-addressing table of the faces by sorted key (rebuilt when it gets half full).
   std::size_t hmask = 0;
   auto hash = [&hmask](const std::array<PointId, 3>& k) {
-    return std::size_t((std::uint64_t(k[0]) * 0x9E3779B97F4A7C15ull ^ std::uint64_t(k[1]) * 0xC2B2AE3D27D4EB4Full ^
+    return std::size_t((std::uint64_t(k[0]) * 0x9E3779B97F4A7C15ull ^
+                        std::uint64_t(k[1]) * 0xC2B2AE3D27D4EB4Full ^
                         std::uint64_t(k[2]) * 0x165667B19E3779F9ull) >>
                        20) &
            hmask;
@@ -1235,8 +1236,8 @@ void Triangulation::fill_hole_by_wrapping(PointId pv, ChangeSet* changes) {
       if (g != kNoTet) {
         Scratch::WrapFace& gf = S.wfront[g];
         if (gf.filler != kNoTet)
-          throw std::logic_error("Triangulation::remove: a face of the hole of vertex " + std::to_string(vid(pv)) +
-                                 " is filled twice");
+          throw std::logic_error("Triangulation::remove: a face of the hole of vertex " +
+                                 std::to_string(vid(pv)) + " is filled twice");
         gf.filler = k;
         S.wtets[k].nb[j] = gf.owner & kLinkBit ? gf.owner : gf.owner >> 2;
         if (!(gf.owner & kLinkBit)) S.wtets[gf.owner >> 2].nb[gf.owner & 3] = k;
@@ -1249,8 +1250,10 @@ void Triangulation::fill_hole_by_wrapping(PointId pv, ChangeSet* changes) {
         nf.key = key;
         nf.owner = 4 * k + std::uint32_t(j);
         S.wfront.push_back(nf);
-        if (2 * S.wfront.size() > hmask + 1) rehash(S.wfront.size());
-        else insert_key(std::uint32_t(S.wfront.size() - 1));
+        if (2 * S.wfront.size() > hmask + 1)
+          rehash(S.wfront.size());
+        else
+          insert_key(std::uint32_t(S.wfront.size() - 1));
       }
     }
   }
@@ -1434,8 +1437,13 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   // Before changing anything, reject p when it is too close to another vertex. A short walk from v finds
   // p after a small move; a far move uses the history. An exact duplicate of p is a vertex of the closed
   // tetrahedron containing p (and not v: p differs from v's position).
-  TetId start = walk_limited(p, vtet_[pv], 64);
-  if (start == kNoTet) start = keep_history_ ? locate_history(p) : walk(p, vtet_[pv]);
+  // (A target farther than 8 times the longest edge of one tetrahedron at v skips the walk.)
+  const TetId tv = vtet_[pv];
+  double edge2 = 0.0;
+  for (int i = 0; i < 4; ++i)
+    edge2 = std::max(edge2, squared_distance(pos_[td_[8 * std::size_t(tv) + i]], pos_[pv]));
+  TetId start = squared_distance(p, pos_[pv]) > 64.0 * edge2 ? kNoTet : walk_limited(p, tv, 64);
+  if (start == kNoTet) start = keep_history_ ? locate_history(p) : walk(p, tv);
   for (int i = 0; i < 4; ++i) {
     const PointId w = td_[8 * std::size_t(start) + i];
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
@@ -1468,9 +1476,13 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
     if (nearest != kNoVertex) return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
   }
 
+  // `start` survives the removal unless it is in v's star (only those are killed; without the history a
+  // killed slot may come back as a new tetrahedron), and then still contains p: no second location.
+  bool start_survives = true;
+  for (int i = 0; i < 4; ++i) start_survives = start_survives && td_[8 * std::size_t(start) + i] != pv;
   ChangeSet removal, insertion;
   remove_impl(v, changes ? &removal : nullptr);
-  TetId t = walk_limited(p, last_tet_, 64);
+  TetId t = start_survives ? start : walk_limited(p, last_tet_, 64);
   if (t == kNoTet) t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
   result = insert_at(p, t, true, 0.0, changes ? &insertion : nullptr, v);
   if (result.status != InsertStatus::Inserted)

@@ -2,43 +2,65 @@
 
 #include <algorithm>
 #include <cstdlib>
+#include <string_view>
 #include <thread>
 #include <vector>
 
 namespace vitri::rbf_detail {
 
-namespace generic {
-bool cholesky_inplace(double* a, long n, long lda);
-void gemm_nt_sub(const double* a, long m, long lda, const double* b, long k, long ldb, long nb, double* c,
-                 long ldc);
-void trsm_right_lower_t(const double* l, long nb, long ldl, double* b, long m, long ldb);
-void rbf_sums(const double* cx, const double* cy, const double* cz, const double* w, long n, const double* q,
-              long m, double* f, double* g);
-}  // namespace generic
+// The entry points of one instruction-set copy of dense_kernels.inc (compiled in its own file).
+#define VITRI_DECLARE_DENSE_COPY(ns)                                                                         \
+  namespace ns {                                                                                             \
+  bool cholesky_inplace(double* a, long n, long lda);                                                        \
+  void gemm_nt_sub(const double* a, long m, long lda, const double* b, long k, long ldb, long nb, double* c, \
+                   long ldc);                                                                                \
+  void trsm_right_lower_t(const double* l, long nb, long ldl, double* b, long m, long ldb);                  \
+  void rbf_sums(const double* cx, const double* cy, const double* cz, const double* w, long n,               \
+                const double* q, long m, double* f, double* g);                                              \
+  }
 
+VITRI_DECLARE_DENSE_COPY(generic)
 #ifdef VITRI_RBF_HAVE_AVX2
-namespace avx2 {
-bool cholesky_inplace(double* a, long n, long lda);
-void gemm_nt_sub(const double* a, long m, long lda, const double* b, long k, long ldb, long nb, double* c,
-                 long ldc);
-void trsm_right_lower_t(const double* l, long nb, long ldl, double* b, long m, long ldb);
-void rbf_sums(const double* cx, const double* cy, const double* cz, const double* w, long n, const double* q,
-              long m, double* f, double* g);
-}  // namespace avx2
+VITRI_DECLARE_DENSE_COPY(avx2)
 #endif
+#ifdef VITRI_RBF_HAVE_AVX512
+VITRI_DECLARE_DENSE_COPY(avx512)
+#endif
+#undef VITRI_DECLARE_DENSE_COPY
+
+std::vector<DenseOps> dense_ops_supported() {
+  std::vector<DenseOps> out;
+#ifdef VITRI_RBF_HAVE_AVX2
+  __builtin_cpu_init();
+#ifdef VITRI_RBF_HAVE_AVX512
+  if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
+      __builtin_cpu_supports("avx512vl"))
+    out.push_back(DenseOps{avx512::cholesky_inplace, avx512::rbf_sums, avx512::gemm_nt_sub,
+                           avx512::trsm_right_lower_t, "avx512"});
+#endif
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
+    out.push_back(DenseOps{avx2::cholesky_inplace, avx2::rbf_sums, avx2::gemm_nt_sub,
+                           avx2::trsm_right_lower_t, "avx2+fma"});
+#endif
+  out.push_back(DenseOps{generic::cholesky_inplace, generic::rbf_sums, generic::gemm_nt_sub,
+                         generic::trsm_right_lower_t, "generic"});
+  return out;
+}
+
+namespace {
+bool env_flag(const char* name) {
+  const char* v = std::getenv(name);
+  return v && v[0] && v[0] != '0';
+}
+}  // namespace
 
 const DenseOps& dense_ops() {
   static const DenseOps ops = [] {
-#ifdef VITRI_RBF_HAVE_AVX2
-    const char* env = std::getenv("VITRI_RBF_GENERIC");
-    const bool forced = env && env[0] && env[0] != '0';
-    __builtin_cpu_init();
-    if (!forced && __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
-      return DenseOps{avx2::cholesky_inplace, avx2::rbf_sums, avx2::gemm_nt_sub, avx2::trsm_right_lower_t,
-                      "avx2+fma"};
-#endif
-    return DenseOps{generic::cholesky_inplace, generic::rbf_sums, generic::gemm_nt_sub,
-                    generic::trsm_right_lower_t, "generic"};
+    const std::vector<DenseOps> all = dense_ops_supported();  // best first, generic last
+    if (env_flag("VITRI_RBF_GENERIC")) return all.back();
+    for (const DenseOps& o : all)
+      if (!(env_flag("VITRI_RBF_NO_AVX512") && std::string_view(o.name) == "avx512")) return o;
+    return all.back();
   }();
   return ops;
 }

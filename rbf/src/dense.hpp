@@ -1,5 +1,7 @@
 #pragma once
-// Run-time dispatch between the portable and the AVX2 + FMA copies of the dense kernels.
+// Run-time dispatch between the portable, the AVX2 + FMA and the AVX-512 copies of the dense kernels.
+
+#include <vector>
 
 namespace vitri::rbf_detail {
 
@@ -20,8 +22,13 @@ struct DenseOps {
 /// Eigen LLT. Returns false when the matrix is not numerically positive definite.
 bool cholesky_parallel(double* a, long n, long lda, unsigned threads);
 
-/// The best copy for this CPU (AVX2 + FMA when built with it and supported), chosen once.
-/// Setting the environment variable VITRI_RBF_GENERIC=1 forces the portable copy.
+/// The best copy for this CPU (AVX-512, else AVX2 + FMA, when built with it and supported), chosen
+/// once. Setting the environment variable VITRI_RBF_GENERIC=1 forces the portable copy,
+/// VITRI_RBF_NO_AVX512=1 skips the AVX-512 copy.
 const DenseOps& dense_ops();
+
+/// Every copy this build has and this CPU runs, best first (the portable one is always last). Tests
+/// compare them with each other.
+std::vector<DenseOps> dense_ops_supported();
 
 }  // namespace vitri::rbf_detail

@@ -3,11 +3,17 @@
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/rbf.hpp"
 
+#include "../../rbf/src/dense.hpp"  // internal: the instruction-set copies of the dense kernels
+
+#include <Eigen/Core>
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
 using vitri::Constraints;
 using vitri::Point3;
@@ -253,4 +259,42 @@ TEST_CASE("rbf fit is independent of the thread count (blocked Cholesky)", "[rbf
   const auto wf = f.weights(), wg = g.weights();
   CHECK(wf == wg);
   CHECK(f.value({0.1, 0.2, 0.3}) == g.value({0.1, 0.2, 0.3}));
+}
+
+TEST_CASE("every instruction-set copy of the dense kernels agrees with the portable one", "[rbf]") {
+  const std::vector<vitri::rbf_detail::DenseOps> all = vitri::rbf_detail::dense_ops_supported();
+  REQUIRE(!all.empty());
+  const vitri::rbf_detail::DenseOps& ref = all.back();
+  REQUIRE(std::string(ref.name) == "generic");
+  // Evaluation sums: 8 explicit lanes and a fixed reduction order, hence bit-identical in every copy.
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const long n = 203, m = 17;  // n not a multiple of the 8 lanes: the tail loop runs too
+  std::vector<double> cx(n), cy(n), cz(n), w(n), q(3 * m);
+  for (long j = 0; j < n; ++j) cx[j] = u(rng), cy[j] = u(rng), cz[j] = u(rng), w[j] = u(rng);
+  for (double& v : q) v = u(rng);
+  std::vector<double> f0(m), g0(3 * m);
+  ref.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), n, q.data(), m, f0.data(), g0.data());
+  // A symmetric positive definite matrix for the Cholesky.
+  const long k = 150;
+  Eigen::MatrixXd a = Eigen::MatrixXd::NullaryExpr(k, k, [&](Eigen::Index, Eigen::Index) { return u(rng); });
+  const Eigen::MatrixXd spd = a * a.transpose() + static_cast<double>(k) * Eigen::MatrixXd::Identity(k, k);
+  Eigen::MatrixXd l0 = spd;
+  REQUIRE(ref.cholesky_inplace(l0.data(), k, k));
+  for (const auto& ops : all) {
+    INFO("copy " << ops.name);
+    std::vector<double> f(m), g(3 * m);
+    ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), n, q.data(), m, f.data(), g.data());
+    CHECK(f == f0);
+    CHECK(g == g0);
+    std::vector<double> fv(m);
+    ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), n, q.data(), m, fv.data(), nullptr);
+    CHECK(fv == f0);
+    // The factor may differ in the last bits (FMA, vector width): compare to rounding level.
+    Eigen::MatrixXd l = spd;
+    REQUIRE(ops.cholesky_inplace(l.data(), k, k));
+    const Eigen::MatrixXd lo = l.triangularView<Eigen::Lower>(), lo0 = l0.triangularView<Eigen::Lower>();
+    CHECK((lo - lo0).norm() <= 1e-13 * lo0.norm());
+    CHECK((lo * lo.transpose() - spd).norm() <= 1e-13 * spd.norm());
+  }
 }

@@ -182,4 +182,25 @@ void mesh_points(const Constraints& constraints, double precision, Eigen::Matrix
   to_eigen(mesh_points(constraints, precision, options), V, F, &N);
 }
 
+SurfaceMesh mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,
+                        const MesherOptions& options) {
+  return mesh_points(constraints_from_oriented_points(points, normals, options.constraint_build), precision,
+                     options);
+}
+
+void mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,
+                 Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N, const MesherOptions& options) {
+  to_eigen(mesh_points(points, normals, precision, options), V, F, &N);
+}
+
+SurfaceMesh mesh_points(const Eigen::MatrixXd& in_V, const Eigen::MatrixXi& in_F, double precision,
+                        const MesherOptions& options) {
+  return mesh_points(constraints_from_mesh(in_V, in_F, options.constraint_build), precision, options);
+}
+
+void mesh_points(const Eigen::MatrixXd& in_V, const Eigen::MatrixXi& in_F, double precision, Eigen::MatrixXd& V,
+                 Eigen::MatrixXi& F, Eigen::MatrixXd& N, const MesherOptions& options) {
+  to_eigen(mesh_points(in_V, in_F, precision, options), V, F, &N);
+}
+
 }  // namespace vitri

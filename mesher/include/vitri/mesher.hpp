@@ -2,7 +2,8 @@
 /// @file mesher.hpp
 /// vitri::Mesher, the public entry point: a variational implicit surface (RBF of constraint points) and
 /// its incremental Delaunay polygonization, kept up to date while constraints are added, moved, removed
-/// or change value (Crespin 2003, section 5). vitri::mesh_points() beside it does everything in one call.
+/// or change value (Crespin 2003, section 5). vitri::mesh_points() beside it does everything in one call,
+/// from constraints, oriented points or a closed mesh. Design: docs/mesher.md.
 ///
 ///   vitri::Constraints c = ...;                 // f(points[i]) = values[i], f < 0 inside
 ///   vitri::Mesher mesher(c);                    // fits the RBF, tetrahedralizes constraints + box
@@ -141,5 +142,30 @@ SurfaceMesh mesh_points(const Constraints& constraints, double precision, const 
 /// One call, Eigen out: V #V x 3, F #F x 3, N #V x 3.
 void mesh_points(const Constraints& constraints, double precision, Eigen::MatrixXd& V, Eigen::MatrixXi& F,
                  Eigen::MatrixXd& N, const MesherOptions& options = {});
+
+/// One call from oriented points: normal constraints built with options.constraint_build
+/// (constraints_from_oriented_points: f = 0 on the points, +-d along the normals), then as above.
+/// @param points   surface positions; @param normals one outward normal (any length > 0) per point.
+/// @param precision absolute circumradius bound (e.g. 0.02 x the diagonal of the points' bounding box).
+/// @throws as constraints_from_oriented_points (InvalidPoint, InvalidArgument for mismatched sizes),
+///         Mesher::Mesher and Mesher::refine.
+SurfaceMesh mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,
+                        const MesherOptions& options = {});
+
+/// One call from oriented points, Eigen out: V #V x 3, F #F x 3, N #V x 3.
+void mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,
+                 Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N, const MesherOptions& options = {});
+
+/// One call from a closed, consistently oriented triangle mesh (in_V #V x 3, in_F #F x 3): normal
+/// constraints from its vertices and area-weighted normals (constraints_from_mesh with
+/// options.constraint_build), then as above. `precision` is absolute.
+/// @throws InvalidArgument for an open, non-manifold or inconsistently oriented mesh; as Mesher::Mesher
+///         and Mesher::refine.
+SurfaceMesh mesh_points(const Eigen::MatrixXd& in_V, const Eigen::MatrixXi& in_F, double precision,
+                        const MesherOptions& options = {});
+
+/// One call from a closed triangle mesh, Eigen out: V #V x 3, F #F x 3, N #V x 3.
+void mesh_points(const Eigen::MatrixXd& in_V, const Eigen::MatrixXi& in_F, double precision, Eigen::MatrixXd& V,
+                 Eigen::MatrixXi& F, Eigen::MatrixXd& N, const MesherOptions& options = {});
 
 }  // namespace vitri

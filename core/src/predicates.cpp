@@ -8,20 +8,26 @@
 ///   1. Pre-scale all coordinates of the call by one power of two 2^k (exact; the sign of a homogeneous
 ///      determinant does not change) so that the largest |coordinate| lands just below 2^E, with E
 ///      chosen per predicate so that no intermediate can overflow (nor overflow Dekker's split) while
-///      leaving as much room as possible below for small coordinates. This makes the result exact for
-///      huge and tiny inputs alike, as long as the coordinates of one call span less than a
-///      predicate-dependent number of binary orders (docs/predicates.md, "Valid input range").
-///   2. Form the differences exactly as two-component expansions (two_diff).
-///   3. Evaluate the determinant with the same cofactor scheme as the filter, every product and sum
-///      exact, zero components eliminated (on grids and nearby points most differences are exact
-///      single doubles and the expansions stay a few components long).
+///      leaving as much room as possible below for small coordinates. Expansion arithmetic is exact on
+///      the scaled values as long as the coordinates of one call span at most a predicate-dependent
+///      number of binary orders (docs/predicates.md, "Valid input range"). Calls spread wider than that
+///      (say 1 and 1e-300 together) skip steps 2-4: every coordinate is written as an integer times
+///      2^kmin and the determinant is evaluated with integers modulo 2^N, N chosen from a bound on the
+///      determinant (wide_int.hpp). Slow, but it cannot underflow or overflow, and such calls are rare.
+///   2. Stage 1: the filter's expression in doubles, every operation checked for exactness.
+///   3. Stage 2: form the differences exactly as two-component expansions (two_diff) and evaluate the
+///      determinant with the same cofactor scheme as the filter, every product and sum exact, zero
+///      components eliminated (on grids and nearby points most differences are exact single doubles and
+///      the expansions stay a few components long).
 ///   4. The sign is the sign of the largest component.
 
 #include "vitri/core/predicates.hpp"
 
 #include "expansion.hpp"
+#include "wide_int.hpp"
 
 #include <algorithm>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -45,10 +51,17 @@ namespace {
 constexpr int kOrient3dExponent = 330;
 constexpr int kInsphereExponent = 195;
 constexpr int kOrient2dExponent = 500;
+// The largest exponent spread (binary exponent of the largest minus that of the smallest non-zero
+// |coordinate|) for which the scaled expansion arithmetic cannot underflow: with the largest scaled
+// coordinate below 2^E, the smallest is at least 2^(E - 1 - span), and Dekker's product is exact when
+// degree * (E - 1 - span - 52) >= -970 (docs/predicates.md). Wider calls take the integer path.
+constexpr int kOrient3dMaxSpan = 600;
+constexpr int kInsphereMaxSpan = 336;
+constexpr int kOrient2dMaxSpan = 932;
+static_assert(3 * (kOrient3dExponent - 1 - kOrient3dMaxSpan - 52) >= -970, "orient3d span");
+static_assert(5 * (kInsphereExponent - 1 - kInsphereMaxSpan - 52) >= -970, "insphere span");
+static_assert(2 * (kOrient2dExponent - 1 - kOrient2dMaxSpan - 52) >= -970, "orient2d span");
 
-/// Scales v[0..n) by one power of two so that max |v[i]| lies in [2^(target - 1), 2^target).
-/// Returns false when some value is not finite (the predicates then answer Zero: no precondition
-/// violation may crash or hit undefined behaviour).
 /// 2^k for -1022 <= k <= 1023, built from its bits (no libm call).
 double power_of_two(int k) {
   const std::uint64_t bits = static_cast<std::uint64_t>(k + 1023) << 52;
@@ -57,24 +70,114 @@ double power_of_two(int k) {
   return r;
 }
 
-bool prescale(double* v, int n, int target) {
-  double m = 0.0;
+/// What prescale() found.
+enum class Range {
+  NonFinite,  ///< some value is NaN or infinite (the predicates then answer Zero)
+  Scaled,     ///< scaled: the expansion arithmetic is exact on the values
+  TooWide,    ///< the exponents spread over more than `max_span` binary orders: left unscaled
+};
+
+/// Scales v[0..n) by one power of two so that max |v[i]| lies in [2^(target - 1), 2^target), unless the
+/// binary exponents of the largest and of the smallest non-zero |v[i]| differ by more than `max_span`
+/// (then scaling would let small products underflow, and the call needs the integer path).
+Range prescale(double* v, int n, int target, int max_span) {
+  double m = 0.0, small = DBL_MAX;
   for (int i = 0; i < n; ++i) {
-    if (!std::isfinite(v[i])) return false;
-    m = std::max(m, std::fabs(v[i]));
+    if (!std::isfinite(v[i])) return Range::NonFinite;
+    const double a = std::fabs(v[i]);
+    m = std::max(m, a);
+    if (a != 0.0) small = std::min(small, a);
   }
-  if (m == 0.0) return true;
-  int k = target - 1 - std::ilogb(m);
-  // Multiply by 2^k in steps of at most 2^+-1000 (each factor a normal double): exact unless a value
-  // underflows, which the documented range excludes.
+  if (m == 0.0) return Range::Scaled;
+  const int top = std::ilogb(m);
+  if (top - std::ilogb(small) > max_span) return Range::TooWide;
+  int k = target - 1 - top;
+  // Multiply by 2^k in steps of at most 2^+-1000 (each factor a normal double): exact, since within the
+  // span no value can land below 2^(target - 1 - max_span), far above the subnormals.
   while (k != 0) {
     const int step = std::max(-1000, std::min(1000, k));
     const double f = power_of_two(step);
     for (int i = 0; i < n; ++i) v[i] *= f;
     k -= step;
   }
-  return true;
+  return Range::Scaled;
 }
+
+/// Exact integers for the finite doubles v[0..n): out[i] = v[i] / 2^kmin with kmin the exponent of the
+/// lowest set bit among them, as WideInts wide enough for a determinant of degree `degree` in their
+/// differences (|value| < 2^(degree (B + 1) + 8), B the bit length of the largest integer, which covers
+/// the 6, 72 and 2 monomials of orient3d, insphere and orient2d: docs/predicates.md).
+void to_wide_integers(const double* v, int n, int degree, WideInt* out) {
+  std::uint64_t mant[15];
+  int expo[15];
+  int kmin = 1 << 20;
+  for (int i = 0; i < n; ++i) {
+    std::uint64_t bits;
+    std::memcpy(&bits, &v[i], sizeof bits);
+    const int biased = static_cast<int>((bits >> 52) & 0x7ff);
+    std::uint64_t m = bits & ((std::uint64_t{1} << 52) - 1);
+    int e = -1074;  // subnormal or zero: m * 2^-1074
+    if (biased != 0) {
+      m |= std::uint64_t{1} << 52;
+      e = biased - 1075;
+    }
+    while (m != 0 && (m & 1u) == 0) {  // strip trailing zeros: keeps the integers short
+      m >>= 1;
+      ++e;
+    }
+    mant[i] = m;
+    expo[i] = e;
+    if (m != 0) kmin = std::min(kmin, e);
+  }
+  int b = 1;
+  for (int i = 0; i < n; ++i) {
+    if (mant[i] == 0) continue;
+    int len = 0;
+    while ((mant[i] >> len) != 0) ++len;
+    b = std::max(b, len + expo[i] - kmin);
+  }
+  const auto limbs = static_cast<std::size_t>((degree * (b + 1) + 8 + 1 + 31) / 32);
+  for (int i = 0; i < n; ++i)
+    out[i] = WideInt(mant[i], std::signbit(v[i]), mant[i] == 0 ? 0 : expo[i] - kmin, limbs);
+}
+
+/// The determinants' cofactor schemes (the filter's expressions, predicates.hpp), generic over the
+/// arithmetic: CheckedArithmetic on doubles (stage 1) and WideArithmetic on exact integers. `Arith`
+/// provides sub, add and mul on T.
+/// orient3d: v holds a, b, c, d (12 values); det[b - a, c - a, d - a].
+template <class Arith, class T>
+T orient3d_cofactors(Arith& f, const T* v) {
+  T m[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k) m[r][k] = f.sub(v[3 * (r + 1) + k], v[k]);
+  const T m1 = f.sub(f.mul(m[1][1], m[2][2]), f.mul(m[1][2], m[2][1]));
+  const T m2 = f.sub(f.mul(m[1][2], m[2][0]), f.mul(m[1][0], m[2][2]));
+  const T m3 = f.sub(f.mul(m[1][0], m[2][1]), f.mul(m[1][1], m[2][0]));
+  return f.add(f.add(f.mul(m[0][0], m1), f.mul(m[0][1], m2)), f.mul(m[0][2], m3));
+}
+
+/// insphere from the differences q[r][k] = coordinate k of (point r - e), r = a, b, c, d.
+template <class Arith, class T>
+T insphere_cofactors(Arith& f, const T (&q)[4][3]) {
+  auto minor2 = [&](int i, int j) { return f.sub(f.mul(q[i][0], q[j][1]), f.mul(q[j][0], q[i][1])); };
+  const T ab = minor2(0, 1), bc = minor2(1, 2), cd = minor2(2, 3), da = minor2(3, 0), ac = minor2(0, 2),
+          bd = minor2(1, 3);
+  const T abc = f.add(f.sub(f.mul(q[0][2], bc), f.mul(q[1][2], ac)), f.mul(q[2][2], ab));
+  const T bcd = f.add(f.sub(f.mul(q[1][2], cd), f.mul(q[2][2], bd)), f.mul(q[3][2], bc));
+  const T cda = f.add(f.add(f.mul(q[2][2], da), f.mul(q[3][2], ac)), f.mul(q[0][2], cd));
+  const T dab = f.add(f.add(f.mul(q[3][2], ab), f.mul(q[0][2], bd)), f.mul(q[1][2], da));
+  T lift[4];
+  for (int r = 0; r < 4; ++r)
+    lift[r] = f.add(f.add(f.mul(q[r][0], q[r][0]), f.mul(q[r][1], q[r][1])), f.mul(q[r][2], q[r][2]));
+  return f.add(f.sub(f.mul(lift[0], bcd), f.mul(lift[1], cda)), f.sub(f.mul(lift[2], dab), f.mul(lift[3], abc)));
+}
+
+/// Exact integer arithmetic for the cofactor schemes.
+struct WideArithmetic {
+  WideInt sub(const WideInt& a, const WideInt& b) const { return a - b; }
+  WideInt add(const WideInt& a, const WideInt& b) const { return a + b; }
+  WideInt mul(const WideInt& a, const WideInt& b) const { return a * b; }
+};
 
 /// Double arithmetic that records whether every operation was exact (error-free transformations):
 /// when `exact` is still true at the end, the double result is the exact value. This is the cheap
@@ -151,22 +254,28 @@ namespace {
 }
 }  // namespace
 
+namespace {
+/// The last resort of orient3d_exact for calls spread too widely for the expansions: exact integers.
+[[gnu::noinline]] Sign orient3d_integer(const double* v) {
+  WideInt w[12];
+  to_wide_integers(v, 12, 3, w);
+  WideArithmetic f;
+  return to_sign(orient3d_cofactors(f, w).sign());
+}
+}  // namespace
+
 Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
 #ifdef VITRI_PREDICATE_STATS
   ++predicate_stats().orient3d_exact;
 #endif
   double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
-  if (!prescale(v, 12, kOrient3dExponent)) return Sign::Zero;
+  const Range range = prescale(v, 12, kOrient3dExponent, kOrient3dMaxSpan);
+  if (range == Range::NonFinite) return Sign::Zero;
+  if (range == Range::TooWide) return orient3d_integer(v);
   {
     // Stage 1: the filter's expression, every operation checked for exactness.
     CheckedArithmetic f;
-    double m[3][3];
-    for (int r = 0; r < 3; ++r)
-      for (int k = 0; k < 3; ++k) m[r][k] = f.sub(v[3 * (r + 1) + k], v[k]);
-    const double m1 = f.sub(f.mul(m[1][1], m[2][2]), f.mul(m[1][2], m[2][1]));
-    const double m2 = f.sub(f.mul(m[1][2], m[2][0]), f.mul(m[1][0], m[2][2]));
-    const double m3 = f.sub(f.mul(m[1][0], m[2][1]), f.mul(m[1][1], m[2][0]));
-    const double det = f.add(f.add(f.mul(m[0][0], m1), f.mul(m[0][1], m2)), f.mul(m[0][2], m3));
+    const double det = orient3d_cofactors(f, v);
     if (f.exact) return sign_of(det);
   }
   return orient3d_expansion(v);
@@ -210,12 +319,27 @@ namespace {
 }
 }  // namespace
 
+namespace {
+/// The last resort of insphere_exact for calls spread too widely for the expansions: exact integers.
+[[gnu::noinline]] Sign insphere_integer(const double* v) {
+  WideInt w[15];
+  to_wide_integers(v, 15, 5, w);
+  WideArithmetic f;
+  WideInt q[4][3];
+  for (int r = 0; r < 4; ++r)
+    for (int k = 0; k < 3; ++k) q[r][k] = w[3 * r + k] - w[12 + k];
+  return to_sign(insphere_cofactors(f, q).sign());
+}
+}  // namespace
+
 Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e) {
 #ifdef VITRI_PREDICATE_STATS
   ++predicate_stats().insphere_exact;
 #endif
   double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
-  if (!prescale(v, 15, kInsphereExponent)) return Sign::Zero;
+  const Range range = prescale(v, 15, kInsphereExponent, kInsphereMaxSpan);
+  if (range == Range::NonFinite) return Sign::Zero;
+  if (range == Range::TooWide) return insphere_integer(v);
   {
     // Stage 1: the filter's expression, every operation checked for exactness.
     CheckedArithmetic f;
@@ -223,18 +347,7 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
     for (int r = 0; r < 4; ++r)
       for (int k = 0; k < 3; ++k) q[r][k] = f.sub(v[3 * r + k], v[12 + k]);
     if (f.exact) {  // worth going on only with exact differences
-      auto minor2 = [&](int i, int j) { return f.sub(f.mul(q[i][0], q[j][1]), f.mul(q[j][0], q[i][1])); };
-      const double ab = minor2(0, 1), bc = minor2(1, 2), cd = minor2(2, 3), da = minor2(3, 0),
-                   ac = minor2(0, 2), bd = minor2(1, 3);
-      const double abc = f.add(f.sub(f.mul(q[0][2], bc), f.mul(q[1][2], ac)), f.mul(q[2][2], ab));
-      const double bcd = f.add(f.sub(f.mul(q[1][2], cd), f.mul(q[2][2], bd)), f.mul(q[3][2], bc));
-      const double cda = f.add(f.add(f.mul(q[2][2], da), f.mul(q[3][2], ac)), f.mul(q[0][2], cd));
-      const double dab = f.add(f.add(f.mul(q[3][2], ab), f.mul(q[0][2], bd)), f.mul(q[1][2], da));
-      double lift[4];
-      for (int r = 0; r < 4; ++r)
-        lift[r] = f.add(f.add(f.mul(q[r][0], q[r][0]), f.mul(q[r][1], q[r][1])), f.mul(q[r][2], q[r][2]));
-      const double det = f.add(f.sub(f.mul(lift[0], bcd), f.mul(lift[1], cda)),
-                               f.sub(f.mul(lift[2], dab), f.mul(lift[3], abc)));
+      const double det = insphere_cofactors(f, q);
       if (f.exact) return sign_of(det);
     }
   }
@@ -246,7 +359,13 @@ Sign orient2d_exact(double ax, double ay, double bx, double by, double cx, doubl
   ++predicate_stats().orient2d_exact;
 #endif
   double v[6] = {ax, ay, bx, by, cx, cy};
-  if (!prescale(v, 6, kOrient2dExponent)) return Sign::Zero;
+  const Range range = prescale(v, 6, kOrient2dExponent, kOrient2dMaxSpan);
+  if (range == Range::NonFinite) return Sign::Zero;
+  if (range == Range::TooWide) {
+    WideInt w[6];
+    to_wide_integers(v, 6, 2, w);
+    return to_sign(((w[2] - w[0]) * (w[5] - w[1]) - (w[3] - w[1]) * (w[4] - w[0])).sign());
+  }
   Expansion ux, uy, vx, vy, det;
   ux.assign_difference(v[2], v[0]);
   uy.assign_difference(v[3], v[1]);

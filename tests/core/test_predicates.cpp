@@ -613,3 +613,171 @@ TEST_CASE("predicate statistics count calls and exact fallbacks when enabled", "
     CHECK(stats.orient3d_exact == before.orient3d_exact);
   }
 }
+
+// ---------------------------------------------------------------------------------------------------
+// Wide exponent spreads: coordinates of one call spread over more binary orders than the scaled
+// expansion arithmetic can take without underflow (docs/predicates.md, "Valid input range"); the
+// predicates then use exact integers. Every finite double input counts as non-overflowing.
+
+namespace {
+
+// The spans (binary exponent of the largest minus that of the smallest non-zero |coordinate|) up to
+// which the expansion path is used, as documented in docs/predicates.md.
+constexpr int kOrient3dSpan = 600, kInsphereSpan = 336, kOrient2dSpan = 932;
+
+// A random double m * 2^e, m uniform in [1, 2) with all 53 bits random, random sign.
+double random_double(std::mt19937_64& rng, int e) {
+  const double m = 1.0 + std::ldexp(static_cast<double>(rng() >> 11), -53);
+  return ((rng() & 1) ? -1.0 : 1.0) * std::ldexp(m, e);
+}
+
+// Checks orient3d, insphere and orient2d (all three planes) against the big-integer oracle.
+void check_all_oracles(const Point3 (&p)[5]) {
+  check_orient3d_oracle(p[0], p[1], p[2], p[3]);
+  check_insphere_oracle(p[0], p[1], p[2], p[3], p[4]);
+  for (int i = 0; i < 3; ++i)
+    REQUIRE(to_int(orient2d(p[0], p[1], p[4], i, (i + 1) % 3)) ==
+            vitri::test::oracle_orient2d(p[0], p[1], p[4], i, (i + 1) % 3));
+}
+
+}  // namespace
+
+TEST_CASE("wide spread: orient3d of 1 and 1e-300 in one call (the audit's reproducer)",
+          "[predicates][wide]") {
+  const Point3 a{1, 0, 0}, b{0, 1e-300, 0}, c{0, 0, 1e-300}, d{1e-300, 1e-300, 0};
+  // det = 1e-600 - 1e-900 (times 1 - ...) > 0: exact answer Positive (the expansions underflowed to
+  // Negative).
+  REQUIRE(vitri::test::oracle_orient3d(a, b, c, d) == 1);
+  CHECK(orient3d(a, b, c, d) == Sign::Positive);
+  CHECK(orient3d(b, a, c, d) == Sign::Negative);
+  CHECK(orient3d(d, a, b, c) == Sign::Negative);
+  check_insphere_oracle(a, b, c, d, {1e-300, 0, 1e-300});
+  check_insphere_oracle(a, b, c, d, {3, -3, 1e-300});
+}
+
+TEST_CASE("wide spread: random mixes of +-3 and +-1e-300 against the big-integer oracle",
+          "[predicates][wide]") {
+  const double values[] = {3.0, -3.0, 1e-300, -1e-300, 0.0, 3.0 + 0x1p-51, 1e-300 * (1 + 0x1p-52)};
+  std::mt19937_64 rng(30);
+  std::uniform_int_distribution<int> pick(0, 6);
+  int nonzero = 0;
+  for (int i = 0; i < 1200; ++i) {
+    Point3 p[5];
+    for (Point3& q : p) q = {values[pick(rng)], values[pick(rng)], values[pick(rng)]};
+    check_all_oracles(p);
+    nonzero += insphere(p[0], p[1], p[2], p[3], p[4]) != Sign::Zero;
+  }
+  CHECK(nonzero > 200);  // the tuples are not all degenerate
+}
+
+TEST_CASE("wide spread: random exponents over the whole double range against the big-integer oracle",
+          "[predicates][wide]") {
+  std::mt19937_64 rng(31);
+  std::uniform_int_distribution<int> expo(-1074, 1023), zero(0, 9);
+  auto coordinate = [&]() { return zero(rng) == 0 ? 0.0 : random_double(rng, expo(rng)); };
+  for (int i = 0; i < 400; ++i) {
+    Point3 p[5];
+    for (Point3& q : p) q = {coordinate(), coordinate(), coordinate()};
+    check_all_oracles(p);
+  }
+}
+
+TEST_CASE("wide spread: near-degenerate tuples mixing 1 and 2^-1000", "[predicates][wide]") {
+  // A plane through three points with wide-spread coordinates, and a fourth point moved off it by a
+  // tiny amount: the determinant is dominated by products of the tiny coordinates.
+  std::mt19937_64 rng(32);
+  const double t = 0x1p-1000;
+  for (int i = 0; i < 500; ++i) {
+    const Point3 a{random_double(rng, 0), 0, 0}, b{0, random_double(rng, 0), 0};
+    const Point3 c{random_double(rng, -1000), random_double(rng, -1000), random_double(rng, 0)};
+    const Point3 d = {a.x, random_double(rng, -1040), t * static_cast<double>(i % 7 - 3)};
+    check_orient3d_oracle(a, b, c, d);
+    check_insphere_oracle(a, b, c, d, {b.x, b.y, random_double(rng, -1060)});
+    check_insphere_oracle(a, b, c, d, {random_double(rng, -1030), random_double(rng, -1070), 0});
+  }
+}
+
+TEST_CASE("wide spread: insphere_sos on cospherical mirror configurations equals the lifted perturbation",
+          "[predicates][wide][sos]") {
+  // a and b mirror images in x = 0 put the circumsphere's center on that plane, so the mirror image e
+  // of c lies on the sphere of (a, b, c, d): insphere is exactly Zero and the perturbation decides,
+  // through orient3d calls on the same wide-spread coordinates.
+  const double values[] = {3.0, -3.0, 0x1p-700, -0x1p-700, 1.5, 0x1p-701 * 3};
+  std::mt19937_64 rng(33);
+  std::uniform_int_distribution<int> pick(0, 5);
+  auto v = [&]() { return values[pick(rng)]; };
+  int checked = 0;
+  for (int i = 0; i < 400 && checked < 60; ++i) {
+    const Point3 a{v(), v(), v()}, b{-a.x, a.y, a.z}, c{v(), v(), v()}, d{v(), v(), v()}, e{-c.x, c.y, c.z};
+    Point3 p[5] = {a, b, c, d, e};
+    std::shuffle(p, p + 5, rng);
+    if (orient3d(p[0], p[1], p[2], p[3]) == Sign::Zero) continue;
+    bool distinct = true;
+    for (int j = 0; j < 5; ++j)
+      for (int k = j + 1; k < 5; ++k) distinct = distinct && p[j] != p[k];
+    if (!distinct) continue;
+    REQUIRE(vitri::test::oracle_insphere(p[0], p[1], p[2], p[3], p[4]) == 0);
+    REQUIRE(insphere(p[0], p[1], p[2], p[3], p[4]) == Sign::Zero);
+    const Sign s = insphere_sos(p[0], p[1], p[2], p[3], p[4]);
+    CHECK(s != Sign::Zero);
+    REQUIRE(to_int(s) == vitri::test::oracle_insphere_sos(p[0], p[1], p[2], p[3], p[4]));
+    ++checked;
+  }
+  CHECK(checked >= 60);
+}
+
+TEST_CASE("wide spread: the largest finite and subnormal coordinates against the big-integer oracle",
+          "[predicates][wide]") {
+  // No finite input overflows: differences that overflow in the filter (DBL_MAX - -DBL_MAX) send the call
+  // to the exact path, which scales first. Subnormals next to DBL_MAX span 2098 binary orders.
+  const double big = std::numeric_limits<double>::max(), tiny = std::numeric_limits<double>::denorm_min(),
+               mn = std::numeric_limits<double>::min();
+  const double values[] = {big, -big, std::nextafter(big, 0.0), tiny, -tiny, 3 * tiny, mn, -mn, 1.0, 0.0};
+  const Point3 o{0, 0, 0};
+  CHECK(orient3d(o, {big, 0, 0}, {0, big, 0}, {0, 0, big}) == Sign::Positive);
+  CHECK(orient3d({-big, -big, -big}, {big, -big, -big}, {-big, big, -big}, {-big, -big, big}) ==
+        Sign::Positive);
+  CHECK(orient3d(o, {tiny, 0, 0}, {0, big, 0}, {0, 0, 1}) == Sign::Positive);
+  // (a, b, c, d) on the sphere of radius DBL_MAX about the origin, negatively oriented.
+  const Point3 a{big, 0, 0}, b{0, big, 0}, c{0, 0, big}, d{-big, 0, 0};
+  REQUIRE(orient3d(a, b, c, d) == Sign::Negative);
+  CHECK(insphere(a, b, c, d, o) == Sign::Negative);                // inside
+  CHECK(insphere(a, b, c, d, {0, -big, 0}) == Sign::Zero);         // on the sphere
+  CHECK(insphere(a, b, c, d, {0, -big, tiny}) == Sign::Positive);  // outside by tiny^2
+  CHECK(insphere(a, b, c, d, {tiny, -big, 0}) == Sign::Positive);
+  CHECK(orient2d(o, {big, tiny, 0}, {-big, big, 0}, 0, 1) == Sign::Positive);
+  std::mt19937_64 rng(34);
+  std::uniform_int_distribution<int> pick(0, 9);
+  for (int i = 0; i < 300; ++i) {
+    Point3 p[5];
+    for (Point3& q : p) q = {values[pick(rng)], values[pick(rng)], values[pick(rng)]};
+    check_all_oracles(p);
+  }
+}
+
+TEST_CASE("wide spread: exponent spans at and just past the expansion path's limit", "[predicates][wide]") {
+  // Coordinates 2^top and 2^(top - span) with random 53-bit mantissas (inexact products: the expansions
+  // work), span at the documented limit of each predicate and one past it (the integer path), with the
+  // largest coordinate near the top of the range, in the middle, and so low that the smallest is
+  // subnormal.
+  std::mt19937_64 rng(35);
+  std::uniform_int_distribution<int> coin(0, 2);
+  for (const int span : {kOrient3dSpan, kInsphereSpan, kOrient2dSpan}) {
+    for (const int extra : {0, 1}) {
+      for (const int top : {1022, 0, span - 1060}) {
+        INFO("span " << span + extra << " top " << top);
+        auto coordinate = [&]() {
+          const int c = coin(rng);
+          return c == 0 ? random_double(rng, top) : (c == 1 ? random_double(rng, top - span - extra) : 0.0);
+        };
+        for (int i = 0; i < 40; ++i) {
+          Point3 p[5];
+          for (Point3& q : p) q = {coordinate(), coordinate(), coordinate()};
+          p[0].x = random_double(rng, top);  // make sure both ends occur
+          p[1].y = random_double(rng, top - span - extra);
+          check_all_oracles(p);
+        }
+      }
+    }
+  }
+}

@@ -2,12 +2,13 @@
 /// @file predicates.hpp
 /// Exact geometric predicates on double coordinates.
 ///
-/// Every predicate returns the exact sign of its determinant for every finite double input within the
-/// range documented in docs/predicates.md (in short: no restriction on magnitude, as long as the
-/// binary exponents of the largest and the smallest non-zero |coordinate| of one call differ by at most
-/// 336 for insphere, 600 for orient3d, 932 for orient2d). A certified semi-static floating-point filter,
-/// inline below, answers almost every call on non-degenerate input; the rest fall back to exact expansion
-/// arithmetic (core/src/predicates.cpp). The error bounds are derived in docs/predicates.md.
+/// Every predicate returns the exact sign of its determinant for every finite double input: no finite
+/// input counts as overflowing (coordinates up to +-DBL_MAX, subnormals, and any mix of them in one call).
+/// A certified semi-static floating-point filter, inline below, answers almost every call on
+/// non-degenerate input; the rest fall back to exact expansion arithmetic on pre-scaled coordinates
+/// (core/src/predicates.cpp), or, for calls whose coordinates spread over more binary orders than the
+/// expansions can take without underflow (600 for orient3d, 336 for insphere, 932 for orient2d), to
+/// exact integers. The error bounds and the ranges are derived in docs/predicates.md.
 ///
 /// Conventions (stated once, tested in tests/core/test_predicates.cpp, same as CGAL's):
 /// - orient3d(a, b, c, d) is POSITIVE when (a, b, c, d) is a positively oriented tetrahedron,

@@ -144,8 +144,8 @@ class BigInt {
   std::vector<std::uint32_t> mag_;
 };
 
-/// Exact integers for a set of doubles: x_i = ints[i] * 2^kmin for all i.
-inline std::vector<BigInt> exact_integers(const std::vector<double>& xs) {
+/// Exact integers for a set of doubles: x_i = ints[i] * 2^kmin for all i (kmin stored in *kmin_out).
+inline std::vector<BigInt> exact_integers(const std::vector<double>& xs, int* kmin_out = nullptr) {
   std::vector<long long> mant(xs.size());
   std::vector<int> expo(xs.size());
   int kmin = 1 << 20;
@@ -159,6 +159,7 @@ inline std::vector<BigInt> exact_integers(const std::vector<double>& xs) {
   std::vector<BigInt> out;
   for (std::size_t i = 0; i < xs.size(); ++i)
     out.push_back(xs[i] == 0.0 ? BigInt() : BigInt(mant[i]).shifted(expo[i] - kmin));
+  if (kmin_out) *kmin_out = kmin;
   return out;
 }
 
@@ -200,14 +201,17 @@ inline int oracle_orient2d(const Point3& a, const Point3& b, const Point3& c, in
 
 /// The lifted 4x4 determinant of insphere with integer perturbations of the lifts: the sign of
 /// -det[[p - e, lift_p - lift_e]] with lift_p = |p|^2 * K^5 + pert[p] * ... see oracle_insphere_sos.
-inline int lifted_sign(const std::vector<BigInt>& v, const BigInt lift[5]) {
+inline BigInt lifted_value(const std::vector<BigInt>& v, const BigInt lift[5]) {
   BigInt m[4][4];
   for (int r = 0; r < 4; ++r) {
     for (int k = 0; k < 3; ++k)
       m[r][k] = v[static_cast<std::size_t>(3 * r + k)] - v[static_cast<std::size_t>(12 + k)];
     m[r][3] = lift[r] - lift[4];
   }
-  return -det4(m).sign();
+  return -det4(m);
+}
+inline int lifted_sign(const std::vector<BigInt>& v, const BigInt lift[5]) {
+  return lifted_value(v, lift).sign();
 }
 
 /// Exact insphere sign: -det[[p - e, |p|^2 - |e|^2]] over p = a, b, c, d (equal to the translated form
@@ -260,6 +264,45 @@ inline int oracle_insphere_sos(const Point3& a, const Point3& b, const Point3& c
     lift[p] = (v[s] * v[s] + v[s + 1] * v[s + 1] + v[s + 2] * v[s + 2]) * kpow[5] + kpow[rank[p]];
   }
   return lifted_sign(v, lift);
+}
+
+/// True when |value * 2^scale - center| <= radius exactly, for an integer value and doubles center,
+/// radius >= 0 (all brought to the smallest of the three exponents).
+inline bool within(const BigInt& value, int scale, double center, double radius) {
+  int kc = 0, kr = 0;
+  const auto c = exact_integers({center}, &kc), r = exact_integers({radius}, &kr);
+  if (center == 0.0) kc = scale;
+  if (radius == 0.0) kr = scale;
+  const int k = std::min(scale, std::min(kc, kr));
+  const BigInt diff = value.shifted(scale - k) - c[0].shifted(kc - k);
+  const BigInt rad = r[0].shifted(kr - k);
+  return (diff - rad).sign() <= 0 && (diff + rad).sign() >= 0;
+}
+
+/// True when the exact value of det[b - a, c - a, d - a] lies within `radius` of `center`.
+inline bool orient3d_within(const Point3& a, const Point3& b, const Point3& c, const Point3& d, double center,
+                            double radius) {
+  int kmin = 0;
+  const auto v = exact_integers({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z}, &kmin);
+  BigInt m[3][3];
+  for (int r = 0; r < 3; ++r)
+    for (int k = 0; k < 3; ++k)
+      m[r][k] = v[static_cast<std::size_t>(3 * (r + 1) + k)] - v[static_cast<std::size_t>(k)];
+  return within(det3(m), 3 * kmin, center, radius);
+}
+
+/// True when the exact value whose sign insphere() returns lies within `radius` of `center`.
+inline bool insphere_within(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                            const Point3& e, double center, double radius) {
+  int kmin = 0;
+  const auto v =
+      exact_integers({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z}, &kmin);
+  BigInt lift[5];
+  for (int p = 0; p < 5; ++p) {
+    const auto s = static_cast<std::size_t>(3 * p);
+    lift[p] = v[s] * v[s] + v[s + 1] * v[s + 1] + v[s + 2] * v[s + 2];
+  }
+  return within(lifted_value(v, lift), 5 * kmin, center, radius);
 }
 
 }  // namespace vitri::test

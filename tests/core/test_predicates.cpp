@@ -781,3 +781,125 @@ TEST_CASE("wide spread: exponent spans at and just past the expansion path's lim
     }
   }
 }
+
+// ---------------------------------------------------------------------------------------------------
+// The filters' certified error bounds, checked where they matter: inputs whose determinant is at the
+// rounding-noise level, so that the double value and the bound are of the same size. For every case the
+// exact value must lie within the filter's bound of the double value (the bound is what the filter
+// relies on; a too small constant in predicates.hpp fails here), and the predicate's sign must be the
+// oracle's.
+
+namespace {
+
+// The filters' bounds, computed as in predicates.hpp from the same rounded differences.
+double insphere_filter_bound(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                             const Point3& e) {
+  double m[3] = {0, 0, 0};
+  for (const Point3* p : {&a, &b, &c, &d})
+    for (std::size_t k = 0; k < 3; ++k) m[k] = std::max(m[k], std::fabs((*p)[k] - e[k]));
+  const double lambda = (m[0] * m[0] + m[1] * m[1]) + m[2] * m[2];
+  return vitri::detail::kInsphereBound * ((m[0] * m[1] * m[2]) * lambda);
+}
+
+double orient3d_filter_bound(const Point3& a, const Point3& b, const Point3& c, const Point3& d) {
+  double m[3] = {0, 0, 0};
+  for (const Point3* p : {&b, &c, &d})
+    for (std::size_t k = 0; k < 3; ++k) m[k] = std::max(m[k], std::fabs((*p)[k] - a[k]));
+  return vitri::detail::kOrient3dBound * (m[0] * m[1] * m[2]);
+}
+
+Point3 unit_vector(std::mt19937_64& rng) {
+  const Point3 v = random_point(rng, -1, 1);
+  return v / vitri::norm(v);
+}
+
+// p moved by 0 .. 2^max_log ulps along a random axis, in a random direction.
+Point3 nudged(std::mt19937_64& rng, Point3 p, int max_log) {
+  const std::size_t k = rng() % 3;
+  const double dir = (rng() & 1) ? 1e300 : -1e300;
+  const auto steps = rng() % ((1u << (rng() % static_cast<unsigned>(max_log + 1))) + 1);
+  for (std::uint64_t s = 0; s < steps; ++s) p[k] = std::nextafter(p[k], dir);
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("filter bound: insphere near cospherical points holds its certified error bound",
+          "[predicates][filter]") {
+  // Five points on a sphere, rounded, the fifth nudged by 0..2^10 ulps: spheres about the origin (the
+  // differences round), far from it (exact differences, large lifts), and box corners (exactly
+  // cospherical) translated by an inexact offset.
+  std::mt19937_64 rng(40);
+  int filtered = 0;
+  for (int i = 0; i < 3000; ++i) {
+    Point3 p[5];
+    const int kind = i % 3;
+    if (kind < 2) {
+      const Point3 center = kind == 0 ? 0.5 * random_point(rng, -1, 1) : scaled(random_point(rng, -1, 1), 1e5);
+      const double radius = kind == 0 ? 1.0 : std::ldexp(1.0, static_cast<int>(rng() % 8));
+      for (Point3& q : p) q = center + radius * unit_vector(rng);
+    } else {
+      const Point3 half = {1 + 0.5 * std::uniform_real_distribution<double>(0, 1)(rng), 1.25, 1.5};
+      const Point3 offset = random_point(rng, -2, 2);
+      std::array<int, 8> corner = {0, 1, 2, 3, 4, 5, 6, 7};
+      std::shuffle(corner.begin(), corner.end(), rng);
+      for (int j = 0; j < 5; ++j)
+        p[j] = Point3{(corner[static_cast<std::size_t>(j)] & 1) ? half.x : -half.x,
+                      (corner[static_cast<std::size_t>(j)] & 2) ? half.y : -half.y,
+                      (corner[static_cast<std::size_t>(j)] & 4) ? half.z : -half.z} +
+               offset;
+    }
+    for (int j = 0; j < 4; ++j) {
+      const Point3 e = nudged(rng, p[4], 2 * j + 2);
+      const double det = vitri::insphere_fast(p[0], p[1], p[2], p[3], e);
+      const double bound = insphere_filter_bound(p[0], p[1], p[2], p[3], e);
+      INFO("case " << i << "." << j << " det " << det << " bound " << bound);
+      REQUIRE(vitri::test::insphere_within(p[0], p[1], p[2], p[3], e, det, bound));
+      REQUIRE(to_int(insphere(p[0], p[1], p[2], p[3], e)) == vitri::test::oracle_insphere(p[0], p[1], p[2], p[3], e));
+      filtered += std::fabs(det) > bound;
+    }
+  }
+  CHECK(filtered > 50);  // some cases are decided by the filter right at its bound
+}
+
+TEST_CASE("filter bound: orient3d near coplanar points holds its certified error bound", "[predicates][filter]") {
+  // Four points on a random plane (about the origin or far from it), rounded, the fourth nudged.
+  std::mt19937_64 rng(41);
+  int filtered = 0;
+  for (int i = 0; i < 3000; ++i) {
+    const Point3 origin = (i % 2) ? scaled(random_point(rng, -1, 1), 1e6) : 0.25 * random_point(rng, -1, 1);
+    const Point3 u = random_point(rng, -1, 1), v = random_point(rng, -1, 1);
+    auto on_plane = [&]() {
+      std::uniform_real_distribution<double> s(-2, 2);
+      return origin + s(rng) * u + s(rng) * v;
+    };
+    const Point3 a = on_plane(), b = on_plane(), c = on_plane(), d0 = on_plane();
+    for (int j = 0; j < 4; ++j) {
+      const Point3 d = nudged(rng, d0, 2 * j + 2);
+      const double det = vitri::orient3d_fast(a, b, c, d);
+      const double bound = orient3d_filter_bound(a, b, c, d);
+      INFO("case " << i << "." << j << " det " << det << " bound " << bound);
+      REQUIRE(vitri::test::orient3d_within(a, b, c, d, det, bound));
+      REQUIRE(to_int(orient3d(a, b, c, d)) == vitri::test::oracle_orient3d(a, b, c, d));
+      filtered += std::fabs(det) > bound;
+    }
+  }
+  CHECK(filtered > 50);
+}
+
+TEST_CASE("filter bound: insphere on a tuple whose double value has the wrong sign at 9.4 u", "[predicates][filter]") {
+  // Found by a search (hill climbing over ulp moves of rounded cospherical points) for the largest
+  // |double value| with the wrong sign, in units of u Mx My Mz (Mx^2 + My^2 + Mz^2): 9.4. Random
+  // near-cospherical input stays below about 6 (docs/predicates.md): this case fails any insphere bound
+  // constant below 9.4 u, e.g. the 8 u of the audit.
+  const Point3 a{-0x1.1aa0dd570527ep-1, -0x1.25cb34f9963c5p-4, -0x1.313c0a9633f8p-2},
+      b{0x1.76242984179dp-1, 0x1.fc9413808966p-2, -0x1.13fa9b3a8f19bp-1},
+      c{0x1.5d1eda0909b9bp-1, -0x1.2ae14000ae867p+0, -0x1.1486b2269d0a3p-3},
+      d{-0x1.dfb3bb3b860ebp-3, 0x1.f8131b9e7f2aep-2, -0x1.1d7e65633efp-2},
+      e{0x1.4c285dc94d797p-2, -0x1.50c0bb5f3b33fp-2, -0x1.e68269c75d3b1p-1};
+  const double det = vitri::insphere_fast(a, b, c, d, e), bound = insphere_filter_bound(a, b, c, d, e);
+  REQUIRE(vitri::test::oracle_insphere(a, b, c, d, e) == 1);
+  REQUIRE(det < -9.0 * bound / (vitri::detail::kInsphereBound / vitri::detail::kUnitRoundoff));
+  CHECK(vitri::test::insphere_within(a, b, c, d, e, det, bound));
+  CHECK(insphere(a, b, c, d, e) == Sign::Positive);
+}

@@ -40,6 +40,14 @@ namespace {
 
 constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
+// Thin features: an edge with ends of one sign that is probably crossed twice is refined only when the
+// gradients at its ends point into opposite half-spaces (cosine below this): the crossings then belong to
+// sheets facing each other. A chord of one smooth sheet has nearly parallel end gradients. (Measured on
+// hand.off, largest-first at 0.015: an edge at 85 degrees still bridges a gap; a 60-degree bound, with
+// or without a smaller proximity for these points, made hand.off worse at 0.03-0.04: see the docs.)
+constexpr double kThinCosine = 0.0;
+// Proximity distance of thin-feature points, as a fraction of the refinement's (1: the same rule).
+constexpr double kThinDistance = 1.0;
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
@@ -139,6 +147,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
     if (!seed_values.empty() && !std::isnan(seed_values[i])) {
       set_value(v, seed_values[i]);
       fixed_[v] = 1;
+      if (options_.refine_thin_features) pending_.push_back(v);  // its gradient only
     } else {
       pending_.push_back(v);
     }
@@ -161,6 +170,8 @@ void Polygonizer::grow_vertex_arrays() {
   tcount_.resize(cap, 0);
   moved_.resize(cap, 0);
   lpos_.resize(cap, kNotListed);
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  grad_.resize(cap, Point3{nan, nan, nan});
 }
 
 void Polygonizer::grow_tet_arrays() {
@@ -176,17 +187,26 @@ void Polygonizer::evaluate_pending() {
   std::vector<Point3> pts;
   std::vector<VertexId> ids;
   pts.reserve(pending_.size());
+  // With refine_thin_features the gradient comes with the value (one batch call; about the cost of the
+  // value alone for the RBF), and fixed-value vertices are evaluated for their gradient only.
+  const bool thin = options_.refine_thin_features;
   for (const VertexId v : pending_) {
-    if (!tri_.is_vertex(v) || fixed_[v]) continue;
+    if (!tri_.is_vertex(v) || (fixed_[v] && !thin)) continue;
     ids.push_back(v);
     pts.push_back(tri_.point(v));
   }
   pending_.clear();
   std::vector<double> out(pts.size());
-  f_.values(pts.data(), pts.size(), out.data());
+  std::vector<Point3> grads(thin ? pts.size() : 0);
+  if (thin)
+    f_.values_gradients(pts.data(), pts.size(), out.data(), grads.data());
+  else
+    f_.values(pts.data(), pts.size(), out.data());
   stats_.function_evaluations += pts.size();
   stats_.vertex_evaluations += pts.size();
   for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (thin) grad_[ids[i]] = grads[i];
+    if (fixed_[ids[i]]) continue;
     if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
     set_value(ids[i], out[i]);
   }
@@ -329,30 +349,39 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
       r = tri_.insert(c, min_distance, &changes_);
     }
   } else {
-    // The circumcenter is outside the box. A tetrahedron with a face on the box hull has its
-    // circumradius bounded below by that face (only corners lie on the hull): it cannot be refined,
-    // and inserting points towards the face would only pile them up there. It is dropped.
+    // The circumcenter is outside the box: a fallback point of the interior of t (strictly inside the
+    // box and the circumball, so in conflict with t), subject to the same proximity rule.
     ++stats_.boundary_fallbacks;
-    for (int i = 0; i < 4; ++i)
-      if (tri_.tet_neighbor(t, i) == kNoTet) {
-        if (kind == VertexKind::Refinement) ++stats_.rejected;
-        return false;
-      }
-    // Otherwise: the midpoint of the longest edge pulled 10% towards the centroid, a point of the
-    // interior of t, hence strictly inside the box and the circumball (in conflict), subject to the
-    // same proximity rule.
     const auto v = tri_.tet_vertices(t);
-    double best = -1.0;
-    Point3 m;
     const Point3 g = 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
+    Point3 m;
+    int hull = -1;
     for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
-        if (d > best) {
-          best = d;
-          m = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
+      if (tri_.tet_neighbor(t, i) == kNoTet) hull = i;
+    if (hull >= 0) {
+      // A face on the box hull (three corners: only corners lie on the hull) bounds the circumradius
+      // from below, so t stays larger than the precision whatever is inserted. Fallback (the paper's
+      // face centre): the centroid of the hull face moved a quarter of the way towards the opposite
+      // vertex. The tetrahedron on that face after the insertion has the new point or a vertex closer
+      // to the face as its apex, so a chain of such points approaches the face centroid geometrically
+      // and proximity rejection ends it after O(log(size / min_distance)) points; the tetrahedron is
+      // then dropped (stats: boundary_dropped; boundary_coarse says whether one is left too large).
+      Point3 face{0.0, 0.0, 0.0};
+      for (int i = 0; i < 4; ++i)
+        if (i != hull) face = face + tri_.point(v[i]) * (1.0 / 3.0);
+      m = face + 0.25 * (tri_.point(v[hull]) - face);
+    } else {
+      // Otherwise: the midpoint of the longest edge pulled 10% towards the centroid.
+      double best = -1.0;
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
+          if (d > best) {
+            best = d;
+            m = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
+          }
         }
-      }
+    }
     if (!strictly_inside(box, m)) m = g;  // rounding put it on a face (t is very flat there)
     r.status = InsertStatus::TooClose;
     if (strictly_inside(box, m)) {
@@ -366,7 +395,14 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
     }
   }
   if (r.status != InsertStatus::Inserted) {
-    if (kind == VertexKind::Refinement) ++stats_.rejected;
+    if (kind == VertexKind::Refinement) {
+      ++stats_.rejected;
+      for (int i = 0; i < 4; ++i)
+        if (tri_.tet_neighbor(t, i) == kNoTet) {
+          ++stats_.boundary_dropped;
+          break;
+        }
+    }
     return false;
   }
   grow_vertex_arrays();
@@ -425,10 +461,18 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
     if (radius_[t] > precision) push(t);
   for (const VertexId z : lonely_)
     for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
-  std::vector<TetId> created, retry;
+  // Thin features: edges shorter than 2 dmin are not checked (every point of them is within dmin of an
+  // end, so its point would be rejected anyway). All live tetrahedra are checked once per call (values
+  // and gradients may have changed since the last call, and the length floor moved with the precision);
+  // from then on only the created ones.
+  const bool thin = options_.refine_thin_features;
+  const double thin_dmin = kThinDistance * dmin, thin_min = 2.0 * thin_dmin;
+  thin_.clear();
+  if (thin) check_thin(tri_.live_tetrahedra(), thin_min);
+  std::vector<TetId> created, retry, fresh;
   RefineProgress info;
   bool completed = true;
-  while (queued() > 0) {
+  while (queued() > 0 || !thin_.empty()) {
     const std::size_t n = std::min(queued(), kRoundSize);
     for (std::size_t i = 0; i < n; ++i) {
       TetId t;
@@ -441,23 +485,151 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
         if (tri_.is_live(t)) retry.push_back(t);
       }
     }
+    // Edges flagged by the previous round (or the initial check): one point each.
+    if (!thin_.empty()) {
+      const std::size_t before = stats_.thin_insertions;
+      while (!thin_.empty()) insert_thin_point(thin_dmin, created);
+      info.inserted += stats_.thin_insertions - before;
+    }
     evaluate_pending();
+    if (thin) fresh.assign(created.begin(), created.end());
     classify_created(created);
+    if (thin) check_thin(fresh, thin_min);
     for (const TetId t : retry)
       if (is_active(t)) push(t);
     retry.clear();
     if (progress) {
       info.vertices = tri_.num_vertices();
-      info.queued = queued();
+      info.queued = queued() + thin_.size();
       if (!progress(info)) {
         completed = false;
         clear_queue();
+        thin_.clear();
         break;
       }
     }
   }
+  // Status at the box hull: active tetrahedra with a hull face still larger than the precision (their
+  // fallback points were rejected). A hull face has three corners, so these are among the corners' stars.
+  std::vector<TetId> hull;
+  for (VertexId c = 0; c < 8; ++c)
+    for (const TetId t : tri_.incident_tetrahedra(c))
+      for (int i = 0; i < 4; ++i)
+        if (tri_.tet_neighbor(t, i) == kNoTet) {
+          hull.push_back(t);
+          break;
+        }
+  std::sort(hull.begin(), hull.end());
+  hull.erase(std::unique(hull.begin(), hull.end()), hull.end());
+  stats_.boundary_coarse = 0;
+  for (const TetId t : hull)
+    if (is_active(t) && tri_.circumradius(t) > precision) ++stats_.boundary_coarse;
   stats_.refine_seconds = seconds_since(t0);
   return completed;
+}
+
+// ---- Thin features -------------------------------------------------------------------------------------
+// Marching tetrahedra sees only the signs at the vertices. Where two sheets of the surface are closer
+// than the Delaunay edges (two fingers, a thin wall), an edge can join two vertices of one sign across a
+// thin layer of the other sign: the tetrahedra around it bridge the gap (or punch through the wall) and
+// the mesh gets a spurious handle, although every transverse tetrahedron is smaller than the precision.
+// Test of an edge (a, b) with ends of one sign (made negative by flipping f if needed): the tangent
+// lines of f along the edge at a and at b (slopes from the stored gradients) both rise towards the
+// other end, the first reaches 0 at t_a, the second (going back from b) at t_b, and t_a < t_b: to first
+// order f is >= 0 on [t_a, t_b], i.e. the edge is crossed twice. Required too: grad f(a) . grad f(b) < 0,
+// the two crossings belong to sheets facing each other (one smooth sheet crossed twice by a short chord,
+// near-tangent, has nearly parallel gradients: that is a geometric error, not a topological one, and
+// refining it would refine the whole surface). The point inserted is where the two tangent lines meet
+// (the predicted extremum of f), with the usual proximity rule. If f there has the other sign, the edge
+// is replaced by two crossed edges and ordinary refinement follows the new sheets; if not, the two
+// halves are checked again with the new gradient. Termination: these points too are >= dmin from every
+// vertex (docs/polygonize.md).
+
+bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
+  double fa = values_[a], fb = values_[b];
+  if (is_negative(fa) != is_negative(fb)) return false;
+  const Point3& ga = grad_[a];
+  const Point3& gb = grad_[b];
+  // Facing sheets: the normals at the ends differ by more than 90 degrees (false when a gradient is
+  // unknown, NaN).
+  if (!(dot(ga, gb) < kThinCosine * std::sqrt(dot(ga, ga) * dot(gb, gb)))) return false;
+  const Point3 e = tri_.point(b) - tri_.point(a);
+  if (dot(e, e) < min_length * min_length) return false;
+  double da = dot(ga, e), db = -dot(gb, e);  // slopes of f per unit t, at a towards b, at b towards a
+  if (!is_negative(fa)) {
+    fa = -fa;
+    fb = -fb;
+    da = -da;
+    db = -db;
+  }
+  if (!(da > 0.0 && db > 0.0)) return false;
+  const double ta = -fa / da, tb = 1.0 + fb / db;
+  if (!(ta < tb)) return false;
+  s = std::clamp((fb - fa + db) / (da + db), std::max(ta, 0.0), std::min(tb, 1.0));
+  return s > 0.0 && s < 1.0;
+}
+
+void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) {
+  const std::size_t first = thin_.size();
+  for (const TetId t : tets) {
+    if (!tri_.is_live(t)) continue;
+    const auto v = tri_.tet_vertices(t);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        double s;
+        if (crossed_twice(v[i], v[j], min_length, s)) thin_.push_back({v[i], v[j], t, s});
+      }
+  }
+  // An edge is in several of these tetrahedra: keep one entry per edge.
+  const auto key = [](const ThinEdge& e) { return std::make_pair(std::min(e.a, e.b), std::max(e.a, e.b)); };
+  std::sort(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
+            [&](const ThinEdge& x, const ThinEdge& y) { return key(x) < key(y); });
+  thin_.erase(std::unique(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
+                          [&](const ThinEdge& x, const ThinEdge& y) { return key(x) == key(y); }),
+              thin_.end());
+}
+
+bool Polygonizer::insert_thin_point(double min_distance, std::vector<TetId>& created) {
+  const ThinEdge e = thin_.back();
+  thin_.pop_back();
+  if (!tri_.is_vertex(e.a) || !tri_.is_vertex(e.b)) return false;
+  // A tetrahedron that still has the edge (the one that flagged it may have died; if the edge survived,
+  // a tetrahedron around a or b has it).
+  TetId t = kNoTet;
+  if (tri_.is_live(e.t) && tri_.vertex_index(e.t, e.a) >= 0 && tri_.vertex_index(e.t, e.b) >= 0) {
+    t = e.t;
+  } else {
+    for (const TetId u : tri_.incident_tetrahedra(e.a))
+      if (tri_.vertex_index(u, e.b) >= 0) {
+        t = u;
+        break;
+      }
+  }
+  if (t == kNoTet) return false;  // the edge is gone
+  const Point3& pa = tri_.point(e.a);
+  const Point3 p = pa + e.s * (tri_.point(e.b) - pa);
+  if (!is_finite(p) || !strictly_inside(tri_.box(), p)) return false;
+  // p is on the edge, so strictly inside the circumball of every tetrahedron around it: in conflict.
+  changes_.clear();
+  InsertResult r;
+  try {
+    r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
+  } catch (const InvalidArgument&) {
+    changes_.clear();
+    r = tri_.insert(p, min_distance, &changes_);
+  }
+  if (r.status != InsertStatus::Inserted) return false;
+  grow_vertex_arrays();
+  grow_tet_arrays();
+  kind_[r.vertex] = static_cast<std::uint8_t>(VertexKind::Refinement);
+  fixed_[r.vertex] = 0;
+  tcount_[r.vertex] = 0;
+  pending_.push_back(r.vertex);
+  ++stats_.insertions;
+  ++stats_.thin_insertions;
+  on_killed(changes_);
+  created.insert(created.end(), changes_.created.begin(), changes_.created.end());
+  return true;
 }
 
 // ---- Dynamic editing ----------------------------------------------------------------------------------
@@ -559,17 +731,25 @@ void Polygonizer::function_changed() {
   std::vector<VertexId> ids;
   std::vector<Point3> pts;
   const std::size_t cap = tri_.vertex_capacity();
+  // With refine_thin_features the gradients are refreshed too (fixed-value vertices: gradient only).
+  const bool thin = options_.refine_thin_features;
   for (VertexId v = 0; v < cap; ++v) {
-    if (fixed_[v] || !tri_.is_vertex(v)) continue;
+    if ((fixed_[v] && !thin) || !tri_.is_vertex(v)) continue;
     ids.push_back(v);
     pts.push_back(tri_.point(v));
   }
   std::vector<double> out(pts.size());
-  f_.values(pts.data(), pts.size(), out.data());
+  std::vector<Point3> grads(thin ? pts.size() : 0);
+  if (thin)
+    f_.values_gradients(pts.data(), pts.size(), out.data(), grads.data());
+  else
+    f_.values(pts.data(), pts.size(), out.data());
   stats_.function_evaluations += pts.size();
   stats_.vertex_evaluations += pts.size();
   std::vector<TetId> touched;
   for (std::size_t i = 0; i < ids.size(); ++i) {
+    if (thin) grad_[ids[i]] = grads[i];
+    if (fixed_[ids[i]]) continue;
     if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
     const VertexId v = ids[i];
     const bool flip = is_negative(out[i]) != is_negative(values_[v]);

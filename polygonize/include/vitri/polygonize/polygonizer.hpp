@@ -92,6 +92,16 @@ struct PolygonizerOptions {
   /// constraints). false restores the plain rule (only transverse tetrahedra are refined). See
   /// docs/polygonize.md.
   bool refine_lone_zeros = true;
+  /// Thin features: also refine where a Delaunay edge whose two ends have the same sign is probably
+  /// crossed twice by the surface (two sheets closer than the edge, e.g. two fingers, or a thin wall),
+  /// which marching tetrahedra would otherwise bridge or punch through (a spurious handle). An edge is
+  /// flagged when the tangent lines of f at its ends (values and gradients, stored per vertex) both
+  /// reach the other sign inside the edge, in the right order, and the two gradients point into opposite
+  /// half-spaces (the two crossings belong to facing sheets, not to one curved sheet). The point where
+  /// the tangent lines meet is inserted (proximity rule as for every refinement point). Costs a gradient
+  /// with every vertex evaluation (about free for the RBF) and one gradient per fixed-value vertex. See
+  /// docs/polygonize.md. false: only active tetrahedra are refined (the paper's rule).
+  bool refine_thin_features = true;
 };
 
 /// Counters and timings. Times in seconds; counters cumulative since construction unless stated.
@@ -104,7 +114,15 @@ struct PolygonizerStats {
   std::size_t root_evaluations = 0;     ///< of which by the root finder (value + gradient: the normal)
   std::size_t gradient_evaluations = 0; ///< of which for normals not given by the root finder
   std::size_t insertions = 0;           ///< Delaunay insertions by refinement and sampling
-  std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box (hull tetrahedra dropped, others split inside)
+  std::size_t boundary_fallbacks = 0;   ///< circumcenters outside the box (replaced by a point inside, see docs)
+  /// refine(): tetrahedra with a face on the box hull whose fallback point was rejected (too close to a
+  /// vertex): left unrefined (also counted in `rejected`).
+  std::size_t boundary_dropped = 0;
+  /// After the last refine(): active tetrahedra with a face on the box hull and circumradius > precision
+  /// (at most 12, one per hull face). 0 means the precision holds everywhere; otherwise the surface
+  /// reaches the box hull and the mesh is coarser there (and open where a box corner has f < 0).
+  std::size_t boundary_coarse = 0;
+  std::size_t thin_insertions = 0;      ///< refine(): points inserted on edges probably crossed twice
   std::size_t rejected = 0;             ///< refine(): points rejected by proximity (tetrahedron dropped)
   std::size_t removed_steiner = 0;      ///< refinement vertices removed by collect_garbage()
   std::size_t zero_snapped = 0;         ///< last extract(): zero vertices used as mesh vertices
@@ -230,6 +248,9 @@ class Polygonizer {
   void push_if_big(TetId t);
   void settle_zeros(const std::vector<TetId>& created);
   bool touches_lonely(TetId t) const;
+  bool crossed_twice(VertexId a, VertexId b, double min_length, double& s) const;
+  void check_thin(const std::vector<TetId>& tets, double min_length);
+  bool insert_thin_point(double min_distance, std::vector<TetId>& created);
 
   const ImplicitFunction& f_;
   PolygonizerOptions options_;
@@ -259,6 +280,14 @@ class Polygonizer {
   };
   std::unordered_map<std::uint64_t, RootCacheEntry> root_cache_;
   std::vector<std::uint8_t> moved_;
+  // Thin features: gradient of f per vertex (NaN when unknown) and the edges waiting for a point.
+  std::vector<Point3> grad_;
+  struct ThinEdge {
+    VertexId a, b;
+    TetId t;   // a tetrahedron that had the edge when it was flagged
+    double s;  // parameter of the point from a
+  };
+  std::vector<ThinEdge> thin_;  // flagged edges waiting for their point (one entry per edge)
 };
 
 }  // namespace vitri

@@ -1,0 +1,118 @@
+// Tests of the polygonizer's thin-feature refinement (edges probably crossed twice by facing sheets) on
+// the RBF of hand.off, and of the fallback point for tetrahedra with a face on the box hull.
+#include <catch2/catch.hpp>
+
+#include "vitri/io/io.hpp"
+#include "vitri/mesher.hpp"
+#include "vitri/polygonize/analytic.hpp"
+#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+
+#include <cmath>
+#include <memory>
+#include <string>
+
+using namespace vitri;
+
+namespace {
+
+MeshMetrics metrics_of(const SurfaceMesh& m) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  to_eigen(m, V, F);
+  return compute_mesh_metrics(V, F);
+}
+
+/// Euler characteristic of a fresh polygonization of the mesher's RBF, built as vitri::Mesher (and so
+/// `vitri mesh`) builds it: constraint points as seeds with their values, domain = their box x 2.
+long long euler_at(const Mesher& mesher, double relative, QueueOrder order, bool thin = true) {
+  PolygonizerOptions o;
+  o.order = order;
+  o.refine_thin_features = thin;
+  const Constraints& c = mesher.constraints();
+  Polygonizer poly(mesher.function(), Polygonizer::domain_for(c.points, 2.0), c.points, c.values, o);
+  REQUIRE(poly.refine(relative * mesher.diagonal()));
+  const MeshMetrics mm = metrics_of(poly.extract());
+  INFO("precision " << relative << (order == QueueOrder::Fifo ? " fifo" : " largest-first") << ": V "
+                    << mm.vertices << " chi " << mm.euler_characteristic << " thin points "
+                    << poly.stats().thin_insertions);
+  REQUIRE(mm.closed_manifold());
+  REQUIRE(mm.components == 1);
+  return mm.euler_characteristic;
+}
+
+}  // namespace
+
+// hand.off with the CLI's constraints (3591: both off-surface sides). Its RBF zero set is a sphere
+// (vitri meshes at 0.01, 0.007, 0.005 and 0.004 of the diagonal all have Euler characteristic 2), but at
+// 0.015 the FIFO refinement used to give 0 and largest-first -2: two fingers closer than the Delaunay
+// edges were bridged by edges joining inside vertices across the gap (docs/polygonize.md, Thin features).
+// The fit takes ~1.6 s in Release and about a minute under the sanitizers: hidden from the default run,
+// run it with `test_thin_features "[slow]"`.
+TEST_CASE("thin features: hand.off has the hand's topology at 0.02, 0.015 and 0.01", "[.][slow][polygonize]") {
+  const TriangleMesh in = read_mesh(std::string(VITRI_DATA_DIR) + "/hand.off");
+  const Mesher mesher = Mesher::from_mesh(in.V, in.F);
+  REQUIRE(mesher.size() == 3591);
+  CHECK(euler_at(mesher, 0.02, QueueOrder::Fifo) == 2);
+  CHECK(euler_at(mesher, 0.015, QueueOrder::Fifo) == 2);
+  CHECK(euler_at(mesher, 0.01, QueueOrder::Fifo) == 2);
+  CHECK(euler_at(mesher, 0.02, QueueOrder::LargestFirst) == 2);
+  CHECK(euler_at(mesher, 0.01, QueueOrder::LargestFirst) == 2);
+  // Without the rule the handle is there (what this test guards against).
+  CHECK(euler_at(mesher, 0.015, QueueOrder::Fifo, false) == 0);
+}
+
+// Known gap, not asserted as passing: largest-first at 0.015 still has one spurious handle (chi 0; it was
+// -2 before the rule). Run with `test_thin_features "[!mayfail]"` to see it.
+TEST_CASE("thin features: hand.off largest-first at 0.015 (known: one handle left)", "[.][slow][!mayfail][polygonize]") {
+  const TriangleMesh in = read_mesh(std::string(VITRI_DATA_DIR) + "/hand.off");
+  const Mesher mesher = Mesher::from_mesh(in.V, in.F);
+  CHECK(euler_at(mesher, 0.015, QueueOrder::LargestFirst) == 2);
+}
+
+// Two facing sheets closer than the precision: the union of two spheres of radius 1 whose gap (0.1) is
+// far below the circumradius bound (0.3). Without the rule the gap may be bridged; with it, every flagged
+// edge got its point and the mesh has two sphere components.
+TEST_CASE("thin features: two spheres with a narrow gap stay two spheres", "[polygonize]") {
+  const SphereFunction a({-1.05, 0.0, 0.0}, 1.0), b({1.05, 0.0, 0.0}, 1.0);
+  const UnionFunction f(a, b);
+  const Box3 box{{-3.0, -2.0, -2.0}, {3.0, 2.0, 2.0}};
+  PolygonizerOptions o;
+  Polygonizer poly(f, box, {{-1.05, 0.0, 0.0}, {1.05, 0.0, 0.0}}, {}, o);
+  REQUIRE(poly.refine(0.3));
+  const MeshMetrics mm = metrics_of(poly.extract());
+  REQUIRE(mm.closed_manifold());
+  REQUIRE(mm.components == 2);
+  REQUIRE(mm.euler_characteristic == 4);
+}
+
+// A sphere larger than the box: it crosses the middle of every box face, while the 8 corners stay
+// outside (f > 0), so the mesh is closed but the tetrahedra on the box hull are transverse and their
+// circumcenters leave the box. They get fallback points inside the box (the old rule dropped them
+// at once), then are dropped when proximity rejection stops the chain; stats say so.
+TEST_CASE("box hull: fallback points for hull tetrahedra, dropped ones counted", "[polygonize]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 1.2);
+  const Box3 box{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
+  Polygonizer poly(f, box);
+  const double precision = 0.1;
+  REQUIRE(poly.refine(precision));
+  const PolygonizerStats s = poly.stats();
+  INFO("fallbacks " << s.boundary_fallbacks << " dropped " << s.boundary_dropped << " coarse "
+                    << s.boundary_coarse << " rejected " << s.rejected);
+  REQUIRE(s.boundary_fallbacks > s.boundary_dropped);  // some hull fallback points were inserted
+  REQUIRE(s.boundary_dropped > 0);
+  REQUIRE(s.boundary_dropped <= s.rejected);
+  REQUIRE(s.boundary_coarse >= 1);
+  REQUIRE(s.boundary_coarse <= 12);
+  const SurfaceMesh m = poly.extract();
+  const MeshMetrics mm = metrics_of(m);
+  REQUIRE(mm.closed_manifold());
+  for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3);
+
+  // A surface well inside the box: no hull tetrahedron is active, the status is clean.
+  const SphereFunction g({0.0, 0.0, 0.0}, 0.5);
+  Polygonizer inner(g, box);
+  REQUIRE(inner.refine(precision));
+  REQUIRE(inner.stats().boundary_coarse == 0);
+  REQUIRE(inner.stats().boundary_dropped == 0);
+}

@@ -4,6 +4,7 @@
 // with a message on stderr (the edit line's number for a bad script line).
 #include "vitri/io/io.hpp"
 #include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/polygonize/surface_mesh.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -58,6 +59,31 @@ std::string write_small_model() {
     for (const double s : {-2.0, 2.0})
       c << (k == 0 ? s : 0.0) << ' ' << (k == 1 ? s : 0.0) << ' ' << (k == 2 ? s : 0.0) << " 1\n";
   return path;
+}
+
+/// n oriented points on the unit sphere (Fibonacci spiral, outward normals) in a .pwn file.
+std::string write_sphere_points(const std::string& name, int n) {
+  const std::string path = kDir + "/" + name;
+  std::ofstream p(path);
+  p.precision(17);
+  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - z * z), phi = golden * i;
+    const double x = r * std::cos(phi), y = r * std::sin(phi);
+    p << x << ' ' << y << ' ' << z << ' ' << x << ' ' << y << ' ' << z << '\n';
+  }
+  return path;
+}
+
+/// Distance from q to a mesh file the CLI wrote.
+double distance_to_mesh(const std::string& path, const Point3& q) {
+  const TriangleMesh m = read_mesh(path);
+  SurfaceMesh s;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) s.vertices.push_back({m.V(i, 0), m.V(i, 1), m.V(i, 2)});
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
+    s.triangles.push_back({static_cast<std::uint32_t>(m.F(f, 0)), static_cast<std::uint32_t>(m.F(f, 1)),
+                           static_cast<std::uint32_t>(m.F(f, 2))});
+  return MeshDistance(s).distance(q);
 }
 
 /// Reads a mesh the CLI wrote and checks it is a closed, outward 2-manifold with Euler characteristic
@@ -207,6 +233,19 @@ TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why o
     REQUIRE(run(in + " -o " + out, o, e) == 2);
     REQUIRE(e.find("--precision") != std::string::npos);
   }
+  SECTION("precisions not coarse to fine: increasing or repeated, with nothing written") {
+    const std::string lod = kDir + "/mesh_err_lod.obj";
+    for (const char* bad : {"--precision 0.03 --precision 0.06", "--precision 0.06 --precision 0.06",
+                            "--precision 0.1 --precision 0.05 --precision 0.07"}) {
+      INFO(bad);
+      for (int k = 0; k < 3; ++k) std::remove((kDir + "/mesh_err_lod-" + std::to_string(k) + ".obj").c_str());
+      REQUIRE(run(in + " -o " + lod + " " + bad, o, e) == 2);
+      REQUIRE(e.find("coarse to fine") != std::string::npos);
+      REQUIRE(e.find("strictly decreasing") != std::string::npos);
+      REQUIRE(o.empty());  // rejected before the fit
+      for (int k = 0; k < 3; ++k) REQUIRE_FALSE(exists(kDir + "/mesh_err_lod-" + std::to_string(k) + ".obj"));
+    }
+  }
   SECTION("unknown option, missing output, bad output extension") {
     REQUIRE(run(in + " -o " + out + " --precision 0.1 --frobnicate", o, e) == 2);
     REQUIRE(e.find("--frobnicate") != std::string::npos);
@@ -234,5 +273,60 @@ TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why o
   SECTION("missing edit script") {
     REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + kDir + "/no_such_script.txt", o, e) == 1);
     REQUIRE(e.find("no_such_script.txt") != std::string::npos);
+  }
+}
+
+TEST_CASE("vitri mesh: a long fit is announced on stderr before it starts and after it ends", "[cli][mesh]") {
+  // 400 oriented points, 3 constraints each (no offset is dropped on a sphere this coarse): 1200.
+  const std::string in = write_sphere_points("mesh_fit_progress.pwn", 400), out = kDir + "/mesh_fit.obj";
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --precision 0.1", o, e) == 0);
+  INFO(o << e);
+  REQUIRE(o.find("1200 constraints") != std::string::npos);
+  const std::size_t before = e.find("fitting the implicit function to 1200 constraints...");
+  REQUIRE(before != std::string::npos);
+  REQUIRE(e.find("fit done in ", before) != std::string::npos);
+  check_mesh(out);
+  // -q: nothing on stderr either.
+  REQUIRE(run(in + " -o " + out + " --precision 0.1 -q", o, e) == 0);
+  REQUIRE(e.find("fitting") == std::string::npos);
+  REQUIRE(e.find("fit done") == std::string::npos);
+  // A small fit (25 constraints) is quick: no announcement.
+  REQUIRE(run(write_small_model() + " -o " + out + " --precision 0.1", o, e) == 0);
+  REQUIRE(e.find("fitting") == std::string::npos);
+}
+
+// For oriented points (and meshes) the edit indices refer to the generated constraints: the surface
+// points first (index i = input point i here: no duplicates, no subsampling), then the off-surface ones.
+TEST_CASE("vitri mesh: edit indices of oriented-point input: surface points first, then off-surface",
+          "[cli][mesh]") {
+  const std::string in = write_sphere_points("mesh_edit_order.pwn", 64), out = kDir + "/mesh_order.obj";
+  const std::string script = kDir + "/mesh_order_edits.txt", w_surface = kDir + "/mesh_order_surface.obj",
+                    w_off = kDir + "/mesh_order_off.obj";
+  // Point 0 of the spiral, moved 0.3 further out along its normal.
+  const double z0 = 1.0 - 1.0 / 64.0, r0 = std::sqrt(1.0 - z0 * z0);
+  const Point3 q{1.3 * r0, 0.0, 1.3 * z0};
+  std::ostringstream moved;
+  moved.precision(17);
+  moved << q.x << ' ' << q.y << ' ' << q.z;
+  std::string o, e;
+  // --sides outside: 64 surface constraints (0..63, value 0), then 64 outside ones (64..127, value +D).
+  // Moving constraint 0 pulls the surface out to q; moving constraint 64 (point 0's outside constraint,
+  // f = +D) to q leaves the surface away from q.
+  for (const bool surface : {true, false}) {
+    INFO((surface ? "move 0" : "move 64"));
+    const std::string w = surface ? w_surface : w_off;
+    std::remove(w.c_str());
+    std::ofstream(script) << "move " << (surface ? 0 : 64) << ' ' << moved.str() << "\nwrite " << w << "\n";
+    REQUIRE(run(in + " -o " + out + " --precision 0.03 --sides outside --edits " + script, o, e) == 0);
+    INFO(o << e);
+    REQUIRE(o.find("128 constraints") != std::string::npos);
+    REQUIRE(exists(w));
+    const double d = distance_to_mesh(w, q);
+    INFO("distance " << d);
+    if (surface)
+      REQUIRE(d <= 0.03 * 2.0 * std::sqrt(3.0));  // within the precision (relative to the diagonal)
+    else
+      REQUIRE(d > 0.15);
   }
 }

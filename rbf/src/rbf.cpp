@@ -42,6 +42,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <sstream>
 #include <thread>
@@ -115,6 +116,11 @@ struct Rbf::Impl {
   std::size_t n = 0;                    // size of K = N - 4
   std::size_t edits = 0, edits_since_check = 0, refits = 0;
   double fit_residual = 0.0;  // relative residual right after the last full factorization
+  // Reliability between residual measurements (see after_edit): the relative residual of the last
+  // measurement (fit, refit, drift check), and the condition estimate and cheap bound
+  // (condition_bound()) of the last full estimate, which edits extrapolate.
+  double measured_residual = 0.0;
+  double base_condition = 0.0, base_bound = 1.0;
 
   // ---------- geometry helpers ----------
   Point3 scaled(const Point3& p) const { return (p - center) / scale; }
@@ -386,10 +392,7 @@ struct Rbf::Impl {
     w = dw;
     poly = da;
     rep.refinement_steps = 0;
-    if (max_steps == 0) {  // edits: the residual is measured by the periodic drift check
-      rep.relative_residual = std::numeric_limits<double>::quiet_NaN();
-      return;
-    }
+    if (max_steps == 0) return;  // edits: after_edit() decides whether to measure the residual
     std::vector<double> r = residual();
     double rel = relative(r);
     for (int step = 0; step < max_steps && rel > 1e-15; ++step) {
@@ -412,9 +415,12 @@ struct Rbf::Impl {
     finish_report(rel);
   }
 
+  // Fills the report for the current weights. rel is the measured relative residual, or NaN after an
+  // edit that did not measure it: the warning then keeps the verdict of the last measurement.
   void finish_report(double rel) {
     rep.constraints = cx.size();
     rep.relative_residual = rel;
+    if (!std::isnan(rel)) measured_residual = rel;
     double sw = 0, sx = 0, sy = 0, sz = 0, aw = 0;
     for (std::size_t i = 0; i < w.size(); ++i) {
       sw += w[i];
@@ -425,11 +431,14 @@ struct Rbf::Impl {
     }
     rep.side_condition_residual =
         aw > 0 ? (std::abs(sw) + std::abs(sx) + std::abs(sy) + std::abs(sz)) / aw : 0.0;
-    rep.warning = rel > opt.warn_residual || rep.condition_estimate > opt.warn_condition;
+    rep.warning = measured_residual > opt.warn_residual || rep.condition_estimate > opt.warn_condition;
     rep.message.clear();
     if (rep.warning) {
-      rep.message = "unreliable fit: relative residual " + fmt(rel) + ", condition estimate " +
-                    fmt(rep.condition_estimate) + " (near-duplicate constraints or very uneven spacing?)";
+      rep.message = "unreliable fit: relative residual " + fmt(measured_residual) +
+                    (std::isnan(rel) ? " (last measured " + std::to_string(edits_since_check) + " edits ago)"
+                                     : std::string()) +
+                    ", condition estimate " + fmt(rep.condition_estimate) +
+                    " (near-duplicate constraints or very uneven spacing?)";
     }
   }
 
@@ -454,6 +463,33 @@ struct Rbf::Impl {
       x(j) = 1.0;
     }
     return est;
+  }
+
+  // 1-norm of K (O(n^2) kernel entries).
+  double k_norm1() const {
+    std::vector<double> colsum(n, 0.0);
+    for (std::size_t s = 0; s < n; ++s)
+      for (std::size_t t = s; t < n; ++t) {
+        const double v = std::abs(kentry(order[t], order[s]));
+        colsum[s] += v;
+        if (t != s) colsum[t] += v;
+      }
+    return n ? *std::max_element(colsum.begin(), colsum.end()) : 0.0;
+  }
+
+  // A cheap (O(n)) lower bound of the 2-norm condition number of K: max_s K_ss / min_s L_ss^2. Each
+  // pivot L_ss^2 is a Schur complement of a leading block, so it is >= the smallest eigenvalue of K,
+  // and every diagonal entry is <= the largest one. A nearly dependent constraint (a near-duplicate)
+  // shows up as a tiny pivot wherever it sits in the factor.
+  double condition_bound() const {
+    if (n == 0) return 1.0;
+    double kmax = 0.0, pmin = std::numeric_limits<double>::infinity();
+    for (std::size_t s = 0; s < n; ++s) {
+      const double l = L(static_cast<Eigen::Index>(s), static_cast<Eigen::Index>(s));
+      kmax = std::max(kmax, kentry(order[s], order[s]));
+      pmin = std::min(pmin, l * l);
+    }
+    return kmax / pmin;
   }
 
   // ---------- fitting ----------
@@ -513,6 +549,8 @@ struct Rbf::Impl {
                            " constraints is not numerically positive definite (near-duplicate or degenerate "
                            "constraints?)");
     rep.condition_estimate = knorm * inverse_norm1_estimate();
+    base_condition = rep.condition_estimate;
+    base_bound = condition_bound();
     edits_since_check = 0;
   }
 
@@ -617,18 +655,25 @@ struct Rbf::Impl {
     return true;
   }
 
-  // Replaces anchor k by the non-anchor with the largest |lambda_{.k}| (largest new tetrahedron):
-  // change of basis B' = B (I + e_s t^T), i.e. L' L'^T = (L + t l^T)(L + t l^T)^T with l = row s of L,
-  // re-triangularized by Givens rotations. Throws InvalidArgument when no replacement spans 3D.
-  void swap_anchor(int k) {
-    const auto uk = static_cast<std::size_t>(k);
+  // The slot of the non-anchor that best replaces anchor k: largest |lambda_{.k}| (largest new
+  // tetrahedron). kNoSlot when every non-anchor lies on the plane of the other three anchors.
+  std::size_t anchor_replacement(int k) const {
     std::size_t s = kNoSlot;
     double best = 0.0;
     for (std::size_t t = 0; t < n; ++t) {
       const double v = std::abs(lam[order[t]](k));
       if (v > best) best = v, s = t;
     }
-    if (s == kNoSlot || best < 1e-9)
+    return best < 1e-9 ? kNoSlot : s;
+  }
+
+  // Replaces anchor k by the non-anchor of slot anchor_replacement(k): change of basis
+  // B' = B (I + e_s t^T), i.e. L' L'^T = (L + t l^T)(L + t l^T)^T with l = row s of L,
+  // re-triangularized by Givens rotations. Throws InvalidArgument when no replacement spans 3D.
+  void swap_anchor(int k) {
+    const auto uk = static_cast<std::size_t>(k);
+    const std::size_t s = anchor_replacement(k);
+    if (s == kNoSlot)
       throw InvalidArgument(
           "the remaining constraints would be coplanar: the linear polynomial would be "
           "undetermined");
@@ -683,24 +728,53 @@ struct Rbf::Impl {
     rebuild_slots();
   }
 
-  void after_edit() {
+  // Finishes an edit of constraint `index` whose factor update is done. The cheap condition bound is
+  // compared with the one of the last full condition estimate: when it moved by more than a factor
+  // kBoundJump either way (a near-duplicate added, or removed), the residual and the condition are
+  // measured at once (drift check, refit from scratch if inaccurate), so that the report says what a
+  // fresh fit would; otherwise the condition estimate is extrapolated by the bound and the residual is
+  // left unmeasured (NaN) until the periodic drift check. When the measured residual is above
+  // fail_residual even after a refit, `undo` restores the previous constraints, the function is refitted
+  // to them and NumericalError is thrown, as fit() would.
+  void after_edit(std::size_t index, const std::function<void()>& undo) {
+    constexpr double kBoundJump = 100.0;
     ++edits;
     ++edits_since_check;
     solve_weights(0);
-    if (opt.drift_check_interval && edits_since_check >= opt.drift_check_interval) drift_check();
+    const double jump = condition_bound() / base_bound;
+    const bool moved = !(jump <= kBoundJump && jump >= 1.0 / kBoundJump);
+    if (!moved && !(opt.drift_check_interval && edits_since_check >= opt.drift_check_interval)) {
+      rep.condition_estimate = base_condition * jump;
+      finish_report(std::numeric_limits<double>::quiet_NaN());
+      return;
+    }
+    drift_check(moved);
+    if (!(rep.relative_residual > opt.fail_residual)) return;
+    const double rel = rep.relative_residual, cond = rep.condition_estimate;
+    undo();
+    --edits;
+    load_positions();
+    factor_from_scratch();
+    solve_weights(2);
+    fit_residual = rep.relative_residual;
+    throw NumericalError("edit of constraint " + std::to_string(index) + " refused: the RBF fit would fail " +
+                         "(relative residual " + fmt(rel) + " > " + fmt(opt.fail_residual) +
+                         ", condition estimate " + fmt(cond) +
+                         "): nearly coincident constraints with different values?");
   }
 
-  // Returns true when a refit from scratch was needed.
-  bool drift_check() {
+  // Measures the residual (with iterative refinement) and refits from scratch when it drifted; with
+  // `estimate_condition`, also re-estimates the condition number of the current factor (Hager, O(n^2)),
+  // otherwise extrapolates the last estimate by the cheap bound. Returns true after a refit.
+  bool drift_check(bool estimate_condition) {
     edits_since_check = 0;
-    solve_weights(2);
-    double diag_min = std::numeric_limits<double>::infinity(), diag_max = 0;
-    for (std::size_t s = 0; s < n; ++s) {
-      const double d = L(static_cast<Eigen::Index>(s), static_cast<Eigen::Index>(s));
-      diag_min = std::min(diag_min, d);
-      diag_max = std::max(diag_max, d);
+    const double bound = condition_bound();
+    if (estimate_condition) {
+      base_condition = k_norm1() * inverse_norm1_estimate();
+      base_bound = bound;
     }
-    if (n) rep.condition_estimate = (diag_max / diag_min) * (diag_max / diag_min);
+    rep.condition_estimate = base_condition * (bound / base_bound);
+    solve_weights(2);
     // Rounding in the evaluation bounds the residual of a fresh fit too: drift is measured against it.
     if (rep.relative_residual <= std::max(opt.warn_residual, 10.0 * fit_residual)) return false;
     factor_from_scratch();
@@ -708,6 +782,51 @@ struct Rbf::Impl {
     fit_residual = rep.relative_residual;
     ++refits;
     return true;
+  }
+
+  // Moves anchor i to p when no other constraint can replace it (all non-anchors on the plane of the
+  // other three anchors, e.g. N = 4): the new position is appended first as a temporary constraint,
+  // becomes the replacement anchor if it lies off that plane, and then the old position is deleted and
+  // the temporary takes index i. O(N^2). Throws InvalidPoint(i) (state unchanged) when the moved set
+  // would be coplanar or numerically singular.
+  void move_anchor_by_append(std::size_t i, int k, const Point3& p) {
+    const std::size_t t = cx.size();
+    const Point3 sp = scaled(p);
+    cons.add(p, cons.values[i]);
+    cx.push_back(sp.x), cy.push_back(sp.y), cz.push_back(sp.z), w.push_back(0.0);
+    lam.emplace_back(), aa.emplace_back(), gg.emplace_back();
+    auto drop_last = [this] {
+      cons.points.pop_back(), cons.values.pop_back();
+      cx.pop_back(), cy.pop_back(), cz.pop_back(), w.pop_back();
+      lam.pop_back(), aa.pop_back(), gg.pop_back();
+    };
+    basis_row(t, anchor_kernel());
+    if (!append_slot(t)) {
+      drop_last();
+      throw InvalidPoint(i,
+                         "moving this constraint makes the RBF system numerically singular (too close to "
+                         "other constraints?)");
+    }
+    slot_of.push_back(n - 1);
+    if (anchor_replacement(k) == kNoSlot) {
+      delete_slot(n - 1);  // the last slot: the factor is restored exactly
+      drop_last();
+      rebuild_slots();
+      throw InvalidPoint(i,
+                         "moving this constraint there leaves all constraints coplanar: the linear "
+                         "polynomial would be undetermined");
+    }
+    swap_anchor(k);
+    delete_slot(slot_of[i]);
+    cons.points[i] = p;
+    cx[i] = cx[t], cy[i] = cy[t], cz[i] = cz[t];
+    lam[i] = lam[t], aa[i] = aa[t], gg[i] = gg[t];
+    for (auto& o : order)
+      if (o == t) o = i;
+    for (auto& a : anchor)
+      if (a == t) a = i;
+    drop_last();
+    rebuild_slots();
   }
 
   void check_new_point(const Point3& p, double v, std::size_t index, std::size_t skip) const {
@@ -872,7 +991,7 @@ void Rbf::add_constraint(const Point3& p, double value) {
                        "other constraints?)");
   }
   m.slot_of.push_back(m.n - 1);
-  m.after_edit();
+  m.after_edit(i, [&m] { m.cons.points.pop_back(), m.cons.values.pop_back(); });
 }
 
 void Rbf::remove_constraint(std::size_t i) {
@@ -897,6 +1016,8 @@ void Rbf::remove_constraint(std::size_t i) {
   }
   for (int k = 0; k < 4; ++k)
     if (m.anchor[static_cast<std::size_t>(k)] == i) m.swap_anchor(k);  // throws when coplanar
+  const Point3 old_point = m.cons.points[i];
+  const double old_value = m.cons.values[i];
   m.delete_slot(m.slot_of[i]);
   auto erase = [i](auto& v) { v.erase(v.begin() + static_cast<std::ptrdiff_t>(i)); };
   erase(m.cons.points), erase(m.cons.values), erase(m.cx), erase(m.cy), erase(m.cz), erase(m.w);
@@ -906,7 +1027,10 @@ void Rbf::remove_constraint(std::size_t i) {
   for (auto& a : m.anchor)
     if (a > i) --a;
   m.rebuild_slots();
-  m.after_edit();
+  m.after_edit(i, [&m, i, old_point, old_value] {
+    m.cons.points.insert(m.cons.points.begin() + static_cast<std::ptrdiff_t>(i), old_point);
+    m.cons.values.insert(m.cons.values.begin() + static_cast<std::ptrdiff_t>(i), old_value);
+  });
 }
 
 void Rbf::move_constraint(std::size_t i, const Point3& p) {
@@ -921,9 +1045,17 @@ void Rbf::move_constraint(std::size_t i, const Point3& p) {
     fit(c, m.opt);
     return;
   }
-  for (int k = 0; k < 4; ++k)
-    if (m.anchor[static_cast<std::size_t>(k)] == i) m.swap_anchor(k);
   const Point3 old = m.cons.points[i];
+  auto undo = [&m, i, old] { m.cons.points[i] = old; };
+  for (int k = 0; k < 4; ++k) {
+    if (m.anchor[static_cast<std::size_t>(k)] != i) continue;
+    if (m.anchor_replacement(k) == kNoSlot) {  // the other constraints are coplanar
+      m.move_anchor_by_append(i, k, p);
+      m.after_edit(i, undo);
+      return;
+    }
+    m.swap_anchor(k);
+  }
   m.delete_slot(m.slot_of[i]);
   m.cons.points[i] = p;
   const Point3 s = m.scaled(p);
@@ -940,7 +1072,7 @@ void Rbf::move_constraint(std::size_t i, const Point3& p) {
                        "other constraints?)");
   }
   m.rebuild_slots();
-  m.after_edit();
+  m.after_edit(i, undo);
 }
 
 void Rbf::set_value(std::size_t i, double value) {
@@ -955,18 +1087,21 @@ void Rbf::set_value(std::size_t i, double value) {
     if (!nonzero)
       throw InvalidArgument("setting value " + std::to_string(i) + " to 0 would make all values zero");
   }
-  m.cons.values[i] = value;
-  if (m.opt.solver == RbfSolver::FullLu) {
-    fit(Constraints(m.cons), m.opt);
+  if (m.opt.solver == RbfSolver::FullLu) {  // a failed refit leaves everything unchanged
+    Constraints c = m.cons;
+    c.values[i] = value;
+    fit(c, m.opt);
     return;
   }
-  m.after_edit();
+  const double old = m.cons.values[i];
+  m.cons.values[i] = value;
+  m.after_edit(i, [&m, i, old] { m.cons.values[i] = old; });
 }
 
 bool Rbf::check_drift() {
   impl_->require_fitted();
   if (impl_->opt.solver == RbfSolver::FullLu) return false;
-  return impl_->drift_check();
+  return impl_->drift_check(true);
 }
 
 void Rbf::refit() {

@@ -83,17 +83,23 @@ struct RbfOptions {
 struct FitReport {
   std::size_t constraints = 0;  ///< N.
   /// max_i |f(c_i) - h_i| / max_i |h_i|, evaluated with the final weights (the same code path as value()).
-  /// NaN after an edit until the next drift check (edits do not measure it; see check_drift()).
+  /// NaN after an edit until the next drift check (see check_drift()), except after an edit that moved
+  /// the conditioning (see condition_estimate), which measures it at once.
   double relative_residual = 0.0;
   /// |sum w| + |sum w c| relative to sum |w| |c|-scale: how well the side conditions hold (scaled coords).
   double side_condition_residual = 0.0;
   /// Estimate of the 1-norm condition number of the reduced SPD system (scaled coordinates). 0 for the
-  /// FullLu solver. After edits: a cheap lower bound (max / min diagonal of the Cholesky factor)^2.
+  /// FullLu solver. After edits: the last full estimate scaled by the change of a cheap O(N) lower bound
+  /// (largest diagonal entry of the system over the smallest squared pivot of its Cholesky factor). When
+  /// an edit moves that bound by more than a factor 100 either way (e.g. a near-duplicate point added or
+  /// removed), the condition is re-estimated and the residual measured (drift check) right away, so the
+  /// report says what a fresh fit of the edited constraints would.
   double condition_estimate = 0.0;
   /// Iterative refinement steps applied by the last fit or drift check.
   int refinement_steps = 0;
   /// True when relative_residual > warn_residual or condition_estimate > warn_condition: the function
-  /// may not interpolate the data accurately (near-duplicate points, extreme scales).
+  /// may not interpolate the data accurately (near-duplicate points, extreme scales). After an edit that
+  /// did not measure the residual, the residual of the last measurement is used.
   bool warning = false;
   /// Human-readable summary, empty when !warning.
   std::string message;
@@ -160,6 +166,9 @@ class Rbf : public ImplicitFunction {
   Point3 polynomial_linear() const;
 
   // ----- edits: each O(N^2), keeping the Cholesky factor up to date -----
+  // Every edit also throws NumericalError when the edited set cannot be fitted (relative residual above
+  // fail_residual even after a refit from scratch, as fit() would throw); the function is then refitted
+  // to the constraints before the edit. Other errors leave the function exactly unchanged.
   /// Appends the constraint f(p) = value; it gets index size() - 1.
   /// @throws InvalidPoint (index size()) for non-finite data or a (near-)duplicate of an existing point.
   void add_constraint(const Point3& p, double value);
@@ -167,7 +176,10 @@ class Rbf : public ImplicitFunction {
   /// @throws InvalidPoint when i >= size(); InvalidArgument when fewer than 4 non-coplanar constraints
   ///         or only zero values would remain (the function is then left unchanged).
   void remove_constraint(std::size_t i);
-  /// Moves constraint i to p, keeping its value and index. Same errors as add_constraint (index i).
+  /// Moves constraint i to p, keeping its value and index. Same errors as add_constraint (index i), and
+  /// InvalidPoint(i) when all constraints would then be coplanar. Succeeds exactly when a fresh fit of the
+  /// moved set would (up to the coplanarity tolerance), also when every other constraint is coplanar
+  /// (e.g. N = 4).
   void move_constraint(std::size_t i, const Point3& p);
   /// Sets the value of constraint i. @throws InvalidPoint for a non-finite value or i out of range;
   /// InvalidArgument when every value would be zero.

@@ -101,8 +101,11 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
     }
   }
   const std::size_t per = opt.sides == OffSurface::Both ? 3 : 2;
+  if (opt.max_constraints && opt.max_constraints < per)
+    throw InvalidArgument("max_constraints " + std::to_string(opt.max_constraints) + " is smaller than the " +
+                          std::to_string(per) + " constraints made per surface point (0 means no limit)");
   if (opt.max_constraints) {
-    const std::size_t m = std::max<std::size_t>(opt.max_constraints / per, 1);
+    const std::size_t m = opt.max_constraints / per;
     if (keep.size() > m) {
       std::uint64_t state = opt.seed;
       for (std::size_t i = 0; i < m; ++i) {  // partial Fisher-Yates
@@ -209,13 +212,21 @@ Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixX
   std::vector<bool> used(static_cast<std::size_t>(V.rows()), false);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(F(f, k))] = true;
+  // Validated here, so that errors name the mesh's own vertex numbers (the builder below sees the
+  // referenced vertices only, renumbered).
+  // Coordinates first: one non-finite vertex spoils the normals of its neighbours.
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (used[static_cast<std::size_t>(i)] && !V.row(i).allFinite())
+      throw InvalidPoint(static_cast<std::size_t>(i), "mesh vertex with a non-finite coordinate");
   std::vector<Point3> p, n;
   for (Eigen::Index i = 0; i < V.rows(); ++i) {
     if (!used[static_cast<std::size_t>(i)]) continue;
+    const auto vi = static_cast<std::size_t>(i);
     p.push_back({V(i, 0), V(i, 1), V(i, 2)});
     n.push_back({N(i, 0), N(i, 1), N(i, 2)});
-    if (!(norm(n.back()) > 0))
-      throw InvalidPoint(static_cast<std::size_t>(i), "mesh vertex with a zero area-weighted normal");
+    if (!is_finite(n.back()))
+      throw InvalidPoint(vi, "mesh vertex with a non-finite area-weighted normal (coordinates too large?)");
+    if (!(norm(n.back()) > 0)) throw InvalidPoint(vi, "mesh vertex with a zero area-weighted normal");
   }
   return constraints_from_oriented_points(p, n, options);
 }

@@ -120,6 +120,24 @@ TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary an
   Eigen::MatrixXi H = F;
   H.row(0) << 0, 1, 2;
   CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, H), Catch::Contains("same direction"));
+  // Errors about a vertex name its row in V, unreferenced vertices included (row 0 here).
+  Eigen::MatrixXd W(5, 3);
+  W << 9, 9, 9, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  const Eigen::MatrixXi G1 = F.array() + 1;
+  CHECK(constraints_from_mesh(W, G1).size() == 12);
+  W(3, 1) = std::nan("");
+  try {
+    constraints_from_mesh(W, G1);
+    FAIL("no exception");
+  } catch (const InvalidPoint& e) {
+    CHECK(e.index() == 3);
+    CHECK_THAT(e.what(), Catch::Contains("non-finite coordinate"));
+  }
+  ConstraintBuildOptions two;
+  two.max_constraints = 2;  // fewer than the 3 constraints of a single point
+  CHECK_THROWS_WITH(constraints_from_mesh(V, F, two), Catch::Contains("smaller than the 3 constraints"));
+  two.sides = OffSurface::Outside;
+  CHECK(constraints_from_mesh(V, F, two).size() == 2);  // 1 point x 2
   const TriangleMesh pig = read_mesh(kData + "/pig.off");
   CHECK_THROWS_WITH(constraints_from_mesh(pig.V, pig.F),
                     Catch::Contains("boundary") && Catch::Contains("edge ("));
@@ -145,12 +163,24 @@ TEST_CASE("rbf on real models: ~0 on the surface, < 0 inside, > 0 outside", "[rb
   // the vast majority, and has the right sign half an offset inside and outside.
   const Eigen::MatrixXd N = closed_mesh_vertex_normals(m.V, m.F);
   const Check k = check_vertices(f, m.V, N, d);
-  CHECK(k.near_ok >= k.total * 90 / 100);
-  CHECK(k.inside_ok >= k.total * 80 / 100);
-  CHECK(k.outside_ok >= k.total * 80 / 100);
-  // Far away: positive. Volume centroid of the models with a bulky body: negative.
+  // Per-model floors, 0.4-1.1 points below what this fit gives (percent of the vertices: near / inside /
+  // outside = hand 91.5 / 86.6 / 83.9, bunny 96.5 / 92.4 / 90.7, cactus 99.5 / 97.1 / 94.0); only 250
+  // of the surface points are constraints, so fine detail (fingers, ears) is smoothed over.
+  const std::size_t floors[3] = {name == "hand.off"    ? 91u
+                                 : name == "bunny.off" ? 96u
+                                                       : 99u,
+                                 name == "hand.off"    ? 86u
+                                 : name == "bunny.off" ? 92u
+                                                       : 96u,
+                                 name == "hand.off"    ? 83u
+                                 : name == "bunny.off" ? 90u
+                                                       : 93u};
+  CHECK(k.near_ok * 100 >= k.total * floors[0]);
+  CHECK(k.inside_ok * 100 >= k.total * floors[1]);
+  CHECK(k.outside_ok * 100 >= k.total * floors[2]);
+  // Far away: positive. Volume centroid: clearly negative (hand -0.068, 4.4 offsets d inside).
   for (int corner = 0; corner < 8; ++corner) CHECK(f.value(box.scaled(3.0).corner(corner)) > 0);
-  if (name != "hand.off") CHECK(f.value(volume_centroid(m)) < 0);
+  CHECK(f.value(volume_centroid(m)) < -d);
 }
 
 TEST_CASE("rbf on sphere926.pwn: a sphere, negative at its center", "[rbf][data]") {

@@ -32,6 +32,7 @@ struct ConstraintBuildOptions {
   OffSurface sides = OffSurface::Both;
   /// At most this many constraints in total (0: no limit). Surface points are subsampled uniformly at
   /// random (without replacement, input order kept) to floor(max_constraints / per-point count).
+  /// A nonzero value below the per-point count (3 for Both, 2 otherwise) is refused (InvalidArgument).
   std::size_t max_constraints = 0;
   /// Seed of the subsampling (deterministic on every platform: splitmix64, no std distributions).
   std::uint64_t seed = 1;
@@ -40,8 +41,8 @@ struct ConstraintBuildOptions {
 /// Constraints from oriented points. Normals need not be unit length (they are normalized) and must
 /// point outwards (f > 0 outside). Exact duplicate positions are merged (the first one is kept).
 /// @throws InvalidPoint (index of the point) for non-finite data or a zero normal; InvalidArgument for
-///         mismatched sizes, an empty input or a missing normal array (points alone do not define an
-///         inside and an outside).
+///         mismatched sizes, an empty input, a missing normal array (points alone do not define an
+///         inside and an outside) or max_constraints below the per-point count.
 Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
                                              const std::vector<Point3>& normals,
                                              const ConstraintBuildOptions& options = {});
@@ -55,7 +56,9 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
 Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
 
 /// Constraints from a closed triangle mesh: its referenced vertices with closed_mesh_vertex_normals(),
-/// then constraints_from_oriented_points(). Same errors as both.
+/// then constraints_from_oriented_points(). Same errors as both; InvalidPoint carries the mesh's own
+/// vertex index (row of V, unreferenced vertices included) for a non-finite coordinate or a zero or
+/// non-finite normal.
 Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                   const ConstraintBuildOptions& options = {});
 

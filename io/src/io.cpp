@@ -152,11 +152,13 @@ OrientedPoints parse_points(std::string_view text, const std::string& name, bool
   OrientedPoints p;
   std::size_t columns = 0;
   long long declared = -1;
+  std::size_t declared_line = 0;
   bool first = true;
   while (s.next_data_line()) {
     const std::size_t nt = s.tokens().size();
     if (first && nt == 1) {  // optional point count
       declared = s.integer(0, 0, std::numeric_limits<long long>::max());
+      declared_line = s.line();
       first = false;
       continue;
     }
@@ -176,7 +178,7 @@ OrientedPoints parse_points(std::string_view text, const std::string& name, bool
   }
   if (p.points.empty()) throw ParseError(name, 0, "no point in file");
   if (declared >= 0 && static_cast<std::size_t>(declared) != p.points.size())
-    throw ParseError(name, 1,
+    throw ParseError(name, declared_line,
                      "header declares " + std::to_string(declared) + " points, file has " +
                          std::to_string(p.points.size()));
   return p;

@@ -270,6 +270,12 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
                  std::to_string(e.count));
       }
       std::size_t tok = 0;
+      // Errors inside a record: line number in ascii; line 0 and a byte offset in binary.
+      const std::size_t record_at = binary ? br.offset() : 0;
+      auto fail_at = [&](const std::string& what, std::size_t byte) {
+        if (binary) throw ParseError(name, 0, what + " at byte offset " + std::to_string(byte));
+        throw ParseError(name, s.line(), what);
+      };
       auto next_value = [&](PlyType t, bool integer_only) -> double {
         if (binary) return br.read(t, e.name.c_str(), r);
         if (tok >= s.tokens().size())
@@ -288,22 +294,24 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
         }
         const double cnt = next_value(p.count_type, true);
         if (cnt < 0 || cnt > 1e6)
-          throw ParseError(name, binary ? 0 : s.line(),
-                           e.name + " " + std::to_string(r) + ": invalid list length " +
-                               std::to_string(static_cast<long long>(cnt)));
+          fail_at(e.name + " " + std::to_string(r) + ": invalid list length " +
+                      std::to_string(static_cast<long long>(cnt)),
+                  record_at);
         const auto c = static_cast<std::size_t>(cnt);
         if (binary && c * type_size(p.type) > br.left())
-          throw ParseError(name, 0,
-                           e.name + " " + std::to_string(r) + ": list of " + std::to_string(c) +
-                               " items runs past the end of the file");
+          fail_at(e.name + " " + std::to_string(r) + ": list of " + std::to_string(c) + " items (" +
+                      std::to_string(c * type_size(p.type)) + " bytes) runs past the end of the file (" +
+                      std::to_string(br.left()) + " bytes left)",
+                  br.offset());
         for (std::size_t j = 0; j < c; ++j) {
+          const std::size_t item_at = binary ? br.offset() : 0;
           const double val = next_value(p.type, false);
           if (is_f && static_cast<int>(k) == ilist) {
             if (val < 0 || val >= static_cast<double>(ve->count))
-              throw ParseError(name, binary ? 0 : s.line(),
-                               "face " + std::to_string(r) + ": vertex index " +
-                                   std::to_string(static_cast<long long>(val)) + " out of range (" +
-                                   std::to_string(ve->count) + " vertices)");
+              fail_at("face " + std::to_string(r) + ": vertex index " +
+                          std::to_string(static_cast<long long>(val)) + " out of range (" +
+                          std::to_string(ve->count) + " vertices)",
+                      item_at);
             poly.push_back(static_cast<int>(val));
           }
         }
@@ -315,17 +323,20 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
         for (int k : {ix, iy, iz}) {
           const double x = rec[static_cast<std::size_t>(k)];
           if (!std::isfinite(x))
-            throw ParseError(name, binary ? 0 : s.line(),
-                             "vertex " + std::to_string(r) + ": non-finite coordinate");
+            fail_at("vertex " + std::to_string(r) + ": non-finite coordinate", record_at);
           v.push_back(x);
         }
         if (normals)
-          for (int k : {inx, iny, inz}) n.push_back(rec[static_cast<std::size_t>(k)]);
+          for (int k : {inx, iny, inz}) {
+            const double x = rec[static_cast<std::size_t>(k)];
+            if (!std::isfinite(x)) fail_at("vertex " + std::to_string(r) + ": non-finite normal", record_at);
+            n.push_back(x);
+          }
       } else if (is_f) {
         if (poly.size() < 3)
-          throw ParseError(name, binary ? 0 : s.line(),
-                           "face " + std::to_string(r) + " has " + std::to_string(poly.size()) +
-                               " vertices (at least 3 needed)");
+          fail_at("face " + std::to_string(r) + " has " + std::to_string(poly.size()) +
+                      " vertices (at least 3 needed)",
+                  record_at);
         for (std::size_t k = 1; k + 1 < poly.size(); ++k) {
           tris.push_back(poly[0]);
           tris.push_back(poly[k]);

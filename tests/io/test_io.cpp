@@ -227,3 +227,32 @@ TEST_CASE("io regression corpus: every file parses or throws vitri::Error", "[io
   closedir(d);
   CHECK(files >= 40);
 }
+
+TEST_CASE("io regression corpus: what the hand-written error files report", "[io][corpus][errors]") {
+  const std::string dir = std::string(VITRI_TESTS_DIR) + "/io/corpus/";
+  // Runs read_input on a corpus file that must be refused; returns the error.
+  auto refused = [&](const std::string& name) -> ParseError {
+    try {
+      (void)read_input(dir + name);
+    } catch (const ParseError& e) {
+      return e;
+    }
+    FAIL(name << " was accepted");
+    return ParseError("", 0, "");
+  };
+  // Binary PLY: line 0 and the byte offset (169 header bytes + one 12-byte vertex + the list count).
+  const ParseError overrun = refused("ply_binary_list_overrun.ply");
+  CHECK(overrun.line() == 0);
+  CHECK_THAT(overrun.what(), Catch::Contains("list of 255 items") && Catch::Contains("runs past the end") &&
+                                 Catch::EndsWith("at byte offset 182"));
+  // Non-finite normals are refused like non-finite coordinates (record at 249 header bytes + 2 x 24).
+  const ParseError nan_normal = refused("ply_binary_nan_normal.ply");
+  CHECK(nan_normal.line() == 0);
+  CHECK_THAT(nan_normal.what(),
+             Catch::Contains("vertex 2: non-finite normal") && Catch::EndsWith("at byte offset 297"));
+  CHECK_THAT(refused("ply_binary_inf_normal.ply").what(), Catch::Contains("vertex 1: non-finite normal"));
+  // A point count after comment lines: the error names the count's own line.
+  const ParseError count = refused("xyz_count_after_comments.xyz");
+  CHECK(count.line() == 4);
+  CHECK_THAT(count.what(), Catch::Contains("declares 5 points, file has 3"));
+}

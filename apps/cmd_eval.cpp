@@ -6,9 +6,14 @@
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/rbf.hpp"
 
+#include <charconv>
+#include <cstdint>
 #include <cstdio>
 #include <iostream>
+#include <limits>
 #include <string>
+#include <system_error>
+#include <type_traits>
 
 namespace vitri::cli {
 
@@ -23,6 +28,21 @@ double parse_number(const std::string& flag, const std::string& s) {
     used = 0;
   }
   if (used != s.size()) throw InvalidArgument(flag + ": not a number: '" + s + "'");
+  return v;
+}
+
+// A non-negative decimal integer (no sign, no fraction, no exponent) that fits in T.
+template <typename T>
+T parse_unsigned(const std::string& flag, const std::string& s) {
+  static_assert(std::is_unsigned<T>::value, "unsigned types only");
+  T v = 0;
+  const char* end = s.data() + s.size();
+  const auto r = std::from_chars(s.data(), end, v);
+  if (r.ec == std::errc::result_out_of_range)
+    throw InvalidArgument(flag + ": '" + s + "' is too large (at most " +
+                          std::to_string(std::numeric_limits<T>::max()) + ")");
+  if (s.empty() || r.ec != std::errc() || r.ptr != end)
+    throw InvalidArgument(flag + ": not a non-negative integer: '" + s + "'");
   return v;
 }
 
@@ -60,9 +80,9 @@ int run_eval(const Args& args) {
     else if (a == "--offset")
       opt.offset = parse_number(a, value());
     else if (a == "--max-constraints")
-      opt.max_constraints = static_cast<std::size_t>(parse_number(a, value()));
+      opt.max_constraints = parse_unsigned<std::size_t>(a, value());
     else if (a == "--seed")
-      opt.seed = static_cast<std::uint64_t>(parse_number(a, value()));
+      opt.seed = parse_unsigned<std::uint64_t>(a, value());
     else if (!a.empty() && a[0] == '-') {
       std::cerr << "vitri eval: unknown option '" << a << "'\n";
       return 2;
@@ -101,7 +121,8 @@ const char* eval_usage() {
          "       .off / .obj / .ply (vertex normals area-weighted, oriented outwards).\n"
          "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal "
          "(0.01)\n"
-         "  --max-constraints N  subsample points / vertices to at most N constraints (0: all)\n"
+         "  --max-constraints N  subsample points / vertices to at most N constraints (0: all; else at\n"
+         "                       least the 3 constraints made per point)\n"
          "  --seed S             seed of the subsampling (1)\n";
 }
 

@@ -3,6 +3,8 @@
 // message naming the file and line; usage errors exit with 2.
 #include <catch2/catch.hpp>
 
+#include <sys/wait.h>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -10,7 +12,6 @@
 #include <random>
 #include <sstream>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 namespace {
@@ -33,7 +34,9 @@ int run(const std::string& args, std::string& out, std::string& err) {
   return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
 }
 
-double linear(double x, double y, double z) { return 0.5 + x + 2 * y - z; }
+double linear(double x, double y, double z) {
+  return 0.5 + x + 2 * y - z;
+}
 
 }  // namespace
 
@@ -93,4 +96,108 @@ TEST_CASE("vitri eval usage errors", "[cli][eval]") {
   CHECK(run(kDir + "/does_not_exist.xyzv --at " + kDir + "/also_missing.xyz", out, err) == 1);
   CHECK(err.find("does_not_exist.xyzv") != std::string::npos);
   CHECK(run("", out, err) == 2);  // no input, no --at
+}
+
+namespace {
+
+// Parses `vitri eval` output: one `f gx gy gz` line per query point.
+std::vector<std::array<double, 4>> parse_eval(const std::string& out) {
+  std::vector<std::array<double, 4>> rows;
+  std::istringstream lines(out);
+  std::array<double, 4> r{};
+  while (lines >> r[0] >> r[1] >> r[2] >> r[3]) rows.push_back(r);
+  return rows;
+}
+
+// A closed octahedron |x| + |y| + |z| = 1 (outward winding), optionally without its last triangle.
+void write_octahedron(const std::string& path, bool open) {
+  std::ofstream o(path);
+  o << "OFF\n6 " << (open ? 7 : 8) << " 0\n1 0 0\n-1 0 0\n0 1 0\n0 -1 0\n0 0 1\n0 0 -1\n";
+  const int tri[8][3] = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                         {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  for (int t = 0; t < (open ? 7 : 8); ++t)
+    o << "3 " << tri[t][0] << ' ' << tri[t][1] << ' ' << tri[t][2] << '\n';
+}
+
+}  // namespace
+
+TEST_CASE("vitri eval fits a closed mesh and oriented points: negative inside, positive outside",
+          "[cli][eval]") {
+  const std::string query = kDir + "/eval_query_sign.xyz";
+  {
+    std::ofstream f(query);
+    f << "0 0 0\n5 0 0\n1 0 0\n";  // center, far away, a vertex
+  }
+  std::string out, err;
+  SECTION("mesh (.off)") {
+    const std::string mesh = kDir + "/eval_octahedron.off";
+    write_octahedron(mesh, false);
+    REQUIRE(run(mesh + " --at " + query, out, err) == 0);
+    const auto r = parse_eval(out);
+    REQUIRE(r.size() == 3);
+    CHECK(r[0][0] < 0);
+    CHECK(r[1][0] > 0);
+    CHECK(std::abs(r[2][0]) <= 1e-9);  // the vertex is a constraint with value 0
+    CHECK(r[2][1] > 0);                // gradient points outwards (+x at (1, 0, 0))
+  }
+  SECTION("oriented points (.pwn), subsampled") {
+    // sphere926.pwn: 926 points on the sphere of radius 10 around the origin, outward normals.
+    const std::string q = kDir + "/eval_query_sphere.xyz";
+    {
+      std::ofstream f(q);
+      f << "0 0 0\n30 0 0\n10 0 0\n";  // center, far away, on the sphere
+    }
+    const std::string args =
+        std::string(VITRI_DATA_DIR) + "/sphere926.pwn --max-constraints 300 --seed 5 --at " + q;
+    REQUIRE(run(args, out, err) == 0);
+    const auto r = parse_eval(out);
+    REQUIRE(r.size() == 3);
+    CHECK(r[0][0] < 0);
+    CHECK(r[1][0] > 0);
+    CHECK(std::abs(r[2][0]) <= 0.1);  // 1% of the radius: most surface points are not constraints
+    CHECK(r[2][1] > 0);               // gradient points outwards
+    std::string out2;
+    REQUIRE(run(args, out2, err) == 0);
+    CHECK(out2 == out);  // the subsample is deterministic
+  }
+}
+
+TEST_CASE("vitri eval refuses inputs without an inside and bad option values", "[cli][eval][errors]") {
+  const std::string query = kDir + "/eval_query_refuse.xyz";
+  {
+    std::ofstream f(query);
+    f << "0 0 0\n";
+  }
+  std::string out, err;
+  const std::string points = kDir + "/eval_points3.xyz";
+  {
+    std::ofstream p(points);
+    p << "0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 1\n";
+  }
+  CHECK(run(points + " --at " + query, out, err) == 1);
+  CHECK(err.find("eval_points3.xyz") != std::string::npos);
+  CHECK(err.find("without normals") != std::string::npos);
+  CHECK(out.empty());
+
+  const std::string open = kDir + "/eval_open_octahedron.off";
+  write_octahedron(open, true);
+  CHECK(run(open + " --at " + query, out, err) == 1);
+  CHECK(err.find("boundary") != std::string::npos);
+  CHECK(err.find("edge (") != std::string::npos);
+  CHECK(out.empty());
+
+  const std::string mesh = kDir + "/eval_octahedron_opts.off";
+  write_octahedron(mesh, false);
+  for (const char* bad : {"--max-constraints -3", "--max-constraints 2.5", "--max-constraints 1e3",
+                          "--seed -1", "--seed 0x10", "--max-constraints ''"}) {
+    INFO(bad);
+    CHECK(run(mesh + " " + bad + " --at " + query, out, err) == 1);
+    CHECK(err.find("not a non-negative integer") != std::string::npos);
+    CHECK(out.empty());
+  }
+  CHECK(run(mesh + " --seed 99999999999999999999999 --at " + query, out, err) == 1);
+  CHECK(err.find("too large") != std::string::npos);
+  CHECK(run(mesh + " --max-constraints 2 --at " + query, out, err) == 1);
+  CHECK(err.find("smaller than the 3 constraints made per surface point") != std::string::npos);
+  CHECK(run(mesh + " --max-constraints 18 --seed 3 --at " + query, out, err) == 0);  // all 6 vertices x 3
 }

@@ -180,8 +180,8 @@ void BM_insphere_cgal(benchmark::State& s, Input in) {
            [&](const KP* p) { return static_cast<int>(o(p[0], p[1], p[2], p[3], p[4])); });
 }
 
-// Counts sign disagreements between vitri and CGAL on every dataset (expected: none).
-void check_agreement_with_cgal() {
+// Counts sign disagreements between vitri and CGAL on every dataset (expected: none); returns the count.
+std::size_t check_agreement_with_cgal() {
   const auto o = K().orientation_3_object();
   const auto s = K().side_of_oriented_sphere_3_object();
   CgalDelaunay dt;
@@ -212,6 +212,7 @@ void check_agreement_with_cgal() {
   }
   std::printf("agreement with CGAL: %zu sign mismatches in %zu calls (%zu decided by the perturbation)\n",
               mismatches, calls, perturbed);
+  return mismatches;
 }
 #endif
 
@@ -277,21 +278,26 @@ void interleaved_ratios() {
         cgal_sphere_data(Input::Random),
         [&](const KP* p) { return static_cast<int>(cgal_sphere(p[0], p[1], p[2], p[3], p[4])); }, i_cgal);
 #endif
-    min_pass_ns(od, [](const Point3* p) { return sgn(vitri::orient3d_fast(p[0], p[1], p[2], p[3])); }, o_plain);
-    min_pass_ns(od, [](const Point3* p) { return vitri::to_int(vitri::orient3d(p[0], p[1], p[2], p[3])); }, o_filt);
-    min_pass_ns(sd, [](const Point3* p) { return sgn(vitri::insphere_fast(p[0], p[1], p[2], p[3], p[4])); },
-                i_plain);
-    min_pass_ns(sd, [](const Point3* p) { return vitri::to_int(vitri::insphere(p[0], p[1], p[2], p[3], p[4])); },
-                i_filt);
-    min_pass_ns(sd,
-                [](const Point3* p) { return vitri::to_int(vitri::insphere_sos(p[0], p[1], p[2], p[3], p[4])); },
-                i_sos);
+    min_pass_ns(
+        od, [](const Point3* p) { return sgn(vitri::orient3d_fast(p[0], p[1], p[2], p[3])); }, o_plain);
+    min_pass_ns(
+        od, [](const Point3* p) { return vitri::to_int(vitri::orient3d(p[0], p[1], p[2], p[3])); }, o_filt);
+    min_pass_ns(
+        sd, [](const Point3* p) { return sgn(vitri::insphere_fast(p[0], p[1], p[2], p[3], p[4])); }, i_plain);
+    min_pass_ns(
+        sd, [](const Point3* p) { return vitri::to_int(vitri::insphere(p[0], p[1], p[2], p[3], p[4])); },
+        i_filt);
+    min_pass_ns(
+        sd, [](const Point3* p) { return vitri::to_int(vitri::insphere_sos(p[0], p[1], p[2], p[3], p[4])); },
+        i_sos);
   }
   std::printf("\ninterleaved, fastest of %d passes over %zu random tuples (ns per call)\n", kRounds, kTuples);
-  std::printf("orient3d  plain %6.2f  filtered %6.2f  filtered/plain %5.2f  CGAL %6.2f  CGAL/filtered %5.2f\n",
-              o_plain, o_filt, o_filt / o_plain, o_cgal, o_cgal / o_filt);
-  std::printf("insphere  plain %6.2f  filtered %6.2f  filtered/plain %5.2f  CGAL %6.2f  CGAL/filtered %5.2f\n",
-              i_plain, i_filt, i_filt / i_plain, i_cgal, i_cgal / i_filt);
+  std::printf(
+      "orient3d  plain %6.2f  filtered %6.2f  filtered/plain %5.2f  CGAL %6.2f  CGAL/filtered %5.2f\n",
+      o_plain, o_filt, o_filt / o_plain, o_cgal, o_cgal / o_filt);
+  std::printf(
+      "insphere  plain %6.2f  filtered %6.2f  filtered/plain %5.2f  CGAL %6.2f  CGAL/filtered %5.2f\n",
+      i_plain, i_filt, i_filt / i_plain, i_cgal, i_cgal / i_filt);
   std::printf("insphere_sos %6.2f  sos/plain %5.2f\n", i_sos, i_sos / i_plain);
 }
 
@@ -314,8 +320,9 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
 #ifdef VITRI_HAVE_CGAL
-  check_agreement_with_cgal();
+  const std::size_t mismatches = check_agreement_with_cgal();
 #else
+  const std::size_t mismatches = 0;
   std::printf("CGAL not found: CGAL comparison skipped\n");
 #endif
   RatioReporter reporter;
@@ -337,5 +344,9 @@ int main(int argc, char** argv) {
   }
   interleaved_ratios();
   benchmark::Shutdown();
+  if (mismatches != 0) {
+    std::fprintf(stderr, "bench_predicates: %zu sign mismatches with CGAL\n", mismatches);
+    return 1;
+  }
   return 0;
 }

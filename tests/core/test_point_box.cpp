@@ -84,3 +84,15 @@ TEST_CASE("Box3::scaled(2) doubles every side about the center", "[box]") {
   CHECK(same.hi == box.hi);
   CHECK(std::abs(big.diagonal() - 2.0 * box.diagonal()) < 1e-12);
 }
+
+TEST_CASE("Box3 Eigen round trip: column 0 is lo, column 1 is hi", "[box]") {
+  const Box3 box{{1, 2, 3}, {4, 6, 8}};
+  const Eigen::Matrix<double, 3, 2> m = box.eigen();
+  CHECK(m(0, 0) == 1);
+  CHECK(m(2, 0) == 3);
+  CHECK(m(1, 1) == 6);
+  const Box3 back = Box3::from(m.col(0), m.col(1));
+  CHECK(back.lo == box.lo);
+  CHECK(back.hi == box.hi);
+  CHECK(Box3::from(Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 1)).empty());
+}

@@ -43,10 +43,20 @@ struct Box3 {
     return {c - h, c + h};
   }
 
-  /// Corner k, k in 0..7: x from bit 0, y from bit 1, z from bit 2 (max when the bit is set).
-  Point3 corner(int k) const {
-    return {(k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z};
+  /// Eigen form: column 0 is lo, column 1 is hi (by value).
+  Eigen::Matrix<double, 3, 2> eigen() const {
+    Eigen::Matrix<double, 3, 2> m;
+    m.col(0) = lo.eigen();
+    m.col(1) = hi.eigen();
+    return m;
   }
+  /// The box [lo, hi] from two Eigen vectors (not reordered: lo > hi on an axis gives an empty box).
+  static Box3 from(const Eigen::Ref<const Eigen::Vector3d>& lo, const Eigen::Ref<const Eigen::Vector3d>& hi) {
+    return {Point3::from(lo), Point3::from(hi)};
+  }
+
+  /// Corner k, k in 0..7: x from bit 0, y from bit 1, z from bit 2 (max when the bit is set).
+  Point3 corner(int k) const { return {(k & 1) ? hi.x : lo.x, (k & 2) ? hi.y : lo.y, (k & 4) ? hi.z : lo.z}; }
 };
 
 }  // namespace vitri

@@ -24,14 +24,30 @@ struct Point3 {
   static Point3 from(const Eigen::Ref<const Eigen::Vector3d>& v) { return {v.x(), v.y(), v.z()}; }
 };
 
-constexpr Point3 operator+(const Point3& a, const Point3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-constexpr Point3 operator-(const Point3& a, const Point3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-constexpr Point3 operator-(const Point3& a) { return {-a.x, -a.y, -a.z}; }
-constexpr Point3 operator*(double s, const Point3& a) { return {s * a.x, s * a.y, s * a.z}; }
-constexpr Point3 operator*(const Point3& a, double s) { return {s * a.x, s * a.y, s * a.z}; }
-constexpr Point3 operator/(const Point3& a, double s) { return {a.x / s, a.y / s, a.z / s}; }
-constexpr bool operator==(const Point3& a, const Point3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
-constexpr bool operator!=(const Point3& a, const Point3& b) { return !(a == b); }
+constexpr Point3 operator+(const Point3& a, const Point3& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+constexpr Point3 operator-(const Point3& a, const Point3& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+constexpr Point3 operator-(const Point3& a) {
+  return {-a.x, -a.y, -a.z};
+}
+constexpr Point3 operator*(double s, const Point3& a) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+constexpr Point3 operator*(const Point3& a, double s) {
+  return {s * a.x, s * a.y, s * a.z};
+}
+constexpr Point3 operator/(const Point3& a, double s) {
+  return {a.x / s, a.y / s, a.z / s};
+}
+constexpr bool operator==(const Point3& a, const Point3& b) {
+  return a.x == b.x && a.y == b.y && a.z == b.z;
+}
+constexpr bool operator!=(const Point3& a, const Point3& b) {
+  return !(a == b);
+}
 
 /// Lexicographic order on (x, y, z): the order used by the symbolic perturbation of the predicates.
 constexpr bool lex_less(const Point3& a, const Point3& b) {
@@ -40,14 +56,24 @@ constexpr bool lex_less(const Point3& a, const Point3& b) {
   return a.z < b.z;
 }
 
-constexpr double dot(const Point3& a, const Point3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr double dot(const Point3& a, const Point3& b) {
+  return a.x * b.x + a.y * b.y + a.z * b.z;
+}
 constexpr Point3 cross(const Point3& a, const Point3& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-constexpr double squared_norm(const Point3& a) { return dot(a, a); }
-inline double norm(const Point3& a) { return std::sqrt(squared_norm(a)); }
-constexpr double squared_distance(const Point3& a, const Point3& b) { return squared_norm(a - b); }
-inline double distance(const Point3& a, const Point3& b) { return std::sqrt(squared_distance(a, b)); }
+constexpr double squared_norm(const Point3& a) {
+  return dot(a, a);
+}
+inline double norm(const Point3& a) {
+  return std::sqrt(squared_norm(a));
+}
+constexpr double squared_distance(const Point3& a, const Point3& b) {
+  return squared_norm(a - b);
+}
+inline double distance(const Point3& a, const Point3& b) {
+  return std::sqrt(squared_distance(a, b));
+}
 
 /// True when all three coordinates are finite (no NaN, no infinity).
 inline bool is_finite(const Point3& a) {

@@ -266,9 +266,9 @@ inline Sign orient2d(const Point3& a, const Point3& b, const Point3& c, int i, i
 /// Symbolically perturbed in-sphere test: never Zero when (a, b, c, d) is not flat.
 ///
 /// Equal to insphere() whenever that is non-zero. Otherwise it is the sign of insphere() on points
-/// lifted to (p, |p|^2 + eps^(4 - rank(p))) for an infinitesimal eps > 0, where rank 0..4 orders the
-/// five points by lex_less (the lexicographically largest point gets the dominant perturbation eps^0
-/// relative to the others): Devillers & Teillaud 2011, "Perturbations for Delaunay and weighted Delaunay
+/// lifted to (p, |p|^2 + eps^(5 - rank(p))) for an infinitesimal eps > 0, where rank 0..4 orders the
+/// five points by lex_less (the lexicographically largest point gets the dominant perturbation eps^1,
+/// the smallest eps^5): Devillers & Teillaud 2011, "Perturbations for Delaunay and weighted Delaunay
 /// 3D triangulations", the same perturbation as CGAL's Delaunay_triangulation_3. Concretely, take the
 /// five points from the lexicographically largest down; for the current point q:
 ///   - q is e: return -orient3d(a, b, c, d);

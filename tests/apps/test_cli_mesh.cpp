@@ -182,17 +182,7 @@ TEST_CASE("vitri mesh: an edit script runs, reports each edit and writes meshes"
 
 TEST_CASE("vitri mesh --sides: outside/inside/both build 2 or 3 constraints per point", "[cli][mesh]") {
   // 64 oriented points on the unit sphere (Fibonacci spiral), outward normals.
-  const std::string in = kDir + "/mesh_sphere.pwn";
-  {
-    std::ofstream p(in);
-    p.precision(17);
-    const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
-    for (int i = 0; i < 64; ++i) {
-      const double z = 1.0 - 2.0 * (i + 0.5) / 64.0, r = std::sqrt(1.0 - z * z), phi = golden * i;
-      const double x = r * std::cos(phi), y = r * std::sin(phi);
-      p << x << ' ' << y << ' ' << z << ' ' << x << ' ' << y << ' ' << z << '\n';
-    }
-  }
+  const std::string in = write_sphere_points("mesh_sphere.pwn", 64);
   std::string o, e;
   const struct {
     const char* sides;

@@ -127,6 +127,19 @@ void vitri_grid(benchmark::State& state) {
     tr.insert_points(pts);
     benchmark::DoNotOptimize(tr.num_tetrahedra());
     state.counters["tets"] = double(tr.num_tetrahedra());
+    // Not timed: the result is checked once (a cospherical grid is where a wrong predicate would show).
+    state.PauseTiming();
+    bool valid = true;
+    try {
+      tr.verify_topology();
+      tr.verify_delaunay();
+    } catch (const std::logic_error& e) {
+      std::fprintf(stderr, "vitri_grid/%d: INVALID: %s\n", n, e.what());
+      valid = false;
+    }
+    state.counters["valid"] = valid ? 1.0 : 0.0;
+    if (!valid) state.SkipWithError("the grid tetrahedralization failed verify_topology/verify_delaunay");
+    state.ResumeTiming();
   }
 }
 BENCHMARK(vitri_grid)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
@@ -212,6 +225,64 @@ void vitri_move1M_small(benchmark::State& state) { vitri_move_impl(state, true);
 void vitri_move1M_far(benchmark::State& state) { vitri_move_impl(state, false); }
 BENCHMARK(vitri_move1M_small)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(vitri_move1M_far)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// ---- churn: history rebuilds ------------------------------------------------------------------------
+// 10^5 points, then 2 x 10^5 far moves of random vertices (or 4 x 10^4 moves of one vertex by 1e-3 x
+// the spacing, with a point inserted next to it and removed every 8 moves, for the "one place"
+// variant): time per move including the amortized history rebuilds, the history
+// depth at random probes afterwards and the bytes per vertex. Arg: history_rebuild_factor x 10 (0 =
+// no rebuild, the behaviour before rebuilds existed).
+void vitri_churn(benchmark::State& state, bool one_place) {
+  const double factor = double(state.range(0)) / 10.0;
+  const std::size_t n = 100000, ops = one_place ? 40000 : 200000;
+  const auto pts = uniform(n, 7);
+  for (auto _ : state) {
+    state.PauseTiming();
+    vitri::TriangulationOptions opt;
+    opt.history_rebuild_factor = factor;
+    vitri::Triangulation tr(kBox, opt);
+    tr.insert_points(pts);
+    std::mt19937_64 rng(8);
+    std::uniform_real_distribution<double> u(0.0, 1.0), d(-1e-5, 1e-5);
+    std::vector<vitri::VertexId> vs(ops);
+    std::vector<Point3> to(ops);
+    for (std::size_t i = 0; i < ops; ++i) {
+      vs[i] = one_place ? vitri::VertexId(8 + n / 2) : vitri::VertexId(8 + rng() % n);
+      to[i] = one_place ? pts[n / 2] + Point3{d(rng), d(rng), d(rng)} : Point3{u(rng), u(rng), u(rng)};
+    }
+    state.ResumeTiming();
+    for (std::size_t i = 0; i < ops; ++i) {
+      benchmark::DoNotOptimize(tr.move(vs[i], to[i]).status);
+      if (one_place && i % 8 == 0) {  // a point located near the edited region, then removed again
+        const vitri::InsertResult r = tr.insert(to[i] + Point3{2e-5, 0.0, 0.0});
+        if (r.status == vitri::InsertStatus::Inserted) tr.remove(r.vertex);
+      }
+    }
+    state.PauseTiming();
+    std::size_t deepest = 0, total = 0;
+    for (int k = 0; k < 1000; ++k) {
+      const Point3 p =
+          one_place ? pts[n / 2] + Point3{d(rng), d(rng), d(rng)} : Point3{u(rng), u(rng), u(rng)};
+      const std::size_t levels = tr.history_path(p).first;
+      deepest = std::max(deepest, levels);
+      total += levels;
+    }
+    state.counters["rebuilds"] = double(tr.history_rebuilds());
+    state.counters["depth_mean"] = double(total) / 1000.0;
+    state.counters["depth_max"] = double(deepest);
+    state.counters["bytes_per_vertex"] = double(tr.memory_total_bytes()) / double(tr.num_vertices());
+    state.ResumeTiming();
+  }
+  state.SetItemsProcessed(state.iterations() * std::int64_t(ops));
+}
+void vitri_churn_far(benchmark::State& state) {
+  vitri_churn(state, false);
+}
+void vitri_churn_one_place(benchmark::State& state) {
+  vitri_churn(state, true);
+}
+BENCHMARK(vitri_churn_far)->Arg(10)->Arg(0)->Unit(benchmark::kMillisecond)->Iterations(1);
+BENCHMARK(vitri_churn_one_place)->Arg(10)->Arg(0)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 #ifdef VITRI_HAVE_CGAL
 CDTFast& cgal_big_fast() {

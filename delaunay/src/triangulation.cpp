@@ -24,7 +24,7 @@
 // * Removal: the hole is the star of v. The tetrahedra filling it in DT(S \ v) are Delaunay for the link
 //   vertices (all in S \ v), so they are exactly the tetrahedra of the perturbed DT(link) inside the hole:
 //   found by gift wrapping from the link faces (fill_hole_by_wrapping). For stars with more than
-//   kMaxWrapLink link vertices: the tetrahedra of DT(link + corners), built in a small scratch
+//   max_wrap_link link vertices: the tetrahedra of DT(link + corners), built in a small scratch
 //   Triangulation over the same box, that a flood fill from a link face reaches without crossing one.
 // * Move: if every tetrahedron of the star stays positive and every face of the star stays locally
 //   Delaunay at the new position, the star is rebuilt with the same combinatorics; otherwise remove then
@@ -208,7 +208,13 @@ struct Triangulation::Scratch {
 Triangulation::Triangulation(const Box3& box) : Triangulation(box, TriangulationOptions{}) {}
 
 Triangulation::Triangulation(const Box3& box, const TriangulationOptions& options)
-    : box_(box), keep_history_(options.keep_history), scratch_(std::make_unique<Scratch>()) {
+    : box_(box),
+      keep_history_(options.keep_history),
+      rebuild_factor_(options.history_rebuild_factor),
+      max_wrap_link_(options.max_wrap_link),
+      scratch_(std::make_unique<Scratch>()) {
+  if (!(rebuild_factor_ >= 0.0))
+    throw InvalidArgument("Triangulation: history_rebuild_factor must be >= 0 (0 disables the rebuild)");
   if (!is_finite(box.lo) || !is_finite(box.hi))
     throw InvalidArgument("Triangulation: the box has non-finite coordinates");
   if (!(box.lo.x < box.hi.x && box.lo.y < box.hi.y && box.lo.z < box.hi.z))
@@ -236,6 +242,11 @@ Triangulation::Triangulation(const Triangulation& o)
       num_live_tets_(o.num_live_tets_),
       free_head_(o.free_head_),
       last_tet_(o.last_tet_),
+      rebuild_factor_(o.rebuild_factor_),
+      max_wrap_link_(o.max_wrap_link_),
+      edit_tets_(o.edit_tets_),
+      excess_levels_(o.excess_levels_),
+      rebuilds_(o.rebuilds_),
       init_td_(o.init_td_),
       scratch_(std::make_unique<Scratch>()) {}
 
@@ -307,6 +318,8 @@ void Triangulation::reset_to_corners() {
   num_live_tets_ = m;
   free_head_ = kNoTet;
   last_tet_ = 0;
+  edit_tets_ = 0;
+  excess_levels_ = 0;
 }
 
 // ---- Checks ----------------------------------------------------------------------------------------
@@ -433,8 +446,10 @@ TetId Triangulation::descend(TetId dead, const Point3& p, std::size_t* visited) 
     }
     // Not reached with exact predicates; fall through to the scan for safety.
   }
+  // The hint lies in the range, except for records overwritten by later moves (try_move_in_place).
+  const std::uint32_t h = hint >= op.first && hint - op.first < op.count ? hint - op.first : 0;
   for (std::uint32_t k = 0; k < op.count; ++k) {
-    const TetId s = op.first + (hint - op.first + k) % op.count;
+    const TetId s = op.first + (h + k) % op.count;
     if (visited) ++*visited;
     if (in_op_tet(op, s, p)) return s;
   }
@@ -442,13 +457,27 @@ TetId Triangulation::descend(TetId dead, const Point3& p, std::size_t* visited) 
                          " does not cover the point " + fmt_point(p));
 }
 
-TetId Triangulation::locate_history(const Point3& p) const {
+TetId Triangulation::locate_history(const Point3& p, std::size_t* levels) const {
   TetId t = kNoTet;
   const Op& root = ops_[0];
   for (TetId s = root.first; s < root.first + root.count && t == kNoTet; ++s)
     if (in_op_tet(root, s, p)) t = s;
   if (t == kNoTet) throw std::logic_error("Triangulation::locate: point not in the root tetrahedra");
-  while (tf_[t] & kDead) t = descend(t, p, nullptr);
+  std::size_t n = 0;
+  for (; tf_[t] & kDead; ++n) t = descend(t, p, nullptr);
+  if (levels) *levels = n;
+  return t;
+}
+
+// Location on behalf of a mutation: counts the levels of descent beyond what a freshly built history
+// gives (about 4 ln n records), the work wasted because edits stacked records in one region; it pays
+// for the next rebuild (see maybe_rebuild).
+TetId Triangulation::locate_for_edit(const Point3& p) {
+  if (!keep_history_) return walk(p, last_tet_);
+  std::size_t levels = 0;
+  const TetId t = locate_history(p, &levels);
+  const auto limit = std::size_t(6.0 * std::log2(double(num_live_vertices_) + 2.0)) + 64;
+  if (levels > limit) excess_levels_ += levels - limit;
   return t;
 }
 
@@ -555,7 +584,9 @@ Triangulation::PointId Triangulation::alloc_point(const Point3& p, VertexId reus
 }
 
 void Triangulation::record_op(TetId first, std::uint32_t count, PointId apex) {
-  if (keep_history_) ops_.push_back({first, count, apex});
+  if (!keep_history_) return;
+  ops_.push_back({first, count, apex});
+  if (apex == kNoVertex) edit_tets_ += count;  // a removal or a move
 }
 
 // ---- Insertion -------------------------------------------------------------------------------------
@@ -846,7 +877,7 @@ InsertResult Triangulation::insert(const Point3& p, double min_distance, ChangeS
   check_point(p, 0);
   check_min_distance(min_distance);
   if (changes) changes->clear();
-  const TetId t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
+  const TetId t = locate_for_edit(p);
   return insert_at(p, t, true, min_distance, changes, kNoVertex);
 }
 
@@ -928,7 +959,9 @@ void Triangulation::collect_star(PointId v) {
 void Triangulation::remove(VertexId v, ChangeSet* changes) {
   check_vertex(v, "remove");
   if (changes) changes->clear();
+  const bool renumbered = maybe_rebuild();
   remove_impl(v, changes);
+  if (renumbered) report_renumbered(changes);
 }
 
 void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
@@ -961,7 +994,7 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
   }
   std::sort(S.link.begin(), S.link.end());
   S.link.erase(std::unique(S.link.begin(), S.link.end()), S.link.end());
-  if (S.link.size() <= kMaxWrapLink) {
+  if (S.link.size() <= max_wrap_link_) {
     fill_hole_by_wrapping(pv, changes);
     return;
   }
@@ -1412,8 +1445,22 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
   for (TetId s : S.created)
     for (int i = 0; i < 4; ++i) vtet_[td_[8 * std::size_t(s) + i]] = s;
   if (np != pv) vtet_[pv] = kNoTet;
-  const std::uint32_t op = std::uint32_t(ops_.size());
-  record_op(first, std::uint32_t(S.created.size()), kNoVertex);
+  // Every record's new tetrahedra cover exactly the region of those it killed. When the star is exactly
+  // the set the last record created (typically: the previous move of this same vertex), the new star
+  // covers that record's region too, so the record is overwritten instead of stacking a new one above
+  // it: a vertex moved back and forth adds no depth to the history (the old stars become unreachable
+  // garbage until the next rebuild, and count towards it).
+  std::uint32_t op = std::uint32_t(ops_.size());
+  bool reuse = keep_history_ && ops_.size() > 1 && ops_.back().count == S.star.size();
+  for (std::size_t k = 0; reuse && k < S.star.size(); ++k)
+    reuse = S.star[k] >= ops_.back().first && S.star[k] - ops_.back().first < ops_.back().count;
+  if (reuse) {
+    op = std::uint32_t(ops_.size() - 1);
+    ops_[op] = {first, std::uint32_t(S.created.size()), kNoVertex};
+    edit_tets_ += S.created.size();
+  } else {
+    record_op(first, std::uint32_t(S.created.size()), kNoVertex);
+  }
   for (std::size_t k = 0; k < S.star.size(); ++k) kill(S.star[k], op, S.created[k]);
   last_tet_ = S.created.front();
   if (changes) {
@@ -1429,8 +1476,36 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   check_point(p, 0);
   check_min_distance(min_distance);
   if (changes) changes->clear();
+  const bool renumbered = maybe_rebuild();
+  const InsertResult result = move_impl(v, p, min_distance, changes);
+  if (renumbered) report_renumbered(changes);
+  return result;
+}
+
+InsertResult Triangulation::move_impl(VertexId v, const Point3& p, double min_distance, ChangeSet* changes) {
   const PointId pv = pid(v);
-  if (pos_[pv] == p) return {InsertStatus::Inserted, v, kNoVertex};
+  if (pos_[pv] == p) {
+    // Nothing moves, but the contract still holds: TooClose when another vertex is closer than
+    // min_distance. The nearest other vertex of v is a Delaunay neighbour, a vertex of its star.
+    if (min_distance > 0.0) {
+      collect_star(pv);
+      double best = min_distance * min_distance;
+      PointId nearest = kNoVertex;
+      for (TetId t : scratch_->star) {
+        tf_[t] &= std::uint8_t(~kMark);
+        for (int i = 0; i < 4; ++i) {
+          const PointId w = td_[8 * std::size_t(t) + i];
+          const double d2 = squared_distance(pos_[w], p);
+          if (w != pv && d2 < best) {
+            best = d2;
+            nearest = w;
+          }
+        }
+      }
+      if (nearest != kNoVertex) return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+    }
+    return {InsertStatus::Inserted, v, kNoVertex};
+  }
   InsertResult result;
   if (try_move_in_place(v, p, min_distance, result, changes)) return result;
 
@@ -1443,7 +1518,7 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   for (int i = 0; i < 4; ++i)
     edge2 = std::max(edge2, squared_distance(pos_[td_[8 * std::size_t(tv) + i]], pos_[pv]));
   TetId start = squared_distance(p, pos_[pv]) > 64.0 * edge2 ? kNoTet : walk_limited(p, tv, 64);
-  if (start == kNoTet) start = keep_history_ ? locate_history(p) : walk(p, tv);
+  if (start == kNoTet) start = keep_history_ ? locate_for_edit(p) : walk(p, tv);
   for (int i = 0; i < 4; ++i) {
     const PointId w = td_[8 * std::size_t(start) + i];
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
@@ -1483,7 +1558,7 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   ChangeSet removal, insertion;
   remove_impl(v, changes ? &removal : nullptr);
   TetId t = start_survives ? start : walk_limited(p, last_tet_, 64);
-  if (t == kNoTet) t = keep_history_ ? locate_history(p) : walk(p, last_tet_);
+  if (t == kNoTet) t = locate_for_edit(p);
   result = insert_at(p, t, true, 0.0, changes ? &insertion : nullptr, v);
   if (result.status != InsertStatus::Inserted)
     throw std::logic_error("Triangulation::move: reinsertion rejected after the proximity check");
@@ -1496,6 +1571,114 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
     net_changes(events, *changes);
   }
   return result;
+}
+
+// ---- History rebuild -------------------------------------------------------------------------------
+
+namespace {
+constexpr std::size_t kRebuildLevels = 16;  // excess levels per vertex that pay for a rebuild (below)
+}  // namespace
+//
+// Why: the expected O(log n) depth of the history comes from the random order of the *insertions*. A
+// removal or a move stacks one record on the region it touches, and nothing randomizes those: moving
+// one vertex back and forth k times puts k records above every point near it. The history is therefore
+// rebuilt, before a removal or move changes anything, when either
+// - the records of removals and moves hold more tetrahedra than the live mesh: memory stays O(n), and
+//   the O(n log n) rebuild is paid by Omega(n) edited tetrahedra, O(log n) amortized per edit; or
+// - the locations of insert() and move() have descended, in total, more than 16 n levels beyond the
+//   depth of a fresh history (6 log2 n + 64 each). A rebuild costs about 8 us per vertex (bulk
+//   insertion with history) and a level of a pile of edit records about 0.5 us (a scan of ~27
+//   tetrahedra, 4 orientations each), so the rebuild costs about what deep locations have already
+//   wasted (ski rental): at most about twice the cost of the best rebuilding schedule in hindsight.
+// An in-place move that rebuilds exactly the star created by the previous record overwrites that
+// record instead of stacking a new one (try_move_in_place), so repeated moves of one vertex add no depth.
+//
+//   before:  root -> insertions -> remove p -> move q -> move q -> ... -> live
+//   after:   root -> insertions of the live vertices (BRIO order)      -> live (same tetrahedra)
+//
+// The tetrahedralization is unique (perturbed predicates), so a fresh insertion of the live vertices
+// gives exactly the live tetrahedra, under new ids; vertex ids are kept through the translation tables.
+
+bool Triangulation::maybe_rebuild() {
+  if (!keep_history_ || rebuild_factor_ <= 0.0) return false;
+  const bool big = double(edit_tets_) > rebuild_factor_ * double(num_live_tets_);
+  const bool deep = excess_levels_ > kRebuildLevels * num_live_vertices_;
+  if (!big && !deep) return false;
+  rebuild_history(nullptr);
+  return true;
+}
+
+void Triangulation::report_renumbered(ChangeSet* changes) const {
+  if (!changes) return;
+  changes->killed.clear();
+  changes->created = live_tetrahedra();
+  changes->renumbered = true;
+}
+
+void Triangulation::rebuild_history(ChangeSet* changes) {
+  if (changes) changes->clear();
+  if (!keep_history_) return;
+  const std::size_t nv = vertex_capacity();
+  std::vector<VertexId> live;
+  std::vector<Point3> pts;
+  live.reserve(num_live_vertices_);
+  pts.reserve(num_live_vertices_);
+  for (VertexId v = 8; v < nv; ++v)
+    if (is_vertex(v)) {
+      live.push_back(v);
+      pts.push_back(point(v));
+    }
+  TriangulationOptions options;
+  options.history_rebuild_factor = rebuild_factor_;
+  options.max_wrap_link = max_wrap_link_;
+  Triangulation fresh(box_, options);
+  const std::vector<InsertResult> res = fresh.insert_points(pts);
+  // fresh has no moves: its point ids are its vertex ids. Our vertex v becomes point new_pid[v]; removed
+  // vertices keep their last position in a point slot of their own (point() still answers for them).
+  std::vector<PointId> new_pid(nv, kNoVertex);
+  for (PointId k = 0; k < 8; ++k) new_pid[k] = k;
+  for (std::size_t i = 0; i < live.size(); ++i) {
+    if (res[i].status != InsertStatus::Inserted)
+      throw std::logic_error("Triangulation::rebuild_history: live vertex " + std::to_string(live[i]) +
+                             " was rejected on reinsertion");
+    new_pid[live[i]] = res[i].vertex;
+  }
+  std::vector<Point3> pos = std::move(fresh.pos_);
+  std::vector<TetId> vtet = std::move(fresh.vtet_);
+  bool identity = true;
+  for (VertexId v = 0; v < nv; ++v) {
+    if (new_pid[v] == kNoVertex) {
+      new_pid[v] = PointId(pos.size());
+      pos.push_back(point(v));
+      vtet.push_back(kNoTet);
+    }
+    identity = identity && new_pid[v] == v;
+  }
+  if (fresh.num_live_vertices_ != num_live_vertices_)
+    throw std::logic_error("Triangulation::rebuild_history: vertex count changed");
+  pid_of_vid_.clear();
+  vid_of_pid_.clear();
+  if (!identity) {
+    vid_of_pid_.assign(pos.size(), kNoVertex);
+    for (VertexId v = 0; v < nv; ++v) vid_of_pid_[new_pid[v]] = v;
+    pid_of_vid_ = std::move(new_pid);
+  }
+  pos_ = std::move(pos);
+  vtet_ = std::move(vtet);
+  td_ = std::move(fresh.td_);
+  tf_ = std::move(fresh.tf_);
+  hnb_ = std::move(fresh.hnb_);
+  ops_ = std::move(fresh.ops_);
+  num_live_tets_ = fresh.num_live_tets_;
+  free_head_ = kNoTet;
+  last_tet_ = fresh.last_tet_;
+  edit_tets_ = 0;
+  excess_levels_ = 0;
+  ++rebuilds_;
+  if (changes) {
+    changes->created = live_tetrahedra();
+    changes->renumbered = true;
+  }
 }
 
 // ---- Queries ---------------------------------------------------------------------------------------

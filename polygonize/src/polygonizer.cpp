@@ -285,8 +285,26 @@ void Polygonizer::settle_zeros(const std::vector<TetId>& created) {
 }
 
 void Polygonizer::on_killed(const ChangeSet& cs) {
+  if (cs.renumbered) {
+    // The Delaunay tree rebuilt its history and renumbered every tetrahedron (rare: after Omega(n)
+    // edited tetrahedra): drop the per-tetrahedron state; cs.created lists every live tetrahedron and
+    // the caller classifies them (O(n), amortized O(1) per edit). Vertex state is kept.
+    tlist_.clear();
+    std::fill(tpos_.begin(), tpos_.end(), kNotListed);
+    std::fill(tcount_.begin(), tcount_.end(), 0u);
+    clear_queue();
+    return;
+  }
   for (const TetId t : cs.killed)
     if (t < tpos_.size() && tpos_[t] != kNotListed) set_transverse(t, false);
+}
+
+// After a rejected move: the tree may still have renumbered its tetrahedra before rejecting it.
+void Polygonizer::absorb_renumbering() {
+  if (!changes_.renumbered) return;
+  on_killed(changes_);
+  std::vector<TetId> all(changes_.created.begin(), changes_.created.end());
+  classify_created(all);
 }
 
 void Polygonizer::classify(TetId t, bool requeue) {
@@ -686,13 +704,17 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
   changes_.clear();
   InsertResult r = tri_.move(v, p, 0.0, &changes_);
   if (r.status != InsertStatus::Inserted) {
+    absorb_renumbering();  // nothing moved, but the tetrahedra may have been renumbered first
     const auto k = static_cast<VertexKind>(kind_[r.nearest]);
     if (r.nearest == v) return true;  // moved onto itself
     if (k != VertexKind::Sampling && k != VertexKind::Refinement) return false;
     remove_vertex(r.nearest);
     changes_.clear();
     r = tri_.move(v, p, 0.0, &changes_);
-    if (r.status != InsertStatus::Inserted) return false;
+    if (r.status != InsertStatus::Inserted) {
+      absorb_renumbering();
+      return false;
+    }
   }
   grow_tet_arrays();
   moved_[v] = 1;

@@ -301,11 +301,17 @@ TEST_CASE("delaunay: inserting then removing k points gives the tetrahedralizati
       {"integer sphere", Box3{{-10, -10, -10}, {10, 10, 10}}, integer_sphere_points()},
       {"clustered", kUnitBox, clustered_points(150, 22)},
   };
+  // Both ways of filling the hole of a removal: gift wrapping (stars up to max_wrap_link link vertices)
+  // and the scratch triangulation of the link (max_wrap_link = 0 forces it for every star).
+  const std::size_t wrap = GENERATE(std::size_t(64), std::size_t(0));
   for (bool history : {true, false}) {
     for (const auto& in : inputs) {
-      INFO(in.name << " history " << history);
+      INFO(in.name << " history " << history << " max_wrap_link " << wrap);
       const std::size_t n = in.points.size();
-      auto b = build(in.box, in.points, iota_order(n), false, TriangulationOptions{history});
+      TriangulationOptions opt;
+      opt.keep_history = history;
+      opt.max_wrap_link = wrap;
+      auto b = build(in.box, in.points, iota_order(n), false, opt);
       const auto removal = shuffled(n, 23);
       const std::size_t k = n / 2;
       std::set<std::size_t> removed;
@@ -318,6 +324,7 @@ TEST_CASE("delaunay: inserting then removing k points gives the tetrahedralizati
         b.label.erase(v);
         removed.insert(i);
         check(b.tr);
+        if (j % 20 == 0) check_brute_force_empty(b.tr);
       }
       std::vector<std::size_t> rest;
       for (std::size_t i = 0; i < n; ++i)
@@ -335,63 +342,109 @@ TEST_CASE("delaunay: inserting then removing k points gives the tetrahedralizati
   }
 }
 
+// Random point sources for the edit sequences: generic, an integer grid (cospherical everywhere),
+// coplanar layers on a lattice (coplanar and cocircular), and clusters of points 1-3 ulps apart.
+Point3 random_point(int kind, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> u(0.01, 0.99);
+  switch (kind) {
+    case 1:
+      return {double(1 + rng() % 7) / 8.0, double(1 + rng() % 7) / 8.0, double(1 + rng() % 7) / 8.0};
+    case 2:
+      return {double(1 + rng() % 15) / 16.0, double(1 + rng() % 15) / 16.0, 0.25 * double(1 + rng() % 3)};
+    case 3: {
+      Point3 p{double(1 + rng() % 5) / 6.0, double(1 + rng() % 5) / 6.0, double(1 + rng() % 5) / 6.0};
+      for (double* c : {&p.x, &p.y, &p.z})
+        for (int k = int(rng() % 4); k > 0; --k) *c = std::nextafter(*c, 1.0);
+      return p;
+    }
+    default:
+      return {u(rng), u(rng), u(rng)};
+  }
+}
+
 TEST_CASE("delaunay: long random insert / remove / move sequences stay valid and canonical") {
-  for (bool history : {true, false}) {
-    INFO("history " << history);
-    Triangulation tr(kUnitBox, TriangulationOptions{history});
-    std::mt19937_64 rng(31 + history);
-    std::uniform_real_distribution<double> u(0.01, 0.99);
+  const int kind = GENERATE(0, 1, 2, 3);
+  const char* const kinds[] = {"uniform", "integer grid", "coplanar layers", "1-ulp clusters"};
+  // history on (default rebuild factor, and a small one so that rebuilds happen often), history off.
+  struct Variant {
+    bool history;
+    double rebuild;
+  };
+  for (const Variant var : {Variant{true, 1.0}, Variant{true, 0.2}, Variant{false, 0.0}}) {
+    INFO(kinds[kind] << ", history " << var.history << ", rebuild factor " << var.rebuild);
+    TriangulationOptions opt;
+    opt.keep_history = var.history;
+    opt.history_rebuild_factor = var.rebuild;
+    Triangulation tr(kUnitBox, opt);
+    std::mt19937_64 rng(31 + unsigned(kind) * 7 + unsigned(var.history) + unsigned(10 * var.rebuild));
     std::uniform_real_distribution<double> small(-0.02, 0.02);
     std::map<VertexId, Point3> alive;
-    std::size_t moves_in_place = 0, ops = 0;
-    const int kOps = 2500;
+    std::size_t moves_in_place = 0, renumbered = 0;
+    const int kOps = kind == 3 ? 400 : 1500;  // ulp clusters run the exact arithmetic: slower
     for (int op = 0; op < kOps; ++op) {
-      const int kind = alive.size() < 40 ? 0 : int(rng() % 3);
+      const int what = alive.size() < 40 ? 0 : int(rng() % 3);
       ChangeSet ch;
       const std::vector<TetId> before = tr.live_tetrahedra();
-      if (kind == 0) {
-        const Point3 p{u(rng), u(rng), u(rng)};
+      if (what == 0) {
+        const Point3 p = random_point(kind, rng);
         const InsertResult r = tr.insert(p, 0.0, &ch);
-        REQUIRE(r.status == InsertStatus::Inserted);
-        alive[r.vertex] = p;
+        if (r.status == InsertStatus::Inserted) {
+          alive[r.vertex] = p;
+        } else {  // an exact duplicate (lattice inputs): the reported vertex is there
+          REQUIRE(tr.is_vertex(r.nearest));
+          REQUIRE(tr.point(r.nearest) == p);
+        }
       } else {
         auto it = alive.begin();
         std::advance(it, long(rng() % alive.size()));
         const VertexId v = it->first;
-        if (kind == 1) {
+        if (what == 1) {
           tr.remove(v, &ch);
           alive.erase(it);
           REQUIRE_FALSE(tr.is_vertex(v));
         } else {
           // Small moves usually keep the combinatorics; large ones do not.
-          Point3 p = (rng() % 2) ? it->second + Point3{small(rng), small(rng), small(rng)}
-                                 : Point3{u(rng), u(rng), u(rng)};
+          Point3 p = (kind == 0 && rng() % 2) ? it->second + Point3{small(rng), small(rng), small(rng)}
+                                              : random_point(kind, rng);
           p = {std::clamp(p.x, 0.001, 0.999), std::clamp(p.y, 0.001, 0.999), std::clamp(p.z, 0.001, 0.999)};
           const std::size_t cap = tr.tet_capacity();
           const InsertResult r = tr.move(v, p, 0.0, &ch);
-          REQUIRE(r.status == InsertStatus::Inserted);
-          REQUIRE(r.vertex == v);
-          REQUIRE(tr.point(v) == p);
-          it->second = p;
-          if (ch.created.size() == ch.killed.size() && tr.tet_capacity() - cap <= ch.created.size())
-            ++moves_in_place;
+          if (r.status == InsertStatus::Inserted) {
+            REQUIRE(r.vertex == v);
+            REQUIRE(tr.point(v) == p);
+            it->second = p;
+            if (!ch.renumbered && ch.created.size() == ch.killed.size() &&
+                tr.tet_capacity() - cap <= ch.created.size())
+              ++moves_in_place;
+          } else {  // onto another vertex: v stays where it was
+            REQUIRE(tr.point(r.nearest) == p);
+            REQUIRE(tr.point(v) == it->second);
+          }
         }
       }
-      ++ops;
-      // Change events: killed were live and are dead, created are live, and live = before - killed + created.
-      std::set<TetId> live_before(before.begin(), before.end());
-      for (TetId t : ch.killed) REQUIRE(live_before.count(t));
+      // Change events: killed were live and are dead, created are live, and live = before - killed +
+      // created; after a renumbering, created is the whole live set.
+      std::set<TetId> expect;
+      if (ch.renumbered) {
+        ++renumbered;
+        REQUIRE(ch.killed.empty());
+      } else {
+        expect.insert(before.begin(), before.end());
+        for (TetId t : ch.killed) REQUIRE(expect.count(t));
+        for (TetId t : ch.killed) expect.erase(t);
+      }
       for (TetId t : ch.created) REQUIRE(tr.is_live(t));
-      std::set<TetId> expect = live_before;
-      for (TetId t : ch.killed) expect.erase(t);
       for (TetId t : ch.created) expect.insert(t);
       const auto after = tr.live_tetrahedra();
       REQUIRE(expect == std::set<TetId>(after.begin(), after.end()));
-      if (op % 10 == 0 || op > kOps - 20) check(tr);
+      check(tr);
+      if (op % 250 == 0) check_brute_force_empty(tr);
     }
-    check(tr);
+    check_brute_force_empty(tr);
     check_euler(tr);
-    CHECK(moves_in_place > 0);
+    if (kind == 0) CHECK(moves_in_place > 0);
+    if (var.history) CHECK(renumbered == tr.history_rebuilds());
+    if (var.history && var.rebuild < 1.0) CHECK(renumbered > 0);
     CHECK(tr.num_vertices() == alive.size() + 8);
     // Canonical: the same as building the surviving points directly.
     std::vector<Point3> pts;
@@ -407,6 +460,167 @@ TEST_CASE("delaunay: long random insert / remove / move sequences stay valid and
       REQUIRE(tr.is_live(t));
       REQUIRE(contains_closed(tr, t, p));
     }
+  }
+}
+
+TEST_CASE("delaunay: repeated edits in one place keep the history shallow and its memory bounded") {
+  // One vertex moved back and forth thousands of times, with a point inserted near it and removed
+  // again every few moves: without the rebuild, every move stacks a record on the same region.
+  const auto pts = uniform_points(2000, 91);
+  const double limit = 6.0 * std::log2(2008.0 + 2.0) + 64.0;  // the rebuild's depth threshold
+  std::size_t deepest[2] = {0, 0}, memory[2] = {0, 0};
+  for (const double factor : {1.0, 0.0}) {
+    INFO("rebuild factor " << factor);
+    TriangulationOptions opt;
+    opt.history_rebuild_factor = factor;
+    Triangulation tr(kUnitBox, opt);
+    tr.insert_points(pts);
+    const std::size_t fresh_bytes = tr.memory_total_bytes();
+    const VertexId v = 8 + 1000;
+    const Point3 home = tr.point(v);
+    std::mt19937_64 rng(92);
+    std::uniform_real_distribution<double> jitter(-0.002, 0.002);
+    for (int k = 0; k < 3000; ++k) {
+      const Point3 target = home + Point3{jitter(rng), jitter(rng), jitter(rng)};
+      REQUIRE(tr.move(v, target).status == InsertStatus::Inserted);
+      if (k % 4 == 0) {
+        const InsertResult r = tr.insert(home + Point3{0.01, jitter(rng), jitter(rng)});
+        REQUIRE(r.status == InsertStatus::Inserted);
+        tr.remove(r.vertex);
+      }
+    }
+    check(tr);
+    const std::size_t i = factor > 0.0 ? 0 : 1;
+    for (int k = 0; k < 50; ++k)
+      deepest[i] =
+          std::max(deepest[i], tr.history_path(home + Point3{jitter(rng), jitter(rng), jitter(rng)}).first);
+    memory[i] = tr.memory_total_bytes();
+    if (factor > 0.0) {
+      CHECK(tr.history_rebuilds() > 0);
+      // The rebuild is amortized (it waits until deep locations have wasted about its cost), so the
+      // depth is not a hard bound; here it stays within a few times a fresh history's.
+      CHECK(double(deepest[i]) <= 4.0 * limit);
+      CHECK(memory[i] <= 3 * fresh_bytes);
+    } else {
+      CHECK(tr.history_rebuilds() == 0);
+    }
+  }
+  // Without the rebuild the same sequence goes far deeper and keeps far more memory: what the
+  // rebuild is for (and proof that the bounds above can fail).
+  CHECK(deepest[1] > 8 * deepest[0]);
+  CHECK(memory[1] > 2 * memory[0]);
+}
+
+TEST_CASE("delaunay: rebuild_history keeps vertex ids and the tetrahedra, renumbers the rest") {
+  auto pts = uniform_points(300, 95);
+  auto b = build(kUnitBox, pts, iota_order(pts.size()), false);
+  Triangulation& tr = b.tr;
+  // Some removals and moves first, so that point and vertex ids differ.
+  auto it = b.label.begin();
+  for (int k = 0; k < 20; ++k, ++it) {
+    const VertexId v = it->first;
+    if (k % 2) {
+      tr.remove(v);
+    } else {
+      pts[std::size_t(it->second)] = tr.point(v) + Point3{0.003, -0.002, 0.001};
+      REQUIRE(tr.move(v, pts[std::size_t(it->second)]).status == InsertStatus::Inserted);
+    }
+  }
+  std::map<VertexId, Point3> positions;
+  for (VertexId v = 0; v < tr.vertex_capacity(); ++v) positions[v] = tr.point(v);
+  std::map<VertexId, long> label;
+  for (const auto& [v, l] : b.label)
+    if (tr.is_vertex(v)) label[v] = l;
+  const TetSet before = tet_set(tr, label);
+  ChangeSet ch;
+  tr.rebuild_history(&ch);
+  CHECK(ch.renumbered);
+  CHECK(ch.killed.empty());
+  CHECK(ch.created.size() == tr.num_tetrahedra());
+  CHECK(tr.history_rebuilds() == 1);
+  check(tr);
+  CHECK(tet_set(tr, label) == before);
+  for (const auto& [v, p] : positions) CHECK(tr.point(v) == p);  // removed vertices keep their last position
+  for (const auto& [v, l] : b.label) CHECK(tr.is_vertex(v) == (label.count(v) > 0));
+  // Location and further edits work on the rebuilt history, new ids continue after the old ones.
+  for (const Point3& p : uniform_points(100, 96, 0.001, 0.999)) REQUIRE(contains_closed(tr, tr.locate(p), p));
+  const InsertResult r = tr.insert({0.5, 0.5, 0.5});
+  REQUIRE(r.status == InsertStatus::Inserted);
+  CHECK(r.vertex == VertexId(8 + 300));
+  tr.remove(label.begin()->first);
+  check(tr);
+  // Without the history there is nothing to rebuild.
+  Triangulation plain(kUnitBox, TriangulationOptions{false});
+  plain.insert_points(uniform_points(50, 97));
+  ChangeSet none;
+  plain.rebuild_history(&none);
+  CHECK_FALSE(none.renumbered);
+  CHECK(plain.history_rebuilds() == 0);
+}
+
+namespace vitri {
+// Test-only access to the flat arrays, to corrupt them on purpose.
+struct TriangulationTestAccess {
+  static std::uint32_t& vertex_slot(Triangulation& tr, TetId t, int i) {
+    return tr.td_[8 * std::size_t(t) + i];
+  }
+  static std::uint32_t& neighbor_slot(Triangulation& tr, TetId t, int i) {
+    return tr.td_[8 * std::size_t(t) + 4 + i];
+  }
+  static Point3& position(Triangulation& tr, VertexId v) { return tr.pos_[tr.pid(v)]; }
+};
+}  // namespace vitri
+
+TEST_CASE("delaunay: the validators detect broken structures") {
+  using A = TriangulationTestAccess;
+  auto b = build(Box3{{-1, -1, -1}, {4, 4, 4}}, grid_points(4), shuffled(64, 5), false);
+  Triangulation& tr = b.tr;
+  check(tr);
+  const TetId t = tr.live_tetrahedra()[10];
+  SECTION("a negatively oriented tetrahedron") {
+    std::swap(A::vertex_slot(tr, t, 0), A::vertex_slot(tr, t, 1));
+    CHECK_THROWS_AS(tr.verify_topology(), std::logic_error);
+  }
+  SECTION("an asymmetric neighbour link") {
+    int i = 0;
+    while (tr.tet_neighbor(t, i) == kNoTet) ++i;
+    A::neighbor_slot(tr, t, i) = tr.tet_neighbor(t, (i + 1) % 4);  // the other side still points back
+    CHECK_THROWS_AS(tr.verify_topology(), std::logic_error);
+  }
+  SECTION("a hull face inside the box") {
+    int i = 0;
+    while (tr.tet_neighbor(t, i) == kNoTet) ++i;
+    const TetId n = tr.tet_neighbor(t, i);
+    A::neighbor_slot(tr, t, i) = kNoTet;
+    for (int j = 0; j < 4; ++j)
+      if (tr.tet_neighbor(n, j) == t) A::neighbor_slot(tr, n, j) = kNoTet;
+    CHECK_THROWS_AS(tr.verify_topology(), std::logic_error);
+  }
+  SECTION(
+      "a grid point moved by 1e-9: the perturbed tetrahedralization changes, the old one is not Delaunay") {
+    // Every grid configuration is cospherical, decided by the perturbation; a tiny move along an axis
+    // decides some of them exactly the other way, without changing any orientation.
+    int failures = 0, tries = 0;
+    for (const auto& [v, label] : b.label) {
+      const Point3 p = tr.point(v);
+      if (p.x < 1 || p.x > 2 || p.y < 1 || p.y > 2 || p.z < 1 || p.z > 2) continue;  // interior points
+      for (const Point3 d : {Point3{1e-9, 0, 0}, Point3{-1e-9, 0, 0}, Point3{0, 1e-9, 0}, Point3{0, -1e-9, 0},
+                             Point3{0, 0, 1e-9}, Point3{0, 0, -1e-9}}) {
+        A::position(tr, v) = p + d;
+        REQUIRE_NOTHROW(tr.verify_topology());
+        ++tries;
+        try {
+          tr.verify_delaunay();
+        } catch (const std::logic_error&) {
+          ++failures;
+        }
+        A::position(tr, v) = p;
+      }
+    }
+    INFO(failures << " of " << tries << " moves broke the Delaunay property");
+    CHECK(tries == 48);
+    CHECK(failures > 0);
+    check(tr);
   }
 }
 

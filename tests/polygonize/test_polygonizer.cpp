@@ -260,9 +260,18 @@ TEST_CASE("dynamic function: re-evaluation, local reclassification, garbage coll
     require_closed(m, 2, 1);
     for (const TetId t : poly.transverse_tetrahedra())
       REQUIRE(poly.triangulation().circumradius(t) <= precision);
+    // The transverse set kept from change events (renumberings included) equals a full scan.
+    std::set<TetId> listed(poly.transverse_tetrahedra().begin(), poly.transverse_tetrahedra().end()), scan;
+    poly.triangulation().for_each_tetrahedron([&](TetId t) {
+      if (poly.is_transverse(t)) scan.insert(t);
+    });
+    REQUIRE(listed == scan);
     const auto dist = [&](const Point3& p) { return std::abs(norm(p - f.c) - f.r); };
     REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
   }
+  // The garbage collection's removals made the Delaunay tree rebuild its history (renumbering every
+  // tetrahedron) at least once, so the renumbering path above was exercised.
+  CHECK(poly.triangulation().history_rebuilds() > 0);
   // Compare with a fresh mesh of the final function.
   Polygonizer fresh(f, kCube);
   REQUIRE(fresh.refine(precision));

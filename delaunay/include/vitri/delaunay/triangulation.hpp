@@ -126,12 +126,20 @@ struct InsertResult {
 };
 
 /// The tetrahedra an operation killed and created, in creation order. Reused between operations.
+///
+/// Process `killed` before `created`: without the history a slot freed by the operation may be reused
+/// by it, so an id can appear in both lists (it is live afterwards).
 struct ChangeSet {
   std::vector<TetId> killed;
   std::vector<TetId> created;
+  /// The operation rebuilt the history (Triangulation::rebuild_history) and so renumbered every
+  /// tetrahedron: all ids from before the operation are invalid (they may be reused), `killed` is
+  /// empty and `created` lists every live tetrahedron. A consumer drops its per-tetrahedron state.
+  bool renumbered = false;
   void clear() {
     killed.clear();
     created.clear();
+    renumbered = false;
   }
 };
 
@@ -142,6 +150,19 @@ struct TriangulationOptions {
   /// false: dead slots are recycled (a killed id may come back as a created id in a later operation),
   /// memory is that of the live mesh only, and location walks from the last created tetrahedron.
   bool keep_history = true;
+  /// History only. Removals and moves stack records on the regions they touch, so repeated edits in one
+  /// place deepen the history there. remove() and move() rebuild it (rebuild_history(), renumbering the
+  /// tetrahedra) before they change anything once the tetrahedra created by removals and moves since
+  /// the last rebuild exceed `history_rebuild_factor` times the live tetrahedra, or once the locations
+  /// of insert() and move() have descended, in total, more than 16 n levels beyond 6 log2(n) + 64 each
+  /// (the const locate() does not count). Memory stays O(n) under any sequence of edits, and the time
+  /// spent in deep locations is at most about the cost of the rebuilds (O(n log n) each), which are
+  /// themselves O(log n) amortized per edit. 0 disables the automatic rebuild.
+  double history_rebuild_factor = 1.0;
+  /// Removal fills the hole by gift wrapping when the star has at most this many link vertices,
+  /// otherwise through a scratch triangulation of the link (both give the same tetrahedra; a tuning
+  /// knob, exposed so that tests can force either method).
+  std::size_t max_wrap_link = 64;
 };
 
 /// Exact, dynamic Delaunay tetrahedralization of points inside a box. Not thread-safe for writes;
@@ -161,6 +182,7 @@ class Triangulation {
   ~Triangulation();
   Triangulation(const Triangulation& other);
   Triangulation& operator=(const Triangulation& other);
+  /// A moved-from Triangulation may only be destroyed or assigned to.
   Triangulation(Triangulation&&) noexcept;
   Triangulation& operator=(Triangulation&&) noexcept;
 
@@ -189,13 +211,24 @@ class Triangulation {
 
   /// Removes vertex v (not a box corner). The result is exactly the Delaunay tetrahedralization of the
   /// remaining points. @throws InvalidArgument for a corner, a removed or an unknown vertex.
+  /// @note May rebuild the history first (see TriangulationOptions::history_rebuild_factor); the
+  /// ChangeSet then says `renumbered`.
   void remove(VertexId v, ChangeSet* changes = nullptr);
 
   /// Moves vertex v to p; v keeps its id. Returns TooClose (and leaves v where it was) when p is closer
   /// than min_distance to another vertex. @throws as remove() and insert().
   /// When every tetrahedron around v stays positively oriented and locally Delaunay at p, only the
   /// star of v is rebuilt (same combinatorics); otherwise v is removed and reinserted.
+  /// @note May rebuild the history first, as remove().
   InsertResult move(VertexId v, const Point3& p, double min_distance = 0.0, ChangeSet* changes = nullptr);
+
+  /// Rebuilds the history from the live vertices alone (a fresh randomized insertion of them, which
+  /// gives the same tetrahedra: the tetrahedralization is unique) and renumbers the tetrahedra
+  /// (`changes->renumbered`). Vertex ids do not change. Frees the history of removed vertices and old
+  /// positions of moved ones. O(n log n) expected. Without the history: does nothing.
+  void rebuild_history(ChangeSet* changes = nullptr);
+  /// Number of history rebuilds so far (automatic or explicit).
+  std::size_t history_rebuilds() const { return rebuilds_; }
 
   // ---- Queries --------------------------------------------------------------------------------------
   /// A live tetrahedron containing p (closed); p must lie in the box. Uses the history DAG.
@@ -264,6 +297,7 @@ class Triangulation {
   // Flat-array members and inline accessors are the implementer's choice (no pimpl: accessors are
   // on the hot path of refinement and extraction).
  private:
+  friend struct TriangulationTestAccess;  // tests only: corrupts the structure to show the validators fail
   // Internal point ids (PointId) index pos_, whose entries never change once written, because dead
   // tetrahedra of the history refer to them. A moved vertex gets a new PointId and keeps its VertexId;
   // until the first move the two numberings coincide and the translation tables are empty.
@@ -281,9 +315,6 @@ class Triangulation {
   static constexpr std::uint8_t kMark = 2;      // temporary: in the current cavity / star
   static constexpr std::uint8_t kTested = 4;    // temporary: tested, not in conflict
   static constexpr std::uint16_t kNoOffset = 0xffff;
-  // Removal: stars with at most this many link vertices are filled by gift wrapping (O(link^2)
-  // predicates), larger ones through a scratch triangulation of the link.
-  static constexpr std::size_t kMaxWrapLink = 64;
 
   PointId pid(VertexId v) const { return pid_of_vid_.empty() ? v : pid_of_vid_[v]; }
   VertexId vid(PointId p) const { return vid_of_pid_.empty() ? p : vid_of_pid_[p]; }
@@ -293,7 +324,10 @@ class Triangulation {
   void check_vertex(VertexId v, const char* what) const;
   TetId walk(const Point3& p, TetId start) const;
   TetId walk_limited(const Point3& p, TetId start, std::size_t max_steps) const;
-  TetId locate_history(const Point3& p) const;
+  TetId locate_history(const Point3& p, std::size_t* levels = nullptr) const;
+  TetId locate_for_edit(const Point3& p);
+  bool maybe_rebuild();
+  void report_renumbered(ChangeSet* changes) const;
   bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
   TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
   TetId alloc_tet();
@@ -306,6 +340,7 @@ class Triangulation {
                          ChangeSet* changes, VertexId reuse_vid);
   void collect_star(PointId v);
   void remove_impl(VertexId v, ChangeSet* changes);
+  InsertResult move_impl(VertexId v, const Point3& p, double min_distance, ChangeSet* changes);
   void fill_hole_by_wrapping(PointId pv, ChangeSet* changes);
   bool try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,
                          ChangeSet* changes);
@@ -332,6 +367,11 @@ class Triangulation {
   std::size_t num_live_tets_ = 0;
   TetId free_head_ = kNoTet;           // recycled slots (keep_history == false)
   TetId last_tet_ = 0;                 // a live tetrahedron near the last operation (walk start)
+  double rebuild_factor_ = 1.0;        // TriangulationOptions::history_rebuild_factor
+  std::size_t max_wrap_link_ = 64;     // TriangulationOptions::max_wrap_link
+  std::size_t edit_tets_ = 0;          // tetrahedra created by removals and moves since the last rebuild
+  std::size_t excess_levels_ = 0;      // levels descended beyond 6 log2 n + 64 by insert() and move()
+  std::size_t rebuilds_ = 0;
   std::vector<std::uint32_t> init_td_; // the 8-corner triangulation, for reset_to_corners()
   std::unique_ptr<Scratch> scratch_;   // work buffers, never shared between copies
 };

@@ -234,6 +234,7 @@ class Polygonizer {
   void grow_tet_arrays();
   void evaluate_pending();
   void on_killed(const ChangeSet& cs);
+  void absorb_renumbering();
   void classify(TetId t, bool requeue);
   void set_transverse(TetId t, bool on);
   void push(TetId t);

@@ -1,5 +1,6 @@
 # vitri_target_options(<target>): warnings, sanitizers and floating-point flags for vitri's own targets.
-# Nothing here leaks into CMAKE_CXX_FLAGS or into consumers (everything is PRIVATE).
+# Nothing here leaks into CMAKE_CXX_FLAGS or into consumers (everything is PRIVATE), except the sanitizer
+# flags of a VITRI_SANITIZE build (see below).
 function(vitri_target_options target)
   target_compile_features(${target} PUBLIC cxx_std_17)
   set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF)
@@ -17,8 +18,12 @@ function(vitri_target_options target)
     target_compile_options(${target} PRIVATE /W4 /fp:precise)
   endif()
   if(VITRI_SANITIZE)
-    target_compile_options(${target} PRIVATE -fsanitize=${VITRI_SANITIZE} -fno-omit-frame-pointer
-                                             -fno-sanitize-recover=all)
+    # PUBLIC: a sanitized vitri is only usable by sanitized code. Eigen allocates differently under
+    # AddressSanitizer (__SANITIZE_ADDRESS__ turns off its "malloc is already aligned" path), so an Eigen
+    # matrix filled inside vitri and freed by a consumer compiled without it is a bad free (seen in
+    # the install_consumer test).
+    target_compile_options(${target} PUBLIC -fsanitize=${VITRI_SANITIZE})
+    target_compile_options(${target} PRIVATE -fno-omit-frame-pointer -fno-sanitize-recover=all)
     target_link_options(${target} PUBLIC -fsanitize=${VITRI_SANITIZE})
     if(CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
       # GCC's flow analysis reports false "maybe-uninitialized" inside libstdc++ (std::function in

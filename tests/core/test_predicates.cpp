@@ -599,6 +599,7 @@ TEST_CASE("non-finite input answers Zero without undefined behaviour", "[predica
   CHECK(orient2d(o, x, {inf, 1, 0}, 0, 1) == Sign::Zero);
 }
 
+// The counting itself is checked by test_core_stats (tests/core/test_predicate_stats.cpp, built with it).
 TEST_CASE("predicate statistics count calls and exact fallbacks when enabled", "[predicates]") {
   auto& stats = vitri::predicate_stats();
   const auto before = stats;

@@ -10,7 +10,8 @@
 /// Storage is flat: tetrahedron t has vertices tet_vertex(t, 0..3) and the neighbour opposite vertex i
 /// is tet_neighbor(t, i) (kNoTet on the box hull). Live tetrahedra are positively oriented
 /// (orient3d(v0, v1, v2, v3) == Positive). Dead tetrahedra keep their slot in the history (point
-/// location) and are never reused while the history refers to them.
+/// location) and are never reused while the history refers to them (a history rebuild renumbers all
+/// tetrahedra and says so in the ChangeSet).
 
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
@@ -145,8 +146,9 @@ struct ChangeSet {
 
 /// Construction options of a Triangulation.
 struct TriangulationOptions {
-  /// Keep the history DAG (default). Dead tetrahedra then keep their slot and their vertices forever,
-  /// insert() and locate() descend the history in O(log n) expected, and killed ids are never reused.
+  /// Keep the history DAG (default). Dead tetrahedra then keep their slot and their vertices until the
+  /// next history rebuild (which renumbers everything, see history_rebuild_factor), insert() and
+  /// locate() descend the history in O(log n) expected, and killed ids are not reused before then.
   /// false: dead slots are recycled (a killed id may come back as a created id in a later operation),
   /// memory is that of the live mesh only, and location walks from the last created tetrahedron.
   bool keep_history = true;

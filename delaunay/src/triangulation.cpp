@@ -167,7 +167,8 @@ struct Triangulation::Scratch {
   };
   std::vector<TetId> cavity, tested, created, star;
   std::vector<Boundary> boundary;
-  std::vector<PointId> link;      // link vertices of a removed vertex, sorted
+  std::vector<PointId> link;      // link vertices of a removed vertex (sorted for the scratch method)
+  std::vector<TetId> link_vtet;   // their vtet_ slots while remove_impl() tags them
   std::vector<VertexId> link_sub; // their ids in `sub`
   std::vector<PointId> sub_to_main;
   std::vector<LinkFace> link_faces;
@@ -964,10 +965,10 @@ void Triangulation::remove(VertexId v, ChangeSet* changes) {
   if (renumbered) report_renumbered(changes);
 }
 
-void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
+void Triangulation::remove_impl(VertexId v, ChangeSet* changes, bool star_collected) {
   Scratch& S = *scratch_;
   const PointId pv = pid(v);
-  collect_star(pv);
+  if (!star_collected) collect_star(pv);
   auto face_key = [](const auto& tv, const std::size_t b, int skip, const std::vector<PointId>* map) {
     std::array<PointId, 3> f{};
     std::size_t k = 0;
@@ -978,25 +979,37 @@ void Triangulation::remove_impl(VertexId v, ChangeSet* changes) {
     if (f[0] > f[1]) std::swap(f[0], f[1]);
     return f;
   };
-  // Link vertices and link faces (the face of each star tetrahedron opposite v).
+  // Link vertices, each once: a vertex is tagged by setting its vtet_ slot to lim (above every
+  // tetrahedron id) while it is collected; the slots are restored right after.
   S.link.clear();
+  S.link_vtet.clear();
+  {
+    const TetId lim = TetId(tf_.size());
+    for (TetId t : S.star) {
+      const std::size_t b = 8 * std::size_t(t);
+      for (int i = 0; i < 4; ++i) {
+        const PointId w = td_[b + i];
+        if (w == pv || vtet_[w] == lim) continue;
+        S.link.push_back(w);
+        S.link_vtet.push_back(vtet_[w]);
+        vtet_[w] = lim;
+      }
+    }
+    for (std::size_t k = 0; k < S.link.size(); ++k) vtet_[S.link[k]] = S.link_vtet[k];
+  }
+  if (S.link.size() <= max_wrap_link_) {
+    fill_hole_by_wrapping(pv, changes);
+    return;
+  }
+  std::sort(S.link.begin(), S.link.end());
+  // Link faces (the face of each star tetrahedron opposite v).
   S.link_faces.clear();
   for (TetId t : S.star) {
     const std::size_t b = 8 * std::size_t(t);
     int iv = 0;
-    for (int i = 0; i < 4; ++i) {
-      if (td_[b + i] == pv)
-        iv = i;
-      else
-        S.link.push_back(td_[b + i]);
-    }
+    for (int i = 0; i < 4; ++i)
+      if (td_[b + i] == pv) iv = i;
     S.link_faces.push_back({face_key(td_, b, iv, nullptr), t, kNoTet});
-  }
-  std::sort(S.link.begin(), S.link.end());
-  S.link.erase(std::unique(S.link.begin(), S.link.end()), S.link.end());
-  if (S.link.size() <= max_wrap_link_) {
-    fill_hole_by_wrapping(pv, changes);
-    return;
   }
   std::size_t hsize = 16;
   while (hsize < 4 * S.link_faces.size()) hsize *= 2;
@@ -1222,9 +1235,12 @@ void Triangulation::fill_hole_by_wrapping(PointId pv, ChangeSet* changes) {
     for (std::uint32_t i = 0; i < S.wfront.size(); ++i) insert_key(i);
   };
   rehash(4 * nstar);
+  auto same_key = [](const std::array<PointId, 3>& a, const std::array<PointId, 3>& b) {
+    return ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2])) == 0;
+  };
   auto find = [&](const std::array<PointId, 3>& key) -> std::uint32_t {
     for (std::size_t h = hash(key); S.face_hash[h]; h = (h + 1) & hmask)
-      if (S.wfront[S.face_hash[h] - 1].key == key) return S.face_hash[h] - 1;
+      if (same_key(S.wfront[S.face_hash[h] - 1].key, key)) return S.face_hash[h] - 1;
     return kNoTet;
   };
   const Point3* const pos = pos_.data();
@@ -1556,7 +1572,8 @@ InsertResult Triangulation::move_impl(VertexId v, const Point3& p, double min_di
   bool start_survives = true;
   for (int i = 0; i < 4; ++i) start_survives = start_survives && td_[8 * std::size_t(start) + i] != pv;
   ChangeSet removal, insertion;
-  remove_impl(v, changes ? &removal : nullptr);
+  // S.star still holds v's star, collected by try_move_in_place (and recollected above if needed).
+  remove_impl(v, changes ? &removal : nullptr, true);
   TetId t = start_survives ? start : walk_limited(p, last_tet_, 64);
   if (t == kNoTet) t = locate_for_edit(p);
   result = insert_at(p, t, true, 0.0, changes ? &insertion : nullptr, v);

@@ -341,7 +341,7 @@ class Triangulation {
   InsertResult insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
                          ChangeSet* changes, VertexId reuse_vid);
   void collect_star(PointId v);
-  void remove_impl(VertexId v, ChangeSet* changes);
+  void remove_impl(VertexId v, ChangeSet* changes, bool star_collected = false);
   InsertResult move_impl(VertexId v, const Point3& p, double min_distance, ChangeSet* changes);
   void fill_hole_by_wrapping(PointId pv, ChangeSet* changes);
   bool try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,

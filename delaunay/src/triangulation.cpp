@@ -785,6 +785,24 @@ void Triangulation::link_around_apex(PointId q) {
     }
 }
 
+// The vertex of the tetrahedra `tets` other than `skip` nearest to p with squared distance below best2
+// (which it lowers), or kNoVertex. The proximity tests: p's nearest vertex is a Delaunay neighbour of p,
+// hence a vertex of its cavity (or, for a move, of the moved vertex's star).
+Triangulation::PointId Triangulation::nearest_vertex(const std::vector<TetId>& tets, const Point3& p,
+                                                     PointId skip, double& best2) const {
+  PointId nearest = kNoVertex;
+  for (TetId t : tets)
+    for (int i = 0; i < 4; ++i) {
+      const PointId w = td_[8 * std::size_t(t) + i];
+      const double d2 = squared_distance(pos_[w], p);
+      if (w != skip && d2 < best2) {
+        best2 = d2;
+        nearest = w;
+      }
+    }
+  return nearest;
+}
+
 InsertResult Triangulation::insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
                                       ChangeSet* changes, VertexId reuse_vid) {
   Scratch& S = *scratch_;
@@ -797,18 +815,8 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, bool start_c
   if (!grow_cavity(p, start, start_contains, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
 
   if (min_distance > 0.0) {
-    // The nearest vertex of p is a Delaunay neighbour of p, hence a vertex of the cavity.
-    double best = min_distance * min_distance;
-    PointId nearest = kNoVertex;
-    for (TetId t : S.cavity)
-      for (int i = 0; i < 4; ++i) {
-        const PointId w = td_[8 * std::size_t(t) + i];
-        const double d2 = squared_distance(pos_[w], p);
-        if (d2 < best) {
-          best = d2;
-          nearest = w;
-        }
-      }
+    double best2 = min_distance * min_distance;
+    const PointId nearest = nearest_vertex(S.cavity, p, kNoVertex, best2);
     if (nearest != kNoVertex) {
       clear_cavity_marks();
       return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
@@ -1397,18 +1405,8 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
   }
   // The new Delaunay neighbours of v are its link vertices.
   if (min_distance > 0.0) {
-    double best = min_distance * min_distance;
-    PointId nearest = kNoVertex;
-    for (TetId t : S.star)
-      for (int i = 0; i < 4; ++i) {
-        const PointId w = td_[8 * std::size_t(t) + i];
-        if (w == pv) continue;
-        const double d2 = squared_distance(pos_[w], p);
-        if (d2 < best) {
-          best = d2;
-          nearest = w;
-        }
-      }
+    double best2 = min_distance * min_distance;
+    const PointId nearest = nearest_vertex(S.star, p, pv, best2);
     if (nearest != kNoVertex) {
       unmark();
       result = {InsertStatus::TooClose, kNoVertex, vid(nearest)};
@@ -1505,19 +1503,9 @@ InsertResult Triangulation::move_impl(VertexId v, const Point3& p, double min_di
     // min_distance. The nearest other vertex of v is a Delaunay neighbour, a vertex of its star.
     if (min_distance > 0.0) {
       collect_star(pv);
-      double best = min_distance * min_distance;
-      PointId nearest = kNoVertex;
-      for (TetId t : scratch_->star) {
-        tf_[t] &= std::uint8_t(~kMark);
-        for (int i = 0; i < 4; ++i) {
-          const PointId w = td_[8 * std::size_t(t) + i];
-          const double d2 = squared_distance(pos_[w], p);
-          if (w != pv && d2 < best) {
-            best = d2;
-            nearest = w;
-          }
-        }
-      }
+      for (TetId t : scratch_->star) tf_[t] &= std::uint8_t(~kMark);
+      double best2 = min_distance * min_distance;
+      const PointId nearest = nearest_vertex(scratch_->star, p, pv, best2);
       if (nearest != kNoVertex) return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
     }
     return {InsertStatus::Inserted, v, kNoVertex};
@@ -1544,26 +1532,14 @@ InsertResult Triangulation::move_impl(VertexId v, const Point3& p, double min_di
     // p's cavity in DT(S), or (when the edge appears only once v is gone) a link vertex of v.
     Scratch& S = *scratch_;
     collect_star(pv);
-    std::vector<PointId> candidates;
-    for (TetId t : S.star) {
-      tf_[t] &= std::uint8_t(~kMark);
-      for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
-    }
+    for (TetId t : S.star) tf_[t] &= std::uint8_t(~kMark);
     PointId dup = kNoVertex;
     if (!grow_cavity(p, start, true, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
-    for (TetId t : S.cavity)
-      for (int i = 0; i < 4; ++i) candidates.push_back(td_[8 * std::size_t(t) + i]);
-    clear_cavity_marks();
-    double best = min_distance * min_distance;
-    PointId nearest = kNoVertex;
-    for (PointId w : candidates) {
-      if (w == pv) continue;
-      const double d2 = squared_distance(pos_[w], p);
-      if (d2 < best) {
-        best = d2;
-        nearest = w;
-      }
-    }
+    clear_cavity_marks();  // S.cavity keeps the list
+    double best2 = min_distance * min_distance;
+    PointId nearest = nearest_vertex(S.star, p, pv, best2);
+    const PointId in_cavity = nearest_vertex(S.cavity, p, pv, best2);
+    if (in_cavity != kNoVertex) nearest = in_cavity;
     if (nearest != kNoVertex) return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
   }
 
@@ -1603,10 +1579,10 @@ constexpr std::size_t kRebuildLevels = 16;  // excess levels per vertex that pay
 // - the records of removals and moves hold more tetrahedra than the live mesh: memory stays O(n), and
 //   the O(n log n) rebuild is paid by Omega(n) edited tetrahedra, O(log n) amortized per edit; or
 // - the locations of insert() and move() have descended, in total, more than 16 n levels beyond the
-//   depth of a fresh history (6 log2 n + 64 each). A rebuild costs about 8 us per vertex (bulk
-//   insertion with history) and a level of a pile of edit records about 0.5 us (a scan of ~27
-//   tetrahedra, 4 orientations each), so the rebuild costs about what deep locations have already
-//   wasted (ski rental): at most about twice the cost of the best rebuilding schedule in hindsight.
+//   depth of a fresh history (6 log2 n + 64 each). A rebuild costs about 4 us per vertex (bulk
+//   insertion with history, measured) and a level of a pile of edit records an estimated 0.3-0.5 us
+//   (a scan of ~27 tetrahedra, 4 orientations each), so the rebuild costs about what deep locations
+//   have already wasted (ski rental): within a small factor of the best schedule in hindsight.
 // An in-place move that rebuilds exactly the star created by the previous record overwrites that
 // record instead of stacking a new one (try_move_in_place), so repeated moves of one vertex add no depth.
 //

@@ -182,34 +182,43 @@ void Polygonizer::grow_tet_arrays() {
   radius_.resize(cap, 0.0);
 }
 
+// Vertices whose evaluation is due: every live vertex without a fixed value, and with
+// refine_thin_features also the fixed ones, for their gradient.
+bool Polygonizer::needs_evaluation(VertexId v) const {
+  return tri_.is_vertex(v) && (!fixed_[v] || options_.refine_thin_features);
+}
+
+// f at the vertices `ids` into `out`, in one batch call; with refine_thin_features the gradients come
+// with the values (about the cost of the values alone for the RBF) and are stored in grad_.
+void Polygonizer::evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
+  std::vector<Point3> pts(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) pts[i] = tri_.point(ids[i]);
+  out.resize(ids.size());
+  if (options_.refine_thin_features) {
+    std::vector<Point3> grads(ids.size());
+    f_.values_gradients(pts.data(), pts.size(), out.data(), grads.data());
+    for (std::size_t i = 0; i < ids.size(); ++i) grad_[ids[i]] = grads[i];
+  } else {
+    f_.values(pts.data(), pts.size(), out.data());
+  }
+  stats_.function_evaluations += ids.size();
+  stats_.vertex_evaluations += ids.size();
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (!fixed_[ids[i]] && std::isnan(out[i]))
+      throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
+}
+
 void Polygonizer::evaluate_pending() {
   if (pending_.empty()) return;
-  std::vector<Point3> pts;
   std::vector<VertexId> ids;
-  pts.reserve(pending_.size());
-  // With refine_thin_features the gradient comes with the value (one batch call; about the cost of the
-  // value alone for the RBF), and fixed-value vertices are evaluated for their gradient only.
-  const bool thin = options_.refine_thin_features;
-  for (const VertexId v : pending_) {
-    if (!tri_.is_vertex(v) || (fixed_[v] && !thin)) continue;
-    ids.push_back(v);
-    pts.push_back(tri_.point(v));
-  }
+  ids.reserve(pending_.size());
+  for (const VertexId v : pending_)
+    if (needs_evaluation(v)) ids.push_back(v);
   pending_.clear();
-  std::vector<double> out(pts.size());
-  std::vector<Point3> grads(thin ? pts.size() : 0);
-  if (thin)
-    f_.values_gradients(pts.data(), pts.size(), out.data(), grads.data());
-  else
-    f_.values(pts.data(), pts.size(), out.data());
-  stats_.function_evaluations += pts.size();
-  stats_.vertex_evaluations += pts.size();
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (thin) grad_[ids[i]] = grads[i];
-    if (fixed_[ids[i]]) continue;
-    if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
-    set_value(ids[i], out[i]);
-  }
+  std::vector<double> out;
+  evaluate_at(ids, out);
+  for (std::size_t i = 0; i < ids.size(); ++i)
+    if (!fixed_[ids[i]]) set_value(ids[i], out[i]);
 }
 
 bool Polygonizer::is_transverse(TetId t) const {
@@ -351,31 +360,51 @@ void Polygonizer::clear_queue() {
   heap_ = {};
 }
 
+// Index of a face of t on the box hull (its neighbour there is kNoTet), or -1.
+int Polygonizer::hull_face(TetId t) const {
+  for (int i = 0; i < 4; ++i)
+    if (tri_.tet_neighbor(t, i) == kNoTet) return i;
+  return -1;
+}
+
+// Inserts p, a point of the circumball of the live tetrahedron t, in conflict with t (no location); when
+// rounding put p just outside t's exact circumsphere (a nearly flat t), with point location instead.
+// The proximity rule is the same either way. On success the new vertex is registered (kind, value
+// pending) and the created tetrahedra are appended to `created`.
+bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, VertexKind kind,
+                               std::vector<TetId>& created) {
+  changes_.clear();
+  InsertResult r;
+  try {
+    r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
+  } catch (const InvalidArgument&) {
+    changes_.clear();
+    r = tri_.insert(p, min_distance, &changes_);
+  }
+  if (r.status != InsertStatus::Inserted) return false;
+  grow_vertex_arrays();
+  grow_tet_arrays();
+  kind_[r.vertex] = static_cast<std::uint8_t>(kind);
+  fixed_[r.vertex] = 0;
+  tcount_[r.vertex] = 0;
+  pending_.push_back(r.vertex);
+  ++stats_.insertions;
+  on_killed(changes_);
+  created.insert(created.end(), changes_.created.begin(), changes_.created.end());
+  return true;
+}
+
 bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKind kind,
                                           std::vector<TetId>& created) {
   const Box3& box = tri_.box();
-  const Point3 c = tri_.circumcenter(t);
-  changes_.clear();
-  InsertResult r;
-  if (is_finite(c) && strictly_inside(box, c)) {
-    try {
-      r = tri_.insert_in_conflict(c, t, min_distance, &changes_);
-    } catch (const InvalidArgument&) {
-      // The rounded circumcenter of a nearly flat tetrahedron can fall just outside its exact
-      // circumsphere: insert it with point location instead (same proximity rule).
-      changes_.clear();
-      r = tri_.insert(c, min_distance, &changes_);
-    }
-  } else {
+  Point3 p = tri_.circumcenter(t);
+  if (!(is_finite(p) && strictly_inside(box, p))) {
     // The circumcenter is outside the box: a fallback point of the interior of t (strictly inside the
     // box and the circumball, so in conflict with t), subject to the same proximity rule.
     ++stats_.boundary_fallbacks;
     const auto v = tri_.tet_vertices(t);
     const Point3 g = 0.25 * (tri_.point(v[0]) + tri_.point(v[1]) + tri_.point(v[2]) + tri_.point(v[3]));
-    Point3 m;
-    int hull = -1;
-    for (int i = 0; i < 4; ++i)
-      if (tri_.tet_neighbor(t, i) == kNoTet) hull = i;
+    const int hull = hull_face(t);
     if (hull >= 0) {
       // A face on the box hull (three corners: only corners lie on the hull) bounds the circumradius
       // from below, so t stays larger than the precision whatever is inserted. Fallback (the paper's
@@ -387,7 +416,7 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
       Point3 face{0.0, 0.0, 0.0};
       for (int i = 0; i < 4; ++i)
         if (i != hull) face = face + tri_.point(v[i]) * (1.0 / 3.0);
-      m = face + 0.25 * (tri_.point(v[hull]) - face);
+      p = face + 0.25 * (tri_.point(v[hull]) - face);
     } else {
       // Otherwise: the midpoint of the longest edge pulled 10% towards the centroid.
       double best = -1.0;
@@ -396,43 +425,18 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
           const double d = squared_distance(tri_.point(v[i]), tri_.point(v[j]));
           if (d > best) {
             best = d;
-            m = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
+            p = 0.9 * (0.5 * (tri_.point(v[i]) + tri_.point(v[j]))) + 0.1 * g;
           }
         }
     }
-    if (!strictly_inside(box, m)) m = g;  // rounding put it on a face (t is very flat there)
-    r.status = InsertStatus::TooClose;
-    if (strictly_inside(box, m)) {
-      try {
-        r = tri_.insert_in_conflict(m, t, min_distance, &changes_);
-      } catch (const InvalidArgument&) {
-        // t is so flat that the rounded m left its circumsphere: locate it instead.
-        changes_.clear();
-        r = tri_.insert(m, min_distance, &changes_);
-      }
-    }
+    if (!strictly_inside(box, p)) p = g;  // rounding put it on a face (t is very flat there)
   }
-  if (r.status != InsertStatus::Inserted) {
-    if (kind == VertexKind::Refinement) {
-      ++stats_.rejected;
-      for (int i = 0; i < 4; ++i)
-        if (tri_.tet_neighbor(t, i) == kNoTet) {
-          ++stats_.boundary_dropped;
-          break;
-        }
-    }
-    return false;
+  const bool inserted = strictly_inside(box, p) && insert_point(p, t, min_distance, kind, created);
+  if (!inserted && kind == VertexKind::Refinement) {
+    ++stats_.rejected;
+    if (hull_face(t) >= 0) ++stats_.boundary_dropped;
   }
-  grow_vertex_arrays();
-  grow_tet_arrays();
-  kind_[r.vertex] = static_cast<std::uint8_t>(kind);
-  fixed_[r.vertex] = 0;
-  tcount_[r.vertex] = 0;
-  pending_.push_back(r.vertex);
-  ++stats_.insertions;
-  on_killed(changes_);
-  created.insert(created.end(), changes_.created.begin(), changes_.created.end());
-  return true;
+  return inserted;
 }
 
 void Polygonizer::sample(double radius) {
@@ -532,11 +536,7 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   std::vector<TetId> hull;
   for (VertexId c = 0; c < 8; ++c)
     for (const TetId t : tri_.incident_tetrahedra(c))
-      for (int i = 0; i < 4; ++i)
-        if (tri_.tet_neighbor(t, i) == kNoTet) {
-          hull.push_back(t);
-          break;
-        }
+      if (hull_face(t) >= 0) hull.push_back(t);
   std::sort(hull.begin(), hull.end());
   hull.erase(std::unique(hull.begin(), hull.end()), hull.end());
   stats_.boundary_coarse = 0;
@@ -628,25 +628,8 @@ bool Polygonizer::insert_thin_point(double min_distance, std::vector<TetId>& cre
   const Point3 p = pa + e.s * (tri_.point(e.b) - pa);
   if (!is_finite(p) || !strictly_inside(tri_.box(), p)) return false;
   // p is on the edge, so strictly inside the circumball of every tetrahedron around it: in conflict.
-  changes_.clear();
-  InsertResult r;
-  try {
-    r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
-  } catch (const InvalidArgument&) {
-    changes_.clear();
-    r = tri_.insert(p, min_distance, &changes_);
-  }
-  if (r.status != InsertStatus::Inserted) return false;
-  grow_vertex_arrays();
-  grow_tet_arrays();
-  kind_[r.vertex] = static_cast<std::uint8_t>(VertexKind::Refinement);
-  fixed_[r.vertex] = 0;
-  tcount_[r.vertex] = 0;
-  pending_.push_back(r.vertex);
-  ++stats_.insertions;
+  if (!insert_point(p, t, min_distance, VertexKind::Refinement, created)) return false;
   ++stats_.thin_insertions;
-  on_killed(changes_);
-  created.insert(created.end(), changes_.created.begin(), changes_.created.end());
   return true;
 }
 
@@ -751,28 +734,14 @@ void Polygonizer::set_vertex_value(VertexId v, double value) {
 void Polygonizer::function_changed() {
   const auto t0 = Clock::now();
   std::vector<VertexId> ids;
-  std::vector<Point3> pts;
   const std::size_t cap = tri_.vertex_capacity();
-  // With refine_thin_features the gradients are refreshed too (fixed-value vertices: gradient only).
-  const bool thin = options_.refine_thin_features;
-  for (VertexId v = 0; v < cap; ++v) {
-    if ((fixed_[v] && !thin) || !tri_.is_vertex(v)) continue;
-    ids.push_back(v);
-    pts.push_back(tri_.point(v));
-  }
-  std::vector<double> out(pts.size());
-  std::vector<Point3> grads(thin ? pts.size() : 0);
-  if (thin)
-    f_.values_gradients(pts.data(), pts.size(), out.data(), grads.data());
-  else
-    f_.values(pts.data(), pts.size(), out.data());
-  stats_.function_evaluations += pts.size();
-  stats_.vertex_evaluations += pts.size();
+  for (VertexId v = 0; v < cap; ++v)
+    if (needs_evaluation(v)) ids.push_back(v);
+  std::vector<double> out;
+  evaluate_at(ids, out);
   std::vector<TetId> touched;
   for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (thin) grad_[ids[i]] = grads[i];
     if (fixed_[ids[i]]) continue;
-    if (std::isnan(out[i])) throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
     const VertexId v = ids[i];
     const bool flip = is_negative(out[i]) != is_negative(values_[v]);
     set_value(v, out[i]);

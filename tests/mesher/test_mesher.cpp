@@ -2,6 +2,7 @@
 // detail, dynamic edits (watertight, on the edited surface, close to a fresh mesh, bounded growth).
 #include <catch2/catch.hpp>
 
+#include "support/surface_metrics.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
@@ -18,12 +19,7 @@ namespace {
 
 const std::string kData = VITRI_DATA_DIR;
 
-MeshMetrics metrics_of(const SurfaceMesh& m) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  to_eigen(m, V, F);
-  return compute_mesh_metrics(V, F);
-}
+using test::metrics_of;
 
 void require_closed(const SurfaceMesh& m) {
   const MeshMetrics mm = metrics_of(m);

@@ -2,6 +2,7 @@
 // functions whose surface, topology and distance are known exactly.
 #include <catch2/catch.hpp>
 
+#include "support/surface_metrics.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/polygonize/analytic.hpp"
 #include "vitri/polygonize/mesh_metrics.hpp"
@@ -17,12 +18,7 @@ using namespace vitri;
 
 namespace {
 
-MeshMetrics metrics_of(const SurfaceMesh& m) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  to_eigen(m, V, F);
-  return compute_mesh_metrics(V, F);
-}
+using test::metrics_of;
 
 /// Largest distance to the true surface over the vertices and the triangle centroids.
 template <class Fn>

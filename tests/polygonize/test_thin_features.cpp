@@ -2,6 +2,7 @@
 // the RBF of hand.off, and of the fallback point for tetrahedra with a face on the box hull.
 #include <catch2/catch.hpp>
 
+#include "support/surface_metrics.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
 #include "vitri/polygonize/analytic.hpp"
@@ -16,12 +17,7 @@ using namespace vitri;
 
 namespace {
 
-MeshMetrics metrics_of(const SurfaceMesh& m) {
-  Eigen::MatrixXd V;
-  Eigen::MatrixXi F;
-  to_eigen(m, V, F);
-  return compute_mesh_metrics(V, F);
-}
+using test::metrics_of;
 
 /// Euler characteristic of a fresh polygonization of the mesher's RBF, built as vitri::Mesher (and so
 /// `vitri mesh`) builds it: constraint points as seeds with their values, domain = their box x 2.

@@ -337,6 +337,7 @@ class Triangulation {
   PointId alloc_point(const Point3& p, VertexId reuse_vid);
   bool grow_cavity(const Point3& p, TetId start, bool start_contains, PointId& duplicate);
   void link_around_apex(PointId q);
+  PointId nearest_vertex(const std::vector<TetId>& tets, const Point3& p, PointId skip, double& best2) const;
   void clear_cavity_marks();
   InsertResult insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
                          ChangeSet* changes, VertexId reuse_vid);

@@ -232,6 +232,8 @@ class Polygonizer {
   bool is_negative_value(VertexId v) const { return values_[v] < 0.0; }  // sign(0) = +
   void grow_vertex_arrays();
   void grow_tet_arrays();
+  bool needs_evaluation(VertexId v) const;
+  void evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out);
   void evaluate_pending();
   void on_killed(const ChangeSet& cs);
   void absorb_renumbering();
@@ -242,6 +244,9 @@ class Polygonizer {
   std::size_t queued() const;
   void clear_queue();
   void sample(double radius);
+  int hull_face(TetId t) const;
+  bool insert_point(const Point3& p, TetId t, double min_distance, VertexKind kind,
+                    std::vector<TetId>& created);
   bool insert_refinement_point(TetId t, double min_distance, VertexKind kind, std::vector<TetId>& created);
   void classify_created(std::vector<TetId>& created);
   void set_value(VertexId v, double value);

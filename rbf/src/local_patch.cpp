@@ -1,6 +1,8 @@
 // Fitting one patch of the local RBF (see local_patch.hpp).
 #include "local_patch.hpp"
 
+#include "dense.hpp"
+
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/QR>
@@ -73,11 +75,11 @@ bool fit_rbf_patch(const Point3& center, double inv_radius, const std::vector<Po
   coef.assign(4 + 4 * static_cast<std::size_t>(k), 0.0);
   for (int c = 0; c < 4; ++c) coef[static_cast<std::size_t>(c)] = a(c);
   for (Eigen::Index j = 0; j < k; ++j) {
-    double* t = coef.data() + 4 + 4 * j;
+    double* t = coef.data() + 4 + j;
     t[0] = P(j, 1);
-    t[1] = P(j, 2);
-    t[2] = P(j, 3);
-    t[3] = w(j);
+    t[k] = P(j, 2);
+    t[2 * k] = P(j, 3);
+    t[3 * k] = w(j);
   }
   return a.allFinite();
 }
@@ -88,6 +90,19 @@ void fit_linear_patch(const Point3& center, double inv_radius, const std::vector
   const Eigen::Map<const Eigen::VectorXd> h(values.data(), static_cast<Eigen::Index>(values.size()));
   const Eigen::VectorXd a = polynomial_qr(P).solve(h);
   coef.assign(a.data(), a.data() + 4);
+}
+
+double patch_value(const double* coef, std::size_t count, const Point3& u, Point3* grad) {
+  double f = coef[0] + coef[1] * u.x + coef[2] * u.y + coef[3] * u.z;
+  if (grad) *grad = {coef[1], coef[2], coef[3]};
+  if (count == 0) return f;
+  static const rbf_detail::DenseOps& ops = rbf_detail::dense_ops();
+  const double* t = coef + 4;
+  const auto k = static_cast<long>(count);
+  double sum = 0, g[3] = {0, 0, 0};
+  ops.rbf_sums(t, t + k, t + 2 * k, t + 3 * k, k, &u.x, 1, &sum, grad ? g : nullptr);
+  if (grad) *grad = *grad + Point3{g[0], g[1], g[2]};
+  return f + sum;
 }
 
 }  // namespace vitri::local_detail

@@ -26,36 +26,9 @@ bool fit_rbf_patch(const Point3& center, double inv_radius, const std::vector<Po
 void fit_linear_patch(const Point3& center, double inv_radius, const std::vector<Point3>& points,
                       const std::vector<double>& values, std::vector<double>& coef);
 
-/// Value of the patch at scaled coordinates u.
-inline double patch_value(const double* coef, std::size_t count, const Point3& u) {
-  double f = coef[0] + coef[1] * u.x + coef[2] * u.y + coef[3] * u.z;
-  const double* t = coef + 4;
-  for (std::size_t j = 0; j < count; ++j, t += 4) {
-    const double dx = u.x - t[0], dy = u.y - t[1], dz = u.z - t[2];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    f += t[3] * r2 * std::sqrt(r2);
-  }
-  return f;
-}
-
-/// Value and gradient (with respect to u) of the patch at u.
-inline double patch_value_gradient(const double* coef, std::size_t count, const Point3& u, Point3& grad) {
-  double f = coef[0] + coef[1] * u.x + coef[2] * u.y + coef[3] * u.z;
-  double gx = coef[1], gy = coef[2], gz = coef[3];
-  const double* t = coef + 4;
-  for (std::size_t j = 0; j < count; ++j, t += 4) {
-    const double dx = u.x - t[0], dy = u.y - t[1], dz = u.z - t[2];
-    const double r2 = dx * dx + dy * dy + dz * dz;
-    const double r = std::sqrt(r2);
-    f += t[3] * r2 * r;
-    const double s = 3.0 * t[3] * r;  // d/du (w r^3) = 3 w r (u - u_j)
-    gx += s * dx;
-    gy += s * dy;
-    gz += s * dz;
-  }
-  grad = {gx, gy, gz};
-  return f;
-}
+/// Value of the patch at scaled coordinates u; with `grad`, also its gradient with respect to u. Runs the
+/// best instruction-set copy of the dense RBF sums (rbf/src/dense.hpp), fixed for the process.
+double patch_value(const double* coef, std::size_t count, const Point3& u, Point3* grad);
 
 /// Wendland's C2 weight psi(r) = (1 - r)^4 (4 r + 1) for r in [0, 1), 0 beyond.
 inline double wendland(double r) {

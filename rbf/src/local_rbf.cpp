@@ -111,6 +111,7 @@ struct LocalRbf::Impl {
   SlotRanks ranks;
   std::size_t live = 0;
   std::size_t nonzero = 0;
+  double fit_diagonal = 0;  // bounding-box diagonal of the constraints at the last fit (duplicate tolerance)
   mutable std::mutex cache_mutex;
   mutable Constraints cache;
   mutable bool cache_valid = false;
@@ -144,10 +145,7 @@ struct LocalRbf::Impl {
 // ----- fit -------------------------------------------------------------------------------------------------
 
 double LocalRbf::Impl::duplicate_tolerance2() const {
-  Box3 box;
-  for (std::size_t s = 0; s < slot_point.size(); ++s)
-    if (slot_alive[s]) box.extend(slot_point[s]);
-  const double tol = opt.duplicate_tolerance * box.diagonal();
+  const double tol = opt.duplicate_tolerance * fit_diagonal;
   return tol * tol;
 }
 
@@ -205,6 +203,7 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   nonzero = nz;
   cache_valid = false;
   index.build(slot_point);
+  fit_diagonal = box.diagonal();
   check_duplicates();
   tree.overlap = opt.overlap;
   if (domain.empty()) {
@@ -301,8 +300,10 @@ void LocalRbf::Impl::fit_leaves(const std::vector<std::uint32_t>& leaves) {
 }
 
 void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created) {
-  std::vector<std::uint8_t> is_new(tree.capacity(), 0);
-  for (std::uint32_t c : created) is_new[c] = 1;
+  // Membership in `created` (sorted copy, binary search): no pass over all cells, so an edit stays O(local).
+  std::vector<std::uint32_t> sorted_created = created;
+  std::sort(sorted_created.begin(), sorted_created.end());
+  auto is_new = [&](std::uint32_t c) { return std::binary_search(sorted_created.begin(), sorted_created.end(), c); };
   parallel_chunks(created.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) {
       Cell& cell = tree.cell(created[k]);
@@ -316,7 +317,7 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created) {
     for (std::uint32_t l : tree.cell(n).candidates) tree.cell(l).listed_in.push_back(n);
     tree.leaves_in_ball(tree.cell(n).center, tree.cell(n).radius, found);
     for (std::uint32_t m : found) {
-      if (is_new[m]) continue;
+      if (is_new(m)) continue;
       auto& cand = tree.cell(m).candidates;
       const auto at = std::lower_bound(cand.begin(), cand.end(), n,
                                        [&](auto x, auto y) { return cell_before(tree.cell(x), tree.cell(y)); });
@@ -378,13 +379,13 @@ double LocalRbf::Impl::evaluate_inside(const Point3& x, Point3* grad) const {
     const double r = std::sqrt(d2) * inv;
     const double w = wendland(r);
     if (!grad) {
-      const double fp = patch_value(p.coef.data(), p.terms, u);
+      const double fp = patch_value(p.coef.data(), p.terms, u, nullptr);
       sw += w;
       swf += w * fp;
       continue;
     }
     Point3 gu;
-    const double fp = patch_value_gradient(p.coef.data(), p.terms, u, gu);
+    const double fp = patch_value(p.coef.data(), p.terms, u, &gu);
     const Point3 dw = (wendland_derivative_over_r(r) * inv * inv) * d;
     sw += w;
     swf += w * fp;
@@ -601,15 +602,62 @@ double LocalRbf::value(const Point3& p) const { return impl_->evaluate(p, nullpt
 
 double LocalRbf::value_gradient(const Point3& p, Point3& gradient) const { return impl_->evaluate(p, &gradient); }
 
+namespace {
+
+/// Spreads the low 21 bits of v to every third bit (Morton interleaving).
+std::uint64_t spread_bits(std::uint64_t v) {
+  v &= 0x1fffff;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
+
+/// Order in which a large batch is evaluated: along a Morton curve of the root cube, so that consecutive
+/// points visit the same patches (their coefficients stay in cache). Results do not depend on the order.
+std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, const Box3& root) {
+  std::vector<std::pair<std::uint64_t, std::uint32_t>> keyed(n);
+  const double scale = double(1 << 21) / (root.hi.x - root.lo.x);
+  for (std::size_t i = 0; i < n; ++i) {
+    std::uint64_t code = 0;
+    for (int a = 0; a < 3; ++a) {
+      const double t = std::min(std::max((points[i][a] - root.lo[a]) * scale, 0.0), double((1 << 21) - 1));
+      code |= spread_bits(static_cast<std::uint64_t>(t)) << a;
+    }
+    keyed[i] = {code, static_cast<std::uint32_t>(i)};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint32_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
+  return order;
+}
+
+/// Batches below this size are evaluated in the given order.
+constexpr std::size_t kSortedBatch = 8192;
+
+}  // namespace
+
 void LocalRbf::values(const Point3* points, std::size_t n, double* out) const {
+  const std::vector<std::uint32_t> order =
+      n >= kSortedBatch && n < PointIndex::kNoId ? batch_order(points, n, domain()) : std::vector<std::uint32_t>{};
   parallel_chunks(n, impl_->threads(), 2048, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) out[i] = impl_->evaluate(points[i], nullptr);
+    for (std::size_t k = b; k < e; ++k) {
+      const std::size_t i = order.empty() ? k : order[k];
+      out[i] = impl_->evaluate(points[i], nullptr);
+    }
   });
 }
 
 void LocalRbf::values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const {
+  const std::vector<std::uint32_t> order =
+      n >= kSortedBatch && n < PointIndex::kNoId ? batch_order(points, n, domain()) : std::vector<std::uint32_t>{};
   parallel_chunks(n, impl_->threads(), 2048, [&](std::size_t b, std::size_t e) {
-    for (std::size_t i = b; i < e; ++i) values[i] = impl_->evaluate(points[i], &gradients[i]);
+    for (std::size_t k = b; k < e; ++k) {
+      const std::size_t i = order.empty() ? k : order[k];
+      values[i] = impl_->evaluate(points[i], &gradients[i]);
+    }
   });
 }
 

@@ -29,13 +29,13 @@ namespace vitri {
 struct LocalRbfOptions {
   /// A cell is split while its support ball holds more than this many constraints (so a patch fits at
   /// most this many, unless the cell is at max_depth).
-  std::size_t max_per_patch = 40;
+  std::size_t max_per_patch = 48;
   /// A patch whose support holds fewer constraints is fitted to its min_per_patch nearest constraints
   /// (it still interpolates every constraint in its support). Must be >= 5 and <= max_per_patch.
   std::size_t min_per_patch = 16;
   /// Support radius of a cell's patch: overlap x half the cell diagonal. Must be > 1 (the ball then holds
   /// the cell with a margin, and a child's ball lies inside its parent's).
-  double overlap = 1.4;
+  double overlap = 1.2;
   /// Regularization of every patch fit: (A + smoothing I) w + P a = h, in the patch's scaled coordinates
   /// (lengths divided by the support radius, kernel values of order 1). 0 interpolates; 1e-3..1e-1
   /// smooths a noisy scan. f(c_i) = h_i then holds only approximately.
@@ -50,7 +50,8 @@ struct LocalRbfOptions {
   /// still refits with a cube from domain_factor.
   Box3 domain;
   /// Two constraints closer than duplicate_tolerance x the bounding-box diagonal are rejected
-  /// (InvalidPoint naming both); 0 rejects exact duplicates only.
+  /// (InvalidPoint naming both); 0 rejects exact duplicates only. Edits use the diagonal of the last fit
+  /// (so that an edit costs no pass over all constraints).
   double duplicate_tolerance = 1e-6;
   /// Deepest octree level (root 0). Cells at this level are never split, whatever their count.
   int max_depth = 20;

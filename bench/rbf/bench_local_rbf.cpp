@@ -85,8 +85,9 @@ int main(int argc, char** argv) {
     return 0;
   }
 
+  const bool edits_only = std::getenv("VITRI_EDITS_ONLY") != nullptr;
   // Evaluation: points near the surface (surface samples jittered by 1% of the diagonal).
-  const std::size_t ne = 1000000;
+  const std::size_t ne = edits_only ? 1000 : 1000000;
   std::vector<vitri::Point3> q;
   std::mt19937 rng(7);
   std::normal_distribution<double> jitter(0, 0.01 * vitri::norm(vitri::Point3{mesh.V.col(0).maxCoeff() - mesh.V.col(0).minCoeff(),
@@ -104,7 +105,7 @@ int main(int argc, char** argv) {
   std::uniform_int_distribution<std::size_t> pick(0, c.size() - 1);
   std::uniform_real_distribution<double> small(-0.002, 0.002);
   const double diag = vitri::norm(f.domain().extent()) / 3.0;
-  for (int k = 0; k < 200; ++k) {
+  for (int k = 0; k < (edits_only ? 3000 : 200); ++k) {
     const std::size_t i = pick(rng);
     const vitri::Point3 old = f.point(i);
     t = Clock::now();

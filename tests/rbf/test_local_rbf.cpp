@@ -294,3 +294,25 @@ TEST_CASE("LocalRbf rejects bad input with the culprit", "[local_rbf]") {
     f.validate();
   }
 }
+
+TEST_CASE("LocalRbf with fewer constraints than a patch wants", "[local_rbf]") {
+  // 6 constraints, min_per_patch 16: every patch fits all of them (fit region: everything), so the
+  // function is one RBF blended with itself and interpolates; an edit touches every patch.
+  Constraints c;
+  c.add({0, 0, 0}, -1);
+  for (int a = 0; a < 3; ++a) {
+    Point3 e{0, 0, 0};
+    e[a] = 1;
+    c.add(e, 0.5);
+  }
+  c.add({1, 1, 1}, 1.0);
+  c.add({-1, 0.5, 0.25}, 0.7);
+  LocalRbf f(c);
+  f.validate();
+  REQUIRE(max_residual(f, c) < 1e-12);
+  const auto region = f.move_constraint(5, {-0.8, 0.4, 0.3});
+  c.points[5] = {-0.8, 0.4, 0.3};
+  f.validate();
+  REQUIRE(max_residual(f, c) < 1e-12);
+  REQUIRE(region.contains({0, 0, 0}));
+}

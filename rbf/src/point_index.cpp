@@ -1,0 +1,267 @@
+// vitri::PointIndex: a bucket kd-tree with stable ids (see point_index.hpp).
+#include "vitri/rbf/point_index.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <cassert>
+#include <limits>
+#include <numeric>
+#include <queue>
+#include <utility>
+
+namespace vitri {
+
+namespace {
+
+/// Leaves hold at most this many ids after a build; an insertion splits a leaf past twice as many.
+constexpr std::size_t kBucket = 16;
+
+/// Squared distance from q to the box [lo, hi] (0 inside).
+double box_distance2(const Point3& q, const Point3& lo, const Point3& hi) {
+  double d2 = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double below = lo[a] - q[a];
+    const double above = q[a] - hi[a];
+    if (below > 0) d2 += below * below;
+    else if (above > 0) d2 += above * above;
+  }
+  return d2;
+}
+
+void grow(Point3& lo, Point3& hi, const Point3& p) {
+  for (int a = 0; a < 3; ++a) {
+    lo[a] = std::min(lo[a], p[a]);
+    hi[a] = std::max(hi[a], p[a]);
+  }
+}
+
+}  // namespace
+
+/// The running answer of nearest(): a max-heap on (squared distance, id) of at most k entries.
+struct PointIndex::NearestState {
+  Point3 query;
+  std::size_t k = 0;
+  std::vector<std::pair<double, Id>> heap;
+  /// Squared distance beyond which nothing can enter the answer (infinity until the heap is full).
+  double bound() const {
+    return heap.size() < k ? std::numeric_limits<double>::infinity() : heap.front().first;
+  }
+  void offer(double d2, Id id) {
+    const std::pair<double, Id> entry(d2, id);
+    if (heap.size() < k) {
+      heap.push_back(entry);
+      std::push_heap(heap.begin(), heap.end());
+    } else if (entry < heap.front()) {
+      std::pop_heap(heap.begin(), heap.end());
+      heap.back() = entry;
+      std::push_heap(heap.begin(), heap.end());
+    }
+  }
+};
+
+void PointIndex::build(const std::vector<Point3>& points) {
+  if (points.size() >= static_cast<std::size_t>(kNoId))
+    throw LimitError("PointIndex: " + std::to_string(points.size()) + " points exceed the 2^32 - 2 ids");
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (!is_finite(points[i])) throw InvalidPoint(i, "non-finite coordinate in the spatial index");
+  nodes_.clear();
+  position_ = points;
+  leaf_of_.assign(points.size(), kNoNode);
+  size_ = points.size();
+  std::vector<Id> ids(points.size());
+  std::iota(ids.begin(), ids.end(), Id{0});
+  nodes_.reserve(2 * (points.size() / kBucket + 1));
+  make_subtree(ids.data(), ids.data() + ids.size());
+}
+
+std::uint32_t PointIndex::make_subtree(Id* first, Id* last) {
+  const auto index = static_cast<std::uint32_t>(nodes_.size());
+  nodes_.emplace_back();
+  Point3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+            std::numeric_limits<double>::infinity()};
+  Point3 hi = -lo;
+  for (Id* it = first; it != last; ++it) grow(lo, hi, position_[*it]);
+  nodes_[index].lo = lo;
+  nodes_[index].hi = hi;
+  const auto count = static_cast<std::size_t>(last - first);
+  const Point3 extent = hi - lo;
+  int axis = 0;
+  if (extent.y > extent[axis]) axis = 1;
+  if (extent.z > extent[axis]) axis = 2;
+  if (count <= kBucket || !(extent[axis] > 0)) {  // small, or all points at one position
+    nodes_[index].bucket.assign(first, last);
+    for (Id* it = first; it != last; ++it) leaf_of_[*it] = index;
+    return index;
+  }
+  Id* middle = first + count / 2;
+  std::nth_element(first, middle, last, [&](Id a, Id b) {
+    const double pa = position_[a][axis], pb = position_[b][axis];
+    return pa < pb || (pa == pb && a < b);
+  });
+  // Every id equal to the split value goes right, so that the left side is strictly below it.
+  const double split = position_[*middle][axis];
+  middle = std::partition(first, last, [&](Id a) { return position_[a][axis] < split; });
+  if (middle == first) {  // the lower half is all at `split`: split just above it instead
+    middle = std::partition(first, last, [&](Id a) { return !(position_[a][axis] > split); });
+    if (middle == last) {  // cannot happen with extent > 0, kept for safety
+      nodes_[index].bucket.assign(first, last);
+      for (Id* it = first; it != last; ++it) leaf_of_[*it] = index;
+      return index;
+    }
+  }
+  const double cut = middle == first ? split : position_[*std::min_element(middle, last, [&](Id a, Id b) {
+    return position_[a][axis] < position_[b][axis];
+  })][axis];
+  nodes_[index].axis = static_cast<std::uint8_t>(axis);
+  nodes_[index].split = cut;
+  const std::uint32_t left = make_subtree(first, middle);
+  const std::uint32_t right = make_subtree(middle, last);
+  nodes_[index].children[0] = left;
+  nodes_[index].children[1] = right;
+  return index;
+}
+
+void PointIndex::ensure_id(Id id) {
+  if (id >= leaf_of_.size()) {
+    leaf_of_.resize(static_cast<std::size_t>(id) + 1, kNoNode);
+    position_.resize(static_cast<std::size_t>(id) + 1);
+  }
+}
+
+void PointIndex::insert(Id id, const Point3& p) {
+  if (id == kNoId) throw InvalidPoint(id, "the id 2^32 - 1 is reserved in the spatial index");
+  if (!is_finite(p)) throw InvalidPoint(id, "non-finite coordinate in the spatial index");
+  if (contains(id)) throw InvalidPoint(id, "id already used in the spatial index");
+  ensure_id(id);
+  position_[id] = p;
+  if (nodes_.empty()) {
+    nodes_.emplace_back();
+    nodes_[0].lo = nodes_[0].hi = p;
+  }
+  std::uint32_t node = 0;
+  for (;;) {
+    grow(nodes_[node].lo, nodes_[node].hi, p);
+    if (nodes_[node].leaf()) break;
+    node = nodes_[node].children[p[nodes_[node].axis] < nodes_[node].split ? 0 : 1];
+  }
+  nodes_[node].bucket.push_back(id);
+  leaf_of_[id] = node;
+  ++size_;
+  if (nodes_[node].bucket.size() > 2 * kBucket) split_leaf(node);
+}
+
+void PointIndex::split_leaf(std::uint32_t node) {
+  std::vector<Id> ids = std::move(nodes_[node].bucket);
+  nodes_[node].bucket.clear();
+  const Point3 lo = nodes_[node].lo, hi = nodes_[node].hi;
+  const std::uint32_t sub = make_subtree(ids.data(), ids.data() + ids.size());
+  if (nodes_[sub].leaf()) {  // all at one position: keep one leaf (the node itself)
+    nodes_[node].bucket = std::move(nodes_[sub].bucket);
+    for (Id id : nodes_[node].bucket) leaf_of_[id] = node;
+    nodes_.pop_back();
+    return;
+  }
+  // Move the new root into `node` (its children were appended after it).
+  Node moved = std::move(nodes_[sub]);
+  moved.lo = lo;
+  moved.hi = hi;
+  nodes_[node] = std::move(moved);
+  nodes_.erase(nodes_.begin() + sub);  // sub is the last-but-children slot: shift indices after it
+  for (std::size_t n = sub; n < nodes_.size(); ++n)
+    for (auto& child : nodes_[n].children)
+      if (child != kNoNode && child > sub) --child;
+  for (auto& child : nodes_[node].children)
+    if (child != kNoNode && child > sub) --child;
+  for (std::size_t n = sub; n < nodes_.size(); ++n)
+    if (nodes_[n].leaf())
+      for (Id id : nodes_[n].bucket) leaf_of_[id] = static_cast<std::uint32_t>(n);
+}
+
+void PointIndex::erase(Id id) {
+  if (!contains(id)) throw InvalidPoint(id, "no point with this id in the spatial index");
+  auto& bucket = nodes_[leaf_of_[id]].bucket;
+  const auto it = std::find(bucket.begin(), bucket.end(), id);
+  assert(it != bucket.end());
+  *it = bucket.back();
+  bucket.pop_back();
+  leaf_of_[id] = kNoNode;
+  --size_;
+}
+
+void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out) const {
+  out.clear();
+  if (size_ == 0) return;
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const Node& n = nodes_[stack.back()];
+    stack.pop_back();
+    if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
+    if (n.leaf()) {
+      for (Id id : n.bucket)
+        if (squared_distance(position_[id], center) < radius2) out.push_back(id);
+    } else {
+      stack.push_back(n.children[0]);
+      stack.push_back(n.children[1]);
+    }
+  }
+  std::sort(out.begin(), out.end());
+}
+
+std::size_t PointIndex::count_ball(const Point3& center, double radius2) const {
+  if (size_ == 0) return 0;
+  std::size_t count = 0;
+  std::vector<std::uint32_t> stack;
+  stack.reserve(64);
+  stack.push_back(0);
+  while (!stack.empty()) {
+    const Node& n = nodes_[stack.back()];
+    stack.pop_back();
+    if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
+    if (n.leaf()) {
+      for (Id id : n.bucket) count += squared_distance(position_[id], center) < radius2;
+    } else {
+      stack.push_back(n.children[0]);
+      stack.push_back(n.children[1]);
+    }
+  }
+  return count;
+}
+
+void PointIndex::nearest_recurse(std::uint32_t index, NearestState& state) const {
+  const Node& n = nodes_[index];
+  if (n.leaf()) {
+    for (Id id : n.bucket) {
+      const double d2 = squared_distance(position_[id], state.query);
+      if (d2 <= state.bound()) state.offer(d2, id);
+    }
+    return;
+  }
+  const std::uint32_t a = n.children[0], b = n.children[1];
+  const double da = box_distance2(state.query, nodes_[a].lo, nodes_[a].hi);
+  const double db = box_distance2(state.query, nodes_[b].lo, nodes_[b].hi);
+  const std::uint32_t first = da <= db ? a : b, second = da <= db ? b : a;
+  const double dfirst = std::min(da, db), dsecond = std::max(da, db);
+  // <= keeps points at the bound's distance reachable: ties are broken by id.
+  if (dfirst <= state.bound()) nearest_recurse(first, state);
+  if (dsecond <= state.bound()) nearest_recurse(second, state);
+}
+
+void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, std::vector<double>* dist2) const {
+  ids.clear();
+  if (dist2) dist2->clear();
+  if (size_ == 0 || k == 0) return;
+  NearestState state;
+  state.query = q;
+  state.k = k;
+  state.heap.reserve(std::min(k, size_) + 1);
+  nearest_recurse(0, state);
+  std::sort_heap(state.heap.begin(), state.heap.end());
+  ids.reserve(state.heap.size());
+  for (const auto& [d2, id] : state.heap) {
+    ids.push_back(id);
+    if (dist2) dist2->push_back(d2);
+  }
+}
+
+}  // namespace vitri

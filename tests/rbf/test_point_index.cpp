@@ -1,0 +1,106 @@
+// PointIndex against brute force: ball and k-nearest answers (canonical order) after builds, insertions
+// and removals, on random, clustered and degenerate (repeated coordinates) points.
+#include "vitri/core/error.hpp"
+#include "vitri/rbf/point_index.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <utility>
+#include <vector>
+
+using vitri::Point3;
+using vitri::PointIndex;
+using Id = PointIndex::Id;
+
+namespace {
+
+struct Brute {
+  std::vector<std::pair<Id, Point3>> points;
+  std::vector<Id> ball(const Point3& c, double r2) const {
+    std::vector<Id> out;
+    for (const auto& [id, p] : points)
+      if (vitri::squared_distance(p, c) < r2) out.push_back(id);
+    std::sort(out.begin(), out.end());
+    return out;
+  }
+  std::vector<Id> nearest(const Point3& q, std::size_t k) const {
+    std::vector<std::pair<double, Id>> all;
+    for (const auto& [id, p] : points) all.emplace_back(vitri::squared_distance(p, q), id);
+    std::sort(all.begin(), all.end());
+    std::vector<Id> out;
+    for (std::size_t i = 0; i < std::min(k, all.size()); ++i) out.push_back(all[i].second);
+    return out;
+  }
+};
+
+void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rng) {
+  REQUIRE(index.size() == brute.points.size());
+  std::uniform_real_distribution<double> u(-1.2, 1.2);
+  std::vector<Id> got;
+  for (int q = 0; q < 60; ++q) {
+    const Point3 c{u(rng), u(rng), u(rng)};
+    const double r2 = std::pow(0.05 + 0.01 * q, 2);
+    index.ball(c, r2, got);
+    REQUIRE(got == brute.ball(c, r2));
+    REQUIRE(index.count_ball(c, r2) == got.size());
+    for (std::size_t k : {1u, 7u, 33u}) {
+      std::vector<double> d2;
+      index.nearest(c, k, got, &d2);
+      REQUIRE(got == brute.nearest(c, k));
+      for (std::size_t i = 0; i < got.size(); ++i) REQUIRE(d2[i] == vitri::squared_distance(index.point(got[i]), c));
+    }
+  }
+}
+
+}  // namespace
+
+TEST_CASE("PointIndex answers like brute force after build, insertions and removals", "[point_index]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Point3> pts;
+  for (int i = 0; i < 1500; ++i) pts.push_back({u(rng), u(rng), u(rng)});
+  // Repeated coordinates and exact duplicates: splits must handle ties.
+  for (int i = 0; i < 300; ++i) pts.push_back({std::round(u(rng) * 4) / 4, 0.25, std::round(u(rng) * 4) / 4});
+  for (int i = 0; i < 40; ++i) pts.push_back({0.5, 0.5, 0.5});
+  PointIndex index(pts);
+  Brute brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) brute.points.emplace_back(static_cast<Id>(i), pts[i]);
+  check_queries(index, brute, rng);
+
+  // Insert a dense cluster (forces leaf splits) with sparse ids, then remove every third point.
+  for (Id i = 0; i < 800; ++i) {
+    const Point3 p{0.1 + 0.01 * u(rng), -0.3 + 0.01 * u(rng), 0.2 + 0.01 * u(rng)};
+    const Id id = 5000 + 3 * i;
+    index.insert(id, p);
+    brute.points.emplace_back(id, p);
+  }
+  check_queries(index, brute, rng);
+  std::vector<std::pair<Id, Point3>> kept;
+  for (std::size_t i = 0; i < brute.points.size(); ++i) {
+    if (i % 3 == 0) index.erase(brute.points[i].first);
+    else kept.push_back(brute.points[i]);
+  }
+  brute.points = kept;
+  check_queries(index, brute, rng);
+  REQUIRE_FALSE(index.contains(0));
+  REQUIRE(index.contains(1));
+}
+
+TEST_CASE("PointIndex rejects bad input with the culprit", "[point_index]") {
+  PointIndex index(std::vector<Point3>{{0, 0, 0}, {1, 0, 0}});
+  REQUIRE_THROWS_AS(index.insert(1, {2, 0, 0}), vitri::InvalidPoint);
+  REQUIRE_THROWS_AS(index.insert(7, {NAN, 0, 0}), vitri::InvalidPoint);
+  REQUIRE_THROWS_AS(index.erase(9), vitri::InvalidPoint);
+  REQUIRE_THROWS_AS(PointIndex(std::vector<Point3>{{0, 0, 0}, {INFINITY, 0, 0}}), vitri::InvalidPoint);
+  // An empty index answers nothing; insertion into it works.
+  PointIndex empty;
+  std::vector<Id> out;
+  empty.nearest({0, 0, 0}, 3, out);
+  REQUIRE(out.empty());
+  empty.insert(4, {1, 1, 1});
+  empty.nearest({0, 0, 0}, 3, out);
+  REQUIRE(out == std::vector<Id>{4});
+}

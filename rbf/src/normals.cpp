@@ -218,8 +218,7 @@ std::vector<Id> components(const NeighbourGraph& g) {
 /// alignment of the normals with the edge (see the file comment).
 double edge_cost(const DistinctPoints& d, const std::vector<Point3>& n, Id a, Id b) {
   const Point3 e = d.points[b] - d.points[a];
-  const double len = norm(e);
-  const double along = (std::abs(dot(n[a], e)) + std::abs(dot(n[b], e))) / (2 * len);
+  const double along = (std::abs(dot(n[a], e)) + std::abs(dot(n[b], e))) / (2 * norm(e));
   return 1.0 - std::abs(dot(n[a], n[b])) + along;
 }
 

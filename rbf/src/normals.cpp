@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <functional>
 #include <limits>
@@ -158,6 +159,12 @@ class NeighbourGraph {
   std::vector<Id> adj_;
 };
 
+std::string fmt_ratio(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.3g", v);
+  return buf;
+}
+
 /// PCA normals of the distinct points; throws DegenerateNeighbourhood for the first collinear one.
 std::vector<Point3> pca_normals(const DistinctPoints& d, const NeighbourTable& t, const NormalOptions& opt) {
   const std::size_t n = d.points.size();
@@ -193,7 +200,7 @@ std::vector<Point3> pca_normals(const DistinctPoints& d, const NeighbourTable& t
       throw DegenerateNeighbourhood(d.first[u], "its " + std::to_string(opt.k) +
                                                     " nearest neighbours are (nearly) collinear: no tangent plane "
                                                     "(middle/largest covariance eigenvalue " +
-                                                    std::to_string(planarity[u]) + ")");
+                                                    fmt_ratio(planarity[u]) + ")");
   return normals;
 }
 

@@ -63,12 +63,14 @@ std::size_t memory_budget(const RbfOptions& options) {
 void require_memory(std::size_t bytes, const std::string& what, const RbfOptions& options) {
   const std::size_t limit = memory_budget(options);
   if (limit == 0 || bytes <= limit) return;
-  const std::string source = options.max_memory_bytes ? "RbfOptions::max_memory_bytes" : "the physical memory";
-  throw LimitError(what + " needs about " + gigabytes(static_cast<double>(bytes)) + " (" + std::to_string(bytes) +
-                   " bytes: the dense global RBF system grows as N^2), more than the limit of " +
-                   gigabytes(static_cast<double>(limit)) + " (" + std::to_string(limit) + " bytes, " + source +
-                   "); use the local function (--function local; vitri/rbf/local_rbf.hpp) for large inputs, or fewer "
-                   "constraints (ConstraintBuildOptions::max_constraints)");
+  const std::string source =
+      options.max_memory_bytes ? "RbfOptions::max_memory_bytes" : "the physical memory";
+  throw LimitError(
+      what + " needs about " + gigabytes(static_cast<double>(bytes)) + " (" + std::to_string(bytes) +
+      " bytes: the dense global RBF system grows as N^2), more than the limit of " +
+      gigabytes(static_cast<double>(limit)) + " (" + std::to_string(limit) + " bytes, " + source +
+      "); use the local function (--function local; vitri/rbf/local_rbf.hpp) for large inputs, or fewer "
+      "constraints (ConstraintBuildOptions::max_constraints)");
 }
 
 }  // namespace rbf_detail

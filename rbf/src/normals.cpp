@@ -24,8 +24,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <numeric>
@@ -44,7 +44,7 @@ constexpr double kMinSeedAlignment = 0.1;
 
 /// The distinct positions of the input and the map between the two numberings.
 struct DistinctPoints {
-  std::vector<Point3> points;     ///< Distinct positions, in the order of their first occurrence.
+  std::vector<Point3> points;      ///< Distinct positions, in the order of their first occurrence.
   std::vector<std::size_t> first;  ///< Input index of the first occurrence of each distinct point.
   std::vector<Id> of;              ///< Distinct id of each input point.
 };
@@ -79,16 +79,19 @@ DistinctPoints distinct_points(const std::vector<Point3>& input) {
 }
 
 void check_options(const NormalOptions& opt, std::size_t distinct) {
-  if (opt.k < 3) throw InvalidArgument("normal estimation: k = " + std::to_string(opt.k) + ", at least 3 needed");
+  if (opt.k < 3)
+    throw InvalidArgument("normal estimation: k = " + std::to_string(opt.k) + ", at least 3 needed");
   if (!(opt.collinear_tolerance >= 0) || !(opt.collinear_tolerance < 1))
     throw InvalidArgument("normal estimation: collinear_tolerance must lie in [0, 1)");
   if (distinct < opt.k + 1)
-    throw InvalidArgument("normal estimation: " + std::to_string(distinct) + " distinct points, at least k + 1 = " +
-                          std::to_string(opt.k + 1) + " needed (k = " + std::to_string(opt.k) + " neighbours)");
+    throw InvalidArgument("normal estimation: " + std::to_string(distinct) +
+                          " distinct points, at least k + 1 = " + std::to_string(opt.k + 1) +
+                          " needed (k = " + std::to_string(opt.k) + " neighbours)");
 }
 
 /// Runs body(begin, end) over [0, count) in contiguous chunks on the threads.
-void parallel_chunks(std::size_t count, unsigned threads, const std::function<void(std::size_t, std::size_t)>& body) {
+void parallel_chunks(std::size_t count, unsigned threads,
+                     const std::function<void(std::size_t, std::size_t)>& body) {
   unsigned t = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
   if (count < 2048) t = 1;
   t = static_cast<unsigned>(std::min<std::size_t>(t, count));
@@ -108,7 +111,8 @@ void parallel_chunks(std::size_t count, unsigned threads, const std::function<vo
 /// The k nearest neighbours of every distinct point (itself excluded): row u of a k-column table.
 class NeighbourTable {
  public:
-  NeighbourTable(const std::vector<Point3>& points, std::size_t k, unsigned threads) : k_(k), ids_(points.size() * k) {
+  NeighbourTable(const std::vector<Point3>& points, std::size_t k, unsigned threads)
+      : k_(k), ids_(points.size() * k) {
     const PointIndex index(points);
     parallel_chunks(points.size(), threads, [&](std::size_t b, std::size_t e) {
       std::vector<Id> found;
@@ -197,10 +201,11 @@ std::vector<Point3> pca_normals(const DistinctPoints& d, const NeighbourTable& t
   });
   for (std::size_t u = 0; u < n; ++u)
     if (!(planarity[u] > opt.collinear_tolerance))
-      throw DegenerateNeighbourhood(d.first[u], "its " + std::to_string(opt.k) +
-                                                    " nearest neighbours are (nearly) collinear: no tangent plane "
-                                                    "(middle/largest covariance eigenvalue " +
-                                                    fmt_ratio(planarity[u]) + ")");
+      throw DegenerateNeighbourhood(d.first[u],
+                                    "its " + std::to_string(opt.k) +
+                                        " nearest neighbours are (nearly) collinear: no tangent plane "
+                                        "(middle/largest covariance eigenvalue " +
+                                        fmt_ratio(planarity[u]) + ")");
   return normals;
 }
 
@@ -275,14 +280,16 @@ OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable&
     if (comp[r] != r) continue;
     const Id s = seed[r];
     if (size[r] < min_size)
-      throw OrientationError(d.first[s], "isolated group of " + std::to_string(size[r]) +
-                                             " points (fewer than " + std::to_string(min_size) +
-                                             ", see NormalOptions::min_component) not connected to the rest "
-                                             "by nearest neighbours: outliers, or a part too sparse to orient");
+      throw OrientationError(d.first[s],
+                             "isolated group of " + std::to_string(size[r]) + " points (fewer than " +
+                                 std::to_string(min_size) +
+                                 ", see NormalOptions::min_component) not connected to the rest "
+                                 "by nearest neighbours: outliers, or a part too sparse to orient");
     if (std::abs(n[s].x) < kMinSeedAlignment)
-      throw OrientationError(d.first[s], "the point of largest x of its component has a normal nearly "
-                                         "perpendicular to x: the component does not look like a closed "
-                                         "surface (flat or open part), its outside is undetermined");
+      throw OrientationError(d.first[s],
+                             "the point of largest x of its component has a normal nearly "
+                             "perpendicular to x: the component does not look like a closed "
+                             "surface (flat or open part), its outside is undetermined");
     if (n[s].x < 0) {
       n[s] = -n[s];
       ++rep.flipped;

@@ -46,7 +46,8 @@ Samples torus(std::size_t nu, std::size_t nv, double R, double r) {
   for (std::size_t i = 0; i < nu; ++i)
     for (std::size_t j = 0; j < nv; ++j) {
       const double u = 2 * kPi * static_cast<double>(i) / static_cast<double>(nu);
-      const double v = 2 * kPi * (static_cast<double>(j) + 0.5 * static_cast<double>(i % 2)) / static_cast<double>(nv);
+      const double v =
+          2 * kPi * (static_cast<double>(j) + 0.5 * static_cast<double>(i % 2)) / static_cast<double>(nv);
       const Point3 n{std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v)};
       s.points.push_back(Point3{R * std::cos(u), R * std::sin(u), 0.0} + r * n);
       s.normals.push_back(n);

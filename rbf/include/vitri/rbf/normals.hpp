@@ -78,7 +78,8 @@ OrientationReport orient_normals(const std::vector<Point3>& points, std::vector<
                                  const NormalOptions& options = {});
 
 /// estimate_normals() then orient_normals(): outward unit normals of the points of closed surfaces.
-std::vector<Point3> estimate_oriented_normals(const std::vector<Point3>& points, const NormalOptions& options = {},
+std::vector<Point3> estimate_oriented_normals(const std::vector<Point3>& points,
+                                              const NormalOptions& options = {},
                                               OrientationReport* report = nullptr);
 
 }  // namespace vitri

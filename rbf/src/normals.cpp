@@ -135,24 +135,23 @@ class NeighbourTable {
 };
 
 /// The symmetric neighbour graph in compressed rows: j adjacent to i when one is a neighbour of the other.
+/// Built by counting (no sort); a mutual pair is listed twice in each row, which neither the union-find
+/// nor Prim's algorithm minds.
 class NeighbourGraph {
  public:
-  explicit NeighbourGraph(const NeighbourTable& t) : start_(t.size() + 1, 0) {
-    std::vector<std::pair<Id, Id>> edges;
-    edges.reserve(2 * t.size() * t.k());
-    for (std::size_t u = 0; u < t.size(); ++u)
-      for (std::size_t c = 0; c < t.k(); ++c) {
-        edges.emplace_back(static_cast<Id>(u), t.at(u, c));
-        edges.emplace_back(t.at(u, c), static_cast<Id>(u));
-      }
-    std::sort(edges.begin(), edges.end());
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    adj_.reserve(edges.size());
-    for (const auto& [a, b] : edges) {
-      ++start_[a + 1];
-      adj_.push_back(b);
+  explicit NeighbourGraph(const NeighbourTable& t) : start_(t.size() + 1, 0), adj_(2 * t.size() * t.k()) {
+    for (std::size_t u = 0; u < t.size(); ++u) {
+      start_[u + 1] += t.k();
+      for (std::size_t c = 0; c < t.k(); ++c) ++start_[t.at(u, c) + 1];
     }
     std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    std::vector<std::size_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t u = 0; u < t.size(); ++u)
+      for (std::size_t c = 0; c < t.k(); ++c) {
+        const Id v = t.at(u, c);
+        adj_[fill[u]++] = v;
+        adj_[fill[v]++] = static_cast<Id>(u);
+      }
   }
   std::size_t size() const { return start_.size() - 1; }
   const Id* begin(std::size_t u) const { return adj_.data() + start_[u]; }

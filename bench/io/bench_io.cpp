@@ -15,20 +15,15 @@
 #include <cstdlib>
 #include <fstream>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
 namespace {
 
-std::uint64_t splitmix64(std::uint64_t& s) {
-  std::uint64_t z = (s += 0x9e3779b97f4a7c15ULL);
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-  return z ^ (z >> 31);
-}
-
-double unit(std::uint64_t& s) {
-  return static_cast<double>(splitmix64(s) >> 11) * 0x1.0p-53;
+/// Uniform in [0, 1), 53 bits.
+double unit(std::mt19937_64& rng) {
+  return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
 
 std::string model_path() {
@@ -53,7 +48,7 @@ vitri::TriangleMesh sample(std::size_t n) {
   s.V.resize(static_cast<Eigen::Index>(n), 3);
   s.N.resize(static_cast<Eigen::Index>(n), 3);
   s.F.resize(0, 3);
-  std::uint64_t state = 11;
+  std::mt19937_64 state(11);
   for (Eigen::Index i = 0; i < s.V.rows(); ++i) {
     const auto f = static_cast<Eigen::Index>(
         std::lower_bound(cumulative.begin(), cumulative.end(), unit(state) * total) - cumulative.begin());

@@ -88,6 +88,19 @@ std::size_t wrong_sides(const std::vector<Point3>& est, const std::vector<Point3
   return wrong;
 }
 
+/// Runs f, which must throw E (an InvalidPoint) with `words` in its message; returns the point it names.
+template <class E, class F>
+std::size_t index_named(F&& f, const std::string& words) {
+  try {
+    f();
+  } catch (const E& e) {
+    CHECK(std::string(e.what()).find(words) != std::string::npos);
+    return e.index();
+  }
+  FAIL("no exception");
+  return 0;
+}
+
 }  // namespace
 
 TEST_CASE("normals: sphere and torus, PCA direction and orientation on every point", "[rbf][normals]") {
@@ -187,12 +200,7 @@ TEST_CASE("normals: bad input gets a clear error naming the point", "[rbf][norma
   Samples s = sphere(500, {0, 0, 0}, 1.0);
   SECTION("non-finite coordinate") {
     s.points[42].y = std::numeric_limits<double>::quiet_NaN();
-    try {
-      estimate_oriented_normals(s.points);
-      FAIL("no exception");
-    } catch (const InvalidPoint& e) {
-      CHECK(e.index() == 42);
-    }
+    CHECK(index_named<InvalidPoint>([&] { estimate_oriented_normals(s.points); }, "non-finite") == 42);
   }
   SECTION("too few distinct points, empty input, k too small") {
     const std::vector<Point3> few(s.points.begin(), s.points.begin() + 10);
@@ -207,24 +215,13 @@ TEST_CASE("normals: bad input gets a clear error naming the point", "[rbf][norma
   SECTION("collinear neighbourhood: the point is named") {
     // A sphere plus a straight line of points far from it: the line points have collinear neighbours.
     for (int i = 0; i < 30; ++i) s.points.push_back({10.0 + 0.1 * i, 0.0, 0.0});
-    try {
-      estimate_normals(s.points);
-      FAIL("no exception");
-    } catch (const DegenerateNeighbourhood& e) {
-      CHECK(e.index() >= 500);
-      CHECK(std::string(e.what()).find("collinear") != std::string::npos);
-    }
+    CHECK(index_named<DegenerateNeighbourhood>([&] { estimate_normals(s.points); }, "collinear") == 500);
   }
   SECTION("a small isolated cluster cannot be oriented") {
     const Samples far = sphere(12, {20, 0, 0}, 0.1);
     s.points.insert(s.points.end(), far.points.begin(), far.points.end());
-    try {
-      estimate_oriented_normals(s.points);
-      FAIL("no exception");
-    } catch (const OrientationError& e) {
-      CHECK(e.index() >= 500);
-      CHECK(std::string(e.what()).find("isolated") != std::string::npos);
-    }
+    CHECK(index_named<OrientationError>([&] { estimate_oriented_normals(s.points); },
+                                        "isolated group of 12") >= 500);
   }
   SECTION("a flat patch has no outside") {
     std::vector<Point3> plane;
@@ -238,12 +235,7 @@ TEST_CASE("normals: bad input gets a clear error naming the point", "[rbf][norma
     CHECK_THROWS_AS(orient_normals(s.points, n), InvalidArgument);
     n = s.normals;
     n[3] = {0, 0, 0};
-    try {
-      orient_normals(s.points, n);
-      FAIL("no exception");
-    } catch (const InvalidPoint& e) {
-      CHECK(e.index() == 3);
-    }
+    CHECK(index_named<InvalidPoint>([&] { orient_normals(s.points, n); }, "zero normal") == 3);
   }
 }
 

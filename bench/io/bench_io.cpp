@@ -115,8 +115,12 @@ void BM_EstimateOrientedNormals(benchmark::State& state) {
     p[i] = {s.V(static_cast<Eigen::Index>(i), 0), s.V(static_cast<Eigen::Index>(i), 1),
             s.V(static_cast<Eigen::Index>(i), 2)};
   std::vector<vitri::Point3> normals;
+  vitri::NormalOptions opt;
+  opt.min_link = 0;  // man has ambiguous links (see docs/normals.md): measure what comes out anyway
+  opt.max_disagreement = 1;
+  vitri::OrientationReport rep;
   for (auto _ : state) {
-    normals = vitri::estimate_oriented_normals(p);
+    normals = vitri::estimate_oriented_normals(p, opt, &rep);
     benchmark::DoNotOptimize(normals.data());
   }
   std::size_t wrong = 0;
@@ -126,6 +130,8 @@ void BM_EstimateOrientedNormals(benchmark::State& state) {
   }
   state.counters["points"] = static_cast<double>(n);
   state.counters["wrong_side"] = static_cast<double>(wrong);
+  state.counters["weakest_link"] = rep.weakest_link;
+  state.counters["disagreement"] = rep.disagreement;
 }
 BENCHMARK(BM_EstimateOrientedNormals)
     ->Arg(100000)

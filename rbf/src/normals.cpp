@@ -83,6 +83,10 @@ void check_options(const NormalOptions& opt, std::size_t distinct) {
     throw InvalidArgument("normal estimation: k = " + std::to_string(opt.k) + ", at least 3 needed");
   if (!(opt.collinear_tolerance >= 0) || !(opt.collinear_tolerance < 1))
     throw InvalidArgument("normal estimation: collinear_tolerance must lie in [0, 1)");
+  if (!(opt.min_link >= 0) || !(opt.min_link <= 1))
+    throw InvalidArgument("normal estimation: min_link must lie in [0, 1]");
+  if (!(opt.max_disagreement >= 0) || !(opt.max_disagreement <= 1))
+    throw InvalidArgument("normal estimation: max_disagreement must lie in [0, 1]");
   if (distinct < opt.k + 1)
     throw InvalidArgument("normal estimation: " + std::to_string(distinct) +
                           " distinct points, at least k + 1 = " + std::to_string(opt.k + 1) +
@@ -235,7 +239,7 @@ double edge_cost(const DistinctPoints& d, const std::vector<Point3>& n, Id a, Id
 
 /// Orients the normals of one component by Prim's algorithm from `seed`; updates the report.
 void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed, std::vector<Point3>& n,
-                      std::vector<char>& done, OrientationReport& rep) {
+                      std::vector<char>& done, OrientationReport& rep, double min_link, std::size_t k) {
   using Item = std::tuple<double, Id, Id>;  // (cost, to, from): ties broken by ids, deterministic
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> frontier;
   auto visit = [&](Id u) {
@@ -250,6 +254,15 @@ void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed,
     (void)cost;
     if (done[to]) continue;
     const double c = dot(n[from], n[to]);
+    if (std::abs(c) < min_link)
+      throw OrientationError(
+          d.first[to],
+          "its orientation is ambiguous: the most reliable path to it from the rest of its "
+          "component crosses two nearly perpendicular normals (|n_i . n_j| = " +
+              fmt_ratio(std::abs(c)) + " < NormalOptions::min_link = " + fmt_ratio(min_link) +
+              ", from point " + std::to_string(d.first[from]) +
+              "): a sharp edge or a thin part sampled too sparsely for k = " + std::to_string(k) +
+              "; sample more densely, change k, or lower min_link");
     rep.weakest_link = std::min(rep.weakest_link, std::abs(c));
     if (c < 0) {
       n[to] = -n[to];
@@ -257,6 +270,34 @@ void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed,
     }
     visit(to);
   }
+}
+
+/// How consistent an orientation is: among the neighbour pairs along the surface (the edge at most 30
+/// degrees out of both tangent planes), those whose oriented normals point to opposite sides, and the
+/// point with the most of them (smallest id on ties).
+struct Disagreement {
+  double fraction = 0.0;  ///< Opposite pairs over pairs along the surface: ~0 consistent, ~1/2 random.
+  Id worst = 0;           ///< The point with the most opposite pairs.
+};
+
+Disagreement disagreement(const DistinctPoints& d, const NeighbourTable& t, const std::vector<Point3>& n) {
+  std::size_t along = 0, opposite = 0, worst_count = 0;
+  Disagreement out;
+  for (std::size_t u = 0; u < t.size(); ++u) {
+    std::size_t mine = 0;
+    for (std::size_t c = 0; c < t.k(); ++c) {
+      const Id v = t.at(u, c);
+      const Point3 e = d.points[v] - d.points[u];
+      const double half = 0.5 * norm(e);  // |n . e| <= |e| / 2: the edge is within 30 degrees of the plane
+      if (std::abs(dot(n[u], e)) > half || std::abs(dot(n[v], e)) > half) continue;
+      ++along;
+      mine += dot(n[u], n[v]) < 0;
+    }
+    opposite += mine;
+    if (mine > worst_count) worst_count = mine, out.worst = static_cast<Id>(u);
+  }
+  out.fraction = along ? static_cast<double>(opposite) / static_cast<double>(along) : 0.0;
+  return out;
 }
 
 /// Orients the normals of the distinct points, every component from its own seed.
@@ -294,8 +335,21 @@ OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable&
       ++rep.flipped;
     }
     ++rep.components;
-    orient_component(d, g, s, n, done, rep);
+    orient_component(d, g, s, n, done, rep, opt.min_link, opt.k);
   }
+  const Disagreement dis = disagreement(d, t, n);
+  rep.disagreement = dis.fraction;
+  if (dis.fraction > opt.max_disagreement)
+    throw OrientationError(d.first[dis.worst],
+                           "the orientation is not consistent: " + fmt_ratio(100 * dis.fraction) +
+                               "% of the neighbour pairs along the surface get opposite normals (more than "
+                               "NormalOptions::max_disagreement = " +
+                               fmt_ratio(100 * opt.max_disagreement) + "%), most around this point: the " +
+                               std::to_string(opt.k) +
+                               " nearest neighbours do not see a surface (noise larger than their spread: "
+                               "raise k, e.g. 50-80, --neighbours in "
+                               "the CLI; "
+                               "or sampling too sparse)");
   return rep;
 }
 

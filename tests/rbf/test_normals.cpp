@@ -167,6 +167,14 @@ TEST_CASE("normals: unoriented noisy sphere_20k.xyz, every point", "[rbf][normal
   opt.k = 80;
   const auto n = estimate_oriented_normals(p.points, opt);
   CHECK(wrong_sides(n, truth) == 0);
+  // With the default k = 10 the planes fit the noise: the orientation is a guess (14071 points wrong when
+  // the check is off), which the disagreement check refuses, naming a point.
+  CHECK_THROWS_WITH(estimate_oriented_normals(p.points), Catch::Contains("orientation is not consistent"));
+  opt.k = 10;
+  opt.max_disagreement = 1;
+  OrientationReport rep;
+  CHECK(wrong_sides(estimate_oriented_normals(p.points, opt, &rep), truth) > 5000);
+  CHECK(rep.disagreement > 0.05);
 }
 
 TEST_CASE("normals: orient_normals restores random flips; threads and duplicates", "[rbf][normals]") {

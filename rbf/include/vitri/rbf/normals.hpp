@@ -36,6 +36,18 @@ struct NormalOptions {
   /// (OrientationError naming a point of the component): a small cluster is an outlier or a part too
   /// sparsely sampled to orient. 0 means 2 (k + 1).
   std::size_t min_component = 0;
+  /// The orientation crosses, for every point, the most reliable tree edge available; when that edge
+  /// joins two normals with |n_i . n_j| below `min_link` (0.1 by default: more than 84 degrees apart), the
+  /// sign decided there is a guess, and the whole part beyond it may come out flipped: orient_normals()
+  /// throws OrientationError naming the point reached instead. 0 accepts every sign (the smallest value
+  /// met is reported as OrientationReport::weakest_link).
+  double min_link = 0.1;
+  /// After the orientation, the fraction of neighbour pairs along the surface whose normals point to
+  /// opposite sides (OrientationReport::disagreement) is ~0 for a surface the neighbourhoods resolve and
+  /// ~1/2 when they only see noise; above `max_disagreement` (0.01 by default; at most 0.005 measured on
+  /// the bundled models) orient_normals() throws OrientationError naming the point with the most such
+  /// pairs. 1 disables the check.
+  double max_disagreement = 0.01;
 };
 
 /// A point whose neighbourhood does not define a tangent plane (collinear neighbours).
@@ -45,7 +57,8 @@ class DegenerateNeighbourhood : public InvalidPoint {
 };
 
 /// The normals cannot be oriented consistently at this point (a component of the neighbour graph too
-/// small, or a seed whose orientation is undetermined).
+/// small, a seed whose orientation is undetermined, or a point reached only across nearly perpendicular
+/// normals: NormalOptions::min_link).
 class OrientationError : public InvalidPoint {
  public:
   using InvalidPoint::InvalidPoint;
@@ -65,6 +78,9 @@ struct OrientationReport {
   /// Smallest |n_i . n_j| over the tree edges the orientation crossed: near 0, a sign was decided
   /// between two nearly perpendicular normals (a sharp edge or a sparse part): the least certain step.
   double weakest_link = 1.0;
+  /// Fraction of the neighbour pairs along the surface (edge at most 30 degrees out of both tangent
+  /// planes) whose oriented normals point to opposite sides; see NormalOptions::max_disagreement.
+  double disagreement = 0.0;
 };
 
 /// Orients unit normals consistently (flips signs only), in place: minimum spanning tree of the
@@ -73,7 +89,9 @@ struct OrientationReport {
 /// component, whose normal is made to point to +x. Exact duplicate positions get the same normal.
 /// @throws InvalidArgument for mismatched sizes or too few points; InvalidPoint (index) for non-finite
 ///         data or a zero normal; OrientationError (index) for a component smaller than
-///         options.min_component, or a seed whose normal is perpendicular to x.
+///         options.min_component, a seed whose normal is nearly perpendicular to x, a point whose
+///         sign would be decided across normals less aligned than options.min_link, or a result whose
+///         disagreement exceeds options.max_disagreement.
 OrientationReport orient_normals(const std::vector<Point3>& points, std::vector<Point3>& normals,
                                  const NormalOptions& options = {});
 

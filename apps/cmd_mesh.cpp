@@ -21,7 +21,8 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj --precision P [--precision P2 ...] [--edits SCRIPT]\n"
-    "                  [--sides both|inside|outside] [--offset D] [--neighbours K] [-q]\n"
+    "                  [--sides both|inside|outside] [--offset D] [--neighbours K]\n"
+    "                  [--function global|local|auto] [--smoothing S] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -64,6 +65,12 @@ const char* const kUsage =
     "                       point: fewer constraints, a faster fit). Ignored for .xyzv input.\n"
     "  --neighbours K       neighbours per point for the normals of unoriented points (default 10;\n"
     "                       larger for noisy points, e.g. 50-80 when the noise exceeds the spacing)\n"
+    "  --function F         the implicit function: global (one dense RBF: smoothest, O(N^2) memory,\n"
+    "                       O(N^3) fit), local (partition of unity of local RBF patches: O(N) memory and\n"
+    "                       fit, local edits, no surface far from the data) or auto (default: global up\n"
+    "                       to 4000 constraints, local above). See docs/local_rbf.md.\n"
+    "  --smoothing S        local function only: regularization of every patch (0 interpolates, the\n"
+    "                       default; 1e-3..1e-1 smooths a noisy scan)\n"
     "  -q, --quiet          no table, no progress\n"
     "\n"
     "Progress goes to stderr: a line before and after the fit of 1000 or more constraints (the fit is\n"
@@ -131,6 +138,7 @@ int run_mesh(const Args& args) {
   std::vector<double> precisions;
   bool quiet = false;
   MesherOptions options;
+  options.function = FunctionKind::Auto;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&](std::string& out) {
@@ -163,6 +171,17 @@ int run_mesh(const Args& args) {
       std::size_t k = 0;
       if (!value(v) || !parse_index(v, k) || k < 3) return usage_error("--neighbours needs an integer >= 3");
       options.constraint_build.normals.k = k;
+    } else if (a == "--function") {
+      if (!value(v)) return usage_error("--function needs global, local or auto");
+      if (v == "global") options.function = FunctionKind::Global;
+      else if (v == "local") options.function = FunctionKind::Local;
+      else if (v == "auto") options.function = FunctionKind::Auto;
+      else return usage_error("--function must be global, local or auto, got '" + v + "'");
+    } else if (a == "--smoothing") {
+      double sm;
+      if (!value(v) || !parse_double(v, sm) || !(sm >= 0.0) || !std::isfinite(sm))
+        return usage_error("--smoothing needs a number >= 0");
+      options.local.smoothing = sm;
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (!a.empty() && a[0] == '-') {
@@ -204,8 +223,9 @@ int run_mesh(const Args& args) {
   const double diag = mesher.diagonal();
   const double build_ms = ms_since(t_start);
   if (!quiet) {
-    std::printf("%s: %zu constraints, diagonal %.6g; fit %.0f ms, initial tetrahedralization %.0f ms\n",
-                input.c_str(), mesher.size(), diag, mesher.stats().fit_seconds * 1e3,
+    std::printf("%s: %zu constraints, diagonal %.6g; %s fit %.0f ms, initial tetrahedralization %.0f ms\n",
+                input.c_str(), mesher.size(), diag, mesher.local_function() ? "local" : "global",
+                mesher.stats().fit_seconds * 1e3,
                 build_ms - mesher.stats().fit_seconds * 1e3);
     std::printf("%5s %10s %9s %10s %11s %11s %10s\n", "level", "precision", "vertices", "triangles", "refine ms",
                 "extract ms", "total ms");

@@ -32,16 +32,35 @@ double now_seconds() { return std::chrono::duration<double>(Clock::now().time_si
 }  // namespace
 
 Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
-    : options_(options), rbf_(std::make_unique<Rbf>()), precision_(std::numeric_limits<double>::infinity()) {
+    : options_(options), precision_(std::numeric_limits<double>::infinity()) {
   if (!(options_.box_factor > 1.0) || !std::isfinite(options_.box_factor))
     throw InvalidArgument("MesherOptions::box_factor must be > 1");
   if (!(options_.garbage_fraction >= 0.0) || !std::isfinite(options_.garbage_fraction))
     throw InvalidArgument("MesherOptions::garbage_fraction must be >= 0");
   const double t0 = now_seconds();
-  rbf_->fit(constraints, options_.rbf);
+  const bool local = options_.function == FunctionKind::Local ||
+                     (options_.function == FunctionKind::Auto && constraints.size() > options_.auto_local_above);
+  if (local) {
+    local_ = std::make_unique<LocalRbf>();
+    local_->fit(constraints, options_.local);
+  } else {
+    rbf_ = std::make_unique<Rbf>();
+    rbf_->fit(constraints, options_.rbf);
+  }
   stats_.fit_seconds = now_seconds() - t0;
   build();
 }
+
+const ImplicitFunction& Mesher::function() const {
+  if (rbf_) return *rbf_;
+  return *local_;
+}
+
+const Constraints& Mesher::constraints() const { return rbf_ ? rbf_->constraints() : local_->constraints(); }
+
+std::size_t Mesher::size() const { return rbf_ ? rbf_->size() : local_->size(); }
+
+double Mesher::value_of(std::size_t i) const { return rbf_ ? rbf_->constraints().values[i] : local_->value_of(i); }
 
 Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                                    const MesherOptions& options) {
@@ -57,16 +76,16 @@ Mesher& Mesher::operator=(Mesher&&) noexcept = default;
 Mesher::~Mesher() = default;
 
 void Mesher::build() {
-  const Constraints& c = rbf_->constraints();
+  const Constraints& c = constraints();
   const Box3 domain = Polygonizer::domain_for(c.points, options_.box_factor);
-  poly_ = std::make_unique<Polygonizer>(*rbf_, domain, c.points, c.values, options_.polygonizer);
+  poly_ = std::make_unique<Polygonizer>(function(), domain, c.points, c.values, options_.polygonizer);
   vertex_of_ = poly_->seed_vertices();
   mesh_valid_ = false;
 }
 
 double Mesher::diagonal() const {
   Box3 b;
-  for (const Point3& p : rbf_->constraints().points) b.extend(p);
+  for (const Point3& p : constraints().points) b.extend(p);
   return b.diagonal();
 }
 
@@ -92,9 +111,14 @@ const SurfaceMesh& Mesher::surface() {
 
 void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { to_eigen(surface(), V, F, &N); }
 
-void Mesher::after_edit(double rbf_seconds, double t_start) {
+void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion* region) {
   const double t1 = now_seconds();
-  poly_->function_changed();
+  if (region && !region->everywhere) {
+    const Box3 bounds = region->bounds();
+    poly_->function_changed([&](const Point3& p) { return bounds.contains(p) && region->contains(p); });
+  } else {
+    poly_->function_changed();
+  }
   if (std::isfinite(precision_)) poly_->refine(precision_);
   if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction);
   mesh_valid_ = false;
@@ -103,36 +127,36 @@ void Mesher::after_edit(double rbf_seconds, double t_start) {
   stats_.edit_seconds = now_seconds() - t_start;
 }
 
+bool Mesher::rebuild_if_outside(const Point3& p, double t_start, double t_rbf) {
+  if (inside_domain(p)) return false;
+  ++stats_.rebuilds;
+  build();
+  if (std::isfinite(precision_)) poly_->refine(precision_);
+  stats_.edit_rbf_seconds = t_rbf;
+  stats_.edit_seconds = now_seconds() - t_start;
+  return true;
+}
+
 std::size_t Mesher::add_constraint(const Point3& p, double value) {
   const double t0 = now_seconds();
-  rbf_->add_constraint(p, value);  // validates p and value; throws before anything changes
+  ChangedRegion region;  // validates p and value; throws before anything changes
+  if (rbf_) rbf_->add_constraint(p, value);
+  else region = local_->add_constraint(p, value);
   const double t_rbf = now_seconds() - t0;
-  if (!inside_domain(p)) {
-    ++stats_.rebuilds;
-    build();
-    if (std::isfinite(precision_)) poly_->refine(precision_);
-    stats_.edit_rbf_seconds = t_rbf;
-    stats_.edit_seconds = now_seconds() - t0;
-    return rbf_->size() - 1;
-  }
+  if (rebuild_if_outside(p, t0, t_rbf)) return size() - 1;
   vertex_of_.push_back(poly_->insert_vertex(p, value, VertexKind::Seed));
-  after_edit(t_rbf, t0);
-  return rbf_->size() - 1;
+  after_edit(t_rbf, t0, local_ ? &region : nullptr);
+  return size() - 1;
 }
 
 void Mesher::move_constraint(std::size_t i, const Point3& p) {
   const double t0 = now_seconds();
-  rbf_->move_constraint(i, p);
+  ChangedRegion region;
+  if (rbf_) rbf_->move_constraint(i, p);
+  else region = local_->move_constraint(i, p);
   const double t_rbf = now_seconds() - t0;
-  if (!inside_domain(p)) {
-    ++stats_.rebuilds;
-    build();
-    if (std::isfinite(precision_)) poly_->refine(precision_);
-    stats_.edit_rbf_seconds = t_rbf;
-    stats_.edit_seconds = now_seconds() - t0;
-    return;
-  }
-  const double value = rbf_->constraints().values[i];
+  if (rebuild_if_outside(p, t0, t_rbf)) return;
+  const double value = value_of(i);
   const VertexId v = vertex_of_[i];
   if (v != kNoVertex) {
     if (!poly_->move_vertex(v, p, value)) {
@@ -143,31 +167,35 @@ void Mesher::move_constraint(std::size_t i, const Point3& p) {
   } else {
     vertex_of_[i] = poly_->insert_vertex(p, value, VertexKind::Seed);
   }
-  after_edit(t_rbf, t0);
+  after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 
 void Mesher::remove_constraint(std::size_t i) {
   const double t0 = now_seconds();
-  rbf_->remove_constraint(i);  // throws on a bad index or an impossible removal
+  ChangedRegion region;  // throws on a bad index or an impossible removal
+  if (rbf_) rbf_->remove_constraint(i);
+  else region = local_->remove_constraint(i);
   const double t_rbf = now_seconds() - t0;
   const VertexId v = vertex_of_[i];
   vertex_of_.erase(vertex_of_.begin() + static_cast<std::ptrdiff_t>(i));
   if (v != kNoVertex) poly_->remove_vertex(v);
-  after_edit(t_rbf, t0);
+  after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 
 void Mesher::set_value(std::size_t i, double value) {
   const double t0 = now_seconds();
-  rbf_->set_value(i, value);
+  ChangedRegion region;
+  if (rbf_) rbf_->set_value(i, value);
+  else region = local_->set_value(i, value);
   const double t_rbf = now_seconds() - t0;
   if (vertex_of_[i] != kNoVertex) poly_->set_vertex_value(vertex_of_[i], value);
-  after_edit(t_rbf, t0);
+  after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 
 MesherStats Mesher::stats() const {
   MesherStats s = stats_;
   s.polygonizer = poly_->stats();
-  s.constraints = rbf_->size();
+  s.constraints = size();
   return s;
 }
 

@@ -731,12 +731,14 @@ void Polygonizer::set_vertex_value(VertexId v, double value) {
   settle_zeros({});
 }
 
-void Polygonizer::function_changed() {
+void Polygonizer::function_changed() { function_changed([](const Point3&) { return true; }); }
+
+void Polygonizer::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
   const auto t0 = Clock::now();
   std::vector<VertexId> ids;
   const std::size_t cap = tri_.vertex_capacity();
   for (VertexId v = 0; v < cap; ++v)
-    if (needs_evaluation(v)) ids.push_back(v);
+    if (needs_evaluation(v) && may_have_changed(tri_.point(v))) ids.push_back(v);
   std::vector<double> out;
   evaluate_at(ids, out);
   std::vector<TetId> touched;

@@ -208,7 +208,7 @@ void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out
   std::sort(out.begin(), out.end());
 }
 
-std::size_t PointIndex::count_ball(const Point3& center, double radius2) const {
+std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::size_t limit) const {
   if (size_ == 0) return 0;
   std::size_t count = 0;
   std::vector<std::uint32_t> stack;
@@ -220,6 +220,7 @@ std::size_t PointIndex::count_ball(const Point3& center, double radius2) const {
     if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
     if (n.leaf()) {
       for (Id id : n.bucket) count += squared_distance(position_[id], center) < radius2;
+      if (count > limit) return limit + 1;
     } else {
       stack.push_back(n.children[0]);
       stack.push_back(n.children[1]);

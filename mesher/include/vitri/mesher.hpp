@@ -21,6 +21,7 @@
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 #include "vitri/rbf/constraints.hpp"
+#include "vitri/rbf/local_rbf.hpp"
 #include "vitri/rbf/rbf.hpp"
 
 #include <Eigen/Core>
@@ -31,8 +32,25 @@
 
 namespace vitri {
 
+/// Which variational function the Mesher fits (docs/local_rbf.md).
+enum class FunctionKind {
+  Global,  ///< vitri::Rbf: one dense cubic RBF over all constraints (O(N^2) memory, O(N^3) fit, global edits)
+  Local,   ///< vitri::LocalRbf: partition of unity of local RBF patches (O(N) memory and fit, local edits)
+  Auto,    ///< Global up to MesherOptions::auto_local_above constraints, Local above
+};
+
 /// Options of the Mesher.
 struct MesherOptions {
+  /// The implicit function. The library default stays Global (the paper's function); the CLI's is Auto.
+  FunctionKind function = FunctionKind::Global;
+  /// Auto: the largest constraint count fitted with the global function. By fit time the two cross at
+  /// about 500 constraints (measured: 300 constraints 2 ms global vs 7 ms local, 1000 38 vs 6 ms, 3000
+  /// 0.8 s vs 45 ms; docs/benchmarks.md), but the global function is smoother on sparse data (a local
+  /// patch sees at most LocalRbfOptions::max_per_patch constraints), so Auto keeps it while its fit
+  /// stays around a second: up to 4000 constraints (e.g. a 1300-vertex mesh with normal constraints).
+  std::size_t auto_local_above = 4000;
+  /// Options of the local function (FunctionKind::Local or Auto above the threshold).
+  LocalRbfOptions local;
   /// Refinement and extraction options (queue order, root finder, sampling, zero-vertex snapping).
   PolygonizerOptions polygonizer;
   /// Fit and edit options of the RBF.
@@ -109,9 +127,15 @@ class Mesher {
   void set_value(std::size_t i, double value);
 
   // ---- Queries ----------------------------------------------------------------------------------------
-  const Rbf& function() const { return *rbf_; }
-  const Constraints& constraints() const { return rbf_->constraints(); }
-  std::size_t size() const { return rbf_->size(); }
+  /// The fitted implicit function (global or local).
+  const ImplicitFunction& function() const;
+  /// The global function, or nullptr when the Mesher uses the local one.
+  const Rbf* global_function() const { return rbf_.get(); }
+  /// The local function, or nullptr when the Mesher uses the global one.
+  const LocalRbf* local_function() const { return local_.get(); }
+  /// Current constraints (for the local function built on demand after edits, O(N)).
+  const Constraints& constraints() const;
+  std::size_t size() const;
   /// Diagonal of the bounding box of the current constraints (the unit of the CLI's precision).
   double diagonal() const;
   /// Absolute precision of the last refine() (infinity before the first).
@@ -122,11 +146,14 @@ class Mesher {
 
  private:
   void build();
-  void after_edit(double rbf_seconds, double t_start);
+  void after_edit(double rbf_seconds, double t_start, const ChangedRegion* region = nullptr);
+  bool rebuild_if_outside(const Point3& p, double t_start, double t_rbf);
+  double value_of(std::size_t i) const;
   bool inside_domain(const Point3& p) const;
 
   MesherOptions options_;
-  std::unique_ptr<Rbf> rbf_;  // stable address: the polygonizer keeps a reference
+  std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer
+  std::unique_ptr<LocalRbf> local_;  // keeps a reference. Exactly one of the two is set.
   std::unique_ptr<Polygonizer> poly_;
   std::vector<VertexId> vertex_of_;  // Delaunay vertex of each constraint (kNoVertex: duplicate position)
   double precision_;

@@ -197,6 +197,10 @@ class Polygonizer {
   /// The function changed: re-evaluates f at every vertex without a fixed value (one batch), and
   /// reclassifies only the tetrahedra around vertices whose sign changed. Call refine() afterwards.
   void function_changed();
+  /// The function changed only where `may_have_changed(p)` is true (e.g. the region a local function's
+  /// edit reports): re-evaluates f at those vertices only, then as function_changed(). The scan over the
+  /// vertices is O(n) but cheap; the evaluations are confined to the region.
+  void function_changed(const std::function<bool(const Point3&)>& may_have_changed);
   /// Removes Refinement vertices that no transverse tetrahedron touches (they no longer serve the
   /// surface; those in the star of a lone zero are kept). Removing such a vertex never creates a
   /// transverse tetrahedron. Returns how many.

@@ -51,8 +51,10 @@ class PointIndex {
   /// Ids of the points strictly inside the ball, |p - center|^2 < radius2, appended to `out` in increasing
   /// id order (out is cleared first).
   void ball(const Point3& center, double radius2, std::vector<Id>& out) const;
-  /// Number of points strictly inside the ball (same test as ball()).
-  std::size_t count_ball(const Point3& center, double radius2) const;
+  /// Number of points strictly inside the ball (same test as ball()). The count stops as soon as it
+  /// exceeds `limit` (the answer is then limit + 1), so that "more than n?" costs O(log size() + n).
+  std::size_t count_ball(const Point3& center, double radius2,
+                         std::size_t limit = static_cast<std::size_t>(-1)) const;
   /// The k nearest points to q (all of them when size() < k), by increasing (squared distance, id);
   /// `dist2`, when given, receives their squared distances. Both vectors are cleared first.
   void nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, std::vector<double>* dist2 = nullptr) const;

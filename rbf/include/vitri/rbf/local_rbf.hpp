@@ -1,0 +1,155 @@
+#pragma once
+/// @file local_rbf.hpp
+/// vitri::LocalRbf, the local (partition-of-unity) variational implicit function: an adaptive octree over
+/// a cube around the constraints; every leaf cell carries a *patch*, the same cubic RBF + linear polynomial
+/// as vitri::Rbf fitted to the constraints inside the patch's support ball; patches are blended with
+/// compactly supported (Wendland C2) weights normalized to sum to one:
+///
+///   f(x) = sum_p W_p(x) f_p(x) / sum_p W_p(x),   W_p(x) = psi(|x - c_p| / R_p),  psi(r) = (1-r)^4 (4r+1).
+///
+/// Every constraint inside a support is interpolated by that patch, so f(c_i) = h_i up to rounding. Fit and
+/// memory are O(N), an evaluation costs the few patches overlapping x (independent of N), and an edit refits
+/// only the patches whose data it touches and reports the region where f changed. Design, guarantees and
+/// limits (far field, continuity, what is not guaranteed): docs/local_rbf.md.
+///
+/// Sign convention of the project: f < 0 inside, f > 0 outside.
+
+#include "vitri/core/box.hpp"
+#include "vitri/core/implicit.hpp"
+#include "vitri/core/point.hpp"
+#include "vitri/rbf/rbf.hpp"
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+namespace vitri {
+
+/// Options of LocalRbf::fit.
+struct LocalRbfOptions {
+  /// A cell is split while its support ball holds more than this many constraints (so a patch fits at
+  /// most this many, unless the cell is at max_depth).
+  std::size_t max_per_patch = 40;
+  /// A patch whose support holds fewer constraints is fitted to its min_per_patch nearest constraints
+  /// (it still interpolates every constraint in its support). Must be >= 5 and <= max_per_patch.
+  std::size_t min_per_patch = 16;
+  /// Support radius of a cell's patch: overlap x half the cell diagonal. Must be > 1 (the ball then holds
+  /// the cell with a margin, and a child's ball lies inside its parent's).
+  double overlap = 1.4;
+  /// Regularization of every patch fit: (A + smoothing I) w + P a = h, in the patch's scaled coordinates
+  /// (lengths divided by the support radius, kernel values of order 1). 0 interpolates; 1e-3..1e-1
+  /// smooths a noisy scan. f(c_i) = h_i then holds only approximately.
+  double smoothing = 0.0;
+  /// The octree's root is the cube centered on the constraints' bounding box with side domain_factor x its
+  /// largest extent. Outside it f continues as f(y) + |x - y| (y the nearest point of the cube).
+  /// Edits outside the cube refit everything with a new cube. Must be >= 1.
+  double domain_factor = 3.0;
+  /// When not empty, the root cube is the smallest cube centered on this box that holds it (and
+  /// domain_factor is ignored), e.g. to share a domain with a mesher or to refit on the cube of an edited
+  /// function (LocalRbf::domain()). Constraints outside it are refused (InvalidPoint). An edit outside it
+  /// still refits with a cube from domain_factor.
+  Box3 domain;
+  /// Two constraints closer than duplicate_tolerance x the bounding-box diagonal are rejected
+  /// (InvalidPoint naming both); 0 rejects exact duplicates only.
+  double duplicate_tolerance = 1e-6;
+  /// Deepest octree level (root 0). Cells at this level are never split, whatever their count.
+  int max_depth = 20;
+  /// Threads of the fit (over patches) and of the batch evaluation: 0 = hardware concurrency.
+  unsigned threads = 0;
+};
+
+/// A ball of R^3.
+struct Ball {
+  Point3 center;
+  double radius = 0;
+};
+
+/// Where an edit changed f: f(x) is bitwise unchanged at every x outside every ball (and outside the
+/// domain cube's exterior when `everywhere`). `everywhere` is set when the edit refitted the whole
+/// function (e.g. a constraint moved outside the domain cube).
+struct ChangedRegion {
+  bool everywhere = false;
+  std::vector<Ball> balls;
+  /// True when x may have a different value after the edit.
+  bool contains(const Point3& x) const;
+  /// Bounding box of the balls (the whole space when everywhere; empty box when nothing changed).
+  Box3 bounds() const;
+};
+
+/// What the last fit or edit did.
+struct LocalFitReport {
+  std::size_t constraints = 0;    ///< N
+  std::size_t patches = 0;        ///< leaf cells (one patch each)
+  std::size_t far_patches = 0;    ///< of which patches with no constraint in their support (linear)
+  std::size_t max_fitted = 0;     ///< largest number of constraints fitted by one patch
+  double mean_fitted = 0;         ///< mean number of constraints fitted by an RBF patch
+  int depth = 0;                  ///< deepest leaf level
+  std::size_t memory_bytes = 0;   ///< approximate memory of the structure and the coefficients
+  std::size_t refitted = 0;       ///< last edit: patches refitted (created ones included)
+  std::size_t removed = 0;        ///< last edit: patches removed by splits or merges
+  double seconds = 0;             ///< last fit or edit, wall time
+};
+
+/// The local variational implicit function. Constraint numbering as vitri::Rbf: fit() order, add appends,
+/// remove shifts later indices down by one (like std::vector::erase), move and set_value keep indices.
+/// Thread safety: const members may run concurrently; edits need exclusive access.
+class LocalRbf : public ImplicitFunction {
+ public:
+  LocalRbf();
+  explicit LocalRbf(const Constraints& constraints, const LocalRbfOptions& options = {});
+  ~LocalRbf() override;
+  LocalRbf(LocalRbf&&) noexcept;
+  LocalRbf& operator=(LocalRbf&&) noexcept;
+  LocalRbf(const LocalRbf&) = delete;
+  LocalRbf& operator=(const LocalRbf&) = delete;
+
+  /// Fits the function, replacing any previous state.
+  /// @throws InvalidPoint    non-finite position or value, (near-)duplicate positions (later index; the
+  ///                         message names both).
+  /// @throws InvalidArgument fewer than 4 constraints, all values zero, options out of range.
+  /// @throws NumericalError  a patch system that is not positive definite (names the patch and its size).
+  const LocalFitReport& fit(const Constraints& constraints, const LocalRbfOptions& options = {});
+
+  bool fitted() const;
+  std::size_t size() const;
+  /// Current constraints in the public numbering (built on demand after edits, O(N), then cached).
+  const Constraints& constraints() const;
+  /// Position and value of constraint i, O(log N). @throws InvalidPoint when i >= size().
+  Point3 point(std::size_t i) const;
+  double value_of(std::size_t i) const;
+  const LocalRbfOptions& options() const;
+  const LocalFitReport& report() const;
+  /// The octree's root cube (the domain where patches live).
+  Box3 domain() const;
+
+  /// Checks every invariant of the structure (octree links, the split rule against the current
+  /// constraints, candidate lists, edit reach bounds); throws std::logic_error naming the first broken one.
+  /// O(N log N); for tests.
+  void validate() const;
+
+  // ----- evaluation (ImplicitFunction) -----
+  double value(const Point3& p) const override;
+  double value_gradient(const Point3& p, Point3& gradient) const override;
+  void values(const Point3* points, std::size_t n, double* out) const override;
+  void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const override;
+
+  // ----- edits: cost independent of N (amortized), each returns where f changed -----
+  // Errors leave the function unchanged.
+  /// Appends f(p) = value (index size() - 1). @throws InvalidPoint (index size()) for non-finite data or a
+  /// near-duplicate of an existing constraint.
+  ChangedRegion add_constraint(const Point3& p, double value);
+  /// Moves constraint i to p. @throws InvalidPoint (i) as add_constraint, or i out of range.
+  ChangedRegion move_constraint(std::size_t i, const Point3& p);
+  /// Removes constraint i (later indices shift down). @throws InvalidPoint for i out of range;
+  /// InvalidArgument when fewer than 4 constraints or only zero values would remain.
+  ChangedRegion remove_constraint(std::size_t i);
+  /// Sets the value of constraint i. @throws InvalidPoint (i) for a non-finite value or i out of range;
+  /// InvalidArgument when every value would be zero.
+  ChangedRegion set_value(std::size_t i, double value);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace vitri

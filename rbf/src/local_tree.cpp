@@ -1,0 +1,176 @@
+// The octree of the local RBF: storage, descent queries, validation (see local_tree.hpp).
+#include "local_tree.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace vitri::local_detail {
+
+void LocalTree::reset(const Point3& center, double half) {
+  cells_.clear();
+  free_blocks_.clear();
+  Cell root;
+  root.center = center;
+  root.half = half;
+  root.alive = true;
+  root.radius = support_radius(half);
+  root.fit_reach = root.radius;
+  cells_.push_back(std::move(root));
+}
+
+double LocalTree::support_radius(double half) const { return overlap * std::sqrt(3.0) * half; }
+
+std::uint32_t LocalTree::split(std::uint32_t c) {
+  std::uint32_t first;
+  if (!free_blocks_.empty()) {
+    first = free_blocks_.back();
+    free_blocks_.pop_back();
+  } else {
+    first = static_cast<std::uint32_t>(cells_.size());
+    cells_.resize(cells_.size() + 8);
+  }
+  Cell& parent = cells_[c];
+  parent.first_child = first;
+  parent.coef.clear();
+  parent.terms = 0;
+  const double h = 0.5 * parent.half;
+  for (int k = 0; k < 8; ++k) {
+    Cell& child = cells_[first + static_cast<std::uint32_t>(k)];
+    child = Cell();
+    child.center = parent.center + Point3{(k & 1) ? h : -h, (k & 2) ? h : -h, (k & 4) ? h : -h};
+    child.half = h;
+    child.parent = c;
+    child.depth = parent.depth + 1;
+    child.alive = true;
+    child.radius = support_radius(h);
+    child.fit_reach = child.radius;
+  }
+  return first;
+}
+
+void LocalTree::collapse(std::uint32_t c, std::vector<std::uint32_t>& freed_leaves) {
+  const std::uint32_t first = cells_[c].first_child;
+  if (first == kNone) return;
+  for (int k = 0; k < 8; ++k) {
+    const std::uint32_t ch = first + static_cast<std::uint32_t>(k);
+    if (cells_[ch].leaf()) freed_leaves.push_back(ch);
+    else collapse(ch, freed_leaves);
+    cells_[ch].alive = false;
+  }
+  free_blocks_.push_back(first);
+  cells_[c].first_child = kNone;
+}
+
+std::uint32_t LocalTree::locate(const Point3& p) const {
+  std::uint32_t c = 0;
+  while (!cells_[c].leaf()) {
+    const Cell& cell = cells_[c];
+    const int k = (p.x >= cell.center.x ? 1 : 0) | (p.y >= cell.center.y ? 2 : 0) | (p.z >= cell.center.z ? 4 : 0);
+    c = cell.first_child + static_cast<std::uint32_t>(k);
+  }
+  return c;
+}
+
+void LocalTree::leaves_meeting_cube(const Cell& target, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    const Cell& cell = cells_[c];
+    if (!(cube_distance2(target, cell.center) < cell.radius * cell.radius)) continue;
+    if (cell.leaf()) out.push_back(c);
+    else
+      for (int k = 0; k < 8; ++k) stack.push_back(child(c, k));
+  }
+}
+
+void LocalTree::leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    const Cell& cell = cells_[c];
+    if (!(cube_distance2(cell, center) < radius * radius)) continue;
+    if (cell.leaf()) out.push_back(c);
+    else
+      for (int k = 0; k < 8; ++k) stack.push_back(child(c, k));
+  }
+}
+
+void LocalTree::leaves_fitting(const Point3& q, std::vector<std::uint32_t>& out) const {
+  out.clear();
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    const Cell& cell = cells_[c];
+    const double d2 = squared_distance(q, cell.center);
+    if (cell.leaf()) {
+      if (d2 <= cell.fit_r2) out.push_back(c);
+    } else if (std::sqrt(d2) <= cell.fit_reach * (1 + 1e-12)) {
+      for (int k = 0; k < 8; ++k) stack.push_back(child(c, k));
+    }
+  }
+}
+
+void LocalTree::update_reach(std::uint32_t c) {
+  while (c != kNone) {
+    Cell& cell = cells_[c];
+    double reach = cell.leaf() ? std::max(cell.radius, std::sqrt(cell.fit_r2)) : 0.0;
+    if (!cell.leaf())
+      for (int k = 0; k < 8; ++k) {
+        const Cell& ch = cells_[child(c, k)];
+        reach = std::max(reach, distance(ch.center, cell.center) + ch.fit_reach);
+      }
+    cell.fit_reach = reach;
+    c = cell.parent;
+  }
+}
+
+std::vector<std::uint32_t> LocalTree::leaves() const {
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t c = 0; c < cells_.size(); ++c)
+    if (cells_[c].alive && cells_[c].leaf()) out.push_back(c);
+  return out;
+}
+
+Box3 LocalTree::root_box() const {
+  const Cell& r = cells_[0];
+  const Point3 h{r.half, r.half, r.half};
+  Box3 b;
+  b.lo = r.center - h;
+  b.hi = r.center + h;
+  return b;
+}
+
+void LocalTree::validate() const {
+  auto fail = [](std::uint32_t c, const std::string& what) {
+    throw std::logic_error("local RBF octree: cell " + std::to_string(c) + ": " + what);
+  };
+  std::vector<std::uint32_t> found;
+  for (std::uint32_t c = 0; c < cells_.size(); ++c) {
+    const Cell& cell = cells_[c];
+    if (!cell.alive) continue;
+    if (c != 0 && (cell.parent == kNone || !cells_[cell.parent].alive)) fail(c, "orphan");
+    if (!cell.leaf()) {
+      for (int k = 0; k < 8; ++k)
+        if (cells_[child(c, k)].parent != c || !cells_[child(c, k)].alive) fail(c, "broken child link");
+      continue;
+    }
+    leaves_meeting_cube(cell, found);
+    std::sort(found.begin(), found.end(), [&](auto a, auto b) { return cell_before(cells_[a], cells_[b]); });
+    if (found != cell.candidates) fail(c, "candidate list differs from the leaves whose ball meets the cell");
+    for (std::uint32_t l : cell.candidates)
+      if (std::find(cells_[l].listed_in.begin(), cells_[l].listed_in.end(), c) == cells_[l].listed_in.end())
+        fail(c, "candidate " + std::to_string(l) + " does not list it back");
+    for (std::uint32_t p = c; p != kNone; p = cells_[p].parent)
+      if (distance(cell.center, cells_[p].center) + std::sqrt(cell.fit_r2) > cells_[p].fit_reach * (1 + 1e-12))
+        fail(c, "fit ball outside the reach of ancestor " + std::to_string(p));
+  }
+}
+
+}  // namespace vitri::local_detail

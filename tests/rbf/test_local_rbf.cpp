@@ -1,0 +1,296 @@
+// vitri::LocalRbf: interpolation, gradient, continuity across patch borders, far field, agreement with the
+// global Rbf near the data, edits equal to fresh fits (bit for bit) and confined to the reported region,
+// structure invariants after every edit, bad input.
+#include "vitri/core/error.hpp"
+#include "vitri/rbf/constraints.hpp"
+#include "vitri/rbf/local_rbf.hpp"
+#include "vitri/rbf/rbf.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+using vitri::Constraints;
+using vitri::LocalRbf;
+using vitri::LocalRbfOptions;
+using vitri::Point3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Normal constraints of n points on a torus (R = 1, r = 0.35) around the z axis.
+Constraints torus_constraints(int n, unsigned seed = 3) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0, 2 * kPi);
+  std::vector<Point3> p, nrm;
+  for (int i = 0; i < n; ++i) {
+    const double a = u(rng), b = u(rng);
+    const Point3 ring{std::cos(a), std::sin(a), 0};
+    const Point3 normal{std::cos(b) * ring.x, std::cos(b) * ring.y, std::sin(b)};
+    p.push_back(ring + 0.35 * normal);
+    nrm.push_back(normal);
+  }
+  return vitri::constraints_from_oriented_points(p, nrm);
+}
+
+/// Normal constraints of n Fibonacci points on the unit sphere.
+Constraints sphere_constraints(int n) {
+  std::vector<Point3> p, nrm;
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z), phi = i * kPi * (3 - std::sqrt(5.0));
+    p.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    nrm.push_back(p.back());
+  }
+  return vitri::constraints_from_oriented_points(p, nrm);
+}
+
+double max_residual(const LocalRbf& f, const Constraints& c) {
+  double worst = 0;
+  for (std::size_t i = 0; i < c.size(); ++i) worst = std::max(worst, std::abs(f.value(c.points[i]) - c.values[i]));
+  return worst;
+}
+
+std::vector<Point3> random_points(int n, double half, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-half, half);
+  std::vector<Point3> out;
+  for (int i = 0; i < n; ++i) out.push_back({u(rng), u(rng), u(rng)});
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("LocalRbf interpolates every constraint and has a valid structure", "[local_rbf]") {
+  const Constraints c = torus_constraints(1500);
+  LocalRbf f(c);
+  f.validate();
+  const auto& rep = f.report();
+  CHECK(rep.patches > 8);
+  CHECK(rep.max_fitted <= LocalRbfOptions{}.max_per_patch);
+  CHECK(max_residual(f, c) < 1e-9);  // values are +-0.01 x diagonal ~ 0.03: relative 3e-8
+  // Batch evaluation equals single evaluation, bit for bit, whatever the threads.
+  const auto pts = random_points(5000, 2.0, 11);
+  std::vector<double> v(pts.size()), vg(pts.size());
+  std::vector<Point3> g(pts.size());
+  f.values(pts.data(), pts.size(), v.data());
+  f.values_gradients(pts.data(), pts.size(), vg.data(), g.data());
+  for (std::size_t i = 0; i < pts.size(); i += 7) {
+    Point3 gi;
+    REQUIRE(v[i] == f.value(pts[i]));
+    REQUIRE(vg[i] == f.value_gradient(pts[i], gi));
+    REQUIRE(gi == g[i]);
+  }
+}
+
+TEST_CASE("LocalRbf gradient matches finite differences", "[local_rbf]") {
+  LocalRbf f(torus_constraints(800));
+  const auto pts = random_points(300, 1.6, 5);
+  const double h = 1e-6;
+  for (const Point3& p : pts) {
+    Point3 g;
+    f.value_gradient(p, g);
+    for (int a = 0; a < 3; ++a) {
+      Point3 e{0, 0, 0};
+      e[a] = h;
+      const double fd = (f.value(p + e) - f.value(p - e)) / (2 * h);
+      REQUIRE(std::abs(fd - g[a]) <= 1e-5 * (1 + std::abs(g[a])));
+    }
+  }
+}
+
+TEST_CASE("LocalRbf is continuous across patch borders", "[local_rbf]") {
+  // Dense samples along segments crossing many cells: consecutive differences stay within the
+  // gradient bound times the step (no jump beyond rounding).
+  LocalRbf f(torus_constraints(1200));
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  const int steps = 20000;
+  for (int s = 0; s < 6; ++s) {
+    const Point3 a{u(rng), u(rng), u(rng)}, b{u(rng), u(rng), u(rng)};
+    const double step = vitri::distance(a, b) / steps;
+    double prev = f.value(a);
+    for (int k = 1; k <= steps; ++k) {
+      const Point3 x = a + (double(k) / steps) * (b - a);
+      Point3 g;
+      const double cur = f.value_gradient(x, g);
+      REQUIRE(std::abs(cur - prev) <= 4 * vitri::norm(g) * step + 1e-12);
+      prev = cur;
+    }
+  }
+}
+
+TEST_CASE("LocalRbf far field: positive far outside, negative deep inside", "[local_rbf]") {
+  LocalRbf f(sphere_constraints(1500));
+  // Deep inside: the centre and a small ball around it.
+  for (const Point3& p : random_points(200, 0.4, 2)) REQUIRE(f.value(p) < 0);
+  // Far outside: a shell beyond 1.3, out to far beyond the octree's cube.
+  std::mt19937 rng(4);
+  std::normal_distribution<double> n(0, 1);
+  for (int i = 0; i < 400; ++i) {
+    Point3 d{n(rng), n(rng), n(rng)};
+    d = d / vitri::norm(d);
+    const double r = 1.3 + 0.05 * i;
+    REQUIRE(f.value(r * d) > 0);
+  }
+  // The zero set lies near the sphere only: along rays, one sign change, between 0.97 and 1.03.
+  for (int i = 0; i < 100; ++i) {
+    Point3 d{n(rng), n(rng), n(rng)};
+    d = d / vitri::norm(d);
+    int changes = 0;
+    double prev = f.value(0.0 * d), where = 0;
+    for (int k = 1; k <= 600; ++k) {
+      const double cur = f.value((k * 0.005) * d);
+      if ((cur < 0) != (prev < 0)) {
+        ++changes;
+        where = k * 0.005;
+      }
+      prev = cur;
+    }
+    REQUIRE(changes == 1);
+    REQUIRE(std::abs(where - 1.0) < 0.03);
+  }
+}
+
+TEST_CASE("LocalRbf and the global Rbf have close zero sets near the data", "[local_rbf]") {
+  const Constraints c = torus_constraints(600);
+  LocalRbf local(c);
+  vitri::Rbf global(c);
+  // Near the data (within the off-surface distance d of an on-surface constraint), the two functions
+  // agree to a small fraction of d: both interpolate the same constraints 0, +d, -d there.
+  const double d = 0.01 * 2.7 * 1.0;  // offset x diagonal of the torus' box (about 2.7 x 2.7 x 0.7)
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-1, 1);
+  double worst = 0;
+  for (std::size_t i = 0; i < c.size(); i += 3) {
+    if (c.values[i] != 0) continue;
+    const Point3 x = c.points[i] + (0.5 * d) * Point3{u(rng), u(rng), u(rng)};
+    Point3 gl, gg;
+    const double fl = local.value_gradient(x, gl), fg = global.value_gradient(x, gg);
+    // Distance between the zero sets, to first order: the difference of the distance estimates f/|grad f|.
+    worst = std::max(worst, std::abs(fl / vitri::norm(gl) - fg / vitri::norm(gg)));
+  }
+  INFO("largest zero-set distance estimate " << worst << " (d = " << d << ")");
+  REQUIRE(worst < 0.25 * d);
+}
+
+TEST_CASE("LocalRbf edits equal a fresh fit and stay inside the reported region", "[local_rbf]") {
+  Constraints c = torus_constraints(700, 21);
+  LocalRbf f(c);
+  const auto probes = random_points(4000, 1.8, 13);
+  std::vector<double> before(probes.size()), after(probes.size());
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<double> u(-1.2, 1.2);
+  std::uniform_int_distribution<int> kind(0, 3);
+  for (int step = 0; step < 40; ++step) {
+    f.values(probes.data(), probes.size(), before.data());
+    std::uniform_int_distribution<std::size_t> pick(0, c.size() - 1);
+    vitri::ChangedRegion region;
+    const std::size_t i = pick(rng);
+    switch (kind(rng)) {
+      case 0: {
+        const Point3 p{u(rng), u(rng), 0.3 * u(rng)};
+        region = f.add_constraint(p, 0.02);
+        c.add(p, 0.02);
+        break;
+      }
+      case 1: {
+        const Point3 p = c.points[i] + Point3{0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng)};
+        region = f.move_constraint(i, p);
+        c.points[i] = p;
+        break;
+      }
+      case 2:
+        region = f.remove_constraint(i);
+        c.points.erase(c.points.begin() + static_cast<long>(i));
+        c.values.erase(c.values.begin() + static_cast<long>(i));
+        break;
+      default:
+        region = f.set_value(i, c.values[i] + 0.01);
+        c.values[i] += 0.01;
+    }
+    INFO("step " << step);
+    f.validate();
+    REQUIRE(f.size() == c.size());
+    REQUIRE(f.constraints().points == c.points);
+    REQUIRE(f.constraints().values == c.values);
+    REQUIRE_FALSE(region.everywhere);
+    f.values(probes.data(), probes.size(), after.data());
+    for (std::size_t k = 0; k < probes.size(); ++k)
+      if (!region.contains(probes[k])) REQUIRE(after[k] == before[k]);
+  }
+  LocalRbfOptions same_domain;
+  same_domain.domain = f.domain();
+  LocalRbf fresh(c, same_domain);
+  std::vector<double> expected(probes.size());
+  fresh.values(probes.data(), probes.size(), expected.data());
+  double worst_diff = 0;
+  for (std::size_t k = 0; k < probes.size(); ++k) worst_diff = std::max(worst_diff, std::abs(after[k] - expected[k]));
+  INFO("patches " << f.report().patches << " vs " << fresh.report().patches << ", largest difference " << worst_diff);
+  REQUIRE(after == expected);  // same structure, same patch systems in the same order: bit for bit
+  REQUIRE(max_residual(f, c) < 1e-8);
+}
+
+TEST_CASE("LocalRbf edit outside the domain refits everything", "[local_rbf]") {
+  Constraints c = sphere_constraints(200);
+  LocalRbf f(c);
+  const auto region = f.add_constraint({10, 0, 0}, 1.0);
+  REQUIRE(region.everywhere);
+  REQUIRE(f.domain().contains({10, 0, 0}));
+  f.validate();
+}
+
+TEST_CASE("LocalRbf smoothing trades interpolation for smoothness", "[local_rbf]") {
+  const Constraints c = torus_constraints(800);
+  LocalRbfOptions o;
+  o.smoothing = 1e-2;
+  LocalRbf smooth(c, o), exact(c);
+  const double rs = max_residual(smooth, c), re = max_residual(exact, c);
+  REQUIRE(re < 1e-9);
+  REQUIRE(rs > 100 * re);
+  REQUIRE(rs < 0.01);  // values are +-0.027: the zero set moves by a fraction of the offset at most
+}
+
+TEST_CASE("LocalRbf rejects bad input with the culprit", "[local_rbf]") {
+  Constraints c = sphere_constraints(100);
+  SECTION("non-finite") {
+    c.points[17].y = NAN;
+    try {
+      LocalRbf f(c);
+      FAIL("no throw");
+    } catch (const vitri::InvalidPoint& e) {
+      REQUIRE(e.index() == 17);
+    }
+  }
+  SECTION("duplicate") {
+    c.points[40] = c.points[12];
+    try {
+      LocalRbf f(c);
+      FAIL("no throw");
+    } catch (const vitri::InvalidPoint& e) {
+      REQUIRE(e.index() == 40);
+      REQUIRE(std::string(e.what()).find("12") != std::string::npos);
+    }
+  }
+  SECTION("too few, all zero, bad options") {
+    Constraints few;
+    for (int i = 0; i < 3; ++i) few.add({double(i), 0, 0}, 1.0);
+    REQUIRE_THROWS_AS(LocalRbf(few), vitri::InvalidArgument);
+    for (auto& v : c.values) v = 0;
+    REQUIRE_THROWS_AS(LocalRbf(c), vitri::InvalidArgument);
+    LocalRbfOptions o;
+    o.overlap = 1.0;
+    REQUIRE_THROWS_AS(LocalRbf(sphere_constraints(50), o), vitri::InvalidArgument);
+  }
+  SECTION("edits") {
+    LocalRbf f(c);
+    REQUIRE_THROWS_AS(f.move_constraint(5000, {0, 0, 0}), vitri::InvalidPoint);
+    REQUIRE_THROWS_AS(f.add_constraint(c.points[3], 0.0), vitri::InvalidPoint);
+    REQUIRE_THROWS_AS(f.set_value(2, INFINITY), vitri::InvalidPoint);
+    REQUIRE(f.constraints().points == c.points);  // unchanged
+    f.validate();
+  }
+}

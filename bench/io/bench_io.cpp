@@ -1,5 +1,6 @@
-// Large inputs: reading a 10^6-point binary PLY, a 10^6-vertex OFF (NOFF: positions and normals) and a
-// 10^6-point .xyz, each as `vitri mesh` reads it (read_input: whole file, then parse); and estimating and
+// Large inputs: reading a 10^6-point binary PLY, a 10^6-vertex OFF (NOFF: positions and normals), a
+// 10^6-point .xyz and a closed 10^6-vertex, 2 x 10^6-triangle mesh (a latitude-longitude sphere) as OFF and
+// binary PLY, each as `vitri mesh` reads it (read_input: whole file, then parse); and estimating and
 // orienting the normals of the 10^6 points. The inputs are made once, in a temporary folder, by sampling
 // a closed model area-weighted with its triangle normals (../shared/data/man.off when present, else
 // data/hand.off; VITRI_BENCH_MODEL overrides). Run in Release; see docs/benchmarks.md "## Large inputs".
@@ -61,6 +62,38 @@ vitri::TriangleMesh sample(std::size_t n) {
   return s;
 }
 
+/// A closed mesh of about 10^6 vertices and 2 x 10^6 triangles: a latitude-longitude sphere, 1000 rings of
+/// 1000 vertices plus the two poles.
+vitri::TriangleMesh sphere_mesh() {
+  const int rings = 1000, around = 1000;
+  vitri::TriangleMesh m;
+  m.V.resize(rings * around + 2, 3);
+  m.N.resize(0, 3);
+  const double pi = 3.14159265358979323846;
+  for (int r = 0; r < rings; ++r)
+    for (int a = 0; a < around; ++a) {
+      const double t = pi * (r + 1) / (rings + 1), p = 2 * pi * a / around;
+      m.V.row(r * around + a) << std::sin(t) * std::cos(p), std::sin(t) * std::sin(p), std::cos(t);
+    }
+  const int north = rings * around, south = north + 1;
+  m.V.row(north) << 0, 0, 1;
+  m.V.row(south) << 0, 0, -1;
+  std::vector<int> f;
+  auto tri = [&](int a, int b, int c) { f.insert(f.end(), {a, b, c}); };
+  for (int a = 0; a < around; ++a) {
+    const int b = (a + 1) % around;
+    tri(north, a, b);
+    tri(south, (rings - 1) * around + b, (rings - 1) * around + a);
+    for (int r = 0; r + 1 < rings; ++r) {
+      tri(r * around + a, (r + 1) * around + a, (r + 1) * around + b);
+      tri(r * around + a, (r + 1) * around + b, r * around + b);
+    }
+  }
+  m.F = Eigen::Map<Eigen::Matrix<int, Eigen::Dynamic, 3, Eigen::RowMajor>>(
+      f.data(), static_cast<Eigen::Index>(f.size() / 3), 3);
+  return m;
+}
+
 /// The input files, written once: kind -> path.
 const std::string& input(const std::string& kind) {
   static std::map<std::string, std::string> files;
@@ -75,6 +108,11 @@ const std::string& input(const std::string& kind) {
     vitri::OrientedPoints p;
     for (Eigen::Index i = 0; i < s.V.rows(); ++i) p.points.push_back({s.V(i, 0), s.V(i, 1), s.V(i, 2)});
     vitri::write_points(files["xyz"], p);
+    const vitri::TriangleMesh sphere = sphere_mesh();
+    files["mesh.off"] = dir + "/vitri_bench_1M_mesh.off";
+    files["mesh.ply"] = dir + "/vitri_bench_1M_mesh.ply";
+    vitri::write_off(files["mesh.off"], sphere);
+    vitri::write_ply(files["mesh.ply"], sphere, vitri::PlyEncoding::BinaryLittleEndian);
   }
   return files.at(kind);
 }
@@ -84,8 +122,9 @@ void read_file(benchmark::State& state, const std::string& kind) {
   std::size_t points = 0;
   for (auto _ : state) {
     const vitri::Input in = vitri::read_input(path);
-    points = in.points.points.size();
+    points = in.points.points.size() + static_cast<std::size_t>(in.mesh.V.rows());
     benchmark::DoNotOptimize(in.points.points.data());
+    benchmark::DoNotOptimize(in.mesh.F.data());
   }
   std::ifstream f(path, std::ios::binary | std::ios::ate);
   state.counters["points"] = static_cast<double>(points);
@@ -101,7 +140,15 @@ void BM_ReadNoff1M(benchmark::State& state) {
 void BM_ReadXyz1M(benchmark::State& state) {
   read_file(state, "xyz");
 }
+void BM_ReadOffMesh1M(benchmark::State& state) {
+  read_file(state, "mesh.off");
+}
+void BM_ReadBinaryPlyMesh1M(benchmark::State& state) {
+  read_file(state, "mesh.ply");
+}
 BENCHMARK(BM_ReadBinaryPly1M)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_ReadOffMesh1M)->Unit(benchmark::kMillisecond)->Iterations(3);
+BENCHMARK(BM_ReadBinaryPlyMesh1M)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_ReadNoff1M)->Unit(benchmark::kMillisecond)->Iterations(3);
 BENCHMARK(BM_ReadXyz1M)->Unit(benchmark::kMillisecond)->Iterations(3);
 

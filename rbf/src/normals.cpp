@@ -15,6 +15,10 @@
 // would flip one sheet; with the penalty (~1 for such an edge, ~0 along a surface) the tree goes around.
 // The seed of each connected component is its point of largest x (ties: smallest index), on the convex
 // hull of the component, where the outward normal of a closed surface points to +x.
+// Two checks turn a guessed orientation into an error naming a point (docs/normals.md gives the
+// measurements behind their thresholds): a tree edge across nearly perpendicular normals (the sign of
+// everything beyond it is a guess), and, after the fact, too many neighbour pairs along the surface with
+// opposite normals (the neighbourhoods saw noise, not a surface).
 
 #include "vitri/rbf/normals.hpp"
 
@@ -216,7 +220,7 @@ std::vector<Point3> pca_normals(const DistinctPoints& d, const NeighbourTable& t
 std::vector<Id> components(const NeighbourGraph& g) {
   std::vector<Id> parent(g.size());
   std::iota(parent.begin(), parent.end(), Id{0});
-  std::function<Id(Id)> find = [&](Id a) {
+  auto find = [&](Id a) {
     while (parent[a] != a) a = parent[a] = parent[parent[a]];
     return a;
   };

@@ -42,9 +42,7 @@ std::size_t rbf_fit_memory_bytes(std::size_t n, RbfSolver solver) {
     const double cap = reduced + std::floor(reduced / 8) + 16;
     bytes = cap * cap * sizeof(double);
   }
-  bytes += kPerConstraintBytes * N;
-  const double max = static_cast<double>(std::numeric_limits<std::size_t>::max());
-  return bytes >= max ? std::numeric_limits<std::size_t>::max() : static_cast<std::size_t>(bytes);
+  return rbf_detail::saturated_bytes(bytes + kPerConstraintBytes * N);
 }
 
 std::size_t physical_memory_bytes() {
@@ -55,6 +53,11 @@ std::size_t physical_memory_bytes() {
 }
 
 namespace rbf_detail {
+
+std::size_t saturated_bytes(double bytes) {
+  const double max = static_cast<double>(std::numeric_limits<std::size_t>::max());
+  return bytes >= max ? std::numeric_limits<std::size_t>::max() : static_cast<std::size_t>(bytes);
+}
 
 std::size_t memory_budget(const RbfOptions& options) {
   return options.max_memory_bytes ? options.max_memory_bytes : physical_memory_bytes();

@@ -7,6 +7,9 @@
 
 namespace vitri::rbf_detail {
 
+/// A byte count computed in floating point, saturated at SIZE_MAX.
+std::size_t saturated_bytes(double bytes);
+
 /// The budget in force: options.max_memory_bytes, or the physical memory when it is 0 (0 = no limit when
 /// neither is known).
 std::size_t memory_budget(const RbfOptions& options);

@@ -310,7 +310,7 @@ struct Rbf::Impl {
     if (static_cast<std::size_t>(L.rows()) >= need) return;
     const auto cap = static_cast<double>(grown_capacity(need));
     const double bytes = (cap * cap + static_cast<double>(L.size())) * sizeof(double);
-    rbf_detail::require_memory(bytes >= 1.8e19 ? std::size_t(-1) : static_cast<std::size_t>(bytes),
+    rbf_detail::require_memory(rbf_detail::saturated_bytes(bytes),
                                "adding a constraint to the global RBF of " + std::to_string(cons.size()) +
                                    " constraints (the system grows to " + std::to_string(grown_capacity(need)) +
                                    " rows)",

@@ -48,7 +48,6 @@ T parse_unsigned(const std::string& flag, const std::string& s) {
 
 }  // namespace
 
-/// Constraints of any input file: .xyzv as is; oriented points and closed meshes through the builders.
 Constraints constraints_of_input(const std::string& path, const ConstraintBuildOptions& opt) {
   const Input in = read_input(path);
   switch (in.kind) {
@@ -57,9 +56,11 @@ Constraints constraints_of_input(const std::string& path, const ConstraintBuildO
     case InputKind::OrientedPoints:
       return constraints_from_oriented_points(in.points.points, in.points.normals, opt);
     case InputKind::Points:
-      throw InvalidArgument(path +
-                            ": points without normals (3 columns) do not define an inside and an outside; "
-                            "give x y z nx ny nz, a .xyzv constraint file or a closed mesh");
+      try {
+        return constraints_from_points(in.points.points, opt);
+      } catch (const InvalidArgument& e) {  // say which file (the message names the point)
+        throw InvalidArgument(path + ": points without normals: " + e.what());
+      }
     case InputKind::Mesh:
       return constraints_from_mesh(in.mesh.V, in.mesh.F, opt);
   }
@@ -83,6 +84,8 @@ int run_eval(const Args& args) {
       opt.max_constraints = parse_unsigned<std::size_t>(a, value());
     else if (a == "--seed")
       opt.seed = parse_unsigned<std::uint64_t>(a, value());
+    else if (a == "--neighbours")
+      opt.normals.k = parse_unsigned<std::size_t>(a, value());
     else if (!a.empty() && a[0] == '-') {
       std::cerr << "vitri eval: unknown option '" << a << "'\n";
       return 2;
@@ -111,6 +114,7 @@ int run_eval(const Args& args) {
 
 const char* eval_usage() {
   return "usage: vitri eval INPUT --at QUERY.xyz [--offset F] [--max-constraints N] [--seed S]\n"
+         "                  [--neighbours K]\n"
          "\n"
          "Fits the variational implicit function of INPUT and prints 'f gx gy gz' (value and gradient, "
          "%.17g)\n"
@@ -118,12 +122,16 @@ const char* eval_usage() {
          "f < 0 inside, f > 0 outside.\n"
          "\n"
          "INPUT: constraints .xyzv (x y z value), oriented points .pwn / 6-column .xyz, or a closed mesh\n"
-         "       .off / .obj / .ply (vertex normals area-weighted, oriented outwards).\n"
+         "       .off / .obj / .ply (vertex normals area-weighted, oriented outwards), or points without\n"
+         "       normals (3-column .xyz, a .ply / .off without faces): normals estimated from the K nearest\n"
+         "       neighbours and oriented consistently (docs/normals.md).\n"
          "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal "
          "(0.01)\n"
          "  --max-constraints N  subsample points / vertices to at most N constraints (0: all; else at\n"
          "                       least the 3 constraints made per point)\n"
-         "  --seed S             seed of the subsampling (1)\n";
+         "  --seed S             seed of the subsampling (1)\n"
+         "  --neighbours K       neighbours per point for the normals of unoriented points (10; more for\n"
+         "                       noisy points)\n";
 }
 
 }  // namespace vitri::cli

@@ -21,8 +21,8 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj --precision P [--precision P2 ...] [--edits SCRIPT]\n"
-    "                  [--sides both|inside|outside] [--offset D] [--function global|local|auto]\n"
-    "                  [--smoothing S] [-q]\n"
+    "                  [--sides both|inside|outside] [--offset D] [--neighbours K]\n"
+    "                  [--function global|local|auto] [--smoothing S] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -31,6 +31,10 @@ const char* const kUsage =
     "INPUT   .xyzv  constraints 'x y z value' (f < 0 inside, f > 0 outside, 0 on the surface)\n"
     "        .pwn / 6-column .xyz  oriented points (outward normals): normal constraints are built\n"
     "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals\n"
+    "        3-column .xyz, .ply / .off without faces  unoriented points (samples of closed surfaces):\n"
+    "                normals estimated from the K nearest neighbours (PCA) and oriented consistently\n"
+    "                (minimum spanning tree, Hoppe et al. 1992; docs/normals.md), then as oriented points.\n"
+    "                A point whose orientation cannot be decided is named in the error.\n"
     "OUT     .obj, .ply or .off (with vertex normals where the format has them)\n"
     "\n"
     "options:\n"
@@ -59,6 +63,8 @@ const char* const kUsage =
     "  --sides S            off-surface constraints per point for points/meshes: both (default; +D\n"
     "                       outside and -D inside, 3 constraints per point), outside or inside (2 per\n"
     "                       point: fewer constraints, a faster fit). Ignored for .xyzv input.\n"
+    "  --neighbours K       neighbours per point for the normals of unoriented points (default 10;\n"
+    "                       larger for noisy points, e.g. 50-80 when the noise exceeds the spacing)\n"
     "  --function F         the implicit function: global (one dense RBF: smoothest, O(N^2) memory,\n"
     "                       O(N^3) fit), local (partition of unity of local RBF patches: O(N) memory and\n"
     "                       fit, local edits, no surface far from the data) or auto (default: global up\n"
@@ -119,29 +125,6 @@ void write_current(Mesher& mesher, const std::string& path) {
   write_mesh(path, tm);
 }
 
-/// The constraints of INPUT: read as such (.xyzv), or built from oriented points or a closed mesh
-/// exactly as Mesher::from_oriented_points / Mesher::from_mesh build them (surface points first, then
-/// the off-surface constraints; see constraints_from_oriented_points).
-Constraints read_constraints(const std::string& input, const MesherOptions& options) {
-  Input in = read_input(input);
-  switch (in.kind) {
-    case InputKind::Constraints: {
-      Constraints c;
-      c.points = std::move(in.constraints.points);
-      c.values = std::move(in.constraints.values);
-      return c;
-    }
-    case InputKind::OrientedPoints:
-      return constraints_from_oriented_points(in.points.points, in.points.normals, options.constraint_build);
-    case InputKind::Mesh:
-      return constraints_from_mesh(in.mesh.V, in.mesh.F, options.constraint_build);
-    case InputKind::Points:
-      break;
-  }
-  throw InvalidArgument(input + ": points without normals do not define an inside and an outside; give "
-                                "oriented points (.pwn, 6-column .xyz), constraints (.xyzv) or a closed mesh");
-}
-
 /// From this many constraints on, the fit (O(N^3)) is announced on stderr before it starts and after it
 /// ends: it is the one long phase without a progress callback.
 constexpr std::size_t kFitProgressConstraints = 1000;
@@ -184,6 +167,10 @@ int run_mesh(const Args& args) {
       else if (v == "inside") options.constraint_build.sides = OffSurface::Inside;
       else if (v == "outside") options.constraint_build.sides = OffSurface::Outside;
       else return usage_error("--sides must be both, inside or outside, got '" + v + "'");
+    } else if (a == "--neighbours") {
+      std::size_t k = 0;
+      if (!value(v) || !parse_index(v, k) || k < 3) return usage_error("--neighbours needs an integer >= 3");
+      options.constraint_build.normals.k = k;
     } else if (a == "--function") {
       if (!value(v)) return usage_error("--function needs global, local or auto");
       if (v == "global") options.function = FunctionKind::Global;
@@ -227,7 +214,7 @@ int run_mesh(const Args& args) {
   }
 
   const auto t_start = Clock::now();
-  const Constraints constraints = read_constraints(input, options);
+  const Constraints constraints = constraints_of_input(input, options.constraint_build);
   const bool announce_fit = !quiet && constraints.size() >= kFitProgressConstraints;
   if (announce_fit)
     std::fprintf(stderr, "fitting the implicit function to %zu constraints...\n", constraints.size());

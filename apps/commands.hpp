@@ -2,6 +2,8 @@
 // The subcommands of the vitri CLI. Each takes the arguments after its name and returns the exit code.
 // A command throws vitri::Error (or std::exception) on bad input; main() prints it and returns 1.
 
+#include "vitri/rbf/constraints.hpp"
+
 #include <string>
 #include <vector>
 
@@ -19,6 +21,10 @@ struct Command {
 
 /// All subcommands, in the order `vitri --help` lists them (defined in main.cpp).
 const std::vector<Command>& commands();
+
+/// Constraints of any input file (cmd_eval.cpp): .xyzv as is; oriented points, unoriented points (normals
+/// estimated and oriented, options.normals) and closed meshes through the builders of vitri::rbf.
+Constraints constraints_of_input(const std::string& path, const ConstraintBuildOptions& options);
 
 /// True when args holds -h or --help.
 bool wants_help(const Args& args);

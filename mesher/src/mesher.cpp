@@ -67,6 +67,10 @@ Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std
   return Mesher(constraints_from_oriented_points(points, normals, options.constraint_build), options);
 }
 
+Mesher Mesher::from_points(const std::vector<Point3>& points, const MesherOptions& options) {
+  return Mesher(constraints_from_points(points, options.constraint_build), options);
+}
+
 Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options) {
   return Mesher(constraints_from_mesh(V, F, options.constraint_build), options);
 }
@@ -208,6 +212,10 @@ SurfaceMesh mesh_points(const Constraints& constraints, double precision, const 
 void mesh_points(const Constraints& constraints, double precision, Eigen::MatrixXd& V, Eigen::MatrixXi& F,
                  Eigen::MatrixXd& N, const MesherOptions& options) {
   to_eigen(mesh_points(constraints, precision, options), V, F, &N);
+}
+
+SurfaceMesh mesh_points(const std::vector<Point3>& points, double precision, const MesherOptions& options) {
+  return mesh_points(constraints_from_points(points, options.constraint_build), precision, options);
 }
 
 SurfaceMesh mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,

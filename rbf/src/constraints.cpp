@@ -83,7 +83,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   if (normals.empty())
     throw InvalidArgument(
         "points without normals: an inside and an outside cannot be told apart "
-        "(give oriented points, .pwn or 6-column .xyz, or a closed mesh)");
+        "(estimate them with constraints_from_points(), or give oriented points or a closed mesh)");
   if (normals.size() != points.size())
     throw InvalidArgument(std::to_string(points.size()) + " points but " + std::to_string(normals.size()) +
                           " normals");
@@ -149,6 +149,11 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
     }
   }
   return c;
+}
+
+Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options) {
+  if (points.empty()) throw InvalidArgument("no points to build constraints from");
+  return constraints_from_oriented_points(points, estimate_oriented_normals(points, options.normals), options);
 }
 
 Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {

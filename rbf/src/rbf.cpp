@@ -33,6 +33,7 @@
 #include "vitri/rbf/rbf.hpp"
 
 #include "dense.hpp"
+#include "memory.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
 
@@ -300,9 +301,25 @@ struct Rbf::Impl {
     for (std::size_t s = 0; s < order.size(); ++s) slot_of[order[s]] = s;
   }
 
+  static std::size_t grown_capacity(std::size_t need) { return std::max<std::size_t>(need + need / 8, 16); }
+
+  // Throws LimitError, before anything changes, when one more slot would grow the factor past the memory
+  // budget (the old and the new factor coexist during the copy).
+  void require_room_for_one_more() const {
+    const std::size_t need = n + 1;
+    if (static_cast<std::size_t>(L.rows()) >= need) return;
+    const auto cap = static_cast<double>(grown_capacity(need));
+    const double bytes = (cap * cap + static_cast<double>(L.size())) * sizeof(double);
+    rbf_detail::require_memory(rbf_detail::saturated_bytes(bytes),
+                               "adding a constraint to the global RBF of " + std::to_string(cons.size()) +
+                                   " constraints (the system grows to " + std::to_string(grown_capacity(need)) +
+                                   " rows)",
+                               opt);
+  }
+
   void ensure_capacity(std::size_t need) {
     if (static_cast<std::size_t>(L.rows()) >= need) return;
-    const std::size_t cap = std::max<std::size_t>(need + need / 8, 16);
+    const std::size_t cap = grown_capacity(need);
     Eigen::MatrixXd nl(static_cast<Eigen::Index>(cap), static_cast<Eigen::Index>(cap));
     const auto m = static_cast<Eigen::Index>(n);
     nl.topLeftCorner(m, m) = L.topLeftCorner(m, m);
@@ -871,6 +888,8 @@ const FitReport& Rbf::fit(const Constraints& constraints, const RbfOptions& opti
   auto fresh = std::make_unique<Impl>();
   fresh->opt = options;
   fresh->validate(constraints);
+  rbf_detail::require_memory(rbf_fit_memory_bytes(constraints.size(), options.solver),
+                             "the global RBF fit of " + std::to_string(constraints.size()) + " constraints", options);
   fresh->cons = constraints;
   fresh->setup_scaling(constraints);
   fresh->fit_all();
@@ -971,6 +990,7 @@ void Rbf::add_constraint(const Point3& p, double value) {
   Impl& m = *impl_;
   const std::size_t i = m.cons.size();
   m.check_new_point(p, value, i, kNoSlot);
+  if (m.opt.solver == RbfSolver::Cholesky) m.require_room_for_one_more();
   if (m.opt.solver == RbfSolver::FullLu) {
     Constraints c = m.cons;
     c.add(p, value);

@@ -162,7 +162,7 @@ TEST_CASE("vitri eval fits a closed mesh and oriented points: negative inside, p
   }
 }
 
-TEST_CASE("vitri eval refuses inputs without an inside and bad option values", "[cli][eval][errors]") {
+TEST_CASE("vitri eval refuses inputs without an inside (too few unoriented points, open mesh) and bad option values", "[cli][eval][errors]") {
   const std::string query = kDir + "/eval_query_refuse.xyz";
   {
     std::ofstream f(query);
@@ -177,6 +177,7 @@ TEST_CASE("vitri eval refuses inputs without an inside and bad option values", "
   CHECK(run(points + " --at " + query, out, err) == 1);
   CHECK(err.find("eval_points3.xyz") != std::string::npos);
   CHECK(err.find("without normals") != std::string::npos);
+  CHECK(err.find("5 distinct points, at least k + 1 = 11 needed") != std::string::npos);
   CHECK(out.empty());
 
   const std::string open = kDir + "/eval_open_octahedron.off";

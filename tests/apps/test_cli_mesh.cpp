@@ -75,6 +75,28 @@ std::string write_sphere_points(const std::string& name, int n) {
   return path;
 }
 
+/// n points on the sphere of radius r (Fibonacci spiral) without normals: `x y z` lines (.xyz), or a PLY
+/// with a vertex element only (.ply, binary).
+std::string write_unoriented_sphere(const std::string& name, int n, double r = 1.0) {
+  const std::string path = kDir + "/" + name;
+  TriangleMesh m;
+  m.V.resize(n, 3);
+  m.F.resize(0, 3);
+  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, s = std::sqrt(1.0 - z * z), phi = golden * i;
+    m.V.row(i) << r * s * std::cos(phi), r * s * std::sin(phi), r * z;
+  }
+  if (file_extension(path) == "ply") {
+    write_ply(path, m, PlyEncoding::BinaryLittleEndian);
+  } else {
+    OrientedPoints p;
+    for (int i = 0; i < n; ++i) p.points.push_back({m.V(i, 0), m.V(i, 1), m.V(i, 2)});
+    write_points(path, p);
+  }
+  return path;
+}
+
 /// Distance from q to a mesh file the CLI wrote.
 double distance_to_mesh(const std::string& path, const Point3& q) {
   const TriangleMesh m = read_mesh(path);
@@ -199,6 +221,55 @@ TEST_CASE("vitri mesh --sides: outside/inside/both build 2 or 3 constraints per 
   }
   REQUIRE(run(in + " -o " + kDir + "/mesh_sides_bad.obj --precision 0.05 --sides middle", o, e) == 2);
   REQUIRE(e.find("--sides") != std::string::npos);
+}
+
+TEST_CASE("vitri mesh: unoriented points (.xyz, PLY without faces) get estimated, oriented normals",
+          "[cli][mesh][normals]") {
+  for (const std::string name : {"mesh_sphere3.xyz", "mesh_sphere3.ply"}) {
+    INFO(name);
+    const std::string in = write_unoriented_sphere(name, 400, 2.0), out = kDir + "/" + name + ".obj";
+    std::remove(out.c_str());
+    std::string o, e;
+    REQUIRE(run(in + " -o " + out + " --precision 0.05", o, e) == 0);
+    INFO(o << e);
+    REQUIRE(o.find("1200 constraints") != std::string::npos);  // 3 per point: the normals were built
+    check_mesh(out);  // closed, outward (positive volume): the normals point outwards
+    const double d = distance_to_mesh(out, {0, 0, 0});
+    CHECK(d > 1.9);
+    CHECK(d < 2.1);
+  }
+}
+
+TEST_CASE("vitri mesh: unoriented points that cannot be oriented, and a fit too large for memory",
+          "[cli][mesh][normals][errors]") {
+  std::string o, e;
+  const std::string out = kDir + "/mesh_bad_points.obj";
+  SECTION("collinear neighbours: the point is named") {
+    const std::string in = kDir + "/mesh_line.xyz";
+    {
+      std::ofstream f(in);
+      for (int i = 0; i < 40; ++i) f << 0.1 * i << " 0 0\n";
+    }
+    REQUIRE(run(in + " -o " + out + " --precision 0.1", o, e) == 1);
+    CHECK(e.find("mesh_line.xyz") != std::string::npos);
+    CHECK(e.find("point 0") != std::string::npos);
+    CHECK(e.find("collinear") != std::string::npos);
+  }
+  SECTION("too few points, or fewer than --neighbours") {
+    const std::string in = write_unoriented_sphere("mesh_few.xyz", 30);
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --neighbours 40", o, e) == 1);
+    CHECK(e.find("30 distinct points, at least k + 1 = 41 needed") != std::string::npos);
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --neighbours 2", o, e) == 2);
+  }
+  SECTION("a global fit larger than the memory is a clear error, before any allocation") {  // auto: local
+    // 60000 points, 180000 constraints: the dense fit would need about 360 GB.
+    const std::string in = write_unoriented_sphere("mesh_big.ply", 60000);
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 -q --function global", o, e) == 1);
+    CHECK(e.find("180000 constraints") != std::string::npos);
+    CHECK(e.find("GB") != std::string::npos);
+    CHECK(e.find("--function local") != std::string::npos);
+    CHECK(e.find("bad_alloc") == std::string::npos);
+  }
 }
 
 TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why on stderr", "[cli][mesh]") {

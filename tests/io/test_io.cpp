@@ -106,6 +106,48 @@ TEST_CASE("io constraints and points round-trip", "[io]") {
   for (const char* f : {"c.xyzv", "p.pwn", "q.pwn"}) std::remove(tmp(f).c_str());
 }
 
+TEST_CASE("io: a mesh file without faces is a point cloud, with normals when its vertices have them",
+          "[io][points]") {
+  TriangleMesh m;
+  m.V.resize(5, 3);
+  m.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.25, 0.5, 0.125;
+  m.F.resize(0, 3);
+  m.N.resize(0, 3);
+  const std::vector<Point3> expected{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}, {0.25, 0.5, 0.125}};
+  for (const char* name : {"cloud.ply", "cloud_bin.ply", "cloud.off"}) {
+    INFO(name);
+    if (std::string(name) == "cloud_bin.ply")
+      write_ply(tmp(name), m, PlyEncoding::BinaryLittleEndian);
+    else
+      write_mesh(tmp(name), m);
+    const Input in = read_input(tmp(name));
+    CHECK(in.kind == InputKind::Points);
+    CHECK(in.points.points == expected);
+    CHECK_FALSE(in.points.has_normals());
+    CHECK(in.mesh.V.rows() == 0);
+    std::remove(tmp(name).c_str());
+  }
+  m.N = m.V;
+  m.N(0, 0) = -1;
+  for (const char* name : {"ncloud.ply", "ncloud.off"}) {
+    INFO(name);
+    write_mesh(tmp(name), m);
+    const Input in = read_input(tmp(name));
+    CHECK(in.kind == InputKind::OrientedPoints);
+    CHECK(in.points.points == expected);
+    REQUIRE(in.points.has_normals());
+    CHECK(in.points.normals[0] == Point3{-1, 0, 0});
+    CHECK(in.points.normals[4] == expected[4]);
+    std::remove(tmp(name).c_str());
+  }
+  // One face: a mesh, as before.
+  m.F.resize(1, 3);
+  m.F << 0, 1, 2;
+  write_mesh(tmp("tri.ply"), m);
+  CHECK(read_input(tmp("tri.ply")).kind == InputKind::Mesh);
+  std::remove(tmp("tri.ply").c_str());
+}
+
 TEST_CASE("io reads the bundled models", "[io][data]") {
   const std::string dir = VITRI_DATA_DIR;
   const TriangleMesh hand = read_mesh(dir + "/hand.off");

@@ -147,6 +147,24 @@ TEST_CASE("one-call mesh_points equals the stateful mesher", "[mesher]") {
   REQUIRE(mm.euler_characteristic == 2);
 }
 
+TEST_CASE("unoriented points: from_points and mesh_points estimate and orient the normals", "[mesher][normals]") {
+  // The knot's vertices without their faces: the same closed genus-1 surface as from the mesh itself.
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  std::vector<Point3> p;
+  for (Eigen::Index i = 0; i < in.V.rows(); ++i) p.push_back({in.V(i, 0), in.V(i, 1), in.V(i, 2)});
+  MesherOptions o;
+  o.constraint_build.max_constraints = 1500;
+  Mesher mesher = Mesher::from_points(p, o);
+  REQUIRE(mesher.size() == 1500);
+  REQUIRE(mesher.refine(0.03 * mesher.diagonal()));
+  require_closed(mesher.surface());
+  REQUIRE(metrics_of(mesher.surface()).euler_characteristic == 0);
+  const SurfaceMesh once = mesh_points(p, 0.03 * mesher.diagonal(), o);
+  REQUIRE(once.vertices.size() == mesher.surface().vertices.size());
+  p.resize(5);
+  REQUIRE_THROWS_AS(Mesher::from_points(p, o), InvalidArgument);
+}
+
 TEST_CASE("scripted edits: watertight, on the edited surface, close to a fresh mesh", "[mesher]") {
   const double precision = 0.05;
   Mesher mesher(small_model());

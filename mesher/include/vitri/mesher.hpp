@@ -95,6 +95,11 @@ class Mesher {
   /// @param points   positions; @param normals one outward normal (any length > 0) per point.
   static Mesher from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                                      const MesherOptions& options = {});
+  /// Normal constraints from unoriented points, samples of closed surfaces (constraints_from_points with
+  /// options.constraint_build: normals estimated and oriented as options.constraint_build.normals says,
+  /// docs/normals.md), then as above. @throws as constraints_from_points (DegenerateNeighbourhood,
+  /// OrientationError naming a point, InvalidArgument for too few points) and Mesher::Mesher.
+  static Mesher from_points(const std::vector<Point3>& points, const MesherOptions& options = {});
   /// Normal constraints from a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3;
   /// constraints_from_mesh), then as above. @throws InvalidArgument for an open or non-manifold mesh.
   static Mesher from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options = {});
@@ -182,6 +187,9 @@ SurfaceMesh mesh_points(const std::vector<Point3>& points, const std::vector<Poi
 /// One call from oriented points, Eigen out: V #V x 3, F #F x 3, N #V x 3.
 void mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,
                  Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N, const MesherOptions& options = {});
+
+/// One call from unoriented points (Mesher::from_points, then refine and surface).
+SurfaceMesh mesh_points(const std::vector<Point3>& points, double precision, const MesherOptions& options = {});
 
 /// One call from a closed, consistently oriented triangle mesh (in_V #V x 3, in_F #F x 3): normal
 /// constraints from its vertices and area-weighted normals (constraints_from_mesh with

@@ -93,9 +93,10 @@ void write_ply(const std::string& path, const TriangleMesh& mesh, PlyEncoding en
 /// What read_input() found.
 enum class InputKind {
   Constraints,     ///< .xyzv: `constraints` is set.
-  OrientedPoints,  ///< .pwn or 6-column .xyz: `points` with normals.
-  Points,          ///< 3-column .xyz: `points` without normals (not enough to define a surface).
-  Mesh,            ///< .off, .obj, .ply: `mesh`.
+  OrientedPoints,  ///< .pwn, 6-column .xyz, or a mesh file without faces with vertex normals: `points`.
+  Points,          ///< 3-column .xyz, or a mesh file without faces and normals: `points` without normals
+                   ///< (their normals must be estimated: constraints_from_points in vitri::rbf).
+  Mesh,            ///< .off, .obj, .ply with at least one face: `mesh`.
 };
 
 /// One input file of any supported kind; only the member matching `kind` is filled.
@@ -106,7 +107,9 @@ struct Input {
   TriangleMesh mesh;
 };
 
-/// Reads any supported input, detected by extension (.xyzv, .xyz, .pwn, .off, .obj, .ply).
+/// Reads any supported input, detected by extension (.xyzv, .xyz, .pwn, .off, .obj, .ply). A mesh file
+/// with no face (a PLY point cloud, an OFF with 0 faces) is read as points, with normals when its
+/// vertices have them (PLY nx ny nz, NOFF, OBJ vn).
 /// @throws ParseError for an unknown extension (line 0) or a malformed file.
 Input read_input(const std::string& path);
 

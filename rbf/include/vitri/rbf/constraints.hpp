@@ -6,6 +6,7 @@
 /// fraction of the bounding-box diagonal. See docs/rbf.md.
 
 #include "vitri/core/point.hpp"
+#include "vitri/rbf/normals.hpp"
 #include "vitri/rbf/rbf.hpp"
 
 #include <Eigen/Core>
@@ -36,16 +37,25 @@ struct ConstraintBuildOptions {
   std::size_t max_constraints = 0;
   /// Seed of the subsampling (deterministic on every platform: splitmix64, no std distributions).
   std::uint64_t seed = 1;
+  /// Normal estimation and orientation of unoriented points (constraints_from_points() only).
+  NormalOptions normals;
 };
 
 /// Constraints from oriented points. Normals need not be unit length (they are normalized) and must
 /// point outwards (f > 0 outside). Exact duplicate positions are merged (the first one is kept).
 /// @throws InvalidPoint (index of the point) for non-finite data or a zero normal; InvalidArgument for
-///         mismatched sizes, an empty input, a missing normal array (points alone do not define an
-///         inside and an outside) or max_constraints below the per-point count.
+///         mismatched sizes, an empty input, a missing normal array (use constraints_from_points() for
+///         points without normals) or max_constraints below the per-point count.
 Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
                                              const std::vector<Point3>& normals,
                                              const ConstraintBuildOptions& options = {});
+
+/// Constraints from unoriented points (samples of closed surfaces): outward normals estimated and
+/// oriented by estimate_oriented_normals() with options.normals, then constraints_from_oriented_points().
+/// @throws as both: InvalidPoint (index) for non-finite data, DegenerateNeighbourhood (index) for a
+///         collinear neighbourhood, OrientationError (index) where the orientation cannot be made
+///         consistent, InvalidArgument for too few points.
+Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options = {});
 
 /// Area-weighted vertex normals of a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3),
 /// oriented outwards: when the signed volume is negative (triangles wound inwards) every normal is

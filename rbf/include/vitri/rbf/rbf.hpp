@@ -77,7 +77,21 @@ struct RbfOptions {
   /// and 10x the residual of the last full fit (after iterative refinement), the function is refitted
   /// from scratch. 0 disables the automatic check (check_drift() still works).
   std::size_t drift_check_interval = 64;
+  /// Memory budget of the dense fit, in bytes: fit() computes what it would allocate
+  /// (rbf_fit_memory_bytes()) before allocating anything large and throws LimitError when that exceeds
+  /// the budget. 0 (default): the physical memory of the machine (physical_memory_bytes()), so that a
+  /// fit too large for the machine fails at once with a clear message instead of std::bad_alloc or
+  /// swapping. The edits that grow the system (add_constraint) are checked against the same budget.
+  std::size_t max_memory_bytes = 0;
 };
+
+/// Bytes the dense fit of n constraints allocates with this solver (the N x N system or its factor with
+/// the headroom kept for edits, the LU copy for FullLu, and the O(N) arrays), saturated at SIZE_MAX.
+/// About 10 n^2 bytes for Cholesky (1 GB at 10^4 constraints, 100 GB at 10^5), 16 n^2 for FullLu.
+std::size_t rbf_fit_memory_bytes(std::size_t n, RbfSolver solver = RbfSolver::Cholesky);
+
+/// Physical memory of the machine in bytes (sysconf; 0 when unknown, then no limit is applied).
+std::size_t physical_memory_bytes();
 
 /// What a fit (or the last drift check) measured.
 struct FitReport {
@@ -132,6 +146,9 @@ class Rbf : public ImplicitFunction {
   /// @throws InvalidPoint     non-finite coordinate or value (index of the constraint), exact or
   ///                          near-duplicate positions (index of the later one; message names both).
   /// @throws InvalidArgument  fewer than 4 constraints, or all values equal to zero (f would be 0).
+  /// @throws LimitError       the dense system would need more memory than options.max_memory_bytes
+  ///                          (default: the physical memory); the message names N, the bytes needed and
+  ///                          the limit, and suggests the local function.
   /// @throws NumericalError   all constraints coplanar (the linear polynomial is undetermined), the
   ///                          reduced system is not positive definite, or the relative residual is
   ///                          above options.fail_residual.

@@ -39,13 +39,16 @@ bool Triangulation::grow_cavity(const Point3& p, TetId start, bool start_contain
         cav.boundary.push_back({t, i});
         continue;
       }
-      const Points4 A = points_of(n);
-      if (!start_contains && (p == *A[0] || p == *A[1] || p == *A[2] || p == *A[3])) {
-        duplicate = tets_.vertex(n, p == *A[0] ? 0 : p == *A[1] ? 1 : p == *A[2] ? 2 : 3);
+      const Point3& a0 = pos_[tets_.vertex(n, 0)];
+      const Point3& a1 = pos_[tets_.vertex(n, 1)];
+      const Point3& a2 = pos_[tets_.vertex(n, 2)];
+      const Point3& a3 = pos_[tets_.vertex(n, 3)];
+      if (!start_contains && (p == a0 || p == a1 || p == a2 || p == a3)) {
+        duplicate = tets_.vertex(n, p == a0 ? 0 : p == a1 ? 1 : p == a2 ? 2 : 3);
         clear_cavity_marks(cav);
         return false;
       }
-      if (insphere_sos(*A[0], *A[1], *A[2], *A[3], p) == Sign::Positive) {
+      if (insphere_sos(a0, a1, a2, a3, p) == Sign::Positive) {
         tets_.mark(n, Store::kMark);
         cav.tets.push_back(n);
       } else {

@@ -194,4 +194,47 @@ struct Triangulation::Scratch {
   std::size_t memory_bytes() const;
 };
 
+// ---- Hot storage steps shared by the operation files (inline: they run once per tetrahedron) ----
+
+// n new slots (recycled ones first without the history) written to `out`; returns the first id, which
+// with the history is the start of a contiguous range. Vertices and neighbours are the caller's to write.
+inline TetId Triangulation::alloc_tets(std::size_t n, std::vector<TetId>& out) {
+  out.resize(n);
+  std::size_t k = 0;
+  if (!keep_history_)
+    for (; k < n && free_head_ != kNoTet; ++k) {
+      out[k] = free_head_;
+      free_head_ = tets_.pop_free(free_head_);
+    }
+  const TetId base = tets_.append(n - k);
+  for (TetId t = base; k < n; ++k, ++t) out[k] = t;
+  return n ? out[0] : base;
+}
+
+inline void Triangulation::kill(TetId t, std::uint32_t op, TetId hint) {
+  if (keep_history_)
+    tets_.set_history(t, op, hint);
+  else
+    free_head_ = tets_.push_free(t, free_head_);
+}
+
+// Every vertex of the new tetrahedra points to one of them (vtet_).
+inline void Triangulation::attach_vertices(const std::vector<TetId>& created) {
+  for (TetId s : created)
+    for (int i = 0; i < 4; ++i) vtet_[tets_.vertex(s, i)] = s;
+}
+
+// The new tetrahedron `inner` takes the place of the dying `old_inner` across a face on the boundary of
+// the changed region (inner_face of inner, old_face of old_inner): the outer neighbour is linked to
+// `inner` both ways.
+inline void Triangulation::glue_outside(TetId inner, int inner_face, TetId old_inner, int old_face) {
+  const TetId n = tets_.neighbor(old_inner, old_face);
+  tets_.set_neighbor(inner, inner_face, n);
+  if (n != kNoTet) tets_.replace_neighbor(n, old_inner, inner);
+}
+
+inline void Triangulation::unmark_all(const std::vector<TetId>& tets, std::uint8_t flag) {
+  for (TetId t : tets) tets_.unmark(t, flag);
+}
+
 }  // namespace vitri

@@ -162,28 +162,6 @@ TetId Triangulation::alloc_tet() {
   return tets_.append(1);
 }
 
-// n new slots (recycled ones first without the history) written to `out`; returns the first id, which
-// with the history is the start of a contiguous range. Vertices and neighbours are the caller's to write.
-TetId Triangulation::alloc_tets(std::size_t n, std::vector<TetId>& out) {
-  out.resize(n);
-  std::size_t k = 0;
-  if (!keep_history_)
-    for (; k < n && free_head_ != kNoTet; ++k) {
-      out[k] = free_head_;
-      free_head_ = tets_.pop_free(free_head_);
-    }
-  const TetId base = tets_.append(n - k);
-  for (TetId t = base; k < n; ++k, ++t) out[k] = t;
-  return n ? out[0] : base;
-}
-
-void Triangulation::kill(TetId t, std::uint32_t op, TetId hint) {
-  if (keep_history_)
-    tets_.set_history(t, op, hint);
-  else
-    free_head_ = tets_.push_free(t, free_head_);
-}
-
 Triangulation::PointId Triangulation::alloc_point(const Point3& p, VertexId reuse_vid) {
   if (pos_.size() >= std::size_t(kNoVertex) - 1)
     throw LimitError("Triangulation: more than 2^32 - 2 point slots (moves included)");
@@ -207,27 +185,6 @@ Triangulation::PointId Triangulation::alloc_point(const Point3& p, VertexId reus
     pid_of_vid_[reuse_vid] = id;
   }
   return id;
-}
-
-// ---- Commit steps shared by the operations ---------------------------------------------------------
-
-// Every vertex of the new tetrahedra points to one of them (vtet_).
-void Triangulation::attach_vertices(const std::vector<TetId>& created) {
-  for (TetId s : created)
-    for (int i = 0; i < 4; ++i) vtet_[tets_.vertex(s, i)] = s;
-}
-
-// The new tetrahedron `inner` takes the place of the dying `old_inner` across a face on the boundary of
-// the changed region (inner_face of inner, old_face of old_inner): the outer neighbour is linked to
-// `inner` both ways.
-void Triangulation::glue_outside(TetId inner, int inner_face, TetId old_inner, int old_face) {
-  const TetId n = tets_.neighbor(old_inner, old_face);
-  tets_.set_neighbor(inner, inner_face, n);
-  if (n != kNoTet) tets_.replace_neighbor(n, old_inner, inner);
-}
-
-void Triangulation::unmark_all(const std::vector<TetId>& tets, std::uint8_t flag) {
-  for (TetId t : tets) tets_.unmark(t, flag);
 }
 
 // ---- Queries ---------------------------------------------------------------------------------------

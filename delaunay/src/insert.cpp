@@ -140,6 +140,7 @@ void Triangulation::commit_cavity(PointId q, Cavity& cav, ChangeSet* changes) {
   unmark_all(cav.tested, Store::kTested);
   num_live_tets_ = num_live_tets_ + cav.created.size() - cav.tets.size();
   ++num_live_vertices_;
+  note_vertex(q);
   last_tet_ = cav.created.back();
   detail::report_changes(changes, cav.tets, cav.created);
 }

@@ -138,6 +138,8 @@ TetId Triangulation::locate_history(const Point3& p, std::size_t* levels) const 
 // gives (about 4 ln n records), the work wasted because edits stacked records in one region; it pays
 // for the next rebuild (see maybe_rebuild).
 TetId Triangulation::locate_for_edit(const Point3& p) {
+  const TetId hinted = locate_from_hint(p);
+  if (hinted != kNoTet) return hinted;
   if (!keep_history_) return walk(p, last_tet_);
   std::size_t levels = 0;
   const TetId t = locate_history(p, &levels);
@@ -157,7 +159,39 @@ std::pair<std::size_t, std::size_t> Triangulation::history_path(const Point3& p)
 
 TetId Triangulation::locate(const Point3& p) const {
   check_point(p, 0);
+  const TetId hinted = locate_from_hint(p);
+  if (hinted != kNoTet) return hinted;
   return keep_history_ ? locate_history(p) : walk(p, last_tet_);
+}
+
+// ---- Location hints ----------------------------------------------------------------------------------
+//
+// The grid remembers the last vertex inserted (or moved) in each cell. A walk from a tetrahedron of that
+// vertex reaches p in a few steps for any roughly uniform point set, where the history descent visits
+// about 4 ln n records (54 at 10^6 points) spread over memory. The hint is only a start: a removed
+// vertex gives no hint, and a walk longer than kHintWalk (a hint far from p, e.g. after its vertex moved
+// away) gives up, both falling back to the history (or to the walk from the last tetrahedron).
+
+namespace {
+constexpr std::size_t kHintWalk = 128;
+}  // namespace
+
+TetId Triangulation::locate_from_hint(const Point3& p) const {
+  const VertexId v = grid_.hint(p);
+  if (v == detail::VertexGrid::kEmpty || !is_vertex(v)) return kNoTet;
+  return walk_limited(p, vtet_[pid(v)], kHintWalk);
+}
+
+// The new vertex q enters the grid; past 16 vertices per cell the grid is rebuilt finer from all live
+// vertices (O(n) each time n grows 8-fold: O(1) amortized).
+void Triangulation::note_vertex(PointId q) {
+  if (!grid_.too_coarse(num_live_vertices_)) {
+    grid_.set(pos_[q], vid(q));
+    return;
+  }
+  grid_.reset(box_, num_live_vertices_);
+  for (VertexId v = 0; v < vertex_capacity(); ++v)
+    if (is_vertex(v)) grid_.set(point(v), v);
 }
 
 }  // namespace vitri

@@ -109,6 +109,7 @@ bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_di
   if (!keep_history_) pos_[pv] = p;
   rebuild_star(pv, np, m);
   record_move(m, changes);
+  grid_.set(p, v);
   result = {InsertStatus::Inserted, v, kNoVertex};
   return true;
 }

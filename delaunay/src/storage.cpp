@@ -57,6 +57,7 @@ Triangulation::Triangulation(const Triangulation& o)
       edit_tets_(o.edit_tets_),
       excess_levels_(o.excess_levels_),
       rebuilds_(o.rebuilds_),
+      grid_(o.grid_),
       root_(o.root_),
       scratch_(std::make_unique<Scratch>()) {}
 
@@ -122,6 +123,7 @@ void Triangulation::reset_to_corners() {
   last_tet_ = 0;
   edit_tets_ = 0;
   excess_levels_ = 0;
+  grid_.reset(box_, 8);
 }
 
 // ---- Checks ----------------------------------------------------------------------------------------
@@ -241,13 +243,15 @@ double Triangulation::circumradius(TetId t) const {
 std::size_t Triangulation::memory_live_bytes() const {
   const std::size_t per_vertex =
       sizeof(Point3) + sizeof(TetId) + (pid_of_vid_.empty() ? 0 : sizeof(VertexId) + sizeof(PointId));
-  return sizeof(*this) + num_live_tets_ * Store::kLiveBytesPerTet + num_live_vertices_ * per_vertex;
+  return sizeof(*this) + num_live_tets_ * Store::kLiveBytesPerTet + num_live_vertices_ * per_vertex +
+         grid_.memory_bytes();
 }
 
 std::size_t Triangulation::memory_total_bytes() const {
   using detail::bytes_of;
   std::size_t s = sizeof(*this) + bytes_of(pos_) + bytes_of(vtet_) + bytes_of(vid_of_pid_) +
-                  bytes_of(pid_of_vid_) + tets_.memory_bytes() + bytes_of(ops_) + root_.memory_bytes();
+                  bytes_of(pid_of_vid_) + tets_.memory_bytes() + bytes_of(ops_) + root_.memory_bytes() +
+                  grid_.memory_bytes();
   if (scratch_) s += scratch_->memory_bytes();
   return s;
 }

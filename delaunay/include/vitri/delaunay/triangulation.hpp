@@ -16,6 +16,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/delaunay/detail/tet_store.hpp"
+#include "vitri/delaunay/detail/vertex_grid.hpp"
 
 #include <algorithm>
 #include <array>
@@ -272,6 +273,8 @@ class Triangulation {
   TetId locate_root(const Point3& p, std::size_t* visited) const;
   TetId locate_history(const Point3& p, std::size_t* levels = nullptr) const;
   TetId locate_for_edit(const Point3& p);
+  TetId locate_from_hint(const Point3& p) const;
+  void note_vertex(PointId q);
   bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
   TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
   TetId descend_around_apex(TetId dead, const Point3& p, std::size_t* visited) const;
@@ -348,6 +351,7 @@ class Triangulation {
   std::size_t edit_tets_ = 0;       // tetrahedra created by removals and moves since the last rebuild
   std::size_t excess_levels_ = 0;   // levels descended beyond 6 log2 n + 64 by insert() and move()
   std::size_t rebuilds_ = 0;
+  detail::VertexGrid grid_;           // location hints: the last vertex inserted in each cell
   Store root_;                        // the 8-corner triangulation, for reset_to_corners()
   std::unique_ptr<Scratch> scratch_;  // work buffers, never shared between copies
 };

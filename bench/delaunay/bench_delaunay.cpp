@@ -430,26 +430,27 @@ class RatioReporter : public benchmark::ConsoleReporter {
   void print_ratios() const {
     std::printf("\nratio vitri / CGAL (CPU time; real time in parentheses):\n");
     for (const auto& [name, t] : times_) {
-      if (name.rfind("vitri_", 0) != 0) continue;
-      std::string key = name.substr(6);
-      const auto nh = key.find("_nohist");
-      if (nh != std::string::npos) key.erase(nh, 7);
-      const auto c = times_.find("cgal_" + key);
+      const auto c = reference(name, "cgal_");
       if (c == times_.end()) continue;
       std::printf("  %-34s %8.3f  (%.3f)\n", name.c_str(), t.first / c->second.first, t.second / c->second.second);
     }
     std::printf("\nratio vitri / TetGen (vitri CPU time / TetGen's own Delaunay CPU seconds):\n");
     for (const auto& [name, t] : times_) {
-      if (name.rfind("vitri_", 0) != 0) continue;
-      std::string key = name.substr(6);
-      const auto nh = key.find("_nohist");
-      if (nh != std::string::npos) key.erase(nh, 7);
-      const auto g = times_.find("tetgen_" + key);
+      const auto g = reference(name, "tetgen_");
       if (g != times_.end()) std::printf("  %-34s %8.3f\n", name.c_str(), t.first / g->second.second);
     }
   }
 
  private:
+  // The reference run (prefix "cgal_" or "tetgen_") of a vitri run (bulk_nohist compares with bulk).
+  std::map<std::string, std::pair<double, double>>::const_iterator reference(const std::string& name,
+                                                                            const std::string& prefix) const {
+    if (name.rfind("vitri_", 0) != 0) return times_.end();
+    std::string key = name.substr(6);
+    const auto nh = key.find("_nohist");
+    if (nh != std::string::npos) key.erase(nh, 7);
+    return times_.find(prefix + key);
+  }
   std::map<std::string, std::pair<double, double>> times_;
 };
 

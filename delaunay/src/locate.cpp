@@ -21,6 +21,25 @@ namespace vitri {
 
 using detail::orient_replace;
 
+namespace {
+// One step of a randomized visibility walk from the tetrahedron with corners P: among its faces, taken
+// cyclically from a random one, the first whose tetrahedron across(i) exists (not kNoTet), is not `prev`
+// and lies on p's side (p strictly beyond face i); kNoTet when there is none (p is in the tetrahedron).
+template <class Across>
+TetId walk_step(const std::array<const Point3*, 4>& P, const Point3& p, std::uint32_t& rng, TetId prev,
+                const Across& across) {
+  rng = rng * 1664525u + 1013904223u;
+  const int r = int(rng >> 30);
+  for (int k = 0; k < 4; ++k) {
+    const int i = (r + k) & 3;
+    const TetId n = across(i);
+    if (n == kNoTet || n == prev) continue;
+    if (orient_replace(P, i, p) == Sign::Negative) return n;
+  }
+  return kNoTet;
+}
+}  // namespace
+
 // Visibility walk with a random choice among the faces that separate p from the current tetrahedron:
 // terminates with probability 1 in any triangulation. p lies strictly inside the box, hence never beyond
 // a hull face.
@@ -33,19 +52,7 @@ TetId Triangulation::walk_limited(const Point3& p, TetId t, std::size_t max_step
   TetId prev = kNoTet;
   std::uint32_t rng = 0x9e3779b9u ^ t;
   for (std::size_t step = 0; step < max_steps; ++step) {
-    rng = rng * 1664525u + 1013904223u;
-    const int r = int(rng >> 30);
-    const Points4 P = points_of(t);
-    TetId next = kNoTet;
-    for (int k = 0; k < 4; ++k) {
-      const int i = (r + k) & 3;
-      const TetId n = tets_.neighbor(t, i);
-      if (n == kNoTet || n == prev) continue;
-      if (orient_replace(P, i, p) == Sign::Negative) {
-        next = n;
-        break;
-      }
-    }
+    const TetId next = walk_step(points_of(t), p, rng, prev, [&](int i) { return tets_.neighbor(t, i); });
     if (next == kNoTet) return t;
     prev = t;
     t = next;
@@ -74,21 +81,10 @@ TetId Triangulation::descend_around_apex(TetId dead, const Point3& p, std::size_
   std::uint32_t rng = 0x2545f491u ^ opi;
   for (std::uint32_t steps = 0; steps < 4 * op.count + 8; ++steps) {
     if (visited) ++*visited;
-    const Points4 P = points_of(s);
-    rng = rng * 1664525u + 1013904223u;
-    const int r = int(rng >> 30);
-    TetId next = kNoTet;
-    for (int k = 0; k < 4; ++k) {
-      const int j = (r + k) & 3;
+    const TetId next = walk_step(points_of(s), p, rng, prev, [&](int j) {
       const std::uint16_t off = tets_.offsets(s)[std::size_t(j)];
-      if (tets_.vertex(s, j) == op.apex || off == Store::kNoOffset) continue;
-      const TetId n = op.first + off;
-      if (n == prev) continue;
-      if (orient_replace(P, j, p) == Sign::Negative) {
-        next = n;
-        break;
-      }
-    }
+      return tets_.vertex(s, j) == op.apex || off == Store::kNoOffset ? kNoTet : op.first + off;
+    });
     if (next == kNoTet) return s;
     prev = s;
     s = next;

@@ -9,6 +9,7 @@
 // - grid/n: the n^3 integer grid (cospherical everywhere).
 // - insert1M: 10^4 single insertions at random locations into a 10^6-point triangulation (vitri:
 //   insert(), history location; CGAL: Fast_location, i.e. the Delaunay hierarchy, no hint).
+// - tetgen_bulk/N, tetgen_grid/n: TetGen (`tetgen` command) on the same points, its own Delaunay time.
 // - remove1M, move1M_small, move1M_far: 10^4 removals / moves in a 10^6-point triangulation (CGAL
 //   without the hierarchy, which only slows removal down).
 // Memory: counters bytes_per_vertex (heap growth measured with mallinfo2 around the build), and for vitri
@@ -17,9 +18,11 @@
 
 #include <benchmark/benchmark.h>
 #include <malloc.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <memory>
 #include <random>
@@ -156,6 +159,53 @@ void cgal_grid(benchmark::State& state) {
 }
 BENCHMARK(cgal_grid)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->Iterations(1);
 #endif
+
+// ---- TetGen (second reference, through its command line) ----------------------------------------------
+//
+// tetgen_bulk/N, tetgen_grid/n: the same points written to a .node file (not timed), then
+// `tetgen -NEFV` (no output files, verbose); the time is TetGen's own "Delaunay seconds" line (clock(),
+// i.e. CPU time, excluding its file input), reported as manual time. Skipped when `tetgen` is not on
+// PATH (Debian: tetgen). TetGen triangulates the points alone (no box corners).
+
+void tetgen_run(benchmark::State& state, const std::vector<Point3>& pts) {
+  if (std::system("command -v tetgen > /dev/null 2>&1") != 0) {
+    state.SkipWithError("tetgen not found (Debian package tetgen)");
+    return;
+  }
+  const std::string file = "/tmp/vitri_bench_tetgen_" + std::to_string(::getpid()) + ".node";
+  {
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    if (!f) {
+      state.SkipWithError("cannot write the .node file in /tmp");
+      return;
+    }
+    std::fprintf(f, "%zu 3 0 0\n", pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      std::fprintf(f, "%zu %.17g %.17g %.17g\n", i + 1, pts[i].x, pts[i].y, pts[i].z);
+    std::fclose(f);
+  }
+  for (auto _ : state) {
+    std::FILE* out = ::popen(("tetgen -NEFV " + file + " 2>&1").c_str(), "r");
+    double seconds = -1, tets = 0;
+    char line[512];
+    while (out && std::fgets(line, sizeof line, out)) {
+      std::sscanf(line, "Delaunay seconds: %lf", &seconds);
+      std::sscanf(line, "  Mesh tetrahedra: %lf", &tets);
+    }
+    if (out) ::pclose(out);
+    if (seconds < 0) {
+      state.SkipWithError("tetgen gave no 'Delaunay seconds' line");
+      break;
+    }
+    state.SetIterationTime(seconds);
+    state.counters["tets"] = tets;
+  }
+  std::remove(file.c_str());
+}
+void tetgen_bulk(benchmark::State& state) { tetgen_run(state, uniform(std::size_t(state.range(0)), 1)); }
+void tetgen_grid(benchmark::State& state) { tetgen_run(state, grid(int(state.range(0)))); }
+BENCHMARK(tetgen_bulk)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+BENCHMARK(tetgen_grid)->Arg(50)->Arg(100)->Unit(benchmark::kMillisecond)->UseManualTime()->Iterations(1);
 
 // ---- dynamic operations in a 10^6-point triangulation -----------------------------------------------
 
@@ -371,6 +421,8 @@ class RatioReporter : public benchmark::ConsoleReporter {
       if (agg != std::string::npos) name.erase(agg);
       const auto it = name.find("/iterations");
       if (it != std::string::npos) name.erase(it, name.find('/', it + 1) == std::string::npos ? std::string::npos : name.find('/', it + 1) - it);
+      const auto manual = name.find("/manual_time");
+      if (manual != std::string::npos) name.erase(manual);
       times_[name] = {r.GetAdjustedCPUTime(), r.GetAdjustedRealTime()};
     }
     ConsoleReporter::ReportRuns(runs);
@@ -378,17 +430,27 @@ class RatioReporter : public benchmark::ConsoleReporter {
   void print_ratios() const {
     std::printf("\nratio vitri / CGAL (CPU time; real time in parentheses):\n");
     for (const auto& [name, t] : times_) {
-      if (name.rfind("vitri_", 0) != 0) continue;
-      std::string key = name.substr(6);
-      const auto nh = key.find("_nohist");
-      if (nh != std::string::npos) key.erase(nh, 7);
-      const auto c = times_.find("cgal_" + key);
+      const auto c = reference(name, "cgal_");
       if (c == times_.end()) continue;
       std::printf("  %-34s %8.3f  (%.3f)\n", name.c_str(), t.first / c->second.first, t.second / c->second.second);
+    }
+    std::printf("\nratio vitri / TetGen (vitri CPU time / TetGen's own Delaunay CPU seconds):\n");
+    for (const auto& [name, t] : times_) {
+      const auto g = reference(name, "tetgen_");
+      if (g != times_.end()) std::printf("  %-34s %8.3f\n", name.c_str(), t.first / g->second.second);
     }
   }
 
  private:
+  // The reference run (prefix "cgal_" or "tetgen_") of a vitri run (bulk_nohist compares with bulk).
+  std::map<std::string, std::pair<double, double>>::const_iterator reference(const std::string& name,
+                                                                            const std::string& prefix) const {
+    if (name.rfind("vitri_", 0) != 0) return times_.end();
+    std::string key = name.substr(6);
+    const auto nh = key.find("_nohist");
+    if (nh != std::string::npos) key.erase(nh, 7);
+    return times_.find(prefix + key);
+  }
   std::map<std::string, std::pair<double, double>> times_;
 };
 

@@ -561,12 +561,12 @@ TEST_CASE("delaunay: rebuild_history keeps vertex ids and the tetrahedra, renumb
 namespace vitri {
 // Test-only access to the flat arrays, to corrupt them on purpose.
 struct TriangulationTestAccess {
-  static std::uint32_t& vertex_slot(Triangulation& tr, TetId t, int i) {
-    return tr.td_[8 * std::size_t(t) + i];
+  static void swap_vertices(Triangulation& tr, TetId t, int i, int j) {
+    const std::uint32_t a = tr.tets_.vertex(t, i);
+    tr.tets_.set_vertex(t, i, tr.tets_.vertex(t, j));
+    tr.tets_.set_vertex(t, j, a);
   }
-  static std::uint32_t& neighbor_slot(Triangulation& tr, TetId t, int i) {
-    return tr.td_[8 * std::size_t(t) + 4 + i];
-  }
+  static void set_neighbor(Triangulation& tr, TetId t, int i, TetId n) { tr.tets_.set_neighbor(t, i, n); }
   static Point3& position(Triangulation& tr, VertexId v) { return tr.pos_[tr.pid(v)]; }
 };
 }  // namespace vitri
@@ -578,22 +578,22 @@ TEST_CASE("delaunay: the validators detect broken structures") {
   check(tr);
   const TetId t = tr.live_tetrahedra()[10];
   SECTION("a negatively oriented tetrahedron") {
-    std::swap(A::vertex_slot(tr, t, 0), A::vertex_slot(tr, t, 1));
+    A::swap_vertices(tr, t, 0, 1);
     CHECK_THROWS_AS(tr.verify_topology(), std::logic_error);
   }
   SECTION("an asymmetric neighbour link") {
     int i = 0;
     while (tr.tet_neighbor(t, i) == kNoTet) ++i;
-    A::neighbor_slot(tr, t, i) = tr.tet_neighbor(t, (i + 1) % 4);  // the other side still points back
+    A::set_neighbor(tr, t, i, tr.tet_neighbor(t, (i + 1) % 4));  // the other side still points back
     CHECK_THROWS_AS(tr.verify_topology(), std::logic_error);
   }
   SECTION("a hull face inside the box") {
     int i = 0;
     while (tr.tet_neighbor(t, i) == kNoTet) ++i;
     const TetId n = tr.tet_neighbor(t, i);
-    A::neighbor_slot(tr, t, i) = kNoTet;
+    A::set_neighbor(tr, t, i, kNoTet);
     for (int j = 0; j < 4; ++j)
-      if (tr.tet_neighbor(n, j) == t) A::neighbor_slot(tr, n, j) = kNoTet;
+      if (tr.tet_neighbor(n, j) == t) A::set_neighbor(tr, n, j, kNoTet);
     CHECK_THROWS_AS(tr.verify_topology(), std::logic_error);
   }
   SECTION(
@@ -856,5 +856,103 @@ TEST_CASE("delaunay: huge cavities and stars (the centre of points near a sphere
     check(tr);
     CHECK(quads() == before);
     if (history) CHECK(tr.locate({0.5, 0.5, 0.5}) != kNoTet);
+  }
+}
+
+namespace {
+
+// Everything an observer can read of a triangulation: every slot (live or not), its vertices and, when
+// live, its neighbours; the vertex positions.
+std::vector<std::int64_t> observable_state(const Triangulation& tr) {
+  std::vector<std::int64_t> s = {std::int64_t(tr.num_vertices()), std::int64_t(tr.num_tetrahedra()),
+                                 std::int64_t(tr.tet_capacity()), std::int64_t(tr.vertex_capacity())};
+  for (TetId t = 0; t < tr.tet_capacity(); ++t) {
+    s.push_back(tr.is_live(t));
+    if (!tr.is_live(t)) continue;
+    for (int i = 0; i < 4; ++i) s.push_back(tr.tet_vertex(t, i));
+    for (int i = 0; i < 4; ++i) s.push_back(tr.tet_neighbor(t, i));
+  }
+  for (VertexId v = 0; v < tr.vertex_capacity(); ++v) s.push_back(tr.vertex_tet(v) == kNoTet);
+  return s;
+}
+
+// One step of a fixed random edit sequence (insert with and without min_distance, insertion in conflict,
+// removal, small and large moves); the trace records every result and change set.
+void random_edit(Triangulation& tr, std::mt19937_64& rng, std::vector<std::int64_t>& trace) {
+  std::uniform_real_distribution<double> U(0.01, 0.99), small(-0.01, 0.01);
+  ChangeSet ch;
+  InsertResult r;
+  const int what = int(rng() % 5);
+  const VertexId v = VertexId(8 + rng() % (tr.vertex_capacity() - 8));
+  if (what == 0) {
+    r = tr.insert({U(rng), U(rng), U(rng)}, rng() % 2 ? 0.0 : 0.02, &ch);
+  } else if (what == 1) {
+    const std::vector<TetId> live = tr.live_tetrahedra();
+    const TetId t = live[rng() % live.size()];
+    const Point3 c = tr.circumcenter(t);
+    const Point3 p{std::clamp(c.x, 0.001, 0.999), std::clamp(c.y, 0.001, 0.999), std::clamp(c.z, 0.001, 0.999)};
+    if (insphere_sos(tr.tet_point(t, 0), tr.tet_point(t, 1), tr.tet_point(t, 2), tr.tet_point(t, 3), p) ==
+        Sign::Positive)
+      r = tr.insert_in_conflict(p, t, 0.0, &ch);
+  } else if (!tr.is_vertex(v)) {
+    return;
+  } else if (what == 2) {
+    tr.remove(v, &ch);
+  } else {
+    const Point3 q = tr.point(v);
+    const Point3 p = what == 3 ? Point3{std::clamp(q.x + small(rng), 0.001, 0.999),
+                                        std::clamp(q.y + small(rng), 0.001, 0.999),
+                                        std::clamp(q.z + small(rng), 0.001, 0.999)}
+                               : Point3{U(rng), U(rng), U(rng)};
+    r = tr.move(v, p, rng() % 2 ? 0.0 : 0.01, &ch);
+  }
+  trace.insert(trace.end(), {what, std::int64_t(r.status), r.vertex, r.nearest, ch.renumbered});
+  trace.insert(trace.end(), ch.killed.begin(), ch.killed.end());
+  trace.push_back(-1);
+  trace.insert(trace.end(), ch.created.begin(), ch.created.end());
+  trace.push_back(-2);
+}
+
+}  // namespace
+
+TEST_CASE("delaunay: operations are deterministic and use no state left behind by another operation") {
+  // The same sequence run (a) on one triangulation, (b) on a second one, (c) on a copy of (a) made
+  // halfway: a copy starts with empty work buffers, so an operation that read a buffer another had
+  // left filled would diverge. All three must agree on every id, tetrahedron and change set.
+  struct Variant {
+    bool history;
+    std::size_t max_wrap_link;
+    double rebuild;
+  };
+  for (const Variant var : {Variant{true, 64, 1.0}, Variant{true, 0, 0.1}, Variant{false, 64, 1.0}}) {
+    INFO("history " << var.history << ", max_wrap_link " << var.max_wrap_link);
+    TriangulationOptions opt;
+    opt.keep_history = var.history;
+    opt.max_wrap_link = var.max_wrap_link;
+    opt.history_rebuild_factor = var.rebuild;
+    const auto pts = uniform_points(1500, 77);
+    Triangulation a(kUnitBox, opt), b(kUnitBox, opt);
+    a.insert_points(pts);
+    b.insert_points(pts);
+    std::mt19937_64 rng_a(5), rng_b(5);
+    std::vector<std::int64_t> trace_a, trace_b, trace_c;
+    const int kOps = 600;
+    for (int op = 0; op < kOps / 2; ++op) {
+      random_edit(a, rng_a, trace_a);
+      random_edit(b, rng_b, trace_b);
+    }
+    Triangulation c = a;
+    std::mt19937_64 rng_c = rng_a;
+    for (int op = kOps / 2; op < kOps; ++op) {
+      random_edit(a, rng_a, trace_a);
+      random_edit(b, rng_b, trace_b);
+      random_edit(c, rng_c, trace_c);
+    }
+    CHECK(trace_a == trace_b);
+    CHECK(std::equal(trace_c.begin(), trace_c.end(), trace_a.end() - std::ptrdiff_t(trace_c.size())));
+    CHECK(observable_state(a) == observable_state(b));
+    CHECK(observable_state(a) == observable_state(c));
+    check(c);
+    if (var.history && var.rebuild < 1.0) CHECK(a.history_rebuilds() > 0);
   }
 }

@@ -15,6 +15,8 @@
 
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
+#include "vitri/delaunay/detail/tet_store.hpp"
+#include "vitri/delaunay/detail/vertex_grid.hpp"
 
 #include <algorithm>
 #include <array>
@@ -31,84 +33,6 @@
 
 namespace vitri {
 
-namespace detail {
-
-/// Growable array of a trivially copyable T on malloc/realloc, for the tetrahedron arrays: growing a large
-/// block lets realloc move its pages (mremap) instead of copying hundreds of megabytes, as std::vector
-/// does. resize(n) leaves new elements uninitialized; resize(n, value) and assign fill them.
-template <class T>
-class PodArray {
-  static_assert(std::is_trivially_copyable<T>::value, "PodArray holds trivially copyable types");
-
- public:
-  using value_type = T;
-  PodArray() = default;
-  PodArray(const PodArray& o) { assign(o.begin(), o.end()); }
-  PodArray(PodArray&& o) noexcept : p_(o.p_), n_(o.n_), cap_(o.cap_) {
-    o.p_ = nullptr;
-    o.n_ = o.cap_ = 0;
-  }
-  PodArray& operator=(const PodArray& o) {
-    if (this != &o) assign(o.begin(), o.end());
-    return *this;
-  }
-  PodArray& operator=(PodArray&& o) noexcept {
-    std::swap(p_, o.p_);
-    std::swap(n_, o.n_);
-    std::swap(cap_, o.cap_);
-    return *this;
-  }
-  ~PodArray() { std::free(p_); }
-
-  T& operator[](std::size_t i) { return p_[i]; }
-  const T& operator[](std::size_t i) const { return p_[i]; }
-  T* data() { return p_; }
-  const T* data() const { return p_; }
-  T* begin() { return p_; }
-  T* end() { return p_ + n_; }
-  const T* begin() const { return p_; }
-  const T* end() const { return p_ + n_; }
-  std::size_t size() const { return n_; }
-  std::size_t capacity() const { return cap_; }
-  bool empty() const { return n_ == 0; }
-  void clear() { n_ = 0; }
-  void reserve(std::size_t n) {
-    if (n <= cap_) return;
-    void* q = std::realloc(static_cast<void*>(p_), n * sizeof(T));
-    if (!q) throw std::bad_alloc();
-    p_ = static_cast<T*>(q);
-    cap_ = n;
-  }
-  void resize(std::size_t n) {
-    reserve(n);
-    n_ = n;
-  }
-  void resize(std::size_t n, const T& value) {
-    reserve(n);
-    for (std::size_t i = n_; i < n; ++i) p_[i] = value;
-    n_ = n;
-  }
-  void assign(std::size_t n, const T& value) {
-    n_ = 0;
-    resize(n, value);
-  }
-  template <class It>
-  void assign(It first, It last) {
-    const std::size_t n = std::size_t(last - first);
-    n_ = 0;
-    reserve(n);
-    std::copy(first, last, p_);
-    n_ = n;
-  }
-
- private:
-  T* p_ = nullptr;
-  std::size_t n_ = 0;
-  std::size_t cap_ = 0;
-};
-
-}  // namespace detail
-
 using VertexId = std::uint32_t;  ///< Stable id of a vertex; never reused after removal.
 using TetId = std::uint32_t;     ///< Id of a tetrahedron (live or in the history).
 inline constexpr VertexId kNoVertex = std::numeric_limits<VertexId>::max();
@@ -116,8 +40,8 @@ inline constexpr TetId kNoTet = std::numeric_limits<TetId>::max();
 
 /// What an insertion did.
 enum class InsertStatus {
-  Inserted,        ///< the point is a new vertex
-  TooClose,        ///< rejected: closer than min_distance to `nearest` (exact duplicates included)
+  Inserted,  ///< the point is a new vertex
+  TooClose,  ///< rejected: closer than min_distance to `nearest` (exact duplicates included)
 };
 
 struct InsertResult {
@@ -247,7 +171,7 @@ class Triangulation {
   /// One past the largest vertex id ever used.
   std::size_t vertex_capacity() const { return pid_of_vid_.empty() ? pos_.size() : pid_of_vid_.size(); }
   /// One past the largest tetrahedron id ever used (history included).
-  std::size_t tet_capacity() const { return tf_.size(); }
+  std::size_t tet_capacity() const { return tets_.size(); }
 
   /// v is a live vertex.
   bool is_vertex(VertexId v) const { return v < vertex_capacity() && vtet_[pid(v)] != kNoTet; }
@@ -255,13 +179,13 @@ class Triangulation {
   /// Position of vertex v (for a removed vertex: its last position). @pre v < vertex_capacity().
   const Point3& point(VertexId v) const { return pos_[pid(v)]; }
   /// t is a live tetrahedron (false for dead, recycled or out-of-range ids).
-  bool is_live(TetId t) const { return t < tf_.size() && !(tf_[t] & kDead); }
+  bool is_live(TetId t) const { return t < tets_.size() && !tets_.is_dead(t); }
   /// Vertex i (0..3) of tetrahedron t (live or dead).
-  VertexId tet_vertex(TetId t, int i) const { return vid(td_[8 * std::size_t(t) + i]); }
+  VertexId tet_vertex(TetId t, int i) const { return vid(tets_.vertex(t, i)); }
   /// Position of vertex i of t: point(tet_vertex(t, i)) without the id translation.
-  const Point3& tet_point(TetId t, int i) const { return pos_[td_[8 * std::size_t(t) + i]]; }
+  const Point3& tet_point(TetId t, int i) const { return pos_[tets_.vertex(t, i)]; }
   /// Across the face opposite vertex i; kNoTet on the hull. @pre is_live(t).
-  TetId tet_neighbor(TetId t, int i) const { return td_[8 * std::size_t(t) + 4 + i]; }
+  TetId tet_neighbor(TetId t, int i) const { return tets_.neighbor(t, i); }
   std::array<VertexId, 4> tet_vertices(TetId t) const {
     return {tet_vertex(t, 0), tet_vertex(t, 1), tet_vertex(t, 2), tet_vertex(t, 3)};
   }
@@ -304,6 +228,7 @@ class Triangulation {
   // tetrahedra of the history refer to them. A moved vertex gets a new PointId and keeps its VertexId;
   // until the first move the two numberings coincide and the translation tables are empty.
   using PointId = std::uint32_t;
+  using Store = detail::TetStore;
   // One history record: the tetrahedra [first, first + count) created by one operation cover exactly
   // the region of the tetrahedra it killed. apex: the inserted point for an insertion (all created
   // tetrahedra share it), kNoVertex for the root, a removal or a move.
@@ -312,71 +237,123 @@ class Triangulation {
     std::uint32_t count;
     PointId apex;
   };
-  struct Scratch;
-  static constexpr std::uint8_t kDead = 1;      // tetrahedron is dead (or a free slot)
-  static constexpr std::uint8_t kMark = 2;      // temporary: in the current cavity / star
-  static constexpr std::uint8_t kTested = 4;    // temporary: tested, not in conflict
-  static constexpr std::uint16_t kNoOffset = 0xffff;
+  // Named state of one operation, defined in delaunay/src/scratch.hpp and passed explicitly.
+  struct Cavity;     // insertion: the tetrahedra in conflict with a point and the cavity boundary
+  struct Star;       // removal and move: the tetrahedra incident to a vertex
+  struct ApexLinks;  // insertion: tables that glue the new tetrahedra around the apex
+  struct Wrap;       // removal: the front of the gift wrapping
+  struct SubFill;    // removal of a huge star: the scratch triangulation of its link
+  struct MoveState;  // move: the star rebuilt in place
+  struct Scratch;    // one of each, reused between operations (never shared between copies)
+  using Points4 = std::array<const Point3*, 4>;
 
   PointId pid(VertexId v) const { return pid_of_vid_.empty() ? v : pid_of_vid_[v]; }
   VertexId vid(PointId p) const { return vid_of_pid_.empty() ? p : vid_of_pid_[p]; }
+  Points4 points_of(TetId t) const {
+    return {&pos_[tets_.vertex(t, 0)], &pos_[tets_.vertex(t, 1)], &pos_[tets_.vertex(t, 2)],
+            &pos_[tets_.vertex(t, 3)]};
+  }
 
+  // storage.cpp: construction, allocation, killing, shared commit steps
   void init_corners();
+  void reset_to_corners();
   void check_point(const Point3& p, std::size_t index) const;
   void check_vertex(VertexId v, const char* what) const;
-  TetId walk(const Point3& p, TetId start) const;
-  TetId walk_limited(const Point3& p, TetId start, std::size_t max_steps) const;
-  TetId locate_history(const Point3& p, std::size_t* levels = nullptr) const;
-  TetId locate_for_edit(const Point3& p);
-  bool maybe_rebuild();
-  void report_renumbered(ChangeSet* changes) const;
-  bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
-  TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
+  void check_tet_limit(std::size_t extra) const;
   TetId alloc_tet();
   TetId alloc_tets(std::size_t n, std::vector<TetId>& out);
   PointId alloc_point(const Point3& p, VertexId reuse_vid);
-  bool grow_cavity(const Point3& p, TetId start, bool start_contains, PointId& duplicate);
-  void link_around_apex(PointId q);
+  void kill(TetId t, std::uint32_t op, TetId hint);
+  void attach_vertices(const std::vector<TetId>& created);
+  void glue_outside(TetId inner, int inner_face, TetId old_inner, int old_face);
+  void unmark_all(const std::vector<TetId>& tets, std::uint8_t flag);
+  // locate.cpp
+  TetId walk(const Point3& p, TetId start) const;
+  TetId walk_limited(const Point3& p, TetId start, std::size_t max_steps) const;
+  TetId locate_root(const Point3& p, std::size_t* visited) const;
+  TetId locate_history(const Point3& p, std::size_t* levels = nullptr) const;
+  TetId locate_for_edit(const Point3& p);
+  TetId locate_from_hint(const Point3& p) const;
+  void note_vertex(PointId q);
+  bool in_op_tet(const Op& op, TetId s, const Point3& p) const;
+  TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
+  TetId descend_around_apex(TetId dead, const Point3& p, std::size_t* visited) const;
+  // insert.cpp
+  bool grow_cavity(const Point3& p, TetId start, bool start_contains, Cavity& cavity, PointId& duplicate);
+  void clear_cavity_marks(const Cavity& cavity);
   PointId nearest_vertex(const std::vector<TetId>& tets, const Point3& p, PointId skip, double& best2) const;
-  void clear_cavity_marks();
   InsertResult insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
                          ChangeSet* changes, VertexId reuse_vid);
-  void collect_star(PointId v);
-  void remove_impl(VertexId v, ChangeSet* changes, bool star_collected = false);
+  InsertResult check_cavity(const Point3& p, TetId start, bool start_contains, double min_distance,
+                            Cavity& cavity);
+  void build_cavity_tets(PointId q, Cavity& cavity);
+  void commit_cavity(PointId q, Cavity& cavity, ChangeSet* changes);
+  void reserve_bulk(std::size_t n);
+  // link_apex.cpp
+  void link_around_apex(PointId q, const Cavity& cavity, ApexLinks& links);
+  bool link_by_table(PointId q, const Cavity& cavity, ApexLinks& links);
+  void link_by_hash(const Cavity& cavity, ApexLinks& links);
+  // remove.cpp
+  void collect_star(PointId v, Star& star);
+  void collect_link(PointId pv, Star& star);
+  void remove_star(VertexId v, Star& star, ChangeSet* changes);
+  void commit_removal(PointId pv, const Star& star, const std::vector<TetId>& created,
+                      const std::vector<TetId>& hints, ChangeSet* changes);
+  // hole_wrap.cpp (gift wrapping) and hole_sub.cpp (scratch triangulation of the link)
+  void fill_hole_by_wrapping(PointId pv, Star& star, ChangeSet* changes);
+  void wrap_front_init(PointId pv, const Star& star, Wrap& w);
+  void wrap_rehash(Wrap& w, std::size_t n);
+  PointId wrap_apex(PointId pv, const Wrap& w, std::size_t fi, const Star& star) const;
+  void wrap_add_tet(PointId pv, std::size_t fi, PointId apex, Wrap& w);
+  void wrap_commit(PointId pv, const Star& star, Wrap& w, ChangeSet* changes);
+  void fill_hole_by_sub(PointId pv, Star& star, ChangeSet* changes);
+  void sub_link_faces(PointId pv, Star& star, SubFill& f);
+  void sub_build(const Star& star, SubFill& f);
+  TetId sub_seed(PointId pv, const Star& star, SubFill& f);
+  void sub_flood(TetId seed, SubFill& f);
+  void sub_commit(PointId pv, Star& star, SubFill& f, ChangeSet* changes);
+  // move.cpp
   InsertResult move_impl(VertexId v, const Point3& p, double min_distance, ChangeSet* changes);
-  void fill_hole_by_wrapping(PointId pv, ChangeSet* changes);
-  bool try_move_in_place(VertexId v, const Point3& p, double min_distance, InsertResult& result,
+  bool star_survives_move(PointId pv, const Point3& p, const Star& star) const;
+  bool try_move_in_place(VertexId v, const Point3& p, double min_distance, MoveState& m, InsertResult& result,
                          ChangeSet* changes);
+  void rebuild_star(PointId pv, PointId np, MoveState& m);
+  void record_move(MoveState& m, ChangeSet* changes);
+  TetId locate_move_target(PointId pv, const Point3& p);
+  bool move_too_close(PointId pv, const Point3& p, TetId start, double min_distance, MoveState& m,
+                      InsertResult& result);
+  InsertResult move_by_reinsertion(VertexId v, const Point3& p, TetId start, MoveState& m,
+                                   ChangeSet* changes);
+  // history.cpp
   void record_op(TetId first, std::uint32_t count, PointId apex);
-  void kill(TetId t, std::uint32_t op, TetId hint);
-  void reset_to_corners();
+  bool maybe_rebuild();
+  void report_renumbered(ChangeSet* changes) const;
+  void adopt(Triangulation&& fresh, const std::vector<VertexId>& live, const std::vector<InsertResult>& res);
+  // validate.cpp
+  void verify_tet(TetId t) const;
+  void verify_hull_face(TetId t, int i) const;
+  void verify_vertices() const;
 
   Box3 box_;
   bool keep_history_ = true;
-  std::vector<Point3> pos_;            // by PointId; immutable once written
-  std::vector<TetId> vtet_;            // by PointId: one incident live tetrahedron, kNoTet if not live
-  std::vector<VertexId> vid_of_pid_;   // empty until the first move
-  std::vector<PointId> pid_of_vid_;    // empty until the first move
-  // 8 per tetrahedron t, one half cache line: td_[8t + i] vertex i (a PointId), td_[8t + 4 + i] the
-  // neighbour across the face opposite vertex i. Dead: td_[8t + 4] its history Op, td_[8t + 5] a hint.
-  detail::PodArray<std::uint32_t> td_;
-  detail::PodArray<std::uint8_t> tf_;  // flags per tetrahedron
-  // History only: for a tetrahedron created by an insertion, its neighbours across the faces through the
-  // apex at creation time, as offsets in its Op's range (kNoOffset: none / range too large). Location
-  // walks around the apex with them instead of scanning the range.
-  detail::PodArray<std::array<std::uint16_t, 4>> hnb_;
-  std::vector<Op> ops_;                // history records (insertions, removals, moves)
+  std::vector<Point3> pos_;           // by PointId; immutable once written
+  std::vector<TetId> vtet_;           // by PointId: one incident live tetrahedron, kNoTet if not live
+  std::vector<VertexId> vid_of_pid_;  // empty until the first move
+  std::vector<PointId> pid_of_vid_;   // empty until the first move
+  Store tets_;                        // the tetrahedra (invariants in detail/tet_store.hpp)
+  std::vector<Op> ops_;               // history records (insertions, removals, moves)
   std::size_t num_live_vertices_ = 0;
   std::size_t num_live_tets_ = 0;
-  TetId free_head_ = kNoTet;           // recycled slots (keep_history == false)
-  TetId last_tet_ = 0;                 // a live tetrahedron near the last operation (walk start)
-  double rebuild_factor_ = 1.0;        // TriangulationOptions::history_rebuild_factor
-  std::size_t max_wrap_link_ = 64;     // TriangulationOptions::max_wrap_link
-  std::size_t edit_tets_ = 0;          // tetrahedra created by removals and moves since the last rebuild
-  std::size_t excess_levels_ = 0;      // levels descended beyond 6 log2 n + 64 by insert() and move()
+  TetId free_head_ = kNoTet;        // recycled slots (keep_history == false)
+  TetId last_tet_ = 0;              // a live tetrahedron near the last operation (walk start)
+  double rebuild_factor_ = 1.0;     // TriangulationOptions::history_rebuild_factor
+  std::size_t max_wrap_link_ = 64;  // TriangulationOptions::max_wrap_link
+  std::size_t edit_tets_ = 0;       // tetrahedra created by removals and moves since the last rebuild
+  std::size_t excess_levels_ = 0;   // levels descended beyond 6 log2 n + 64 by insert() and move()
   std::size_t rebuilds_ = 0;
-  std::vector<std::uint32_t> init_td_; // the 8-corner triangulation, for reset_to_corners()
-  std::unique_ptr<Scratch> scratch_;   // work buffers, never shared between copies
+  detail::VertexGrid grid_;           // location hints: the last vertex inserted in each cell
+  Store root_;                        // the 8-corner triangulation, for reset_to_corners()
+  std::unique_ptr<Scratch> scratch_;  // work buffers, never shared between copies
 };
 
 }  // namespace vitri

@@ -1,0 +1,226 @@
+// The Delaunay tree, moving a vertex v to p (v keeps its id).
+//
+// If every tetrahedron of the star stays positively oriented at p and every face of the star stays
+// locally Delaunay (perturbed test, one side per face), only the star is rebuilt with the same
+// combinatorics (one history record, or none: see record_move). Otherwise v is removed and reinserted
+// under the same id, after a check that p is not too close to another vertex. The star collected by the
+// in-place test (MoveState::star) is handed to the removal explicitly.
+//
+// Positions are immutable with the history (dead tetrahedra refer to them): a moved vertex gets a new
+// internal point id and keeps its public VertexId.
+#include "scratch.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace vitri {
+
+InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distance, ChangeSet* changes) {
+  check_vertex(v, "move");
+  check_point(p, 0);
+  detail::check_min_distance(min_distance);
+  if (changes) changes->clear();
+  const bool renumbered = maybe_rebuild();
+  const InsertResult result = move_impl(v, p, min_distance, changes);
+  if (renumbered) report_renumbered(changes);
+  return result;
+}
+
+InsertResult Triangulation::move_impl(VertexId v, const Point3& p, double min_distance, ChangeSet* changes) {
+  MoveState& m = scratch_->move;
+  const PointId pv = pid(v);
+  if (pos_[pv] == p) {
+    // Nothing moves, but the contract still holds: TooClose when another vertex is closer than
+    // min_distance. The nearest other vertex of v is a Delaunay neighbour, a vertex of its star.
+    if (min_distance > 0.0) {
+      collect_star(pv, m.star);
+      unmark_all(m.star.tets, Store::kMark);
+      double best2 = min_distance * min_distance;
+      const PointId nearest = nearest_vertex(m.star.tets, p, pv, best2);
+      if (nearest != kNoVertex) return {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+    }
+    return {InsertStatus::Inserted, v, kNoVertex};
+  }
+  InsertResult result;
+  if (try_move_in_place(v, p, min_distance, m, result, changes)) return result;
+  // m.star holds v's star (unmarked) from here on.
+  const TetId start = locate_move_target(pv, p);
+  for (int i = 0; i < 4; ++i) {
+    const PointId w = tets_.vertex(start, i);
+    if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
+  }
+  if (min_distance > 0.0 && move_too_close(pv, p, start, min_distance, m, result)) return result;
+  return move_by_reinsertion(v, p, start, m, changes);
+}
+
+// Every tetrahedron of the (marked) star stays positive with pv at p, and every face of the star stays
+// locally Delaunay (one side of each face suffices: the perturbed test is the orientation of the five
+// lifted points, the same from both sides).
+bool Triangulation::star_survives_move(PointId pv, const Point3& p, const Star& star) const {
+  auto moved_points = [&](TetId t) {
+    Points4 P = points_of(t);
+    for (int i = 0; i < 4; ++i)
+      if (tets_.vertex(t, i) == pv) P[std::size_t(i)] = &p;
+    return P;
+  };
+  for (TetId t : star.tets) {
+    const Points4 P = moved_points(t);
+    if (orient3d(*P[0], *P[1], *P[2], *P[3]) != Sign::Positive) return false;
+  }
+  for (TetId t : star.tets) {
+    const Points4 P = moved_points(t);
+    for (int j = 0; j < 4; ++j) {
+      const TetId n = tets_.neighbor(t, j);
+      if (n == kNoTet || ((tets_.flags(n) & Store::kMark) && n < t)) continue;
+      const Point3& w = pos_[tets_.vertex(n, tets_.neighbor_index(n, t))];
+      if (insphere_sos(*P[0], *P[1], *P[2], *P[3], w) != Sign::Negative) return false;
+    }
+  }
+  return true;
+}
+
+// Collects v's star in m.star. True when the move is decided here: done in place, or TooClose (then
+// nothing changed). False (star unmarked, nothing changed) when v must be removed and reinserted.
+bool Triangulation::try_move_in_place(VertexId v, const Point3& p, double min_distance, MoveState& m,
+                                      InsertResult& result, ChangeSet* changes) {
+  const PointId pv = pid(v);
+  collect_star(pv, m.star);
+  if (!star_survives_move(pv, p, m.star)) {
+    unmark_all(m.star.tets, Store::kMark);
+    return false;
+  }
+  if (min_distance > 0.0) {  // the new Delaunay neighbours of v are its link vertices
+    double best2 = min_distance * min_distance;
+    const PointId nearest = nearest_vertex(m.star.tets, p, pv, best2);
+    if (nearest != kNoVertex) {
+      unmark_all(m.star.tets, Store::kMark);
+      result = {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+      return true;
+    }
+  }
+  PointId np = pv;
+  try {
+    check_tet_limit(m.star.tets.size());
+    if (keep_history_) np = alloc_point(p, v);
+  } catch (...) {
+    unmark_all(m.star.tets, Store::kMark);
+    throw;
+  }
+  if (!keep_history_) pos_[pv] = p;
+  rebuild_star(pv, np, m);
+  record_move(m, changes);
+  grid_.set(p, v);
+  result = {InsertStatus::Inserted, v, kNoVertex};
+  return true;
+}
+
+// A copy of the (marked) star around the point id np instead of pv: m.created[k] copies m.star.tets[k].
+void Triangulation::rebuild_star(PointId pv, PointId np, MoveState& m) {
+  const std::vector<TetId>& star = m.star.tets;
+  m.created.clear();
+  m.old_to_new.clear();
+  for (TetId t : star) {
+    const TetId s = alloc_tet();
+    for (int j = 0; j < 4; ++j) {
+      const PointId w = tets_.vertex(t, j);
+      tets_.set_vertex(s, j, w == pv ? np : w);
+    }
+    m.created.push_back(s);
+    m.old_to_new.emplace_back(t, s);
+  }
+  std::sort(m.old_to_new.begin(), m.old_to_new.end());
+  for (std::size_t k = 0; k < star.size(); ++k) {
+    const TetId t = star[k], s = m.created[k];
+    for (int j = 0; j < 4; ++j) {
+      const TetId n = tets_.neighbor(t, j);
+      if (n != kNoTet && (tets_.flags(n) & Store::kMark))
+        tets_.set_neighbor(
+            s, j,
+            std::lower_bound(m.old_to_new.begin(), m.old_to_new.end(), std::make_pair(n, TetId(0)))->second);
+      else
+        glue_outside(s, j, t, j);
+    }
+  }
+  attach_vertices(m.created);
+  if (np != pv) vtet_[pv] = kNoTet;
+}
+
+// Kills the old star. Every record's new tetrahedra cover exactly the region of those it killed. When
+// the star is exactly the set the last record created (typically: the previous move of this same
+// vertex), the new star covers that record's region too, so the record is overwritten instead of
+// stacking a new one above it: a vertex moved back and forth adds no depth to the history (the old stars
+// become unreachable garbage until the next rebuild, and count towards it).
+void Triangulation::record_move(MoveState& m, ChangeSet* changes) {
+  const std::vector<TetId>& star = m.star.tets;
+  const TetId first = m.created.front();
+  std::uint32_t op = std::uint32_t(ops_.size());
+  bool reuse = keep_history_ && ops_.size() > 1 && ops_.back().count == star.size();
+  for (std::size_t k = 0; reuse && k < star.size(); ++k)
+    reuse = star[k] >= ops_.back().first && star[k] - ops_.back().first < ops_.back().count;
+  if (reuse) {
+    op = std::uint32_t(ops_.size() - 1);
+    ops_[op] = {first, std::uint32_t(m.created.size()), kNoVertex};
+    edit_tets_ += m.created.size();
+  } else {
+    record_op(first, std::uint32_t(m.created.size()), kNoVertex);
+  }
+  for (std::size_t k = 0; k < star.size(); ++k) kill(star[k], op, m.created[k]);
+  last_tet_ = m.created.front();
+  detail::report_changes(changes, star, m.created);
+}
+
+// The tetrahedron containing the target p of a move of pv: a short walk from pv finds it after a small
+// move; a target farther than 8 times the longest edge of one tetrahedron at pv, or a long walk, uses
+// the history.
+TetId Triangulation::locate_move_target(PointId pv, const Point3& p) {
+  const TetId tv = vtet_[pv];
+  double edge2 = 0.0;
+  for (int i = 0; i < 4; ++i) edge2 = std::max(edge2, squared_distance(tet_point(tv, i), pos_[pv]));
+  TetId start = squared_distance(p, pos_[pv]) > 64.0 * edge2 ? kNoTet : walk_limited(p, tv, 64);
+  if (start == kNoTet) start = keep_history_ ? locate_for_edit(p) : walk(p, tv);
+  return start;
+}
+
+// The nearest other vertex of p is a Delaunay neighbour of p in DT(S \ v + p): either a vertex of p's
+// cavity in DT(S), or (when the edge appears only once v is gone) a link vertex of v. True (result set,
+// nothing changed) when it is closer than min_distance.
+bool Triangulation::move_too_close(PointId pv, const Point3& p, TetId start, double min_distance,
+                                   MoveState& m, InsertResult& result) {
+  PointId dup = kNoVertex;
+  if (!grow_cavity(p, start, true, m.probe, dup)) {
+    result = {InsertStatus::TooClose, kNoVertex, vid(dup)};
+    return true;
+  }
+  clear_cavity_marks(m.probe);  // m.probe keeps the list
+  double best2 = min_distance * min_distance;
+  PointId nearest = nearest_vertex(m.star.tets, p, pv, best2);
+  const PointId in_cavity = nearest_vertex(m.probe.tets, p, pv, best2);
+  if (in_cavity != kNoVertex) nearest = in_cavity;
+  if (nearest == kNoVertex) return false;
+  result = {InsertStatus::TooClose, kNoVertex, vid(nearest)};
+  return true;
+}
+
+// Removes v (its star in m.star) and reinserts it at p under the same id. `start` contains p; it
+// survives the removal unless it is in v's star (only those are killed; without the history a killed
+// slot may come back as a new tetrahedron), and then still contains p: no second location.
+InsertResult Triangulation::move_by_reinsertion(VertexId v, const Point3& p, TetId start, MoveState& m,
+                                                ChangeSet* changes) {
+  const bool start_survives = tets_.vertex_index(start, pid(v)) < 0;
+  ChangeSet removal, insertion;
+  remove_star(v, m.star, changes ? &removal : nullptr);
+  TetId t = start_survives ? start : walk_limited(p, last_tet_, 64);
+  if (t == kNoTet) t = locate_for_edit(p);
+  const InsertResult result = insert_at(p, t, true, 0.0, changes ? &insertion : nullptr, v);
+  if (result.status != InsertStatus::Inserted)
+    throw std::logic_error("Triangulation::move: reinsertion rejected after the proximity check");
+  if (changes) {
+    detail::ChangeEvents events;
+    detail::append_events(removal, events);
+    detail::append_events(insertion, events);
+    detail::net_changes(events, *changes);
+  }
+  return result;
+}
+
+}  // namespace vitri

@@ -1,0 +1,262 @@
+// Quality mode, part 1: construction, the refinement loop, insertions and the topology check.
+//
+// The loop (Boissonnat & Oudot 2005, with the manifold rule of CGAL's surface mesher):
+//   1. classify the facets of the tetrahedra changed since the last round (quality_facets.cpp): each
+//      restricted facet gets its surface Delaunay ball and, when it breaks a criterion (angle, distance,
+//      size, a box corner as vertex), a queue entry, largest ball first;
+//   2. when the queue is empty, check the restricted star of every vertex whose star changed: it must be a
+//      topological disk (its link a single cycle); otherwise the largest facet of the star is queued;
+//   3. insert the ball centres of a batch of queue entries whose record is still current (the centre is a
+//      point of the surface and its ball is empty, so it is at least the ball radius from every vertex);
+//      the tetrahedra killed lose their facets, the created ones wait for step 1.
+// It ends when steps 1 and 2 queue nothing. Termination and the guarantees: docs/quality.md.
+#include "vitri/polygonize/quality_mesher.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <string>
+#include <utility>
+
+namespace vitri {
+
+QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
+                             const QualityOptions& options)
+    : f_(f), options_(options), tri_(domain), diagonal_(domain.diagonal()) {
+  validate_options(options_);
+  for (std::size_t i = 0; i < seeds.size(); ++i)
+    if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed is not finite");
+  std::vector<std::uint8_t> ok;
+  const std::vector<Point3> projected = newton_project(seeds, ok);
+  std::vector<Point3> kept;
+  for (std::size_t i = 0; i < projected.size(); ++i)
+    if (ok[i] && inside_domain(projected[i])) kept.push_back(projected[i]);
+  const std::vector<InsertResult> inserted = tri_.insert_points(kept, 0.0, nullptr);
+  grow_vertex_arrays();
+  for (const InsertResult& r : inserted) {
+    if (r.status != InsertStatus::Inserted) continue;
+    on_surface_[r.vertex] = 1;
+    ++stats_.seeds;
+  }
+  forget_all_facets();
+}
+
+bool QualityMesher::inside_domain(const Point3& p) const {
+  const Box3& b = tri_.box();
+  return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+}
+
+void QualityMesher::validate_options(const QualityOptions& o) const {
+  if (!(o.min_angle_degrees >= 0.0 && o.min_angle_degrees <= 30.0))
+    throw InvalidArgument("QualityOptions::min_angle_degrees must be in [0, 30], got " +
+                          std::to_string(o.min_angle_degrees));
+  if (!(o.max_distance > 0.0))
+    throw InvalidArgument("QualityOptions::max_distance must be > 0, got " + std::to_string(o.max_distance));
+  if (!(o.max_size > 0.0))
+    throw InvalidArgument("QualityOptions::max_size must be > 0, got " + std::to_string(o.max_size));
+  if (!(o.root_tolerance > 0.0) || !std::isfinite(o.root_tolerance))
+    throw InvalidArgument("QualityOptions::root_tolerance must be finite and > 0");
+  if (o.max_vertices < 9) throw InvalidArgument("QualityOptions::max_vertices must be >= 9");
+}
+
+void QualityMesher::set_options(const QualityOptions& options) {
+  validate_options(options);
+  options_ = options;
+}
+
+QualityStats QualityMesher::stats() const {
+  QualityStats s = stats_;
+  s.vertices = tri_.num_vertices();
+  s.restricted_facets = facets_.size();
+  return s;
+}
+
+void QualityMesher::grow_tet_arrays() {
+  const std::size_t n = tri_.tet_capacity();
+  if (cvalue_.size() >= n) return;
+  cvalue_.resize(n, std::numeric_limits<double>::quiet_NaN());
+  ccenter_.resize(n);
+  pending_.resize(n, 0);
+}
+
+void QualityMesher::grow_vertex_arrays() {
+  const std::size_t n = tri_.vertex_capacity();
+  if (on_surface_.size() >= n) return;
+  on_surface_.resize(n, 0);
+  dirty_.resize(n, 0);
+}
+
+void QualityMesher::mark_vertex_dirty(VertexId v) {
+  if (dirty_[v]) return;
+  dirty_[v] = 1;
+  dirty_list_.push_back(v);
+}
+
+// The tetrahedron's facets wait for classification and its vertices for the topology check.
+void QualityMesher::mark_dirty(TetId t) {
+  for (int j = 0; j < 4; ++j) mark_vertex_dirty(tri_.tet_vertex(t, j));
+  if (pending_[t]) return;
+  pending_[t] = 1;
+  pending_list_.push_back(t);
+}
+
+// Drops every facet record and circumcentre value: all live tetrahedra are classified again (at
+// construction, after a history rebuild renumbered the tetrahedra, after function_changed()).
+void QualityMesher::forget_all_facets() {
+  facets_.clear();
+  queue_ = {};
+  grow_tet_arrays();
+  grow_vertex_arrays();
+  std::fill(cvalue_.begin(), cvalue_.end(), std::numeric_limits<double>::quiet_NaN());
+  std::fill(pending_.begin(), pending_.end(), std::uint8_t(0));
+  pending_list_.clear();
+  tri_.for_each_tetrahedron([this](TetId t) { mark_dirty(t); });
+}
+
+// Applies the change set of one Delaunay operation: facets of killed tetrahedra are forgotten (those on
+// the boundary of the changed region come back with the created tetrahedra, with their new Voronoi edge).
+void QualityMesher::absorb(const ChangeSet& cs) {
+  grow_tet_arrays();
+  grow_vertex_arrays();
+  if (cs.renumbered) {
+    forget_all_facets();
+    return;
+  }
+  for (TetId t : cs.killed) {
+    for (int i = 0; i < 4; ++i) facets_.erase(key_of(t, i));
+    for (int j = 0; j < 4; ++j) mark_vertex_dirty(tri_.tet_vertex(t, j));
+    cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
+  }
+  for (TetId t : cs.created) {
+    cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
+    mark_dirty(t);
+  }
+}
+
+bool QualityMesher::insert_center(const FacetRecord& r) {
+  if (!inside_domain(r.center)) {
+    ++stats_.rejected;
+    return false;
+  }
+  const InsertResult res = tri_.insert(r.center, 0.0, &changes_);
+  if (res.status != InsertStatus::Inserted) {
+    ++stats_.rejected;
+    return false;
+  }
+  grow_vertex_arrays();
+  on_surface_[res.vertex] = 1;
+  ++stats_.insertions;
+  absorb(changes_);
+  return true;
+}
+
+// Inserts the centres of up to half the queue (at least 32 entries), skipping entries whose record was
+// replaced or erased since they were queued. Returns the number of rejected centres.
+std::size_t QualityMesher::insert_round() {
+  const std::size_t batch = std::max<std::size_t>(32, queue_.size() / 2);
+  std::size_t rejected = 0;
+  for (std::size_t done = 0; done < batch && !queue_.empty();) {
+    const QueueItem item = queue_.top();
+    queue_.pop();
+    const auto it = facets_.find(item.key);
+    if (it == facets_.end() || it->second.stamp != item.stamp) continue;
+    if (!item.topology && !is_bad(it->second)) continue;
+    const FacetRecord r = it->second;
+    if (insert_center(r)) {
+      stats_.topology_insertions += item.topology ? 1 : 0;
+      ++done;
+    } else {
+      ++rejected;
+    }
+  }
+  return rejected;
+}
+
+// True when the restricted facets around v form one disk (or there are none); `star` receives them.
+bool QualityMesher::star_is_disk(VertexId v, std::vector<FacetKey>& star) const {
+  star.clear();
+  for (TetId t : tri_.incident_tetrahedra(v)) {
+    const int vi = tri_.vertex_index(t, v);
+    for (int j = 0; j < 4; ++j) {
+      if (j == vi) continue;
+      const FacetKey key = key_of(t, j);
+      if (facets_.count(key)) star.push_back(key);
+    }
+  }
+  std::sort(star.begin(), star.end());
+  star.erase(std::unique(star.begin(), star.end()), star.end());
+  if (star.empty()) return true;
+  if (star.size() < 3) return false;
+  // The link: one edge (p, q) per facet. A disk's link is a single cycle: every link vertex on exactly two
+  // edges, and a walk along the edges from the first one visits them all.
+  std::vector<std::pair<VertexId, VertexId>> link;
+  for (const FacetKey& k : star) {
+    std::array<VertexId, 2> e{};
+    int n = 0;
+    for (VertexId w : k.v)
+      if (w != v) e[std::size_t(n++)] = w;
+    link.emplace_back(e[0], e[1]);
+  }
+  auto degree = [&](VertexId w) {
+    std::size_t d = 0;
+    for (const auto& e : link) d += (e.first == w) + (e.second == w);
+    return d;
+  };
+  for (const auto& e : link)
+    if (degree(e.first) != 2 || degree(e.second) != 2) return false;
+  std::vector<std::uint8_t> used(link.size(), 0);
+  used[0] = 1;
+  VertexId at = link[0].second;
+  std::size_t visited = 1;
+  while (at != link[0].first) {
+    std::size_t next = link.size();
+    for (std::size_t k = 0; k < link.size() && next == link.size(); ++k)
+      if (!used[k] && (link[k].first == at || link[k].second == at)) next = k;
+    if (next == link.size()) return false;
+    used[next] = 1;
+    ++visited;
+    at = link[next].first == at ? link[next].second : link[next].first;
+  }
+  return visited == link.size();
+}
+
+// Queues the largest facet of the star of every changed vertex whose restricted star is not a disk.
+void QualityMesher::check_topology() {
+  std::vector<FacetKey> star;
+  std::vector<VertexId> list;
+  list.swap(dirty_list_);
+  for (VertexId v : list) {
+    dirty_[v] = 0;
+    if (!tri_.is_vertex(v) || star_is_disk(v, star)) continue;
+    const FacetKey* largest = nullptr;
+    double radius = -1.0;
+    for (const FacetKey& k : star) {
+      const double r = facets_.at(k).radius;
+      if (r > radius) radius = r, largest = &k;
+    }
+    if (largest) push(*largest, facets_.at(*largest), true);
+  }
+}
+
+bool QualityMesher::refine() {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::size_t rejected = 0;
+  requeue_all();
+  for (;;) {
+    classify_pending();
+    if (queue_.empty()) {
+      check_topology();
+      if (queue_.empty()) break;
+    }
+    rejected += insert_round();
+    if (tri_.num_vertices() > options_.max_vertices)
+      throw LimitError("QualityMesher::refine: more than QualityOptions::max_vertices = " +
+                       std::to_string(options_.max_vertices) + " Delaunay vertices needed");
+  }
+  stats_.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return rejected == 0;
+}
+
+}  // namespace vitri

@@ -5,7 +5,7 @@
 // samples of every triangle; and again after levels of detail and edits of f.
 #include <catch2/catch.hpp>
 
-#include "support/surface_metrics.hpp"
+#include "support/quality_checks.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/polygonize/analytic.hpp"
 #include "vitri/polygonize/mesh_metrics.hpp"
@@ -19,71 +19,10 @@ using namespace vitri;
 
 namespace {
 
-using test::metrics_of;
+using test::quality;
+using test::require_quality;
 
 const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
-
-/// Largest first-order distance |f| / |grad f| to the surface over a barycentric grid of `n` steps on
-/// every triangle (vertices, edges and interior; (n + 1)(n + 2) / 2 points per triangle).
-double sampled_distance(const SurfaceMesh& m, const ImplicitFunction& f, int n) {
-  double worst = 0.0;
-  for (const auto& t : m.triangles) {
-    const Point3& a = m.vertices[t[0]];
-    const Point3& b = m.vertices[t[1]];
-    const Point3& c = m.vertices[t[2]];
-    for (int i = 0; i <= n; ++i)
-      for (int j = 0; i + j <= n; ++j) {
-        const Point3 p = a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a);
-        Point3 g;
-        const double v = f.value_gradient(p, g);
-        worst = std::max(worst, std::abs(v) / norm(g));
-      }
-  }
-  return worst;
-}
-
-/// Largest |f| / |grad f| over the vertices alone.
-double vertex_distance(const SurfaceMesh& m, const ImplicitFunction& f) {
-  double worst = 0.0;
-  for (const Point3& p : m.vertices) {
-    Point3 g;
-    worst = std::max(worst, std::abs(f.value_gradient(p, g)) / norm(g));
-  }
-  return worst;
-}
-
-/// The guarantees of the quality mode, asserted over the whole mesh. The sampled distance may exceed the
-/// bound by the slack factor: the criterion holds at the ball centres (see docs/quality.md).
-void require_quality(const SurfaceMesh& m, const ImplicitFunction& f, const QualityOptions& o, long long euler,
-                     std::size_t components, double distance_slack = 1.25) {
-  const MeshMetrics mm = metrics_of(m);
-  INFO("V " << mm.vertices << " F " << mm.triangles << " boundary " << mm.boundary_edges << " nonmanifold e/v "
-            << mm.non_manifold_edges << "/" << mm.non_manifold_vertices << " inconsistent " << mm.inconsistent_edges
-            << " euler " << mm.euler_characteristic << " components " << mm.components << " min angle "
-            << mm.min_angle);
-  REQUIRE(mm.closed_manifold());
-  REQUIRE(mm.isolated_vertices == 0);
-  REQUIRE(mm.euler_characteristic == euler);
-  REQUIRE(mm.components == components);
-  REQUIRE(mm.signed_volume > 0.0);
-  REQUIRE(m.normals.size() == m.vertices.size());
-  // Every triangle: smallest angle >= the bound (min_angle is the minimum over all triangles).
-  REQUIRE(mm.min_angle >= o.min_angle_degrees - 1e-9);
-  REQUIRE(vertex_distance(m, f) <= 1e-8);
-  if (std::isfinite(o.max_distance)) {
-    const double d = sampled_distance(m, f, 8);
-    INFO("sampled distance " << d << " bound " << o.max_distance);
-    REQUIRE(d <= distance_slack * o.max_distance);
-  }
-}
-
-QualityOptions quality(double angle, double distance, double size = std::numeric_limits<double>::infinity()) {
-  QualityOptions o;
-  o.min_angle_degrees = angle;
-  o.max_distance = distance;
-  o.max_size = size;
-  return o;
-}
 
 /// A sphere whose centre and radius can change (an edited function).
 class MovableSphere final : public ImplicitFunction {

@@ -166,11 +166,27 @@ std::size_t QualityMesher::project_vertices(const std::vector<VertexId>& ids) {
 }
 
 void QualityMesher::function_changed() {
+  std::vector<Point3> at;
   std::vector<VertexId> ids;
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
-    if (tri_.is_vertex(v) && on_surface_[v]) ids.push_back(v);
-  project_vertices(ids);
-  forget_all_facets();
+    if (tri_.is_vertex(v) && on_surface_[v]) ids.push_back(v), at.push_back(tri_.point(v));
+  std::vector<double> value(at.size());
+  std::vector<Point3> grad(at.size());
+  if (!at.empty()) f_.values_gradients(at.data(), at.size(), value.data(), grad.data());
+  stats_.function_evaluations += at.size();
+  // The region: every vertex off the new surface, with its restricted star (twice the largest ball).
+  const double tol = options_.edit_tolerance * diagonal_;
+  Box3 region;
+  std::vector<FacetKey> star;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (std::abs(value[k]) <= tol * norm(grad[k])) continue;
+    star_is_disk(ids[k], star);
+    double reach = 0.0;
+    for (const FacetKey& key : star) reach = std::max(reach, 2.0 * facets_.at(key).radius);
+    region.extend(at[k] - Point3{reach, reach, reach});
+    region.extend(at[k] + Point3{reach, reach, reach});
+  }
+  function_changed(region);
 }
 
 void QualityMesher::function_changed(const Box3& region) {

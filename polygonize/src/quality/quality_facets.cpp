@@ -204,27 +204,39 @@ void QualityMesher::solve_brackets(std::vector<Bracket>& brackets) {
 }
 
 // Records the restricted facets of the solved brackets (ball centre and radius, and the first-order
-// distance to the surface at the edge midpoints, one batch) and queues the bad ones.
+// distance |f| / |grad f| at the probes of the facet, one batch) and queues the bad ones. The probes are
+// the points of the barycentric grid of QualityOptions::distance_probes steps, vertices excepted, and
+// the centroid.
 void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
+  const int steps = options_.distance_probes;
+  const std::size_t probes = steps > 0 ? std::size_t((steps + 1) * (steps + 2) / 2 - 3 + 1) : 0;
   std::vector<FacetKey> keys;
-  std::vector<Point3> mid;
-  for (const Bracket& b : brackets) {
-    keys.push_back(key_of(b.t, b.i));
+  std::vector<Point3> probe;
+  for (const Bracket& br : brackets) {
+    keys.push_back(key_of(br.t, br.i));
+    if (probes == 0) continue;
     const FacetKey& k = keys.back();
-    for (int e = 0; e < 3; ++e) mid.push_back(0.5 * (tri_.point(k.v[std::size_t(e)]) + tri_.point(k.v[std::size_t((e + 1) % 3)])));
+    const Point3& a = tri_.point(k.v[0]);
+    const Point3& b = tri_.point(k.v[1]);
+    const Point3& c = tri_.point(k.v[2]);
+    for (int i = 0; i <= steps; ++i)
+      for (int j = 0; i + j <= steps; ++j)
+        if (i != steps && j != steps && i + j != 0)
+          probe.push_back(a + (double(i) / steps) * (b - a) + (double(j) / steps) * (c - a));
+    probe.push_back((a + b + c) / 3.0);
   }
-  std::vector<double> value(mid.size());
-  std::vector<Point3> grad(mid.size());
-  if (!mid.empty()) f_.values_gradients(mid.data(), mid.size(), value.data(), grad.data());
-  stats_.function_evaluations += mid.size();
+  std::vector<double> value(probe.size());
+  std::vector<Point3> grad(probe.size());
+  if (!probe.empty()) f_.values_gradients(probe.data(), probe.size(), value.data(), grad.data());
+  stats_.function_evaluations += probe.size();
   for (std::size_t m = 0; m < brackets.size(); ++m) {
     const Bracket& b = brackets[m];
     const FacetKey& key = keys[m];
     FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, 0.0, ++stamp_, negative(cvalue_[b.t])};
     for (VertexId v : key.v) r.radius = std::max(r.radius, distance(r.center, tri_.point(v)));
-    for (std::size_t e = 3 * m; e < 3 * m + 3; ++e) {
+    for (std::size_t e = probes * m; e < probes * (m + 1); ++e) {
       const double g = norm(grad[e]);
-      r.edge_distance = std::max(r.edge_distance, g > 0.0 ? std::abs(value[e]) / g : std::numeric_limits<double>::infinity());
+      r.probe_distance = std::max(r.probe_distance, g > 0.0 ? std::abs(value[e]) / g : std::numeric_limits<double>::infinity());
     }
     facets_[key] = r;
     for (VertexId v : key.v) mark_vertex_dirty(v);
@@ -254,7 +266,7 @@ bool QualityMesher::is_bad(const FacetRecord& r) const {
   const double twice_area = norm(n);
   if (!(twice_area > 0.0)) return true;
   if (std::abs(dot(r.center - a, n)) / twice_area > options_.max_distance) return true;
-  if (r.edge_distance > options_.max_distance) return true;
+  if (r.probe_distance > options_.max_distance) return true;
   std::array<double, 3> l{squared_distance(a, b), squared_distance(b, c), squared_distance(c, a)};
   std::sort(l.begin(), l.end());
   const double sine = twice_area / std::sqrt(l[1] * l[2]);

@@ -25,7 +25,7 @@ namespace vitri {
 QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                              const QualityOptions& options)
     : f_(f), options_(options), tri_(domain), diagonal_(domain.diagonal()) {
-  validate_options(options_);
+  validate(options_);
   for (std::size_t i = 0; i < seeds.size(); ++i)
     if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed is not finite");
   std::vector<std::uint8_t> ok;
@@ -48,7 +48,7 @@ bool QualityMesher::inside_domain(const Point3& p) const {
   return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
 }
 
-void QualityMesher::validate_options(const QualityOptions& o) const {
+void QualityMesher::validate(const QualityOptions& o) {
   if (!(o.min_angle_degrees >= 0.0 && o.min_angle_degrees <= 30.0))
     throw InvalidArgument("QualityOptions::min_angle_degrees must be in [0, 30], got " +
                           std::to_string(o.min_angle_degrees));
@@ -58,11 +58,16 @@ void QualityMesher::validate_options(const QualityOptions& o) const {
     throw InvalidArgument("QualityOptions::max_size must be > 0, got " + std::to_string(o.max_size));
   if (!(o.root_tolerance > 0.0) || !std::isfinite(o.root_tolerance))
     throw InvalidArgument("QualityOptions::root_tolerance must be finite and > 0");
+  if (!(o.edit_tolerance >= o.root_tolerance) || !std::isfinite(o.edit_tolerance))
+    throw InvalidArgument("QualityOptions::edit_tolerance must be finite and >= root_tolerance");
+  if (o.distance_probes < 0 || o.distance_probes > 16)
+    throw InvalidArgument("QualityOptions::distance_probes must be in [0, 16], got " +
+                          std::to_string(o.distance_probes));
   if (o.max_vertices < 9) throw InvalidArgument("QualityOptions::max_vertices must be >= 9");
 }
 
 void QualityMesher::set_options(const QualityOptions& options) {
-  validate_options(options);
+  validate(options);
   options_ = options;
 }
 

@@ -44,17 +44,27 @@ struct QualityOptions {
   /// proven to terminate up to 30 degrees (radius-edge ratio >= 1, see docs/quality.md). 0: no bound.
   double min_angle_degrees = 30.0;
   /// Bound on the distance between each facet and the surface, checked at the centre of its surface
-  /// Delaunay ball (distance to the facet's plane: how far the surface bulges away from the triangle) and
-  /// at its three edge midpoints (first-order distance |f| / |grad f|, which catches saddles where the
-  /// plane cuts the surface). Curvature-adapted: triangles get small where the surface bends. Must be
-  /// > 0; infinity: no bound.
+  /// Delaunay ball (distance to the facet's plane: how far the surface bulges away from the triangle, the
+  /// criterion of Boissonnat & Oudot and CGAL) and at the probes of the facet (first-order distance
+  /// |f| / |grad f|, which catches saddles where the plane cuts the surface, and wiggles). Curvature-
+  /// adapted: triangles get small where the surface bends. Must be > 0; infinity: no bound.
   double max_distance = std::numeric_limits<double>::infinity();
+  /// Probes of the distance bound: the points of the barycentric grid with this many steps per edge,
+  /// the three vertices excepted, plus the centroid ((n + 1)(n + 2) / 2 - 2 evaluations per facet).
+  /// 0: the ball centre only (CGAL's criterion); 2: edge midpoints and centroid. In [0, 16].
+  int distance_probes = 4;
   /// Bound on the radius of each facet's surface Delaunay ball (about the circumradius of the triangle):
   /// a uniform size bound. Must be > 0; infinity: no bound.
   double max_size = std::numeric_limits<double>::infinity();
   /// The root finder on a Voronoi edge stops when its bracket is shorter than this fraction of the domain
   /// diagonal (the ball centres, i.e. the inserted vertices, are on the surface to this accuracy). > 0.
   double root_tolerance = 1e-10;
+  /// function_changed() without a region re-projects only the vertices farther than this fraction of the
+  /// domain diagonal from the new surface (|f| / |grad f|) and re-meshes around them: a global function
+  /// such as the RBF changes a little everywhere after a local edit (moving one of hand.off's constraints
+  /// moves half the vertices by more than 1e-7 of the diagonal, an eighth by more than 1e-5). After an
+  /// edit the vertices are on the surface to this tolerance. >= root_tolerance.
+  double edit_tolerance = 1e-5;
   /// refine() throws LimitError rather than create more Delaunay vertices than this (box corners and
   /// seeds included): the guard against a criterion that cannot be met at any reasonable size.
   std::size_t max_vertices = 5000000;
@@ -104,14 +114,19 @@ class QualityMesher {
   bool refine();
   /// Replaces the criteria (validated as in the constructor); call refine() afterwards.
   void set_options(const QualityOptions& options);
+  /// @throws InvalidArgument naming the first option out of its domain.
+  static void validate(const QualityOptions& options);
 
   /// The restricted facets as a mesh: vertices are the Delaunay vertices they use (on the surface),
   /// triangles counter-clockwise seen from outside (f > 0), unit normals from the gradient of f. Facets
   /// in a canonical order (sorted vertex ids), so the same structure gives the same mesh.
   SurfaceMesh extract();
 
-  /// f changed everywhere: vertices no longer on the surface are moved back onto it (Newton along the
-  /// gradient) or removed when that fails; every restricted facet is classified again. Call refine().
+  /// f changed, anywhere: the vertices farther than options().edit_tolerance from the new surface are
+  /// moved back onto it (Newton along the gradient) or removed when that fails, and the facets around
+  /// them (a region covering their restricted stars, twice their ball radii) are classified again, as by
+  /// function_changed(region). Call refine() afterwards.
+  /// @note A change that moves no vertex (a new component away from the mesh) is not seen.
   void function_changed();
   /// f changed inside `region` only (closed box): only the vertices inside it are re-projected, only
   /// circumcentres inside it re-evaluated, and only facets whose Voronoi edge meets it re-classified.
@@ -140,7 +155,7 @@ class QualityMesher {
     int i;
     Point3 center;
     double radius;
-    double edge_distance;  // largest |f| / |grad f| at the three edge midpoints
+    double probe_distance;  // largest |f| / |grad f| at the probes (QualityOptions::distance_probes)
     std::uint32_t stamp;
     bool inside_t;  // f < 0 at t's circumcentre: the facet faces outward from t
   };
@@ -162,7 +177,6 @@ class QualityMesher {
 
   FacetKey key_of(TetId t, int i) const;
   bool inside_domain(const Point3& p) const;  // strictly inside the box
-  void validate_options(const QualityOptions& o) const;
   void grow_tet_arrays();
   void evaluate_circumcenters(const std::vector<TetId>& tets);
   void classify_pending();

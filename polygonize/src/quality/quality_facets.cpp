@@ -29,6 +29,10 @@ namespace {
 // are counter-clockwise seen from outside the tetrahedron.
 constexpr int kOutwardFace[4][3] = {{1, 2, 3}, {0, 3, 2}, {0, 1, 3}, {0, 2, 1}};
 
+// The ball centres are located to this fraction of the domain diagonal for the criteria (a distance
+// bound below 1e-4 of the diagonal is far finer than any mesh a user asks for).
+constexpr double kClassifyTolerance = 1e-7;
+
 constexpr double kRadiansPerDegree = 3.14159265358979323846 / 180.0;
 
 bool negative(double value) { return value < 0.0; }  // sign(0) = +
@@ -70,11 +74,12 @@ QualityMesher::FacetKey QualityMesher::key_of(TetId t, int i) const {
   return k;
 }
 
-void QualityMesher::evaluate(const std::vector<Point3>& p, std::vector<double>& out) {
+void QualityMesher::evaluate(const std::vector<Point3>& p, std::vector<double>& out, std::size_t& phase_counter) {
   out.resize(p.size());
   if (p.empty()) return;
   f_.values(p.data(), p.size(), out.data());
   stats_.function_evaluations += p.size();
+  phase_counter += p.size();
 }
 
 // f at the circumcentres of `tets` (one batch); a circumcentre outside the open box gets +infinity (the
@@ -93,7 +98,7 @@ void QualityMesher::evaluate_circumcenters(const std::vector<TetId>& tets) {
     }
   }
   std::vector<double> values;
-  evaluate(points, values);
+  evaluate(points, values, stats_.circumcenter_evaluations);
   for (std::size_t k = 0; k < inside.size(); ++k) cvalue_[inside[k]] = values[k];
 }
 
@@ -124,7 +129,7 @@ void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
         facets_.erase(key_of(t, i));
         continue;
       }
-      brackets.push_back({t, i, ccenter_[t], ccenter_[n], cvalue_[t], cvalue_[n], 0});
+      brackets.push_back({t, i, ccenter_[t], ccenter_[n], cvalue_[t], cvalue_[n], 0, {}, std::numeric_limits<double>::quiet_NaN()});
     }
   }
   for (TetId t : live) pending_[t] = 0;
@@ -151,7 +156,7 @@ void QualityMesher::clip_brackets(std::vector<Bracket>& brackets) {
     which.push_back(k);
   }
   std::vector<double> values;
-  evaluate(points, values);
+  evaluate(points, values, stats_.root_evaluations);
   for (std::size_t m = 0; m < which.size(); ++m) {
     Bracket& b = brackets[which[m]];
     (std::isinf(b.fa) ? b.fa : b.fb) = values[m];
@@ -161,30 +166,57 @@ void QualityMesher::clip_brackets(std::vector<Bracket>& brackets) {
                  brackets.end());
 }
 
-// Illinois regula falsi on all brackets in lockstep (one batch evaluation per iteration) until each is
-// shorter than the root tolerance; bisection after 40 iterations guarantees the end. On return a and b
-// both lie within the tolerance of a root.
+// Safeguarded Newton on all brackets in lockstep (one batch of values and gradients per iteration): the
+// Newton step along the edge from the last evaluated point when it stays inside the bracket, the
+// Illinois regula falsi point otherwise (and bisection after 40 iterations, which guarantees the end).
+// Stops when the bracket, or the last Newton step, is shorter than the classification tolerance
+// (kClassifyTolerance x the diagonal, or the root tolerance if larger): enough for the criteria; the
+// centres that are inserted are polished to the root tolerance before insertion (insert_round()). On
+// return the midpoint of a and b lies within the tolerance of a root.
 void QualityMesher::solve_brackets(std::vector<Bracket>& brackets) {
-  const double tol = options_.root_tolerance * diagonal_;
+  const double tol = std::max(options_.root_tolerance, kClassifyTolerance) * diagonal_;
   std::vector<std::size_t> active(brackets.size());
   for (std::size_t k = 0; k < active.size(); ++k) active[k] = k;
-  std::vector<Point3> points;
+  std::vector<Point3> points, grads;
   std::vector<double> values;
   for (int iteration = 0; !active.empty(); ++iteration) {
     points.clear();
     std::vector<std::size_t> still;
     for (std::size_t k : active) {
       Bracket& b = brackets[k];
-      if (distance(b.a, b.b) <= tol) continue;
-      double s = iteration < 40 ? b.fa / (b.fa - b.fb) : 0.5;
-      if (!(s > 0.0 && s < 1.0)) s = 0.5;
-      points.push_back(b.a + s * (b.b - b.a));
+      const Point3 d = b.b - b.a;
+      const double len = norm(d);
+      if (len <= tol) continue;
+      double step = b.newton;  // along d / len, from the last point; NaN when none
+      if (std::isfinite(step) && std::abs(step) <= 0.5 * tol) {
+        b.a = b.b = b.last + step * (d / len);  // converged: the root is within tol / 2 of this point
+        continue;
+      }
+      Point3 x;
+      const double s_last = dot(b.last - b.a, d) / (len * len);
+      const double s_newton = s_last + step / len;
+      if (iteration < 40 && std::isfinite(step) && s_newton > 0.0 && s_newton < 1.0) {
+        x = b.a + s_newton * d;
+      } else {
+        double s = iteration < 40 ? b.fa / (b.fa - b.fb) : 0.5;
+        if (!(s > 0.0 && s < 1.0)) s = 0.5;
+        x = b.a + s * d;
+      }
+      points.push_back(x);
       still.push_back(k);
     }
-    evaluate(points, values);
+    values.resize(points.size());
+    grads.resize(points.size());
+    if (!points.empty()) f_.values_gradients(points.data(), points.size(), values.data(), grads.data());
+    stats_.function_evaluations += points.size();
+    stats_.root_evaluations += points.size();
     for (std::size_t m = 0; m < still.size(); ++m) {
       Bracket& b = brackets[still[m]];
       const double fx = values[m];
+      const Point3 u = (b.b - b.a) / norm(b.b - b.a);
+      const double slope = dot(grads[m], u);
+      b.last = points[m];
+      b.newton = slope != 0.0 && std::isfinite(slope) ? -fx / slope : std::numeric_limits<double>::quiet_NaN();
       if (fx == 0.0) {
         b.a = b.b = points[m];
       } else if (negative(fx) == negative(b.fa)) {
@@ -203,19 +235,47 @@ void QualityMesher::solve_brackets(std::vector<Bracket>& brackets) {
   }
 }
 
-// Records the restricted facets of the solved brackets (ball centre and radius, and the first-order
-// distance |f| / |grad f| at the probes of the facet, one batch) and queues the bad ones. The probes are
-// the points of the barycentric grid of QualityOptions::distance_probes steps, vertices excepted, and
-// the centroid.
+// Records the restricted facets of the solved brackets (ball centre and radius) and queues the bad ones;
+// those that meet every other criterion wait for their distance probes (probe_pending()).
 void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
-  const int steps = options_.distance_probes;
-  const std::size_t probes = steps > 0 ? std::size_t((steps + 1) * (steps + 2) / 2 - 3 + 1) : 0;
+  for (const Bracket& b : brackets) {
+    const FacetKey key = key_of(b.t, b.i);
+    FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, kNotProbed, ++stamp_, negative(cvalue_[b.t])};
+    for (VertexId v : key.v) r.radius = std::max(r.radius, distance(r.center, tri_.point(v)));
+    facets_[key] = r;
+    for (VertexId v : key.v) mark_vertex_dirty(v);
+    if (is_bad(r)) push(key, r, false);
+    else if (needs_probes(r)) unprobed_.push_back(key);
+  }
+}
+
+// Probes the facets waiting for it that still exist and still need it. Called when the queue is empty:
+// facets created and killed while the mesh is still coarse are never probed.
+void QualityMesher::probe_pending() {
   std::vector<FacetKey> keys;
+  for (const FacetKey& k : unprobed_) {
+    const auto it = facets_.find(k);
+    if (it != facets_.end() && needs_probes(it->second)) keys.push_back(k);
+  }
+  unprobed_.clear();
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  probe_facets(keys);
+}
+
+bool QualityMesher::needs_probes(const FacetRecord& r) const {
+  return r.probe_distance == kNotProbed && options_.distance_probes > 0 && std::isfinite(options_.max_distance);
+}
+
+// The first-order distance |f| / |grad f| at the probes of the facets `keys` (one batch): the points of
+// the barycentric grid of QualityOptions::distance_probes steps, vertices excepted, and the centroid.
+// Facets beyond the distance bound are queued. Probes are evaluated only for facets that meet every
+// other criterion, once nothing else is queued: most facets of an unfinished mesh are refined anyway.
+void QualityMesher::probe_facets(const std::vector<FacetKey>& keys) {
+  const int steps = options_.distance_probes;
+  const std::size_t per_facet = std::size_t((steps + 1) * (steps + 2) / 2 - 3 + 1);
   std::vector<Point3> probe;
-  for (const Bracket& br : brackets) {
-    keys.push_back(key_of(br.t, br.i));
-    if (probes == 0) continue;
-    const FacetKey& k = keys.back();
+  for (const FacetKey& k : keys) {
     const Point3& a = tri_.point(k.v[0]);
     const Point3& b = tri_.point(k.v[1]);
     const Point3& c = tri_.point(k.v[2]);
@@ -225,22 +285,21 @@ void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
           probe.push_back(a + (double(i) / steps) * (b - a) + (double(j) / steps) * (c - a));
     probe.push_back((a + b + c) / 3.0);
   }
+  if (probe.empty()) return;
   std::vector<double> value(probe.size());
   std::vector<Point3> grad(probe.size());
-  if (!probe.empty()) f_.values_gradients(probe.data(), probe.size(), value.data(), grad.data());
+  f_.values_gradients(probe.data(), probe.size(), value.data(), grad.data());
   stats_.function_evaluations += probe.size();
-  for (std::size_t m = 0; m < brackets.size(); ++m) {
-    const Bracket& b = brackets[m];
-    const FacetKey& key = keys[m];
-    FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, 0.0, ++stamp_, negative(cvalue_[b.t])};
-    for (VertexId v : key.v) r.radius = std::max(r.radius, distance(r.center, tri_.point(v)));
-    for (std::size_t e = probes * m; e < probes * (m + 1); ++e) {
+  stats_.probe_evaluations += probe.size();
+  for (std::size_t m = 0; m < keys.size(); ++m) {
+    FacetRecord& r = facets_.at(keys[m]);
+    r.probe_distance = 0.0;
+    for (std::size_t e = per_facet * m; e < per_facet * (m + 1); ++e) {
       const double g = norm(grad[e]);
-      r.probe_distance = std::max(r.probe_distance, g > 0.0 ? std::abs(value[e]) / g : std::numeric_limits<double>::infinity());
+      const double d = g > 0.0 ? std::abs(value[e]) / g : std::numeric_limits<double>::infinity();
+      r.probe_distance = std::max(r.probe_distance, d);
     }
-    facets_[key] = r;
-    for (VertexId v : key.v) mark_vertex_dirty(v);
-    if (is_bad(r)) push(key, r, false);
+    if (r.probe_distance > options_.max_distance) push(keys[m], r, false);
   }
 }
 
@@ -281,8 +340,11 @@ void QualityMesher::push(const FacetKey& key, const FacetRecord& r, bool topolog
 
 void QualityMesher::requeue_all() {
   queue_ = {};
-  for (const auto& kv : facets_)
+  unprobed_.clear();
+  for (const auto& kv : facets_) {
     if (is_bad(kv.second)) push(kv.first, kv.second, false);
+    else if (needs_probes(kv.second)) unprobed_.push_back(kv.first);
+  }
 }
 
 SurfaceMesh QualityMesher::extract() {

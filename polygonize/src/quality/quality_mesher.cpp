@@ -4,7 +4,8 @@
 //   1. classify the facets of the tetrahedra changed since the last round (quality_facets.cpp): each
 //      restricted facet gets its surface Delaunay ball and, when it breaks a criterion (angle, distance,
 //      size, a box corner as vertex), a queue entry, largest ball first;
-//   2. when the queue is empty, check the restricted star of every vertex whose star changed: it must be a
+//   2. when the queue is empty, probe the distance of the facets that meet every other criterion
+//      (quality_facets.cpp); when it is still empty, check the restricted star of every vertex whose star changed: it must be a
 //      topological disk (its link a single cycle); otherwise the largest facet of the star is queued;
 //   3. insert the ball centres of a batch of queue entries whose record is still current (the centre is a
 //      point of the surface and its ball is empty, so it is at least the ball radius from every vertex);
@@ -112,6 +113,7 @@ void QualityMesher::mark_dirty(TetId t) {
 void QualityMesher::forget_all_facets() {
   facets_.clear();
   queue_ = {};
+  unprobed_.clear();
   grow_tet_arrays();
   grow_vertex_arrays();
   std::fill(cvalue_.begin(), cvalue_.end(), std::numeric_limits<double>::quiet_NaN());
@@ -140,12 +142,12 @@ void QualityMesher::absorb(const ChangeSet& cs) {
   }
 }
 
-bool QualityMesher::insert_center(const FacetRecord& r) {
-  if (!inside_domain(r.center)) {
+bool QualityMesher::insert_point(const Point3& p) {
+  if (!inside_domain(p)) {
     ++stats_.rejected;
     return false;
   }
-  const InsertResult res = tri_.insert(r.center, 0.0, &changes_);
+  const InsertResult res = tri_.insert(p, 0.0, &changes_);
   if (res.status != InsertStatus::Inserted) {
     ++stats_.rejected;
     return false;
@@ -158,25 +160,38 @@ bool QualityMesher::insert_center(const FacetRecord& r) {
 }
 
 // Inserts the centres of up to half the queue (at least 32 entries), skipping entries whose record was
-// replaced or erased since they were queued. Returns the number of rejected centres.
+// replaced or erased since they were queued (also by an insertion of this round). The centres, located
+// for the criteria only, are first moved onto the surface to the root tolerance (Newton steps, one batch
+// per step; a few 1e-7 of the diagonal at most). Returns the number of rejected centres.
 std::size_t QualityMesher::insert_round() {
   const std::size_t batch = std::max<std::size_t>(32, queue_.size() / 2);
-  std::size_t rejected = 0;
-  for (std::size_t done = 0; done < batch && !queue_.empty();) {
+  std::vector<QueueItem> items;
+  std::vector<Point3> centers;
+  while (items.size() < batch && !queue_.empty()) {
     const QueueItem item = queue_.top();
     queue_.pop();
-    const auto it = facets_.find(item.key);
-    if (it == facets_.end() || it->second.stamp != item.stamp) continue;
-    if (!item.topology && !is_bad(it->second)) continue;
-    const FacetRecord r = it->second;
-    if (insert_center(r)) {
-      stats_.topology_insertions += item.topology ? 1 : 0;
-      ++done;
+    const FacetRecord* r = current(item);
+    if (!r || (!item.topology && !is_bad(*r))) continue;
+    items.push_back(item);
+    centers.push_back(r->center);
+  }
+  std::vector<std::uint8_t> ok;
+  const std::vector<Point3> polished = newton_project(centers, ok);
+  std::size_t rejected = 0;
+  for (std::size_t k = 0; k < items.size(); ++k) {
+    if (!current(items[k])) continue;  // killed by an insertion of this round
+    if (insert_point(ok[k] ? polished[k] : centers[k])) {
+      stats_.topology_insertions += items[k].topology ? 1 : 0;
     } else {
       ++rejected;
     }
   }
   return rejected;
+}
+
+const QualityMesher::FacetRecord* QualityMesher::current(const QueueItem& item) const {
+  const auto it = facets_.find(item.key);
+  return it == facets_.end() || it->second.stamp != item.stamp ? nullptr : &it->second;
 }
 
 // True when the restricted facets around v form one disk (or there are none); `star` receives them.
@@ -251,6 +266,7 @@ bool QualityMesher::refine() {
   requeue_all();
   for (;;) {
     classify_pending();
+    if (queue_.empty()) probe_pending();
     if (queue_.empty()) {
       check_topology();
       if (queue_.empty()) break;

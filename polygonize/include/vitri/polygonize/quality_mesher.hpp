@@ -79,6 +79,9 @@ struct QualityStats {
   std::size_t topology_insertions = 0;  ///< of which for a vertex whose restricted star was not a disk
   std::size_t rejected = 0;             ///< centres that duplicated a vertex (facet left as it was)
   std::size_t function_evaluations = 0; ///< calls of f (values and gradients), all phases
+  std::size_t circumcenter_evaluations = 0;  ///< of which at circumcentres (signs of the Voronoi edges)
+  std::size_t root_evaluations = 0;          ///< of which by the root finder on Voronoi edges
+  std::size_t probe_evaluations = 0;         ///< of which at the distance probes of facets
   std::size_t projected = 0;            ///< function_changed(): vertices moved back onto the surface
   std::size_t removed = 0;              ///< function_changed(): vertices removed (no root nearby)
   double refine_seconds = 0;            ///< last refine()
@@ -155,7 +158,7 @@ class QualityMesher {
     int i;
     Point3 center;
     double radius;
-    double probe_distance;  // largest |f| / |grad f| at the probes (QualityOptions::distance_probes)
+    double probe_distance;  // largest |f| / |grad f| at the probes, or kNotProbed
     std::uint32_t stamp;
     bool inside_t;  // f < 0 at t's circumcentre: the facet faces outward from t
   };
@@ -173,6 +176,8 @@ class QualityMesher {
     Point3 a, b;    // a: t's side, b: the neighbour's side
     double fa, fb;  // values at a and b (opposite signs)
     int stale;      // Illinois: end kept twice in a row
+    Point3 last;    // the last point evaluated
+    double newton;  // Newton step from `last` along the edge (towards b), NaN when none
   };
 
   FacetKey key_of(TetId t, int i) const;
@@ -184,13 +189,18 @@ class QualityMesher {
   void clip_brackets(std::vector<Bracket>& brackets);
   void solve_brackets(std::vector<Bracket>& brackets);
   void store_facets(const std::vector<Bracket>& brackets);
+  bool needs_probes(const FacetRecord& r) const;
+  void probe_facets(const std::vector<FacetKey>& keys);
+  void probe_pending();
+  static constexpr double kNotProbed = -1.0;
   bool is_bad(const FacetRecord& r) const;
   void push(const FacetKey& key, const FacetRecord& r, bool topology);
   void requeue_all();
   void check_topology();
   bool star_is_disk(VertexId v, std::vector<FacetKey>& star) const;
   std::size_t insert_round();
-  bool insert_center(const FacetRecord& r);
+  bool insert_point(const Point3& p);
+  const FacetRecord* current(const QueueItem& item) const;
   void mark_vertex_dirty(VertexId v);
   void grow_vertex_arrays();
   void absorb(const ChangeSet& cs);
@@ -198,7 +208,7 @@ class QualityMesher {
   void forget_all_facets();
   std::size_t project_vertices(const std::vector<VertexId>& ids);
   std::vector<Point3> newton_project(std::vector<Point3> p, std::vector<std::uint8_t>& ok);
-  void evaluate(const std::vector<Point3>& p, std::vector<double>& out);
+  void evaluate(const std::vector<Point3>& p, std::vector<double>& out, std::size_t& phase_counter);
 
   const ImplicitFunction& f_;
   QualityOptions options_;
@@ -213,6 +223,7 @@ class QualityMesher {
   std::vector<VertexId> dirty_list_;
   std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
   std::priority_queue<QueueItem> queue_;
+  std::vector<FacetKey> unprobed_;      // facets that meet every criterion but wait for their probes
   std::uint32_t stamp_ = 0;
   ChangeSet changes_;
   QualityStats stats_;

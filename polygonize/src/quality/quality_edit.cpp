@@ -177,12 +177,14 @@ void QualityMesher::function_changed() {
   // The region: every vertex off the new surface, with its restricted star (twice the largest ball).
   const double tol = options_.edit_tolerance * diagonal_;
   Box3 region;
-  std::vector<FacetKey> star;
+  std::vector<std::uint32_t> start;
+  std::vector<StarEntry> entries;
+  build_stars(start, entries);
   for (std::size_t k = 0; k < ids.size(); ++k) {
     if (std::abs(value[k]) <= tol * norm(grad[k])) continue;
-    star_is_disk(ids[k], star);
     double reach = 0.0;
-    for (const FacetKey& key : star) reach = std::max(reach, 2.0 * facets_.at(key).radius);
+    for (std::uint32_t e = start[ids[k]]; e < start[ids[k] + 1]; ++e)
+      reach = std::max(reach, 2.0 * entries[e].record->radius);
     region.extend(at[k] - Point3{reach, reach, reach});
     region.extend(at[k] + Point3{reach, reach, reach});
   }
@@ -202,7 +204,7 @@ void QualityMesher::function_changed(const Box3& region) {
     if (std::isnan(cvalue_[t])) return;  // not evaluated yet (already pending)
     if (region.contains(ccenter_[t])) {
       cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
-      mark_dirty(t);
+      mark_pending(t);
     }
   });
   tri_.for_each_tetrahedron([&](TetId t) {
@@ -214,7 +216,7 @@ void QualityMesher::function_changed(const Box3& region) {
       edge.extend(ccenter_[n]);
       const bool meets = edge.lo.x <= region.hi.x && edge.hi.x >= region.lo.x && edge.lo.y <= region.hi.y &&
                          edge.hi.y >= region.lo.y && edge.lo.z <= region.hi.z && edge.hi.z >= region.lo.z;
-      if (meets) mark_dirty(t);
+      if (meets) mark_pending(t);
     }
   });
 }

@@ -60,9 +60,19 @@ bool clip_to_box(const Point3& a, const Point3& b, const Box3& box, double& s0, 
 }  // namespace
 
 std::size_t QualityMesher::FacetKeyHash::operator()(const FacetKey& k) const {
-  std::uint64_t h = 0x9e3779b97f4a7c15ULL;
-  for (VertexId v : k.v) h = (h ^ v) * 0x100000001b3ULL + (h >> 29);
-  return static_cast<std::size_t>(h);
+  std::uint64_t h = std::uint64_t(k.v[0]) * 0x9e3779b97f4a7c15ULL ^ std::uint64_t(k.v[1]) * 0xc2b2ae3d27d4eb4fULL ^
+                    std::uint64_t(k.v[2]) * 0x165667b19e3779f9ULL;
+  h ^= h >> 31;
+  h *= 0xbf58476d1ce4e5b9ULL;
+  return static_cast<std::size_t>(h ^ (h >> 29));
+}
+
+// Flags facet i of t, seen from both tetrahedra that share it, as having a record (erase_facet()).
+void QualityMesher::flag_facet(TetId t, int i) {
+  rflags_[t] = std::uint8_t(rflags_[t] | (1u << i));
+  const TetId n = tri_.tet_neighbor(t, i);
+  for (int j = 0; j < 4; ++j)
+    if (tri_.tet_neighbor(n, j) == t) rflags_[n] = std::uint8_t(rflags_[n] | (1u << j));
 }
 
 QualityMesher::FacetKey QualityMesher::key_of(TetId t, int i) const {
@@ -126,7 +136,7 @@ void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
       const TetId n = tri_.tet_neighbor(t, i);
       if (n == kNoTet || (pending_[n] && n < t)) continue;
       if (negative(cvalue_[t]) == negative(cvalue_[n])) {
-        facets_.erase(key_of(t, i));
+        erase_facet(t, i);
         continue;
       }
       brackets.push_back({t, i, ccenter_[t], ccenter_[n], cvalue_[t], cvalue_[n], 0, {}, std::numeric_limits<double>::quiet_NaN()});
@@ -243,6 +253,7 @@ void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
     FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, kNotProbed, ++stamp_, negative(cvalue_[b.t])};
     for (VertexId v : key.v) r.radius = std::max(r.radius, distance(r.center, tri_.point(v)));
     facets_[key] = r;
+    flag_facet(b.t, b.i);
     for (VertexId v : key.v) mark_vertex_dirty(v);
     if (is_bad(r)) push(key, r, false);
     else if (needs_probes(r)) unprobed_.push_back(key);

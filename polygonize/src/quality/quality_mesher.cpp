@@ -14,6 +14,7 @@
 #include "vitri/polygonize/quality_mesher.hpp"
 
 #include "vitri/core/error.hpp"
+#include "vitri/core/predicates.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -85,6 +86,7 @@ void QualityMesher::grow_tet_arrays() {
   cvalue_.resize(n, std::numeric_limits<double>::quiet_NaN());
   ccenter_.resize(n);
   pending_.resize(n, 0);
+  rflags_.resize(n, 0);
 }
 
 void QualityMesher::grow_vertex_arrays() {
@@ -100,9 +102,8 @@ void QualityMesher::mark_vertex_dirty(VertexId v) {
   dirty_list_.push_back(v);
 }
 
-// The tetrahedron's facets wait for classification and its vertices for the topology check.
-void QualityMesher::mark_dirty(TetId t) {
-  for (int j = 0; j < 4; ++j) mark_vertex_dirty(tri_.tet_vertex(t, j));
+// The tetrahedron's facets wait for classification.
+void QualityMesher::mark_pending(TetId t) {
   if (pending_[t]) return;
   pending_[t] = 1;
   pending_list_.push_back(t);
@@ -118,8 +119,11 @@ void QualityMesher::forget_all_facets() {
   grow_vertex_arrays();
   std::fill(cvalue_.begin(), cvalue_.end(), std::numeric_limits<double>::quiet_NaN());
   std::fill(pending_.begin(), pending_.end(), std::uint8_t(0));
+  std::fill(rflags_.begin(), rflags_.end(), std::uint8_t(0));
   pending_list_.clear();
-  tri_.for_each_tetrahedron([this](TetId t) { mark_dirty(t); });
+  tri_.for_each_tetrahedron([this](TetId t) { mark_pending(t); });
+  for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
+    if (tri_.is_vertex(v)) mark_vertex_dirty(v);
 }
 
 // Applies the change set of one Delaunay operation: facets of killed tetrahedra are forgotten (those on
@@ -132,22 +136,45 @@ void QualityMesher::absorb(const ChangeSet& cs) {
     return;
   }
   for (TetId t : cs.killed) {
-    for (int i = 0; i < 4; ++i) facets_.erase(key_of(t, i));
-    for (int j = 0; j < 4; ++j) mark_vertex_dirty(tri_.tet_vertex(t, j));
+    for (int i = 0; i < 4; ++i) erase_facet(t, i);
     cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
   }
   for (TetId t : cs.created) {
     cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
-    mark_dirty(t);
+    rflags_[t] = 0;
+    mark_pending(t);
   }
 }
 
-bool QualityMesher::insert_point(const Point3& p) {
+// Forgets the record of facet i of t, if t's flags say there may be one; its vertices then wait for the
+// topology check.
+void QualityMesher::erase_facet(TetId t, int i) {
+  const std::uint8_t bit = std::uint8_t(1u << i);
+  if (!(rflags_[t] & bit)) return;
+  rflags_[t] = std::uint8_t(rflags_[t] & ~bit);
+  const auto it = facets_.find(key_of(t, i));
+  if (it == facets_.end()) return;
+  for (VertexId v : it->first.v) mark_vertex_dirty(v);
+  facets_.erase(it);
+}
+
+// Inserts p (a polished ball centre of `facet`). The centre lies in the union of the circumballs of the
+// facet's two tetrahedra (its ball belongs to the pencil of spheres through the facet's circle, between
+// theirs), so one of them is usually in conflict with p and no point location is needed.
+bool QualityMesher::insert_point(const Point3& p, const FacetRecord* facet) {
   if (!inside_domain(p)) {
     ++stats_.rejected;
     return false;
   }
-  const InsertResult res = tri_.insert(p, 0.0, &changes_);
+  TetId conflict = kNoTet;
+  for (TetId t : {facet->t, tri_.tet_neighbor(facet->t, facet->i)}) {
+    if (conflict != kNoTet || t == kNoTet) continue;
+    if (insphere(tri_.tet_point(t, 0), tri_.tet_point(t, 1), tri_.tet_point(t, 2), tri_.tet_point(t, 3), p) ==
+        Sign::Positive)
+      conflict = t;
+  }
+  const InsertResult res = conflict != kNoTet ? tri_.insert_in_conflict(p, conflict, 0.0, &changes_)
+                                              : tri_.insert(p, 0.0, &changes_);
   if (res.status != InsertStatus::Inserted) {
     ++stats_.rejected;
     return false;
@@ -180,7 +207,7 @@ std::size_t QualityMesher::insert_round() {
   std::size_t rejected = 0;
   for (std::size_t k = 0; k < items.size(); ++k) {
     if (!current(items[k])) continue;  // killed by an insertion of this round
-    if (insert_point(ok[k] ? polished[k] : centers[k])) {
+    if (insert_point(ok[k] ? polished[k] : centers[k], current(items[k]))) {
       stats_.topology_insertions += items[k].topology ? 1 : 0;
     } else {
       ++rejected;
@@ -194,30 +221,33 @@ const QualityMesher::FacetRecord* QualityMesher::current(const QueueItem& item) 
   return it == facets_.end() || it->second.stamp != item.stamp ? nullptr : &it->second;
 }
 
-// True when the restricted facets around v form one disk (or there are none); `star` receives them.
-bool QualityMesher::star_is_disk(VertexId v, std::vector<FacetKey>& star) const {
-  star.clear();
-  for (TetId t : tri_.incident_tetrahedra(v)) {
-    const int vi = tri_.vertex_index(t, v);
-    for (int j = 0; j < 4; ++j) {
-      if (j == vi) continue;
-      const FacetKey key = key_of(t, j);
-      if (facets_.count(key)) star.push_back(key);
-    }
-  }
-  std::sort(star.begin(), star.end());
-  star.erase(std::unique(star.begin(), star.end()), star.end());
-  if (star.empty()) return true;
-  if (star.size() < 3) return false;
-  // The link: one edge (p, q) per facet. A disk's link is a single cycle: every link vertex on exactly two
-  // edges, and a walk along the edges from the first one visits them all.
+// The restricted stars of all vertices at once, from the facet records in O(F + V): the star of v is
+// entries[start[v] .. start[v + 1]) (compressed rows). Cheaper than looking up the faces of the incident
+// tetrahedra of every vertex (a surface vertex has many long tetrahedra through the volume).
+void QualityMesher::build_stars(std::vector<std::uint32_t>& start, std::vector<StarEntry>& entries) const {
+  start.assign(tri_.vertex_capacity() + 1, 0);
+  for (const auto& kv : facets_)
+    for (VertexId v : kv.first.v) ++start[v + 1];
+  for (std::size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
+  entries.resize(start.back());
+  std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+  for (const auto& kv : facets_)
+    for (VertexId v : kv.first.v) entries[fill[v]++] = {&kv.first, &kv.second};
+}
+
+// True when the restricted facets [begin, end) around v form one disk (or there are none). The link: one
+// edge (p, q) per facet; a disk's link is a single cycle: every link vertex on exactly two edges, and a
+// walk along the edges from the first one visits them all.
+bool QualityMesher::star_is_disk(VertexId v, const StarEntry* begin, const StarEntry* end) const {
+  if (begin == end) return true;
+  if (end - begin < 3) return false;
   std::vector<std::pair<VertexId, VertexId>> link;
-  for (const FacetKey& k : star) {
-    std::array<VertexId, 2> e{};
+  for (const StarEntry* e = begin; e != end; ++e) {
+    std::array<VertexId, 2> w{};
     int n = 0;
-    for (VertexId w : k.v)
-      if (w != v) e[std::size_t(n++)] = w;
-    link.emplace_back(e[0], e[1]);
+    for (VertexId x : e->key->v)
+      if (x != v) w[std::size_t(n++)] = x;
+    link.emplace_back(w[0], w[1]);
   }
   auto degree = [&](VertexId w) {
     std::size_t d = 0;
@@ -244,19 +274,20 @@ bool QualityMesher::star_is_disk(VertexId v, std::vector<FacetKey>& star) const 
 
 // Queues the largest facet of the star of every changed vertex whose restricted star is not a disk.
 void QualityMesher::check_topology() {
-  std::vector<FacetKey> star;
+  std::vector<std::uint32_t> start;
+  std::vector<StarEntry> entries;
+  build_stars(start, entries);
   std::vector<VertexId> list;
   list.swap(dirty_list_);
   for (VertexId v : list) {
     dirty_[v] = 0;
-    if (!tri_.is_vertex(v) || star_is_disk(v, star)) continue;
-    const FacetKey* largest = nullptr;
-    double radius = -1.0;
-    for (const FacetKey& k : star) {
-      const double r = facets_.at(k).radius;
-      if (r > radius) radius = r, largest = &k;
-    }
-    if (largest) push(*largest, facets_.at(*largest), true);
+    const StarEntry* begin = entries.data() + start[v];
+    const StarEntry* end = entries.data() + start[v + 1];
+    if (!tri_.is_vertex(v) || star_is_disk(v, begin, end)) continue;
+    const StarEntry* largest = begin;
+    for (const StarEntry* e = begin; e != end; ++e)
+      if (e->record->radius > largest->record->radius) largest = e;
+    push(*largest->key, *largest->record, true);
   }
 }
 

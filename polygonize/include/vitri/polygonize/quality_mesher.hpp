@@ -197,14 +197,21 @@ class QualityMesher {
   void push(const FacetKey& key, const FacetRecord& r, bool topology);
   void requeue_all();
   void check_topology();
-  bool star_is_disk(VertexId v, std::vector<FacetKey>& star) const;
+  struct StarEntry {
+    const FacetKey* key;
+    const FacetRecord* record;
+  };
+  void build_stars(std::vector<std::uint32_t>& start, std::vector<StarEntry>& entries) const;
+  bool star_is_disk(VertexId v, const StarEntry* begin, const StarEntry* end) const;
   std::size_t insert_round();
-  bool insert_point(const Point3& p);
+  bool insert_point(const Point3& p, const FacetRecord* facet);
   const FacetRecord* current(const QueueItem& item) const;
   void mark_vertex_dirty(VertexId v);
   void grow_vertex_arrays();
   void absorb(const ChangeSet& cs);
-  void mark_dirty(TetId t);
+  void mark_pending(TetId t);
+  void erase_facet(TetId t, int i);
+  void flag_facet(TetId t, int i);
   void forget_all_facets();
   std::size_t project_vertices(const std::vector<VertexId>& ids);
   std::vector<Point3> newton_project(std::vector<Point3> p, std::vector<std::uint8_t>& ok);
@@ -217,6 +224,7 @@ class QualityMesher {
   std::vector<double> cvalue_;          // per tet: f at its circumcentre (NaN: unknown, +inf: outside box)
   std::vector<Point3> ccenter_;         // per tet: circumcentre, valid with cvalue_
   std::vector<std::uint8_t> pending_;   // per tet: its facets wait for classification
+  std::vector<std::uint8_t> rflags_;    // per tet: bit i set when facet i may have a record
   std::vector<TetId> pending_list_;
   std::vector<std::uint8_t> on_surface_;  // per vertex: a seed or ball centre (not a box corner)
   std::vector<std::uint8_t> dirty_;       // per vertex: star changed since the last topology check

@@ -47,7 +47,9 @@ inline double cpu_now() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
-inline std::string data_path(const std::string& name) { return std::string(VITRI_DATA_DIR) + "/" + name; }
+inline std::string data_path(const std::string& name) {
+  return std::string(VITRI_DATA_DIR) + "/" + name;
+}
 
 /// Forwards to a function and counts evaluations (single and batch; a gradient counts as one).
 class CountingFunction final : public ImplicitFunction {
@@ -84,11 +86,11 @@ struct Surface {
   std::string source;                       // how it was made (for the report)
   std::unique_ptr<ImplicitFunction> owned;  // the function
   const ImplicitFunction* f = nullptr;
-  Box3 shape_box;                           // box containing the surface (constraints' box for RBFs)
-  Box3 domain;                              // vitri's Delaunay domain (shape box x 2, as the Mesher)
-  std::vector<Point3> seeds;                // constraint points (RBF) or none (analytic)
+  Box3 shape_box;             // box containing the surface (constraints' box for RBFs)
+  Box3 domain;                // vitri's Delaunay domain (shape box x 2, as the Mesher)
+  std::vector<Point3> seeds;  // constraint points (RBF) or none (analytic)
   std::vector<double> seed_values;
-  Point3 inside;                            // a point with f < 0 (CGAL's bounding-sphere centre)
+  Point3 inside;  // a point with f < 0 (CGAL's bounding-sphere centre)
   std::size_t constraints = 0;
   double fit_seconds = 0;
   double residual = 0;
@@ -128,7 +130,7 @@ inline Surface analytic_torus() {
 }
 
 inline Surface rbf_surface(const std::string& name, const Constraints& c, const std::string& source,
-                    unsigned threads) {
+                           unsigned threads) {
   Surface s;
   s.name = name;
   s.source = source;
@@ -180,7 +182,8 @@ using CgalFT = GT::FT;
 /// at s.inside through the farthest corner of s.shape_box x 1.05; `error_bound` is Implicit_surface_3's
 /// relative precision of the intersections (CGAL's default 1e-3). V #V x 3, F #F x 3 out.
 inline void cgal_surface_mesh(const ImplicitFunction& f, const Surface& s, double angle, double radius_bound,
-                              double distance_bound, double error_bound, Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+                              double distance_bound, double error_bound, Eigen::MatrixXd& V,
+                              Eigen::MatrixXi& F) {
   double bound2 = 0;  // squared radius of the bounding sphere: farthest shape-box corner x 1.05
   for (int k = 0; k < 8; ++k) bound2 = std::max(bound2, squared_distance(s.inside, s.shape_box.corner(k)));
   bound2 *= 1.05 * 1.05;

@@ -82,9 +82,10 @@ QualityRun run_vitri(const Surface& s, const std::string& name, double size, dou
 
 #ifdef VITRI_HAVE_CGAL
 QualityRun run_cgal(const Surface& s, double size, double distance) {
-  return timed("cgal", distance, *s.f, [&](const ImplicitFunction& f, Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
-    cgal_surface_mesh(f, s, 30.0, size, distance, 1e-6, V, F);
-  });
+  return timed("cgal", distance, *s.f,
+               [&](const ImplicitFunction& f, Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+                 cgal_surface_mesh(f, s, 30.0, size, distance, 1e-6, V, F);
+               });
 }
 #endif
 
@@ -103,7 +104,8 @@ Measured measure(const QualityRun& r, const ImplicitFunction& f) {
     const Point3 b = Point3::from(r.V.row(r.F(t, 1)).transpose());
     const Point3 c = Point3::from(r.V.row(r.F(t, 2)).transpose());
     for (int i = 0; i <= n; ++i)
-      for (int j = 0; i + j <= n; ++j) samples.push_back(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a));
+      for (int j = 0; i + j <= n; ++j)
+        samples.push_back(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a));
   }
   std::vector<double> v(samples.size());
   std::vector<Point3> g(samples.size());
@@ -137,14 +139,14 @@ void report(std::ostream& md, std::ofstream& csv, const Surface& s, double rel, 
      << fmt("%.3f", r.cpu) << " | " << ratio << " | " << cpu_ratio << " | " << r.evaluations << " | "
      << fmt("%.2f", x.m.min_angle) << " | " << fmt("%.4f", x.share_below_30) << " | "
      << (x.m.closed_manifold() && x.m.signed_volume > 0 ? "yes" : "no") << " | " << x.m.euler_characteristic
-     << " | " << fmt("%.2e", x.vertex_distance / diag) << " | " << fmt("%.2e", x.sampled_distance / diag) << " | "
-     << fmt("%.2f", x.sampled_distance / r.distance_bound) << " |\n";
+     << " | " << fmt("%.2e", x.vertex_distance / diag) << " | " << fmt("%.2e", x.sampled_distance / diag)
+     << " | " << fmt("%.2f", x.sampled_distance / r.distance_bound) << " |\n";
   md.flush();
   if (csv.is_open())
-    csv << s.name << ',' << rel << ',' << r.contender << ',' << r.distance_bound / diag << ',' << r.V.rows() << ','
-        << r.wall << ',' << r.cpu << ',' << r.evaluations << ',' << x.m.min_angle << ',' << x.share_below_30 << ','
-        << (x.m.closed_manifold() ? 1 : 0) << ',' << x.m.euler_characteristic << ',' << x.vertex_distance / diag
-        << ',' << x.sampled_distance / diag << '\n';
+    csv << s.name << ',' << rel << ',' << r.contender << ',' << r.distance_bound / diag << ',' << r.V.rows()
+        << ',' << r.wall << ',' << r.cpu << ',' << r.evaluations << ',' << x.m.min_angle << ','
+        << x.share_below_30 << ',' << (x.m.closed_manifold() ? 1 : 0) << ',' << x.m.euler_characteristic
+        << ',' << x.vertex_distance / diag << ',' << x.sampled_distance / diag << '\n';
 }
 
 /// vitri-centre with E tuned so that its vertex count is within 3% of `target` (vertices ~ 1 / E).
@@ -166,22 +168,25 @@ QualityRun match(const Surface& s, double size, double distance, std::size_t tar
 void compare(const Options& opt) {
   std::vector<Surface> surfaces;
   auto wanted = [&](const std::string& n) {
-    return opt.surfaces.empty() || std::find(opt.surfaces.begin(), opt.surfaces.end(), n) != opt.surfaces.end();
+    return opt.surfaces.empty() ||
+           std::find(opt.surfaces.begin(), opt.surfaces.end(), n) != opt.surfaces.end();
   };
   if (wanted("sphere")) surfaces.push_back(analytic_sphere());
   if (wanted("torus")) surfaces.push_back(analytic_torus());
   if (wanted("hand"))
-    surfaces.push_back(rbf_surface("hand", mesh_constraints("hand.off", 2400), "RBF of data/hand.off", opt.threads));
+    surfaces.push_back(
+        rbf_surface("hand", mesh_constraints("hand.off", 2400), "RBF of data/hand.off", opt.threads));
   std::ofstream csv;
   if (!opt.csv.empty()) {
     csv.open(opt.csv);
     csv << "surface,bound,contender,distance_bound_rel,vertices,wall_s,cpu_s,evaluations,min_angle,"
            "share_below_30,closed_manifold,euler,max_vertex_distance_rel,max_sampled_distance_rel\n";
   }
-  std::cout << "| surface | E / diag | contender | E used / diag | vertices | wall s | CPU s | wall / cgal | "
-               "CPU / cgal | evaluations | min angle | share < 30 | closed outward | Euler | max vertex dist / "
-               "diag | max sampled dist / diag | sampled / E |\n"
-               "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  std::cout
+      << "| surface | E / diag | contender | E used / diag | vertices | wall s | CPU s | wall / cgal | "
+         "CPU / cgal | evaluations | min angle | share < 30 | closed outward | Euler | max vertex dist / "
+         "diag | max sampled dist / diag | sampled / E |\n"
+         "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   std::vector<double> bounds = {2e-3};
   if (!opt.quick) bounds.push_back(5e-4);
   for (const Surface& s : surfaces) {

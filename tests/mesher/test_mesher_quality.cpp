@@ -32,7 +32,8 @@ Mesher hand_in_quality_mode(double angle, double relative_distance) {
 
 }  // namespace
 
-TEST_CASE("quality mode on hand.off: angles, closed outward genus 0, distance, levels of detail", "[mesher]") {
+TEST_CASE("quality mode on hand.off: angles, closed outward genus 0, distance, levels of detail",
+          "[mesher]") {
   Mesher mesher = hand_in_quality_mode(30.0, 0.002);
   const double diag = mesher.diagonal();
   REQUIRE(mesher.refine(0.03 * diag));

@@ -24,18 +24,16 @@ using test::require_quality;
 
 const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
 
-/// A sphere whose centre and radius can change (an edited function).
-class MovableSphere final : public ImplicitFunction {
+/// Forwards to a function that the test replaces: an edited f.
+class EditedFunction final : public ImplicitFunction {
  public:
-  Point3 center{0.0, 0.0, 0.0};
-  double radius = 1.0;
-  double value(const Point3& p) const override { return norm(p - center) - radius; }
-  double value_gradient(const Point3& p, Point3& g) const override {
-    const Point3 d = p - center;
-    const double n = norm(d);
-    g = n > 0.0 ? d / n : Point3{0.0, 0.0, 1.0};
-    return n - radius;
-  }
+  explicit EditedFunction(const ImplicitFunction& f) : f_(&f) {}
+  void set(const ImplicitFunction& f) { f_ = &f; }
+  double value(const Point3& p) const override { return f_->value(p); }
+  double value_gradient(const Point3& p, Point3& g) const override { return f_->value_gradient(p, g); }
+
+ private:
+  const ImplicitFunction* f_;
 };
 
 }  // namespace
@@ -76,7 +74,8 @@ TEST_CASE("quality: curvature-adapted size, small triangles where the surface be
   for (const auto& t : m.triangles) {
     const Point3 c = (m.vertices[t[0]] + m.vertices[t[1]] + m.vertices[t[2]]) / 3.0;
     const int which = c.x < -0.6 ? 0 : 1;
-    area[which] += 0.5 * norm(cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]));
+    area[which] +=
+        0.5 * norm(cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]));
     ++count[which];
   }
   REQUIRE(count[0] > 0);
@@ -120,12 +119,13 @@ TEST_CASE("quality: the same structure gives the same mesh (canonical order)", "
 }
 
 TEST_CASE("quality: function_changed() after an edit keeps every guarantee", "[quality]") {
-  MovableSphere f;
+  const SphereFunction before({0.0, 0.0, 0.0}, 1.0);
+  const SphereFunction after({0.15, -0.1, 0.05}, 0.9);  // the whole surface moves
+  EditedFunction f(before);
   QualityMesher q(f, kCube, QualityMesher::seed_points(f, kCube, 0.3), quality(30.0, 0.005));
   REQUIRE(q.refine());
   require_quality(q.extract(), f, q.options(), 2, 1);
-  f.center = {0.15, -0.1, 0.05};  // the whole surface moves
-  f.radius = 0.9;
+  f.set(after);
   q.function_changed();
   REQUIRE(q.refine());
   require_quality(q.extract(), f, q.options(), 2, 1);
@@ -135,14 +135,14 @@ TEST_CASE("quality: function_changed() after an edit keeps every guarantee", "[q
 TEST_CASE("quality: function_changed(region) re-meshes a local edit", "[quality]") {
   // Two separate balls; only the second one moves, inside the region.
   const SphereFunction a({-0.9, 0.0, 0.0}, 0.6);
-  MovableSphere b;
-  b.center = {0.9, 0.0, 0.0};
-  b.radius = 0.6;
+  const SphereFunction b_before({0.9, 0.0, 0.0}, 0.6);
+  const SphereFunction b_after({1.0, 0.1, 0.0}, 0.6);
+  EditedFunction b(b_before);
   const UnionFunction f(a, b);
   QualityMesher q(f, kCube, QualityMesher::seed_points(f, kCube, 0.2), quality(30.0, 0.004));
   REQUIRE(q.refine());
   require_quality(q.extract(), f, q.options(), 4, 2);
-  b.center = {1.0, 0.1, 0.0};
+  b.set(b_after);
   Box3 region{{0.2, -0.6, -0.7}, {1.7, 0.8, 0.7}};
   q.function_changed(region);
   REQUIRE(q.refine());

@@ -1,6 +1,7 @@
 #pragma once
 // Test support: the guarantees of the quality mode (docs/quality.md) asserted over a whole mesh, shared by
 // the QualityMesher tests (analytic functions) and the Mesher tests (real models through the RBF).
+#include "support/mesh_checks.hpp"
 #include "support/surface_metrics.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/polygonize/quality_mesher.hpp"
@@ -42,21 +43,14 @@ inline double vertex_distance(const SurfaceMesh& m, const ImplicitFunction& f) {
   return worst;
 }
 
-/// The guarantees of the quality mode, asserted over the whole mesh. The sampled distance may exceed the
+/// The guarantees of the quality mode, asserted over the whole mesh: require_closed(), every angle, the
+/// vertices on the surface, the distance on dense samples. The sampled distance may exceed the
 /// bound by the slack factor: the criterion holds at the ball centres (see docs/quality.md).
-inline void require_quality(const SurfaceMesh& m, const ImplicitFunction& f, const QualityOptions& o, long long euler,
-                     std::size_t components, double distance_slack = 1.25, double vertex_tolerance = 1e-8) {
+inline void require_quality(const SurfaceMesh& m, const ImplicitFunction& f, const QualityOptions& o,
+                            long long euler, std::size_t components, double distance_slack = 1.25,
+                            double vertex_tolerance = 1e-8) {
+  require_closed(m, euler, components);
   const MeshMetrics mm = metrics_of(m);
-  INFO("V " << mm.vertices << " F " << mm.triangles << " boundary " << mm.boundary_edges << " nonmanifold e/v "
-            << mm.non_manifold_edges << "/" << mm.non_manifold_vertices << " inconsistent " << mm.inconsistent_edges
-            << " euler " << mm.euler_characteristic << " components " << mm.components << " min angle "
-            << mm.min_angle);
-  REQUIRE(mm.closed_manifold());
-  REQUIRE(mm.isolated_vertices == 0);
-  REQUIRE(mm.euler_characteristic == euler);
-  REQUIRE(mm.components == components);
-  REQUIRE(mm.signed_volume > 0.0);
-  REQUIRE(m.normals.size() == m.vertices.size());
   // Every triangle: smallest angle >= the bound (min_angle is the minimum over all triangles).
   REQUIRE(mm.min_angle >= o.min_angle_degrees - 1e-9);
   REQUIRE(vertex_distance(m, f) <= vertex_tolerance);
@@ -67,7 +61,8 @@ inline void require_quality(const SurfaceMesh& m, const ImplicitFunction& f, con
   }
 }
 
-inline QualityOptions quality(double angle, double distance, double size = std::numeric_limits<double>::infinity()) {
+inline QualityOptions quality(double angle, double distance,
+                              double size = std::numeric_limits<double>::infinity()) {
   QualityOptions o;
   o.min_angle_degrees = angle;
   o.max_distance = distance;

@@ -30,7 +30,9 @@ struct Components {
 std::vector<std::uint8_t> thin_out(const std::vector<Point3>& points, double spacing) {
   std::unordered_map<std::uint64_t, std::vector<std::uint32_t>> grid;
   auto cell = [&](const Point3& p, int dx, int dy, int dz) {
-    const auto c = [&](double x, int d) { return std::uint64_t(std::int64_t(std::floor(x / spacing)) + d) & 0x1fffff; };
+    const auto c = [&](double x, int d) {
+      return std::uint64_t(std::int64_t(std::floor(x / spacing)) + d) & 0x1fffff;
+    };
     return c(p.x, dx) | (c(p.y, dy) << 21) | (c(p.z, dz) << 42);
   };
   std::vector<std::uint8_t> keep(points.size(), 0);
@@ -93,7 +95,8 @@ std::vector<Point3> QualityMesher::seeds_from_mesh(const SurfaceMesh& mesh, doub
   return seeds;
 }
 
-std::vector<Point3> QualityMesher::seed_points(const ImplicitFunction& f, const Box3& domain, double spacing) {
+std::vector<Point3> QualityMesher::seed_points(const ImplicitFunction& f, const Box3& domain,
+                                               double spacing) {
   if (!(spacing > 0.0) || !std::isfinite(spacing))
     throw InvalidArgument("QualityMesher::seed_points: spacing must be finite and > 0");
   Polygonizer poly(f, domain);

@@ -35,7 +35,9 @@ constexpr double kClassifyTolerance = 1e-7;
 
 constexpr double kRadiansPerDegree = 3.14159265358979323846 / 180.0;
 
-bool negative(double value) { return value < 0.0; }  // sign(0) = +
+bool negative(double value) {
+  return value < 0.0;
+}  // sign(0) = +
 
 // Entry and exit parameters of the segment a + s (b - a), s in [0, 1], in the closed box; false when it
 // misses the box.
@@ -60,7 +62,8 @@ bool clip_to_box(const Point3& a, const Point3& b, const Box3& box, double& s0, 
 }  // namespace
 
 std::size_t QualityMesher::FacetKeyHash::operator()(const FacetKey& k) const {
-  std::uint64_t h = std::uint64_t(k.v[0]) * 0x9e3779b97f4a7c15ULL ^ std::uint64_t(k.v[1]) * 0xc2b2ae3d27d4eb4fULL ^
+  std::uint64_t h = std::uint64_t(k.v[0]) * 0x9e3779b97f4a7c15ULL ^
+                    std::uint64_t(k.v[1]) * 0xc2b2ae3d27d4eb4fULL ^
                     std::uint64_t(k.v[2]) * 0x165667b19e3779f9ULL;
   h ^= h >> 31;
   h *= 0xbf58476d1ce4e5b9ULL;
@@ -84,7 +87,8 @@ QualityMesher::FacetKey QualityMesher::key_of(TetId t, int i) const {
   return k;
 }
 
-void QualityMesher::evaluate(const std::vector<Point3>& p, std::vector<double>& out, std::size_t& phase_counter) {
+void QualityMesher::evaluate(const std::vector<Point3>& p, std::vector<double>& out,
+                             std::size_t& phase_counter) {
   out.resize(p.size());
   if (p.empty()) return;
   f_.values(p.data(), p.size(), out.data());
@@ -117,8 +121,10 @@ void QualityMesher::evaluate_circumcenters(const std::vector<TetId>& tets) {
 void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
   std::vector<TetId> live;
   for (TetId t : pending_list_)
-    if (pending_[t] && tri_.is_live(t)) live.push_back(t);
-    else pending_[t] = 0;
+    if (pending_[t] && tri_.is_live(t))
+      live.push_back(t);
+    else
+      pending_[t] = 0;
   pending_list_.clear();
   std::vector<TetId> unknown;
   for (TetId t : live) {
@@ -139,7 +145,15 @@ void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
         erase_facet(t, i);
         continue;
       }
-      brackets.push_back({t, i, ccenter_[t], ccenter_[n], cvalue_[t], cvalue_[n], 0, {}, std::numeric_limits<double>::quiet_NaN()});
+      brackets.push_back({t,
+                          i,
+                          ccenter_[t],
+                          ccenter_[n],
+                          cvalue_[t],
+                          cvalue_[n],
+                          0,
+                          {},
+                          std::numeric_limits<double>::quiet_NaN()});
     }
   }
   for (TetId t : live) pending_[t] = 0;
@@ -226,7 +240,8 @@ void QualityMesher::solve_brackets(std::vector<Bracket>& brackets) {
       const Point3 u = (b.b - b.a) / norm(b.b - b.a);
       const double slope = dot(grads[m], u);
       b.last = points[m];
-      b.newton = slope != 0.0 && std::isfinite(slope) ? -fx / slope : std::numeric_limits<double>::quiet_NaN();
+      b.newton =
+          slope != 0.0 && std::isfinite(slope) ? -fx / slope : std::numeric_limits<double>::quiet_NaN();
       if (fx == 0.0) {
         b.a = b.b = points[m];
       } else if (negative(fx) == negative(b.fa)) {
@@ -255,8 +270,10 @@ void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
     facets_[key] = r;
     flag_facet(b.t, b.i);
     for (VertexId v : key.v) mark_vertex_dirty(v);
-    if (is_bad(r)) push(key, r, false);
-    else if (needs_probes(r)) unprobed_.push_back(key);
+    if (is_bad(r))
+      push(key, r, false);
+    else if (needs_probes(r))
+      unprobed_.push_back(key);
   }
 }
 
@@ -275,7 +292,8 @@ void QualityMesher::probe_pending() {
 }
 
 bool QualityMesher::needs_probes(const FacetRecord& r) const {
-  return r.probe_distance == kNotProbed && options_.distance_probes > 0 && std::isfinite(options_.max_distance);
+  return r.probe_distance == kNotProbed && options_.distance_probes > 0 &&
+         std::isfinite(options_.max_distance);
 }
 
 // The first-order distance |f| / |grad f| at the probes of the facets `keys` (one batch): the points of
@@ -353,8 +371,10 @@ void QualityMesher::requeue_all() {
   queue_ = {};
   unprobed_.clear();
   for (const auto& kv : facets_) {
-    if (is_bad(kv.second)) push(kv.first, kv.second, false);
-    else if (needs_probes(kv.second)) unprobed_.push_back(kv.first);
+    if (is_bad(kv.second))
+      push(kv.first, kv.second, false);
+    else if (needs_probes(kv.second))
+      unprobed_.push_back(kv.first);
   }
 }
 

@@ -5,8 +5,9 @@
 //      restricted facet gets its surface Delaunay ball and, when it breaks a criterion (angle, distance,
 //      size, a box corner as vertex), a queue entry, largest ball first;
 //   2. when the queue is empty, probe the distance of the facets that meet every other criterion
-//      (quality_facets.cpp); when it is still empty, check the restricted star of every vertex whose star changed: it must be a
-//      topological disk (its link a single cycle); otherwise the largest facet of the star is queued;
+//      (quality_facets.cpp); when it is still empty, check the restricted star of every vertex whose star
+//      changed: it must be a topological disk (its link a single cycle); otherwise the largest facet of the
+//      star is queued;
 //   3. insert the ball centres of a batch of queue entries whose record is still current (the centre is a
 //      point of the surface and its ball is empty, so it is at least the ball radius from every vertex);
 //      the tetrahedra killed lose their facets, the created ones wait for step 1.

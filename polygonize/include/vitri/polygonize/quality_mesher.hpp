@@ -72,20 +72,20 @@ struct QualityOptions {
 
 /// Counters of a QualityMesher (cumulative since construction unless stated).
 struct QualityStats {
-  std::size_t vertices = 0;             ///< live Delaunay vertices (the 8 box corners included)
-  std::size_t restricted_facets = 0;    ///< current restricted Delaunay facets (the mesh triangles)
-  std::size_t seeds = 0;                ///< seed points inserted by the constructor
-  std::size_t insertions = 0;           ///< surface Delaunay ball centres inserted by refine()
-  std::size_t topology_insertions = 0;  ///< of which for a vertex whose restricted star was not a disk
-  std::size_t rejected = 0;             ///< centres that duplicated a vertex (facet left as it was)
-  std::size_t function_evaluations = 0; ///< calls of f (values and gradients), all phases
+  std::size_t vertices = 0;                  ///< live Delaunay vertices (the 8 box corners included)
+  std::size_t restricted_facets = 0;         ///< current restricted Delaunay facets (the mesh triangles)
+  std::size_t seeds = 0;                     ///< seed points inserted by the constructor
+  std::size_t insertions = 0;                ///< surface Delaunay ball centres inserted by refine()
+  std::size_t topology_insertions = 0;       ///< of which for a vertex whose restricted star was not a disk
+  std::size_t rejected = 0;                  ///< centres that duplicated a vertex (facet left as it was)
+  std::size_t function_evaluations = 0;      ///< calls of f (values and gradients), all phases
   std::size_t circumcenter_evaluations = 0;  ///< of which at circumcentres (signs of the Voronoi edges)
   std::size_t root_evaluations = 0;          ///< of which by the root finder on Voronoi edges
   std::size_t probe_evaluations = 0;         ///< of which at the distance probes of facets
-  std::size_t projected = 0;            ///< function_changed(): vertices moved back onto the surface
-  std::size_t removed = 0;              ///< function_changed(): vertices removed (no root nearby)
-  double refine_seconds = 0;            ///< last refine()
-  double extract_seconds = 0;           ///< last extract()
+  std::size_t projected = 0;                 ///< function_changed(): vertices moved back onto the surface
+  std::size_t removed = 0;                   ///< function_changed(): vertices removed (no root nearby)
+  double refine_seconds = 0;                 ///< last refine()
+  double extract_seconds = 0;                ///< last extract()
 };
 
 /// Restricted Delaunay surface mesher with Delaunay refinement (the quality mode). Not thread-safe.
@@ -221,17 +221,17 @@ class QualityMesher {
   QualityOptions options_;
   Triangulation tri_;
   double diagonal_;
-  std::vector<double> cvalue_;          // per tet: f at its circumcentre (NaN: unknown, +inf: outside box)
-  std::vector<Point3> ccenter_;         // per tet: circumcentre, valid with cvalue_
-  std::vector<std::uint8_t> pending_;   // per tet: its facets wait for classification
-  std::vector<std::uint8_t> rflags_;    // per tet: bit i set when facet i may have a record
+  std::vector<double> cvalue_;         // per tet: f at its circumcentre (NaN: unknown, +inf: outside box)
+  std::vector<Point3> ccenter_;        // per tet: circumcentre, valid with cvalue_
+  std::vector<std::uint8_t> pending_;  // per tet: its facets wait for classification
+  std::vector<std::uint8_t> rflags_;   // per tet: bit i set when facet i may have a record
   std::vector<TetId> pending_list_;
   std::vector<std::uint8_t> on_surface_;  // per vertex: a seed or ball centre (not a box corner)
   std::vector<std::uint8_t> dirty_;       // per vertex: star changed since the last topology check
   std::vector<VertexId> dirty_list_;
   std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
   std::priority_queue<QueueItem> queue_;
-  std::vector<FacetKey> unprobed_;      // facets that meet every criterion but wait for their probes
+  std::vector<FacetKey> unprobed_;  // facets that meet every criterion but wait for their probes
   std::uint32_t stamp_ = 0;
   ChangeSet changes_;
   QualityStats stats_;

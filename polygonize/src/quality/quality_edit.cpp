@@ -200,6 +200,7 @@ void QualityMesher::function_changed(const Box3& region) {
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
     if (tri_.is_vertex(v) && on_surface_[v] && region.contains(tri_.point(v))) ids.push_back(v);
   project_vertices(ids);
+  old_facets_.clear();  // roots and probes of the old f
   // Circumcentres inside the region get new values; a facet whose Voronoi edge meets the region (its
   // bounding box does) is classified again.
   grow_tet_arrays();

@@ -266,6 +266,8 @@ void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
   for (const Bracket& b : brackets) {
     const FacetKey key = key_of(b.t, b.i);
     FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, kNotProbed, ++stamp_, negative(cvalue_[b.t])};
+    const auto old = old_facets_.find(key);
+    if (old != old_facets_.end()) r.probe_distance = old->second.probe_distance;  // same triangle
     for (VertexId v : key.v) r.radius = std::max(r.radius, distance(r.center, tri_.point(v)));
     facets_[key] = r;
     flag_facet(b.t, b.i);
@@ -332,12 +334,28 @@ void QualityMesher::probe_facets(const std::vector<FacetKey>& keys) {
   }
 }
 
+// A facet on the boundary of an insertion's cavity keeps its dual line (through its circumcentre,
+// perpendicular to it): only the ends of its Voronoi edge move. If its old ball centre, a root of f on that
+// line, lies inside the new edge, it is the crossing again: no evaluation. (old_facets_ holds the records
+// erased since the last classification; f has not changed since: function_changed() clears it.)
+void QualityMesher::warm_start(std::vector<Bracket>& brackets) {
+  for (Bracket& b : brackets) {
+    const auto it = old_facets_.find(key_of(b.t, b.i));
+    if (it == old_facets_.end()) continue;
+    const Point3 d = b.b - b.a;
+    const double s = dot(it->second.center - b.a, d) / squared_norm(d);
+    if (s > 0.0 && s < 1.0) b.a = b.b = it->second.center;
+  }
+}
+
 void QualityMesher::classify_pending() {
   std::vector<Bracket> brackets;
   collect_brackets(brackets);
   clip_brackets(brackets);
+  warm_start(brackets);
   solve_brackets(brackets);
   store_facets(brackets);
+  old_facets_.clear();
 }
 
 // The refinement criteria of one restricted facet. The angle test uses sin(smallest angle) = |n| / (l1 l2)

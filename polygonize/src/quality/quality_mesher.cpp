@@ -116,6 +116,7 @@ void QualityMesher::forget_all_facets() {
   facets_.clear();
   queue_ = {};
   unprobed_.clear();
+  old_facets_.clear();
   grow_tet_arrays();
   grow_vertex_arrays();
   std::fill(cvalue_.begin(), cvalue_.end(), std::numeric_limits<double>::quiet_NaN());
@@ -148,7 +149,7 @@ void QualityMesher::absorb(const ChangeSet& cs) {
 }
 
 // Forgets the record of facet i of t, if t's flags say there may be one; its vertices then wait for the
-// topology check.
+// topology check, its ball centre in old_facets_ for the next classification (warm_start()).
 void QualityMesher::erase_facet(TetId t, int i) {
   const std::uint8_t bit = std::uint8_t(1u << i);
   if (!(rflags_[t] & bit)) return;
@@ -156,6 +157,7 @@ void QualityMesher::erase_facet(TetId t, int i) {
   const auto it = facets_.find(key_of(t, i));
   if (it == facets_.end()) return;
   for (VertexId v : it->first.v) mark_vertex_dirty(v);
+  old_facets_[it->first] = {it->second.center, it->second.probe_distance};
   facets_.erase(it);
 }
 

@@ -187,6 +187,7 @@ class QualityMesher {
   void classify_pending();
   void collect_brackets(std::vector<Bracket>& brackets);
   void clip_brackets(std::vector<Bracket>& brackets);
+  void warm_start(std::vector<Bracket>& brackets);
   void solve_brackets(std::vector<Bracket>& brackets);
   void store_facets(const std::vector<Bracket>& brackets);
   bool needs_probes(const FacetRecord& r) const;
@@ -232,6 +233,13 @@ class QualityMesher {
   std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
   std::priority_queue<QueueItem> queue_;
   std::vector<FacetKey> unprobed_;  // facets that meet every criterion but wait for their probes
+  /// What a facet keeps when its record is erased by an insertion: it may come back (a facet on the
+  /// boundary of the cavity) with the same ball centre (same dual line) and the same probes (same triangle).
+  struct OldFacet {
+    Point3 center;
+    double probe_distance;
+  };
+  std::unordered_map<FacetKey, OldFacet, FacetKeyHash> old_facets_;  // records erased since classification
   std::uint32_t stamp_ = 0;
   ChangeSet changes_;
   QualityStats stats_;

@@ -3,8 +3,8 @@
 /// The quality mode: a restricted Delaunay surface mesh refined by surface Delaunay balls (Boissonnat &
 /// Oudot 2005) on vitri's own Delaunay tree, for any ImplicitFunction. Every output triangle has its
 /// smallest angle >= QualityOptions::min_angle_degrees (up to 30), the distance between each triangle and
-/// the surface at its surface Delaunay ball centre is <= max_distance (small triangles where the surface
-/// bends, large where it is flat), and the mesh is a closed, outward, 2-manifold. Method, guarantee and its
+/// the surface is <= max_distance at its surface Delaunay ball centre and its probes (small triangles where
+/// the surface bends, large where it is flat), and the mesh is a closed, outward, 2-manifold. Method, guarantee and its
 /// conditions: docs/quality.md.
 ///
 ///   vitri::TorusFunction f({0, 0, 0}, 1.0, 0.4);

@@ -164,3 +164,16 @@ TEST_CASE("quality: bad options and seeds are rejected with clear errors", "[qua
   QualityMesher q(f, kCube, seeds, tiny);
   REQUIRE_THROWS_AS(q.refine(), LimitError);
 }
+
+TEST_CASE("quality: no seeds or no surface gives an empty mesh, no crash", "[quality]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 1.0);
+  QualityMesher empty(f, kCube, {}, quality(30.0, 0.01));
+  REQUIRE(empty.refine());
+  REQUIRE(empty.extract().triangles.empty());
+  // f > 0 everywhere: the seeds cannot be projected onto a surface and are skipped.
+  const SphereFunction far({10.0, 10.0, 10.0}, 0.5);
+  QualityMesher none(far, kCube, {{0.5, 0.0, 0.0}, {0.0, 0.5, 0.0}}, quality(30.0, 0.01));
+  REQUIRE(none.stats().seeds == 0);
+  REQUIRE(none.refine());
+  REQUIRE(none.extract().triangles.empty());
+}

@@ -6,11 +6,13 @@
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -21,9 +23,9 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj --precision P [--precision P2 ...] [--edits SCRIPT]\n"
+    "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--neighbours K]\n"
-    "                  [--function global|local|auto] [--smoothing S] [-q]\n"
-    "\n"
+    "                  [--function global|local|auto] [--smoothing S] [-q]\n"    "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
     "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
@@ -58,6 +60,16 @@ const char* const kUsage =
     "                       unreferenced vertices skipped), then the off-surface ones, per kept point in\n"
     "                       the same order its +D (outside) then its -D (inside) constraint, those that\n"
     "                       --sides leaves out or a thin part drops being skipped.\n"
+    "  --min-angle A        quality mode (docs/quality.md): a restricted Delaunay mesh refined until every\n"
+    "                       triangle's smallest angle is >= A degrees (0 to 30; default 30 in the\n"
+    "                       quality mode), seeded by the fast mesh at --precision. Any of --min-angle,\n"
+    "                       --max-distance, --max-size turns the quality mode on.\n"
+    "  --max-distance E     quality mode: distance between each triangle and the surface at most E x the\n"
+    "                       diagonal (small triangles where the surface bends). Repeat it for levels of\n"
+    "                       detail (strictly decreasing); with both lists, level k uses the k-th value\n"
+    "                       of each, a shorter list repeating its last value.\n"
+    "  --max-size S         quality mode: surface Delaunay ball radius (about the circumradius of each\n"
+    "                       triangle) at most S x the diagonal\n"
     "  --offset D           off-surface constraint distance for points/meshes, fraction of the\n"
     "                       diagonal (default 0.01)\n"
     "  --sides S            off-surface constraints per point for points/meshes: both (default; +D\n"
@@ -136,6 +148,8 @@ const char* mesh_usage() { return kUsage; }
 int run_mesh(const Args& args) {
   std::string input, output, edits;
   std::vector<double> precisions;
+  std::vector<double> distances;  // quality mode: --max-distance per level (relative)
+  double relative_size = std::numeric_limits<double>::infinity();  // quality mode: --max-size
   bool quiet = false;
   MesherOptions options;
   options.function = FunctionKind::Auto;
@@ -154,6 +168,19 @@ int run_mesh(const Args& args) {
       if (!value(v) || !parse_double(v, p)) return usage_error("--precision needs a number");
       if (!(p > 0.0) || !std::isfinite(p)) return usage_error("--precision must be positive and finite, got " + v);
       precisions.push_back(p);
+    } else if (a == "--min-angle") {
+      double d;
+      if (!value(v) || !parse_double(v, d) || !(d >= 0.0 && d <= 30.0))
+        return usage_error("--min-angle needs a number of degrees in [0, 30]");
+      options.mode = MeshMode::Quality;
+      options.quality.min_angle_degrees = d;
+    } else if (a == "--max-distance" || a == "--max-size") {
+      double d;
+      if (!value(v) || !parse_double(v, d) || !(d > 0.0) || !std::isfinite(d))
+        return usage_error(a + " needs a positive number");
+      options.mode = MeshMode::Quality;
+      if (a == "--max-size") relative_size = d;
+      else distances.push_back(d);
     } else if (a == "--edits") {
       if (!value(edits)) return usage_error("--edits needs a path");
     } else if (a == "--offset") {
@@ -195,13 +222,16 @@ int run_mesh(const Args& args) {
   if (input.empty()) return usage_error("no input file");
   if (output.empty()) return usage_error("no output file (-o OUT.obj)");
   if (precisions.empty()) return usage_error("no --precision");
-  for (std::size_t k = 1; k < precisions.size(); ++k)
-    if (!(precisions[k] < precisions[k - 1])) {
-      std::ostringstream what;
-      what << "--precision values must go from coarse to fine (strictly decreasing): level " << k - 1 << " is "
-           << precisions[k - 1] << ", level " << k << " is " << precisions[k];
-      return usage_error(what.str());
-    }
+  for (const auto* list : {&precisions, &distances})
+    for (std::size_t k = 1; k < list->size(); ++k)
+      if (!((*list)[k] < (*list)[k - 1])) {
+        std::ostringstream what;
+        what << (list == &precisions ? "--precision" : "--max-distance")
+             << " values must go from coarse to fine (strictly decreasing): level " << k - 1 << " is "
+             << (*list)[k - 1] << ", level " << k << " is " << (*list)[k];
+        return usage_error(what.str());
+      }
+  const std::size_t levels = std::max(precisions.size(), distances.size());
   const std::string ext = file_extension(output);
   if (ext != "obj" && ext != "ply" && ext != "off")
     return usage_error("output must end in .obj, .ply or .off, got '" + output + "'");
@@ -231,11 +261,18 @@ int run_mesh(const Args& args) {
                 "extract ms", "total ms");
   }
   double total_ms = build_ms;
-  for (std::size_t k = 0; k < precisions.size(); ++k) {
+  for (std::size_t k = 0; k < levels; ++k) {
+    const double precision = precisions[std::min(k, precisions.size() - 1)];
+    if (options.mode == MeshMode::Quality) {
+      QualityOptions q = options.quality;
+      q.max_size = relative_size * diag;
+      if (!distances.empty()) q.max_distance = distances[std::min(k, distances.size() - 1)] * diag;
+      mesher.set_quality_options(q);
+    }
     const auto t0 = Clock::now();
     auto last_report = Clock::now();
     bool reported = false;
-    mesher.refine(precisions[k] * diag, [&](const RefineProgress& p) {
+    mesher.refine(precision * diag, [&](const RefineProgress& p) {
       if (!quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
         std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
                      p.queued);
@@ -250,10 +287,10 @@ int run_mesh(const Args& args) {
     const SurfaceMesh& m = mesher.surface();
     const double extract_ms = ms_since(t1);
     total_ms += refine_ms + extract_ms;
-    const std::string path = precisions.size() == 1 ? output : level_path(output, k);
+    const std::string path = levels == 1 ? output : level_path(output, k);
     write_current(mesher, path);
     if (!quiet)
-      std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precisions[k], m.vertices.size(),
+      std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
                   m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());
   }
 

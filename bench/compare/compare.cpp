@@ -41,6 +41,7 @@
 //   --grid-box  box enlargement of the grid contender (default 1.6)
 // VITRI_COMPARE_DEBUG=1 in the environment prints every search step to stderr.
 // bench/compare/run_compare.sh builds this in Release and writes bench/compare/results/.
+#include "compare/compare_common.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/core/implicit.hpp"
@@ -54,14 +55,6 @@
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/rbf.hpp"
 
-#ifdef VITRI_HAVE_CGAL
-#include <CGAL/Complex_2_in_triangulation_3.h>
-#include <CGAL/IO/facets_in_complex_2_to_triangle_mesh.h>
-#include <CGAL/Implicit_surface_3.h>
-#include <CGAL/Surface_mesh.h>
-#include <CGAL/Surface_mesh_default_triangulation_3.h>
-#include <CGAL/make_surface_mesh.h>
-#endif
 
 #include <algorithm>
 #include <atomic>
@@ -82,140 +75,7 @@
 namespace {
 
 using namespace vitri;
-
-constexpr std::size_t kRbfConstraints = 2400;  // cap of the RBF surfaces (800 points x 3)
-
-double now() {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
-}
-
-/// CPU seconds of this process (all its threads): less sensitive than wall time to other processes on a
-/// shared machine, but counts both cores when the RBF batch evaluation is threaded.
-double cpu_now() {
-  timespec ts{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
-
-std::string data_path(const std::string& name) { return std::string(VITRI_DATA_DIR) + "/" + name; }
-
-/// Forwards to a function and counts evaluations (single and batch; a gradient counts as one).
-class CountingFunction final : public ImplicitFunction {
- public:
-  explicit CountingFunction(const ImplicitFunction& f) : f_(f) {}
-  double value(const Point3& p) const override {
-    count_.fetch_add(1, std::memory_order_relaxed);
-    return f_.value(p);
-  }
-  double value_gradient(const Point3& p, Point3& g) const override {
-    count_.fetch_add(1, std::memory_order_relaxed);
-    return f_.value_gradient(p, g);
-  }
-  void values(const Point3* p, std::size_t n, double* out) const override {
-    count_.fetch_add(n, std::memory_order_relaxed);
-    f_.values(p, n, out);
-  }
-  void values_gradients(const Point3* p, std::size_t n, double* v, Point3* g) const override {
-    count_.fetch_add(n, std::memory_order_relaxed);
-    f_.values_gradients(p, n, v, g);
-  }
-  std::size_t count() const { return count_.load(); }
-
- private:
-  const ImplicitFunction& f_;
-  mutable std::atomic<std::size_t> count_{0};
-};
-
-// ------------------------------------------------------------------------------------------------------
-// Surfaces
-
-struct Surface {
-  std::string name;
-  std::string source;                       // how it was made (for the report)
-  std::unique_ptr<ImplicitFunction> owned;  // the function
-  const ImplicitFunction* f = nullptr;
-  Box3 shape_box;                           // box containing the surface (constraints' box for RBFs)
-  Box3 domain;                              // vitri's Delaunay domain (shape box x 2, as the Mesher)
-  std::vector<Point3> seeds;                // constraint points (RBF) or none (analytic)
-  std::vector<double> seed_values;
-  Point3 inside;                            // a point with f < 0 (CGAL's bounding-sphere centre)
-  std::size_t constraints = 0;
-  double fit_seconds = 0;
-  double residual = 0;
-};
-
-Surface analytic_sphere() {
-  Surface s;
-  s.name = "sphere";
-  s.source = "analytic, radius 1 (signed distance)";
-  s.owned = std::make_unique<SphereFunction>(Point3{0, 0, 0}, 1.0);
-  s.f = s.owned.get();
-  s.shape_box.extend({-1, -1, -1});
-  s.shape_box.extend({1, 1, 1});
-  s.domain = s.shape_box.scaled(2.0);
-  s.inside = {0, 0, 0};
-  return s;
-}
-
-Surface analytic_torus() {
-  Surface s;
-  s.name = "torus";
-  s.source = "analytic, R = 1, r = 0.35 (signed distance)";
-  s.owned = std::make_unique<TorusFunction>(Point3{0, 0, 0}, 1.0, 0.35);
-  s.f = s.owned.get();
-  s.shape_box.extend({-1.35, -1.35, -0.35});
-  s.shape_box.extend({1.35, 1.35, 0.35});
-  s.domain = s.shape_box.scaled(2.0);
-  s.inside = {1.0, 0, 0};
-  // Seeds on the core circle (f = -r): the initial sampling lattice is coarser than the tube, and a
-  // general function needs user seeds (issue 5); the RBF surfaces use their constraint points instead.
-  for (int k = 0; k < 8; ++k) {
-    const double a = 2 * 3.14159265358979323846 * k / 8.0;
-    s.seeds.push_back({std::cos(a), std::sin(a), 0.0});
-    s.seed_values.push_back(-0.35);
-  }
-  return s;
-}
-
-Surface rbf_surface(const std::string& name, const Constraints& c, const std::string& source,
-                    unsigned threads) {
-  Surface s;
-  s.name = name;
-  s.source = source;
-  auto rbf = std::make_unique<Rbf>();
-  RbfOptions ro;
-  ro.threads = threads;
-  const double t0 = now();
-  rbf->fit(c, ro);
-  s.fit_seconds = now() - t0;
-  s.residual = rbf->report().relative_residual;
-  s.owned = std::move(rbf);
-  s.f = s.owned.get();
-  s.constraints = c.size();
-  for (const Point3& p : c.points) s.shape_box.extend(p);
-  s.domain = Polygonizer::domain_for(c.points, 2.0);
-  s.seeds = c.points;
-  s.seed_values = c.values;
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < c.size(); ++i)
-    if (c.values[i] < c.values[best]) best = i;
-  s.inside = c.points[best];
-  return s;
-}
-
-Constraints mesh_constraints(const std::string& file, std::size_t cap) {
-  const TriangleMesh m = read_mesh(data_path(file));
-  ConstraintBuildOptions o;
-  o.max_constraints = cap;
-  return constraints_from_mesh(m.V, m.F, o);
-}
-
-Constraints points_constraints(const std::string& file, std::size_t cap) {
-  const OrientedPoints p = read_points(data_path(file));
-  ConstraintBuildOptions o;
-  o.max_constraints = cap;
-  return constraints_from_oriented_points(p.points, p.normals, o);
-}
+using namespace vitri::bench_compare;
 
 // ------------------------------------------------------------------------------------------------------
 // Runs
@@ -280,55 +140,18 @@ Run run_grid(const Surface& s, int cells) {
 }
 
 #ifdef VITRI_HAVE_CGAL
-using Tr = CGAL::Surface_mesh_default_triangulation_3;
-using C2t3 = CGAL::Complex_2_in_triangulation_3<Tr>;
-using GT = Tr::Geom_traits;
-using CgalPoint = GT::Point_3;
-using CgalSphere = GT::Sphere_3;
-using CgalFT = GT::FT;
-
 Run run_cgal(const Surface& s, double radius_bound) {
   CountingFunction cf(*s.f);
   Run r;
   r.contender = "cgal";
   r.param_name = "radius_bound";
   r.param = radius_bound;
-  double bound2 = 0;  // squared radius of the bounding sphere: farthest shape-box corner x 1.05
-  for (int k = 0; k < 8; ++k) bound2 = std::max(bound2, squared_distance(s.inside, s.shape_box.corner(k)));
-  bound2 *= 1.05 * 1.05;
   const double c0 = cpu_now();
   const double t0 = now();
-  Tr tr;
-  C2t3 c2t3(tr);
-  const ImplicitFunction* fp = &cf;
-  std::function<CgalFT(CgalPoint)> fn = [fp](CgalPoint p) { return fp->value({p.x(), p.y(), p.z()}); };
-  CGAL::Implicit_surface_3<GT, std::function<CgalFT(CgalPoint)>> surface(
-      fn, CgalSphere(CgalPoint(s.inside.x, s.inside.y, s.inside.z), bound2), 1e-3);
-  CGAL::Surface_mesh_default_criteria_3<Tr> criteria(30.0, radius_bound, 0.25 * radius_bound);
-  CGAL::make_surface_mesh(c2t3, surface, criteria, CGAL::Manifold_tag());
-  CGAL::Surface_mesh<CgalPoint> sm;
-  CGAL::facets_in_complex_2_to_triangle_mesh(c2t3, sm);
+  cgal_surface_mesh(cf, s, 30.0, radius_bound, 0.25 * radius_bound, 1e-3, r.V, r.F);
   r.mesh_seconds = now() - t0;
   r.mesh_cpu_seconds = cpu_now() - c0;
   r.evaluations = cf.count();
-  r.V.resize(static_cast<Eigen::Index>(sm.number_of_vertices()), 3);
-  std::map<std::size_t, int> index;
-  int n = 0;
-  for (auto v : sm.vertices()) {
-    const CgalPoint& p = sm.point(v);
-    r.V.row(n) << p.x(), p.y(), p.z();
-    index[static_cast<std::size_t>(v)] = n++;
-  }
-  r.F.resize(static_cast<Eigen::Index>(sm.number_of_faces()), 3);
-  int fi = 0;
-  for (auto f : sm.faces()) {
-    int k = 0;
-    for (auto v : CGAL::vertices_around_face(sm.halfedge(f), sm)) {
-      if (k < 3) r.F(fi, k) = index[static_cast<std::size_t>(v)];
-      ++k;
-    }
-    ++fi;
-  }
   return r;
 }
 #endif

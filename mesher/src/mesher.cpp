@@ -11,7 +11,9 @@
 //   5. refinement vertices that no transverse tetrahedron touches any more are removed (this never
 //      creates a transverse tetrahedron), so repeated edits do not accumulate Steiner points; in
 //      batches, once they exceed MesherOptions::garbage_fraction of the vertices (removal is the
-//      costliest part of a small update, and a vertex left by one edit often serves the next).
+//      costliest part of a small update, and a vertex left by one edit often serves the next);
+//   6. quality mode: the QualityMesher moves the vertices that the edit took off the surface back onto
+//      it and re-meshes around them (QualityMesher::function_changed(), then refine()).
 // The mesh is extracted on demand afterwards.
 #include "vitri/mesher.hpp"
 
@@ -37,6 +39,7 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
     throw InvalidArgument("MesherOptions::box_factor must be > 1");
   if (!(options_.garbage_fraction >= 0.0) || !std::isfinite(options_.garbage_fraction))
     throw InvalidArgument("MesherOptions::garbage_fraction must be >= 0");
+  QualityMesher::validate(options_.quality);
   const double t0 = now_seconds();
   const bool local = options_.function == FunctionKind::Local ||
                      (options_.function == FunctionKind::Auto && constraints.size() > options_.auto_local_above);
@@ -84,6 +87,7 @@ void Mesher::build() {
   const Box3 domain = Polygonizer::domain_for(c.points, options_.box_factor);
   poly_ = std::make_unique<Polygonizer>(function(), domain, c.points, c.values, options_.polygonizer);
   vertex_of_ = poly_->seed_vertices();
+  quality_.reset();
   mesh_valid_ = false;
 }
 
@@ -102,12 +106,32 @@ bool Mesher::refine(double precision, const ProgressCallback& progress) {
   mesh_valid_ = false;
   const bool done = poly_->refine(precision, progress);
   precision_ = precision;
+  if (done) refine_quality();
   return done;
+}
+
+// Quality mode: builds the quality mesher from the fast mesh at the current precision (first call), or
+// continues it with the current criteria.
+void Mesher::refine_quality() {
+  if (options_.mode != MeshMode::Quality || !std::isfinite(precision_)) return;
+  if (!quality_) {
+    const std::vector<Point3> seeds = QualityMesher::seeds_from_mesh(poly_->extract(), precision_);
+    quality_ = std::make_unique<QualityMesher>(function(), poly_->triangulation().box(), seeds, options_.quality);
+  } else {
+    quality_->set_options(options_.quality);
+  }
+  quality_->refine();
+  mesh_valid_ = false;
+}
+
+void Mesher::set_quality_options(const QualityOptions& quality) {
+  QualityMesher::validate(quality);
+  options_.quality = quality;
 }
 
 const SurfaceMesh& Mesher::surface() {
   if (!mesh_valid_) {
-    mesh_ = poly_->extract();
+    mesh_ = quality_ ? quality_->extract() : poly_->extract();
     mesh_valid_ = true;
   }
   return mesh_;
@@ -125,6 +149,10 @@ void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion*
   }
   if (std::isfinite(precision_)) poly_->refine(precision_);
   if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction);
+  if (quality_) {
+    quality_->function_changed();
+    quality_->refine();
+  }
   mesh_valid_ = false;
   stats_.edit_rbf_seconds = rbf_seconds;
   stats_.edit_refine_seconds = now_seconds() - t1;
@@ -136,6 +164,7 @@ bool Mesher::rebuild_if_outside(const Point3& p, double t_start, double t_rbf) {
   ++stats_.rebuilds;
   build();
   if (std::isfinite(precision_)) poly_->refine(precision_);
+  refine_quality();
   stats_.edit_rbf_seconds = t_rbf;
   stats_.edit_seconds = now_seconds() - t_start;
   return true;
@@ -200,6 +229,7 @@ MesherStats Mesher::stats() const {
   MesherStats s = stats_;
   s.polygonizer = poly_->stats();
   s.constraints = size();
+  if (quality_) s.quality = quality_->stats();
   return s;
 }
 

@@ -391,3 +391,31 @@ TEST_CASE("vitri mesh: edit indices of oriented-point input: surface points firs
       REQUIRE(d > 0.15);
   }
 }
+
+TEST_CASE("vitri mesh --min-angle --max-distance: quality mode, every angle >= A, levels, edits", "[cli][mesh]") {
+  const std::string in = write_small_model(), out = kDir + "/mesh_quality.obj";
+  for (int k = 0; k < 2; ++k) std::remove((kDir + "/mesh_quality-" + std::to_string(k) + ".obj").c_str());
+  const std::string script = kDir + "/mesh_quality_edits.txt";
+  const std::string edited = kDir + "/mesh_quality_edited.obj";
+  std::remove(edited.c_str());
+  std::ofstream(script) << "move 1 0.1 0.05 0.55\nwrite " << edited << "\n";
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --precision 0.1 --min-angle 28 --max-distance 0.004 --max-distance 0.002" +
+                  " --edits " + script,
+              o, e) == 0);
+  INFO(o << e);
+  long last = 0;
+  for (const std::string& path : {kDir + "/mesh_quality-0.obj", kDir + "/mesh_quality-1.obj", edited}) {
+    const long n = check_mesh(path);
+    const TriangleMesh m = read_mesh(path);
+    REQUIRE(compute_mesh_metrics(m.V, m.F).min_angle >= 28.0 - 1e-9);  // over all triangles
+    if (path != edited) REQUIRE(n > last);
+    last = n;
+  }
+  // Usage errors: an angle above 30 degrees, a non-positive bound, bounds that do not decrease.
+  for (const char* bad : {"--min-angle 31", "--min-angle -1", "--max-distance 0", "--max-size -0.1",
+                          "--max-distance 0.002 --max-distance 0.004"}) {
+    INFO(bad);
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 " + bad, o, e) == 2);
+  }
+}

@@ -2,6 +2,7 @@
 // functions whose surface, topology and distance are known exactly.
 #include <catch2/catch.hpp>
 
+#include "support/mesh_checks.hpp"
 #include "support/surface_metrics.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/polygonize/analytic.hpp"
@@ -19,6 +20,7 @@ using namespace vitri;
 namespace {
 
 using test::metrics_of;
+using test::require_closed;
 
 /// Largest distance to the true surface over the vertices and the triangle centroids.
 template <class Fn>
@@ -29,21 +31,6 @@ double max_distance(const SurfaceMesh& m, const Fn& dist, bool centroids) {
     for (const auto& t : m.triangles)
       d = std::max(d, dist((m.vertices[t[0]] + m.vertices[t[1]] + m.vertices[t[2]]) / 3.0));
   return d;
-}
-
-void require_closed(const SurfaceMesh& m, long long euler, std::size_t components) {
-  const MeshMetrics mm = metrics_of(m);
-  INFO("V " << mm.vertices << " F " << mm.triangles << " boundary " << mm.boundary_edges << " nonmanifold e/v "
-            << mm.non_manifold_edges << "/" << mm.non_manifold_vertices << " inconsistent " << mm.inconsistent_edges
-            << " degenerate " << mm.degenerate_triangles << " zero-area " << mm.zero_area_triangles
-            << " duplicates " << mm.duplicate_vertices << " euler " << mm.euler_characteristic << " components "
-            << mm.components);
-  REQUIRE(mm.closed_manifold());
-  REQUIRE(mm.isolated_vertices == 0);
-  REQUIRE(mm.euler_characteristic == euler);
-  REQUIRE(mm.components == components);
-  REQUIRE(mm.signed_volume > 0.0);
-  REQUIRE(m.normals.size() == m.vertices.size());
 }
 
 const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};

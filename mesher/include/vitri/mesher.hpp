@@ -19,6 +19,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
+#include "vitri/polygonize/quality_mesher.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/local_rbf.hpp"
@@ -39,6 +40,15 @@ enum class FunctionKind {
   Auto,    ///< Global up to MesherOptions::auto_local_above constraints, Local above
 };
 
+/// What the Mesher outputs.
+enum class MeshMode {
+  /// Marching tetrahedra over the refined transverse tetrahedra (the paper): fast, any triangle shape.
+  Fast,
+  /// The restricted Delaunay mesh of the QualityMesher, seeded by the fast mesh: every angle >=
+  /// MesherOptions::quality.min_angle_degrees, distance bound (docs/quality.md). Slower.
+  Quality,
+};
+
 /// Options of the Mesher.
 struct MesherOptions {
   /// The implicit function. The library default stays Global (the paper's function); the CLI's is Auto.
@@ -51,6 +61,12 @@ struct MesherOptions {
   std::size_t auto_local_above = 4000;
   /// Options of the local function (FunctionKind::Local or Auto above the threshold).
   LocalRbfOptions local;
+  /// Fast (default) or Quality. In the quality mode, refine(precision) refines the fast structure to
+  /// `precision` (the scale of the seeds: its mesh vertices, thinned to `precision` apart) and then the
+  /// quality mesh to the criteria of `quality`.
+  MeshMode mode = MeshMode::Fast;
+  /// Criteria of the quality mode (absolute lengths), used when mode == Quality.
+  QualityOptions quality;
   /// Refinement and extraction options (queue order, root finder, sampling, zero-vertex snapping).
   PolygonizerOptions polygonizer;
   /// Fit and edit options of the RBF.
@@ -79,6 +95,7 @@ struct MesherStats {
   double edit_rbf_seconds = 0;     ///< last edit: RBF update
   double edit_refine_seconds = 0;  ///< last edit: Delaunay update, re-evaluation, refinement, cleanup
   std::size_t rebuilds = 0;        ///< edits that needed a new domain box (full rebuild)
+  QualityStats quality;            ///< quality mode: counters of the QualityMesher (zero otherwise)
 };
 
 /// Stateful mesher of one variational implicit surface. Not thread-safe. Movable, not copyable.
@@ -111,7 +128,8 @@ class Mesher {
   ~Mesher();
 
   /// Refines until every transverse tetrahedron has circumradius <= precision (absolute). A smaller
-  /// precision than the previous call continues the refinement (levels of detail).
+  /// precision than the previous call continues the refinement (levels of detail). Quality mode: then
+  /// refines the quality mesh (built at the first call, seeded at `precision`) to options().quality.
   /// @return false when the progress callback cancelled. @throws InvalidArgument for precision <= 0.
   bool refine(double precision, const ProgressCallback& progress = {});
 
@@ -120,6 +138,10 @@ class Mesher {
   /// The current mesh as Eigen arrays: V #V x 3, F #F x 3 (CCW seen from outside), N #V x 3 unit
   /// outward normals (gradient of f).
   void mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N);
+
+  /// Quality mode: new criteria for the next refine() (finer bounds continue the same structure: levels
+  /// of detail). @throws InvalidArgument as QualityMesher::validate.
+  void set_quality_options(const QualityOptions& quality);
 
   // ---- Dynamic editing: each edit updates the RBF, the Delaunay tree and the mesh -------------------
   /// Appends the constraint f(p) = value (index size() - 1). @throws as Rbf::add_constraint.
@@ -146,6 +168,8 @@ class Mesher {
   /// Absolute precision of the last refine() (infinity before the first).
   double precision() const { return precision_; }
   const Polygonizer& polygonizer() const { return *poly_; }
+  /// The quality mesher (quality mode, after the first refine()), else nullptr.
+  const QualityMesher* quality_mesher() const { return quality_.get(); }
   MesherStats stats() const;
   const MesherOptions& options() const { return options_; }
 
@@ -154,12 +178,14 @@ class Mesher {
   void after_edit(double rbf_seconds, double t_start, const ChangedRegion* region = nullptr);
   bool rebuild_if_outside(const Point3& p, double t_start, double t_rbf);
   double value_of(std::size_t i) const;
+  void refine_quality();
   bool inside_domain(const Point3& p) const;
 
   MesherOptions options_;
   std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer
   std::unique_ptr<LocalRbf> local_;  // keeps a reference. Exactly one of the two is set.
   std::unique_ptr<Polygonizer> poly_;
+  std::unique_ptr<QualityMesher> quality_;  // quality mode, built by the first refine()
   std::vector<VertexId> vertex_of_;  // Delaunay vertex of each constraint (kNoVertex: duplicate position)
   double precision_;
   SurfaceMesh mesh_;

@@ -1,0 +1,248 @@
+#pragma once
+/// @file quality_mesher.hpp
+/// The quality mode: a restricted Delaunay surface mesh refined by surface Delaunay balls (Boissonnat &
+/// Oudot 2005) on vitri's own Delaunay tree, for any ImplicitFunction. Every output triangle has its
+/// smallest angle >= QualityOptions::min_angle_degrees (up to 30), the distance between each triangle and
+/// the surface is <= max_distance at its surface Delaunay ball centre and its probes (small triangles where
+/// the surface bends, large where it is flat), and the mesh is a closed, outward, 2-manifold. Method, guarantee and its
+/// conditions: docs/quality.md.
+///
+///   vitri::TorusFunction f({0, 0, 0}, 1.0, 0.4);
+///   const vitri::Box3 box{{-2, -2, -1}, {2, 2, 1}};
+///   vitri::QualityOptions o;
+///   o.min_angle_degrees = 30;
+///   o.max_distance = 0.002;
+///   vitri::QualityMesher q(f, box, vitri::QualityMesher::seed_points(f, box, 0.2), o);
+///   q.refine();
+///   vitri::SurfaceMesh m = q.extract();   // closed, outward, every angle >= 30 degrees
+///
+/// Terms. The restricted Delaunay triangulation of the vertices to the surface S = {f = 0} is the set of
+/// Delaunay facets whose dual Voronoi edge (the segment between the circumcentres of the two tetrahedra of
+/// the facet) crosses S: here, whose two circumcentres have different signs of f (sign(0) = +). The
+/// crossing point c, found by root finding on that segment, is the centre of the facet's surface Delaunay
+/// ball, which passes through the facet's three vertices and contains no vertex.
+
+#include "vitri/core/box.hpp"
+#include "vitri/core/implicit.hpp"
+#include "vitri/core/point.hpp"
+#include "vitri/delaunay/triangulation.hpp"
+#include "vitri/polygonize/surface_mesh.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <unordered_map>
+#include <vector>
+
+namespace vitri {
+
+/// Criteria and knobs of the quality mode. Lengths are absolute (units of the function's domain).
+struct QualityOptions {
+  /// Every output triangle's smallest angle is >= this (degrees). Must be in [0, 30]: refinement is
+  /// proven to terminate up to 30 degrees (radius-edge ratio >= 1, see docs/quality.md). 0: no bound.
+  double min_angle_degrees = 30.0;
+  /// Bound on the distance between each facet and the surface, checked at the centre of its surface
+  /// Delaunay ball (distance to the facet's plane: how far the surface bulges away from the triangle, the
+  /// criterion of Boissonnat & Oudot and CGAL) and at the probes of the facet (first-order distance
+  /// |f| / |grad f|, which catches saddles where the plane cuts the surface, and wiggles). Curvature-
+  /// adapted: triangles get small where the surface bends. Must be > 0; infinity: no bound.
+  double max_distance = std::numeric_limits<double>::infinity();
+  /// Probes of the distance bound: the points of the barycentric grid with this many steps per edge,
+  /// the three vertices excepted, plus the centroid ((n + 1)(n + 2) / 2 - 2 evaluations per facet).
+  /// 0: the ball centre only (CGAL's criterion); 2: edge midpoints and centroid. In [0, 16].
+  int distance_probes = 4;
+  /// Bound on the radius of each facet's surface Delaunay ball (about the circumradius of the triangle):
+  /// a uniform size bound. Must be > 0; infinity: no bound.
+  double max_size = std::numeric_limits<double>::infinity();
+  /// The root finder on a Voronoi edge stops when its bracket is shorter than this fraction of the domain
+  /// diagonal (the ball centres, i.e. the inserted vertices, are on the surface to this accuracy). > 0.
+  double root_tolerance = 1e-10;
+  /// function_changed() without a region re-projects only the vertices farther than this fraction of the
+  /// domain diagonal from the new surface (|f| / |grad f|) and re-meshes around them: a global function
+  /// such as the RBF changes a little everywhere after a local edit (moving one of hand.off's constraints
+  /// moves half the vertices by more than 1e-7 of the diagonal, an eighth by more than 1e-5). After an
+  /// edit the vertices are on the surface to this tolerance. >= root_tolerance.
+  double edit_tolerance = 1e-5;
+  /// refine() throws LimitError rather than create more Delaunay vertices than this (box corners and
+  /// seeds included): the guard against a criterion that cannot be met at any reasonable size.
+  std::size_t max_vertices = 5000000;
+};
+
+/// Counters of a QualityMesher (cumulative since construction unless stated).
+struct QualityStats {
+  std::size_t vertices = 0;                  ///< live Delaunay vertices (the 8 box corners included)
+  std::size_t restricted_facets = 0;         ///< current restricted Delaunay facets (the mesh triangles)
+  std::size_t seeds = 0;                     ///< seed points inserted by the constructor
+  std::size_t insertions = 0;                ///< surface Delaunay ball centres inserted by refine()
+  std::size_t topology_insertions = 0;       ///< of which for a vertex whose restricted star was not a disk
+  std::size_t rejected = 0;                  ///< centres that duplicated a vertex (facet left as it was)
+  std::size_t function_evaluations = 0;      ///< calls of f (values and gradients), all phases
+  std::size_t circumcenter_evaluations = 0;  ///< of which at circumcentres (signs of the Voronoi edges)
+  std::size_t root_evaluations = 0;          ///< of which by the root finder on Voronoi edges
+  std::size_t probe_evaluations = 0;         ///< of which at the distance probes of facets
+  std::size_t projected = 0;                 ///< function_changed(): vertices moved back onto the surface
+  std::size_t removed = 0;                   ///< function_changed(): vertices removed (no root nearby)
+  double refine_seconds = 0;                 ///< last refine()
+  double extract_seconds = 0;                ///< last extract()
+};
+
+/// Restricted Delaunay surface mesher with Delaunay refinement (the quality mode). Not thread-safe.
+class QualityMesher {
+ public:
+  /// Tetrahedralizes the box corners and the seeds (moved onto the surface by a few Newton steps first;
+  /// a seed whose projection fails, leaves the box or duplicates another is skipped).
+  /// @param f        the function (kept by reference); f < 0 inside. The surface must lie strictly inside
+  ///                 `domain`; the sign outside the box is taken as + (outside).
+  /// @param seeds    points on or near the surface: at least a few per connected component (seed_points()
+  ///                 gives suitable ones); a component without seeds may be missed.
+  /// @throws InvalidArgument for a bad domain or options; InvalidPoint(i) for a non-finite seed i.
+  QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
+                const QualityOptions& options = {});
+
+  /// Seeds for the constructor: the fast Polygonizer's mesh at precision `spacing` (absolute), thinned
+  /// with seeds_from_mesh(). @throws InvalidArgument when spacing <= 0, as Polygonizer otherwise.
+  static std::vector<Point3> seed_points(const ImplicitFunction& f, const Box3& domain, double spacing);
+  /// A subset of the mesh vertices at least `spacing` apart (greedy, in vertex order), with at least 8
+  /// (or all) vertices of every connected component of the mesh (farthest-point order).
+  static std::vector<Point3> seeds_from_mesh(const SurfaceMesh& mesh, double spacing);
+
+  /// Refines until every restricted facet meets the criteria of options() and every vertex's restricted
+  /// star is a topological disk. Calling it again after set_options() with finer bounds continues the
+  /// same structure (levels of detail).
+  /// @return true when everything holds; false when some facet's centre duplicated a vertex (counted in
+  ///         stats().rejected; not seen on smooth surfaces).
+  /// @throws LimitError when options().max_vertices would be exceeded.
+  bool refine();
+  /// Replaces the criteria (validated as in the constructor); call refine() afterwards.
+  void set_options(const QualityOptions& options);
+  /// @throws InvalidArgument naming the first option out of its domain.
+  static void validate(const QualityOptions& options);
+
+  /// The restricted facets as a mesh: vertices are the Delaunay vertices they use (on the surface),
+  /// triangles counter-clockwise seen from outside (f > 0), unit normals from the gradient of f. Facets
+  /// in a canonical order (sorted vertex ids), so the same structure gives the same mesh.
+  SurfaceMesh extract();
+
+  /// f changed, anywhere: the vertices farther than options().edit_tolerance from the new surface are
+  /// moved back onto it (Newton along the gradient) or removed when that fails, and the facets around
+  /// them (a region covering their restricted stars, twice their ball radii) are classified again, as by
+  /// function_changed(region). Call refine() afterwards.
+  /// @note A change that moves no vertex (a new component away from the mesh) is not seen.
+  void function_changed();
+  /// f changed inside `region` only (closed box): only the vertices inside it are re-projected, only
+  /// circumcentres inside it re-evaluated, and only facets whose Voronoi edge meets it re-classified.
+  void function_changed(const Box3& region);
+
+  const Triangulation& triangulation() const { return tri_; }
+  const ImplicitFunction& function() const { return f_; }
+  const QualityOptions& options() const { return options_; }
+  QualityStats stats() const;
+
+ private:
+  /// A facet by its three vertex ids, sorted.
+  struct FacetKey {
+    std::array<VertexId, 3> v;
+    bool operator==(const FacetKey& o) const { return v == o.v; }
+    bool operator<(const FacetKey& o) const { return v < o.v; }
+  };
+  struct FacetKeyHash {
+    std::size_t operator()(const FacetKey& k) const;
+  };
+  /// A restricted facet: the face opposite vertex `i` of live tetrahedron `t` (valid while the record
+  /// exists: any change to t or its neighbour erases it), its surface Delaunay ball, and a stamp that
+  /// tells queue entries from older records of the same key.
+  struct FacetRecord {
+    TetId t;
+    int i;
+    Point3 center;
+    double radius;
+    double probe_distance;  // largest |f| / |grad f| at the probes, or kNotProbed
+    std::uint32_t stamp;
+    bool inside_t;  // f < 0 at t's circumcentre: the facet faces outward from t
+  };
+  struct QueueItem {
+    double priority;
+    FacetKey key;
+    std::uint32_t stamp;
+    bool topology;  // pushed by the topology check (a vertex whose restricted star is not a disk)
+    bool operator<(const QueueItem& o) const { return priority < o.priority; }
+  };
+  /// A Voronoi edge crossing the surface, bracketed for the root finder.
+  struct Bracket {
+    TetId t;
+    int i;
+    Point3 a, b;    // a: t's side, b: the neighbour's side
+    double fa, fb;  // values at a and b (opposite signs)
+    int stale;      // Illinois: end kept twice in a row
+    Point3 last;    // the last point evaluated
+    double newton;  // Newton step from `last` along the edge (towards b), NaN when none
+  };
+
+  FacetKey key_of(TetId t, int i) const;
+  bool inside_domain(const Point3& p) const;  // strictly inside the box
+  void grow_tet_arrays();
+  void evaluate_circumcenters(const std::vector<TetId>& tets);
+  void classify_pending();
+  void collect_brackets(std::vector<Bracket>& brackets);
+  void clip_brackets(std::vector<Bracket>& brackets);
+  void warm_start(std::vector<Bracket>& brackets);
+  void solve_brackets(std::vector<Bracket>& brackets);
+  void store_facets(const std::vector<Bracket>& brackets);
+  bool needs_probes(const FacetRecord& r) const;
+  void probe_facets(const std::vector<FacetKey>& keys);
+  void probe_pending();
+  static constexpr double kNotProbed = -1.0;
+  bool is_bad(const FacetRecord& r) const;
+  void push(const FacetKey& key, const FacetRecord& r, bool topology);
+  void requeue_all();
+  void check_topology();
+  struct StarEntry {
+    const FacetKey* key;
+    const FacetRecord* record;
+  };
+  void build_stars(std::vector<std::uint32_t>& start, std::vector<StarEntry>& entries) const;
+  bool star_is_disk(VertexId v, const StarEntry* begin, const StarEntry* end) const;
+  std::size_t insert_round();
+  bool insert_point(const Point3& p, const FacetRecord* facet);
+  const FacetRecord* current(const QueueItem& item) const;
+  void mark_vertex_dirty(VertexId v);
+  void grow_vertex_arrays();
+  void absorb(const ChangeSet& cs);
+  void mark_pending(TetId t);
+  void erase_facet(TetId t, int i);
+  void flag_facet(TetId t, int i);
+  void forget_all_facets();
+  std::size_t project_vertices(const std::vector<VertexId>& ids);
+  std::vector<Point3> newton_project(std::vector<Point3> p, std::vector<std::uint8_t>& ok);
+  void evaluate(const std::vector<Point3>& p, std::vector<double>& out, std::size_t& phase_counter);
+
+  const ImplicitFunction& f_;
+  QualityOptions options_;
+  Triangulation tri_;
+  double diagonal_;
+  std::vector<double> cvalue_;         // per tet: f at its circumcentre (NaN: unknown, +inf: outside box)
+  std::vector<Point3> ccenter_;        // per tet: circumcentre, valid with cvalue_
+  std::vector<std::uint8_t> pending_;  // per tet: its facets wait for classification
+  std::vector<std::uint8_t> rflags_;   // per tet: bit i set when facet i may have a record
+  std::vector<TetId> pending_list_;
+  std::vector<std::uint8_t> on_surface_;  // per vertex: a seed or ball centre (not a box corner)
+  std::vector<std::uint8_t> dirty_;       // per vertex: star changed since the last topology check
+  std::vector<VertexId> dirty_list_;
+  std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
+  std::priority_queue<QueueItem> queue_;
+  std::vector<FacetKey> unprobed_;  // facets that meet every criterion but wait for their probes
+  /// What a facet keeps when its record is erased by an insertion: it may come back (a facet on the
+  /// boundary of the cavity) with the same ball centre (same dual line) and the same probes (same triangle).
+  struct OldFacet {
+    Point3 center;
+    double probe_distance;
+  };
+  std::unordered_map<FacetKey, OldFacet, FacetKeyHash> old_facets_;  // records erased since classification
+  std::uint32_t stamp_ = 0;
+  ChangeSet changes_;
+  QualityStats stats_;
+};
+
+}  // namespace vitri

@@ -1,6 +1,7 @@
 // `vitri mesh`: fit the implicit surface of an input, mesh it at one or more levels of detail, and
 // optionally replay an edit script (the paper's Tables 1, 2 and 3).
 #include "commands.hpp"
+#include "input.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
@@ -112,29 +113,6 @@ void write_current(Mesher& mesher, const std::string& path) {
   write_mesh(path, tm);
 }
 
-/// The constraints of INPUT: read as such (.xyzv), or built from oriented points or a closed mesh
-/// exactly as Mesher::from_oriented_points / Mesher::from_mesh build them (surface points first, then
-/// the off-surface constraints; see constraints_from_oriented_points).
-Constraints read_constraints(const std::string& input, const MesherOptions& options) {
-  Input in = read_input(input);
-  switch (in.kind) {
-    case InputKind::Constraints: {
-      Constraints c;
-      c.points = std::move(in.constraints.points);
-      c.values = std::move(in.constraints.values);
-      return c;
-    }
-    case InputKind::OrientedPoints:
-      return constraints_from_oriented_points(in.points.points, in.points.normals, options.constraint_build);
-    case InputKind::Mesh:
-      return constraints_from_mesh(in.mesh.V, in.mesh.F, options.constraint_build);
-    case InputKind::Points:
-      break;
-  }
-  throw InvalidArgument(input + ": points without normals do not define an inside and an outside; give "
-                                "oriented points (.pwn, 6-column .xyz), constraints (.xyzv) or a closed mesh");
-}
-
 /// From this many constraints on, the fit (O(N^3)) is announced on stderr before it starts and after it
 /// ends: it is the one long phase without a progress callback.
 constexpr std::size_t kFitProgressConstraints = 1000;
@@ -208,7 +186,7 @@ int run_mesh(const Args& args) {
   }
 
   const auto t_start = Clock::now();
-  const Constraints constraints = read_constraints(input, options);
+  const Constraints constraints = constraints_of(read_input(input), input, options.constraint_build);
   const bool announce_fit = !quiet && constraints.size() >= kFitProgressConstraints;
   if (announce_fit)
     std::fprintf(stderr, "fitting the implicit function to %zu constraints...\n", constraints.size());

@@ -1,0 +1,17 @@
+#pragma once
+// Turning any input the CLI reads (constraints, oriented points, a closed mesh) into the constraints the
+// Mesher fits: shared by `vitri mesh`, `vitri eval` and `vitri studio`.
+#include "vitri/io/io.hpp"
+#include "vitri/rbf/constraints.hpp"
+
+#include <string>
+
+namespace vitri::cli {
+
+/// The constraints of an input: as read (.xyzv), or built from oriented points or a closed mesh exactly
+/// as Mesher::from_oriented_points / Mesher::from_mesh build them (surface points first, then the
+/// off-surface constraints; see constraints_from_oriented_points). `name` is used in messages.
+/// @throws InvalidArgument for points without normals; as constraints_from_mesh / _oriented_points.
+Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build);
+
+}  // namespace vitri::cli

@@ -242,7 +242,9 @@ ApiResponse Api::mesh(const ApiRequest& r) {
   if (format == "indexed") return json_response(indexed_mesh_json(session_.surface()));
   if (format != "binary" && format != "json")
     throw BadRequest("\"format\" must be binary, json or indexed, got '" + format + "'");
-  const MeshDelta d = session_.delta(version_param(r));
+  const std::string exact = param(r, "exact", "1");
+  if (exact != "0" && exact != "1") throw BadRequest("\"exact\" must be 0 or 1, got '" + exact + "'");
+  const MeshDelta d = session_.delta(version_param(r), exact == "1");
   if (format == "json") return json_response(encode_json(d));
   ApiResponse out;
   out.content_type = "application/octet-stream";

@@ -2,21 +2,23 @@
 
 #include "json.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 namespace vitri::studio {
 namespace {
 
-std::uint64_t bits(double d) {
-  std::uint64_t b;
-  std::memcpy(&b, &d, sizeof b);
-  return b;
+std::int64_t cell_code(double x, double cell) {
+  const double q = std::floor(x / cell);
+  constexpr double kLimit = 4.0e18;  // far beyond any model; keeps the conversion defined
+  return static_cast<std::int64_t>(std::clamp(q, -kLimit, kLimit));
 }
 
-bool less_point(const Point3& a, const Point3& b) {
-  if (a.x != b.x) return a.x < b.x;
-  if (a.y != b.y) return a.y < b.y;
-  return a.z < b.z;
+std::uint32_t float_bits(float f) {
+  std::uint32_t b;
+  std::memcpy(&b, &f, sizeof b);
+  return b;
 }
 
 void append_point(std::vector<float>& out, const Point3& p) {
@@ -48,58 +50,77 @@ void append_json_array(std::string& out, const char* name, const std::vector<T>&
 
 }  // namespace
 
-std::size_t DeltaTracker::KeyHash::operator()(const Key& k) const {
+std::size_t DeltaTracker::CodesHash::operator()(const Codes& k) const {
   std::uint64_t h = 0x9e3779b97f4a7c15ull;
-  for (const std::uint64_t w : k) h = (h ^ w) * 0x100000001b3ull + (h >> 29);
+  for (const std::int64_t w : k) h = (h ^ static_cast<std::uint64_t>(w)) * 0x100000001b3ull + (h >> 29);
   return static_cast<std::size_t>(h);
 }
 
-DeltaTracker::Key DeltaTracker::key_of(const SurfaceMesh& mesh, std::size_t t) {
+void DeltaTracker::set_cell(double cell) {
+  cell_ = cell;
+  reset();
+}
+
+std::size_t DeltaTracker::triangle_key(const SurfaceMesh& mesh, std::size_t t, Codes& codes,
+                                      Corners& corners) const {
   const auto& tri = mesh.triangles[t];
-  std::size_t first = 0;  // rotate so that the smallest corner comes first (cyclic order kept)
+  std::array<std::int64_t, 9> c;  // per corner: codes, in triangle order
+  std::array<float, 9> f;
+  for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t j = 0; j < 3; ++j) {
+      c[3 * k + j] = cell_code(mesh.vertices[tri[k]][j], cell_);
+      f[3 * k + j] = static_cast<float>(mesh.vertices[tri[k]][j]);
+    }
+  // Canonical rotation: the corner with the smallest (codes, float bits) first; cyclic order kept.
+  const auto corner_less = [&](std::size_t a, std::size_t b) {
+    for (std::size_t j = 0; j < 3; ++j)
+      if (c[3 * a + j] != c[3 * b + j]) return c[3 * a + j] < c[3 * b + j];
+    for (std::size_t j = 0; j < 3; ++j)
+      if (float_bits(f[3 * a + j]) != float_bits(f[3 * b + j])) return float_bits(f[3 * a + j]) < float_bits(f[3 * b + j]);
+    return false;
+  };
+  std::size_t first = 0;
   for (std::size_t k = 1; k < 3; ++k)
-    if (less_point(mesh.vertices[tri[k]], mesh.vertices[tri[first]])) first = k;
-  Key key;
-  for (std::size_t k = 0; k < 3; ++k) {
-    const Point3& p = mesh.vertices[tri[(first + k) % 3]];
-    key[3 * k] = bits(p.x);
-    key[3 * k + 1] = bits(p.y);
-    key[3 * k + 2] = bits(p.z);
-  }
-  return key;
+    if (corner_less(k, first)) first = k;
+  for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t j = 0; j < 3; ++j) {
+      codes[3 * k + j] = c[3 * ((first + k) % 3) + j];
+      corners[3 * k + j] = f[3 * ((first + k) % 3) + j];
+    }
+  return first;
 }
 
-void DeltaTracker::add_triangle(const SurfaceMesh& mesh, std::size_t t, const Key& key, MeshDelta& d,
-                                std::unordered_map<Key, std::uint32_t, KeyHash>& into) {
-  const std::uint32_t id = next_id_++;
-  into.emplace(key, id);
-  d.added.push_back(id);
-  const bool has_normals = mesh.normals.size() == mesh.vertices.size();
-  for (const std::uint32_t v : mesh.triangles[t]) {
-    append_point(d.positions, mesh.vertices[v]);
-    append_point(d.normals, has_normals ? mesh.normals[v] : Point3{0, 0, 0});
-  }
-}
-
-MeshDelta DeltaTracker::update(const SurfaceMesh& mesh, std::uint32_t since) {
+MeshDelta DeltaTracker::update(const SurfaceMesh& mesh, std::uint32_t since, bool exact) {
   MeshDelta d;
   d.full = since == 0 || since != version_;
   d.base = d.full ? 0 : since;
   if (d.full) sent_.clear();
-  std::unordered_map<Key, std::uint32_t, KeyHash> next;
+  const bool has_normals = mesh.normals.size() == mesh.vertices.size();
+  SentMap next;
   next.reserve(mesh.triangles.size());
+  Codes codes;
+  Corners corners;
   for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const Key key = key_of(mesh, t);
-    if (next.count(key)) continue;  // a repeated triangle is drawn once (never in a closed mesh)
-    const auto it = sent_.find(key);
-    if (it != sent_.end()) {
-      next.emplace(key, it->second);
-      sent_.erase(it);
-    } else {
-      add_triangle(mesh, t, key, d, next);
+    const std::size_t first = triangle_key(mesh, t, codes, corners);
+    // A sent triangle in the same cells (and, when exact, with the same corners) is kept. Several can
+    // share cells (triangles smaller than a cell): any one of them serves in the approximate mode.
+    auto [lo, hi] = sent_.equal_range(codes);
+    while (lo != hi && exact && lo->second.corners != corners) ++lo;
+    if (lo != hi) {
+      next.emplace(codes, lo->second);
+      sent_.erase(lo);
+      continue;
+    }
+    const Sent s{next_id_++, corners};
+    next.emplace(codes, s);
+    d.added.push_back(s.id);
+    d.positions.insert(d.positions.end(), corners.begin(), corners.end());
+    for (std::size_t k = 0; k < 3; ++k) {  // normals in the rotated order of the corners
+      const std::uint32_t v = mesh.triangles[t][(first + k) % 3];
+      append_point(d.normals, has_normals ? mesh.normals[v] : Point3{0, 0, 0});
     }
   }
-  for (const auto& [key, id] : sent_) d.removed.push_back(id);  // what the new mesh did not claim
+  for (const auto& [key, s] : sent_) d.removed.push_back(s.id);  // what the new mesh did not claim
   sent_ = std::move(next);
   if (d.full || !d.added.empty() || !d.removed.empty()) ++version_;
   d.version = version_;

@@ -2,17 +2,26 @@
 // Mesh deltas for the studio: the server remembers the triangles the client holds (the last mesh sent),
 // each with an id, and answers a mesh request with the ids that went away and the triangles that came.
 //
-// Identity of a triangle = its three corner positions, bit for bit, up to rotation (the cyclic order,
-// hence the orientation, is part of it). After an edit the polygonizer re-places every mesh vertex, but
-// an edge whose root is still within tolerance keeps its previous position exactly (warm-started root
-// finder, docs/polygonize.md), so far from the edit the triangles are bitwise the same and are not sent.
-// Normals do not take part: a triangle whose corners did not move keeps the normals the client has.
+// Identity of a triangle = its three corners, up to rotation (the cyclic order, hence the orientation,
+// is part of it), in one of two modes:
+// - exact: the corners as the client stores them (float32) must be equal. After an edit the polygonizer
+//   re-places every mesh vertex, but an edge whose root is still within tolerance keeps its position
+//   bit for bit (warm-started root finder, docs/polygonize.md), so unchanged regions are not resent.
+// - drag (approximate): the corners must lie in the same cells of a grid of side `cell` (absolute,
+//   Session: 1e-4 x the model's diagonal, a tenth of a pixel when the model fills 1000 pixels). The RBF's
+//   support is global: every edit moves every root a little, so the exact mode resends almost the whole
+//   mesh. During a drag, triangles that moved less than a cell keep the corners the client has (gaps
+//   between a kept and a resent neighbour are below the cell size); the page asks for an exact update
+//   when the drag ends, which brings the client back to the server's mesh.
+// Triangles are hashed by their cell codes and carry their sent float corners for the exact comparison.
+// Normals do not take part: a kept triangle keeps the normals the client has.
 #include "vitri/core/point.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include <array>
 #include <cstdint>
 #include <string>
+#include <cstddef>
 #include <unordered_map>
 #include <vector>
 
@@ -34,23 +43,31 @@ struct MeshDelta {
 class DeltaTracker {
  public:
   /// The delta from the client's version `since` (0: it holds nothing) to `mesh`; `mesh` becomes the
-  /// mesh the client holds. The version changes only when something changed.
-  MeshDelta update(const SurfaceMesh& mesh, std::uint32_t since);
+  /// mesh the client holds (up to `cell` when not `exact`). The version changes only when something did.
+  MeshDelta update(const SurfaceMesh& mesh, std::uint32_t since, bool exact = true);
+  /// Grid cell of the approximate mode (absolute length > 0; also used to hash). Forgets what was sent.
+  void set_cell(double cell);
   /// Version of the mesh last sent (0 before the first).
   std::uint32_t version() const { return version_; }
   /// Forgets everything: the next update is full (after a load).
   void reset();
 
  private:
-  using Key = std::array<std::uint64_t, 9>;  // corner coordinates as bits, rotated to a canonical start
-  struct KeyHash {
-    std::size_t operator()(const Key& k) const;
+  using Codes = std::array<std::int64_t, 9>;  // grid cell of each corner, rotated to a canonical start
+  using Corners = std::array<float, 9>;       // the corners as sent, same rotation
+  struct CodesHash {
+    std::size_t operator()(const Codes& k) const;
   };
-  static Key key_of(const SurfaceMesh& mesh, std::size_t t);
-  void add_triangle(const SurfaceMesh& mesh, std::size_t t, const Key& key, MeshDelta& d,
-                    std::unordered_map<Key, std::uint32_t, KeyHash>& into);
+  struct Sent {
+    std::uint32_t id;
+    Corners corners;
+  };
+  using SentMap = std::unordered_multimap<Codes, Sent, CodesHash>;
+  /// Codes and float corners of triangle t, rotated; @return the rotation (corner t's first corner).
+  std::size_t triangle_key(const SurfaceMesh& mesh, std::size_t t, Codes& codes, Corners& corners) const;
 
-  std::unordered_map<Key, std::uint32_t, KeyHash> sent_;  // key -> id of the triangles the client holds
+  SentMap sent_;  // the triangles the client holds
+  double cell_ = 1e-6;
   std::uint32_t version_ = 0;
   std::uint32_t next_id_ = 1;
 };

@@ -47,6 +47,7 @@ struct Server::Impl {
 Server::Server(Api& api, const ServerOptions& options) : impl_(std::make_unique<Impl>()), options_(options) {
   httplib::Server& http = impl_->http;
   http.set_payload_max_length(options.max_body);
+  http.set_tcp_nodelay(true);  // small responses go out at once (Nagle + delayed ACK cost ~40 ms each)
   const auto to_api = [&api](const httplib::Request& req, httplib::Response& res) {
     ApiRequest r;
     r.method = req.method;

@@ -42,7 +42,7 @@ void Session::load(Constraints constraints, std::string name) {
   for (const Point3& p : mesher_->constraints().points) box.extend(p);
   center_ = box.center();
   current_ = std::numeric_limits<double>::infinity();
-  tracker_.reset();
+  tracker_.set_cell(options_.drag_tolerance * unit_);
   refine_step();
 }
 

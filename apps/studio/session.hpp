@@ -25,6 +25,8 @@ struct SessionOptions {
   std::size_t max_constraints = 20000;
   /// An edited constraint must lie within this many load diagonals of the load box's center.
   double max_reach = 4.0;
+  /// Grid cell of approximate mesh deltas (during drags), relative to the load diagonal (delta.hpp).
+  double drag_tolerance = 1e-4;
   /// Mesher options (RBF, polygonizer, garbage collection); the implicit function choice goes here.
   MesherOptions mesher;
 };
@@ -92,7 +94,8 @@ class Session {
 
   // ---- Queries
   const SurfaceMesh& surface();
-  MeshDelta delta(std::uint32_t since) { return tracker_.update(surface(), since); }
+  /// The mesh delta from the client's version `since` (delta.hpp); `exact` false during drags.
+  MeshDelta delta(std::uint32_t since, bool exact) { return tracker_.update(surface(), since, exact); }
   std::vector<ConstraintInfo> constraints() const;
   std::size_t size() const { return ids_.size(); }
   const std::string& name() const { return name_; }

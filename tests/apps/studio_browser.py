@@ -118,7 +118,7 @@ def max_vertex_distance(a, b):
     return worst
 
 
-def launch_browser(out_dir):
+def launch_browser(out_dir, window="1280,800"):
     chromium = shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
     driver_path = shutil.which("chromedriver") or "/usr/bin/chromedriver"
     if not chromium:
@@ -130,11 +130,13 @@ def launch_browser(out_dir):
     profile = tempfile.mkdtemp(prefix="vitri-studio-chromium-", dir=out_dir)
     for flag in ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
-                 "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--window-size=1280,800",
+                 "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--window-size=" + window,
                  "--user-data-dir=" + profile]:
         opts.add_argument(flag)
     opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
-    return webdriver.Chrome(service=Service(driver_path), options=opts), profile
+    driver = webdriver.Chrome(service=Service(driver_path), options=opts)
+    driver.set_script_timeout(600)
+    return driver, profile
 
 
 def wait_for(what, fn, timeout=120):
@@ -160,13 +162,63 @@ def pointer_to(driver, x, y):
     ab.perform()
 
 
+def api_bench(server):
+    """Edit + delta round trips from a script (no browser): the server's and the transfer's share."""
+    def post(path, body):
+        req = urllib.request.Request(server.url + path, data=json.dumps(body).encode(), method="POST")
+        with urllib.request.urlopen(req, timeout=600) as r:
+            return json.loads(r.read())
+
+    def pull(version, exact):
+        with urllib.request.urlopen("%s/api/mesh?since=%d&exact=%d" % (server.url, version, exact)) as r:
+            data = r.read()
+        return int.from_bytes(data[8:12], "little")
+
+    def median(v):
+        v = sorted(v)
+        return {"median": v[len(v) // 2], "p90": v[min(len(v) - 1, int(0.9 * len(v)))]}
+
+    post("/api/refine", {"all": True})
+    state = server.get("/api/state")
+    unit, version = state["unit"], pull(0, 1)
+    index = next(c["index"] for c in state["constraint_list"] if c["value"] == 0)
+    c = state["constraint_list"][index]["position"]
+    drag, server_ms = [], []
+    for k in range(1, 61):
+        a = 2 * math.pi * k / 60
+        t0 = time.perf_counter()
+        s = post("/api/edit", {"op": "move", "index": index, "merge": k > 1,
+                               "position": [c[0] + 0.01 * unit * math.sin(a), c[1] + 0.01 * unit * (1 - math.cos(a)), c[2]]})
+        version = pull(version, 0)
+        drag.append(1e3 * (time.perf_counter() - t0))
+        server_ms.append(s["edit_ms"] + s["extract_ms"])
+    post("/api/undo", {})
+    version = pull(version, 1)
+    add = []
+    for k in range(12):
+        t0 = time.perf_counter()
+        post("/api/edit", {"op": "add", "value": 0, "position": [c[0] + 0.004 * unit * (k - 5.5), c[1], c[2]]})
+        version = pull(version, 1)
+        add.append(1e3 * (time.perf_counter() - t0))
+        post("/api/undo", {})
+        version = pull(version, 1)
+    print("API_BENCH " + json.dumps({"model": state["name"], "load_average": os.getloadavg()[0],
+                                     "triangles": state["triangles"], "drag": median(drag),
+                                     "drag_server_edit_extract": median(server_ms),
+                                     "drag_updates_per_second": 1e3 * len(drag) / sum(drag), "add": median(add)}))
+    return 0
+
+
 def run(args):
-    server = Server(args.vitri, ([args.model] if args.model else []) + ["--precision", str(args.precision)])
+    server = Server(args.vitri, ([args.model] if args.model else []) + ["--precision", str(args.precision)] +
+                    args.studio_args.split())
     driver = None
     profile = None
     try:
-        driver, profile = launch_browser(args.out)
-        driver.get(server.url + "/")
+        if args.api_bench:
+            return api_bench(server)
+        driver, profile = launch_browser(args.out, args.window)
+        driver.get(server.url + "/" + ("?aa=0" if args.no_antialias else ""))
         wait_for("the page to start", lambda: driver.execute_script("return !!(window.studio && studio.ready)"))
         webgl = driver.execute_script("return !!studio.renderer.getContext()")
         check(webgl, "the page has a WebGL context")
@@ -183,7 +235,7 @@ def run(args):
         check(driver.execute_script("return studio.slots.triangles") == len(m0["triangles"]),
               "the page draws as many triangles as the server holds")
         if args.bench:
-            return bench(driver, server)
+            return bench(driver, server, args.out)
 
         # 1. Click on the surface (middle of the view: the model is framed there): on-surface constraint.
         canvas = driver.find_element("css selector", "#view canvas")
@@ -245,13 +297,14 @@ def run(args):
             shutil.rmtree(profile, ignore_errors=True)
 
 
-def bench(driver, server):
+def bench(driver, server, out_dir):
     run_js = lambda code: driver.execute_async_script(
         "const done = arguments[arguments.length - 1];" + code + ".then(done, (e) => done({error: String(e)}));")
     stats = server.get("/api/stats")
     adds = run_js("studio.benchAdd({count: 12})")
     drag = run_js("studio.benchDrag({moves: 60})")
-    print("BENCH " + json.dumps({"model": stats["name"], "constraints": stats["constraints"],
+    driver.save_screenshot(os.path.join(out_dir, "studio-bench.png"))
+    print("BENCH " + json.dumps({"model": stats["name"], "load_average": os.getloadavg()[0], "constraints": stats["constraints"],
                                  "triangles": stats["triangles"], "vertices": stats["vertices"],
                                  "add": adds, "drag": drag}))
     return 0
@@ -264,6 +317,10 @@ def main():
     ap.add_argument("--model", default="")
     ap.add_argument("--precision", type=float, default=0.03)
     ap.add_argument("--bench", action="store_true")
+    ap.add_argument("--api-bench", action="store_true", help="measure edit + delta round trips without a browser")
+    ap.add_argument("--window", default="1280,800", help="browser window size W,H")
+    ap.add_argument("--no-antialias", action="store_true", help="WebGL without antialiasing (page ?aa=0)")
+    ap.add_argument("--studio-args", default="", help="more vitri studio arguments (space-separated)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)
     try:

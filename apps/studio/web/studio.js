@@ -154,6 +154,8 @@ class ConstraintPoints {
     g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
     g.setAttribute('color', new THREE.BufferAttribute(col, 3));
     g.computeBoundingSphere();
+    // Discs of 11 pixels for a few constraints, down to 5 for thousands (so that the surface shows).
+    this.material.size = Math.max(5, Math.min(11, 60 / Math.sqrt(Math.max(n, 1)))) * window.devicePixelRatio;
   }
 
   moveLocally(index, p) {
@@ -382,6 +384,7 @@ Studio.prototype.ray = function (event) {
 
 // The constraint drawn nearest to the pointer (within 8 pixels), the front-most when several are.
 Studio.prototype.pickConstraint = function (event) {
+  if (!this.constraints.points.visible) return -1;
   const r = this.renderer.domElement.getBoundingClientRect(), v = new THREE.Vector3();
   let best = -1, bestDepth = Infinity;
   this.constraints.list.forEach((c, i) => {
@@ -549,6 +552,7 @@ async function main() {
   byId('redo').onclick = () => studio.command('/api/redo');
   byId('delete').onclick = deleteSelected;
   byId('wireframe').onchange = (e) => { studio.slots.wire.visible = e.target.checked; studio.render(); };
+  byId('show-constraints').onchange = (e) => { studio.constraints.points.visible = e.target.checked; studio.render(); };
   byId('precision').oninput = (e) => { byId('precision-value').textContent = sliderToPrecision(+e.target.value).toPrecision(3); };
   byId('precision').onchange = (e) => studio.setPrecision(sliderToPrecision(+e.target.value));
   const showDepth = () => { byId('depth-value').textContent = (byId('depth').value / 100 * 0.05).toPrecision(2) + ' x diagonal'; };

@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Builds vitri (Release) with the studio and starts it on a bundled model: open http://127.0.0.1:8080/
+# Usage: bash tools/studio.sh [MODEL] [vitri studio options...]   (default: data/hand.off --sides outside
+#        --precision 0.015: 2394 constraints, about 10k mesh vertices)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash tools/deps.sh cmake make g++ libeigen3-dev catch2 libstb-dev pkg-config libcpp-httplib-dev libjs-three
+jobs=$(nproc 2>/dev/null || echo 2)
+cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVITRI_BUILD_TESTS=OFF -DVITRI_BUILD_BENCH=OFF
+cmake --build build-release -j"$jobs" --target vitri_cli
+if [ $# -eq 0 ]; then
+  set -- data/hand.off --sides outside --precision 0.015
+fi
+exec ./build-release/apps/vitri studio "$@"

@@ -5,12 +5,12 @@
 
 #include "vitri/core/error.hpp"
 
-#include <csignal>
+#include <pthread.h>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
-#include <pthread.h>
 #include <thread>
 
 #ifndef VITRI_STUDIO_WEB_DIR
@@ -100,10 +100,14 @@ std::string parse_args(const Args& args, StudioArgs& out) {
       if (!parse_number(v, d) || !(d > 0)) return "--offset needs a positive number";
       out.session.mesher.constraint_build.offset = d;
     } else if (a == "--sides") {
-      if (v == "both") out.session.mesher.constraint_build.sides = OffSurface::Both;
-      else if (v == "inside") out.session.mesher.constraint_build.sides = OffSurface::Inside;
-      else if (v == "outside") out.session.mesher.constraint_build.sides = OffSurface::Outside;
-      else return "--sides must be both, inside or outside, got '" + v + "'";
+      if (v == "both")
+        out.session.mesher.constraint_build.sides = OffSurface::Both;
+      else if (v == "inside")
+        out.session.mesher.constraint_build.sides = OffSurface::Inside;
+      else if (v == "outside")
+        out.session.mesher.constraint_build.sides = OffSurface::Outside;
+      else
+        return "--sides must be both, inside or outside, got '" + v + "'";
     } else if (!a.empty() && a[0] == '-') {
       return "unknown option '" + a + "'";
     } else if (out.input.empty()) {
@@ -117,7 +121,9 @@ std::string parse_args(const Args& args, StudioArgs& out) {
 
 }  // namespace
 
-const char* studio_usage() { return kUsage; }
+const char* studio_usage() {
+  return kUsage;
+}
 
 int run_studio(const Args& args) {
   StudioArgs sa;
@@ -127,7 +133,8 @@ int run_studio(const Args& args) {
   const std::string bad = parse_args(args, sa);
   if (!bad.empty()) return usage_error(bad);
   const ConstraintBuildOptions& build = sa.session.mesher.constraint_build;
-  Constraints constraints = sa.input.empty() ? default_blob() : constraints_of(read_input(sa.input), sa.input, build);
+  Constraints constraints =
+      sa.input.empty() ? default_blob() : constraints_of(read_input(sa.input), sa.input, build);
   std::fprintf(stderr, "fitting %zu constraints...\n", constraints.size());
   studio::Session session(std::move(constraints), sa.input.empty() ? "blob" : sa.input, sa.session);
   studio::Api api(session, build);
@@ -139,8 +146,9 @@ int run_studio(const Args& args) {
   sigaddset(&stop_signals, SIGTERM);
   pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
   const int port = server.bind();
-  std::printf("vitri studio: %s, %zu constraints; open http://%s:%d/  (Ctrl-C stops)\n", session.name().c_str(),
-              session.size(), sa.server.host == "0.0.0.0" ? "127.0.0.1" : sa.server.host.c_str(), port);
+  std::printf("vitri studio: %s, %zu constraints; open http://%s:%d/  (Ctrl-C stops)\n",
+              session.name().c_str(), session.size(),
+              sa.server.host == "0.0.0.0" ? "127.0.0.1" : sa.server.host.c_str(), port);
   std::fflush(stdout);
   std::thread waiter([&] {
     int sig = 0;

@@ -21,8 +21,9 @@ Constraints constraints_of(Input in, const std::string& name, const ConstraintBu
     case InputKind::Points:
       break;
   }
-  throw InvalidArgument(name + ": points without normals do not define an inside and an outside; give "
-                               "oriented points (.pwn, 6-column .xyz), constraints (.xyzv) or a closed mesh");
+  throw InvalidArgument(name +
+                        ": points without normals do not define an inside and an outside; give "
+                        "oriented points (.pwn, 6-column .xyz), constraints (.xyzv) or a closed mesh");
 }
 
 }  // namespace vitri::cli

@@ -4,10 +4,7 @@
 #        --precision 0.015: 2394 constraints, about 10k mesh vertices)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/deps.sh cmake make g++ libeigen3-dev catch2 libstb-dev pkg-config libcpp-httplib-dev libjs-three
-jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVITRI_BUILD_TESTS=OFF -DVITRI_BUILD_BENCH=OFF
-cmake --build build-release -j"$jobs" --target vitri_cli
+bash tools/build_release.sh
 if [ $# -eq 0 ]; then
   set -- data/hand.off --sides outside --precision 0.015
 fi

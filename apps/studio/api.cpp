@@ -7,13 +7,13 @@
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 
+#include <unistd.h>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 namespace vitri::studio {
 namespace {
@@ -154,9 +154,13 @@ Api::~Api() {
   rmdir(temp_dir_.c_str());
 }
 
-std::string Api::temp_path(const std::string& ext) const { return temp_dir_ + "/export." + ext; }
+std::string Api::temp_path(const std::string& ext) const {
+  return temp_dir_ + "/export." + ext;
+}
 
-bool Api::is_api_path(const std::string& path) { return path.rfind("/api/", 0) == 0; }
+bool Api::is_api_path(const std::string& path) {
+  return path.rfind("/api/", 0) == 0;
+}
 
 ApiResponse Api::handle(const ApiRequest& request) {
   try {
@@ -183,11 +187,11 @@ ApiResponse Api::handle(const ApiRequest& request) {
 
 ApiResponse Api::route(const ApiRequest& r) {
   const std::string& p = r.path;
-  const char* method = p == "/api/stats" || p == "/api/state" || p == "/api/mesh" || p == "/api/export" ? "GET"
-                       : p == "/api/edit" || p == "/api/undo" || p == "/api/redo" || p == "/api/refine" ||
-                               p == "/api/load"
-                           ? "POST"
-                           : nullptr;
+  const char* method =
+      p == "/api/stats" || p == "/api/state" || p == "/api/mesh" || p == "/api/export" ? "GET"
+      : p == "/api/edit" || p == "/api/undo" || p == "/api/redo" || p == "/api/refine" || p == "/api/load"
+          ? "POST"
+          : nullptr;
   if (!method) return error_response(404, "no such endpoint: " + p);
   if (r.method != method) return error_response(405, p + " takes " + method + ", not " + r.method);
   if (p == "/api/stats") return stats();
@@ -213,18 +217,22 @@ std::string Api::stats_json(const std::string& extra) {
          ",\"triangles\":" + std::to_string(m.triangles.size()) +
          ",\"precision\":" + (std::isfinite(current) ? json_number(current) : std::string("null")) +
          ",\"target_precision\":" + json_number(session_.target_precision()) +
-         ",\"refined\":" + (session_.refined() ? "true" : "false") + ",\"unit\":" + json_number(session_.unit()) +
+         ",\"refined\":" + (session_.refined() ? "true" : "false") +
+         ",\"unit\":" + json_number(session_.unit()) +
          ",\"edit_ms\":" + json_number(session_.last_update().edit_ms) +
          ",\"rbf_ms\":" + json_number(s.edit_rbf_seconds * 1e3) +
          ",\"extract_ms\":" + json_number(session_.last_update().extract_ms) +
          ",\"delaunay_vertices\":" + std::to_string(s.polygonizer.vertices) +
-         ",\"rebuilds\":" + std::to_string(s.rebuilds) + ",\"undo\":" + std::to_string(session_.undo_depth()) +
+         ",\"rebuilds\":" + std::to_string(s.rebuilds) +
+         ",\"undo\":" + std::to_string(session_.undo_depth()) +
          ",\"redo\":" + std::to_string(session_.redo_depth()) +
          ",\"revision\":" + std::to_string(session_.revision()) + "}";
   return out;
 }
 
-ApiResponse Api::stats() { return json_response(stats_json()); }
+ApiResponse Api::stats() {
+  return json_response(stats_json());
+}
 
 ApiResponse Api::state() {
   std::string list = "[";
@@ -262,7 +270,8 @@ ApiResponse Api::edit(const ApiRequest& r) {
     extra += ",\"index\":" + std::to_string(i);
   } else if (op == "move") {
     check_keys(body, {"op", "index", "position", "merge"});
-    session_.move(index_member(body, "index"), point_member(body, "position"), bool_member(body, "merge", false));
+    session_.move(index_member(body, "index"), point_member(body, "position"),
+                  bool_member(body, "merge", false));
   } else if (op == "remove") {
     check_keys(body, {"op", "index"});
     session_.remove(index_member(body, "index"));

@@ -62,7 +62,7 @@ void DeltaTracker::set_cell(double cell) {
 }
 
 std::size_t DeltaTracker::triangle_key(const SurfaceMesh& mesh, std::size_t t, Codes& codes,
-                                      Corners& corners) const {
+                                       Corners& corners) const {
   const auto& tri = mesh.triangles[t];
   std::array<std::int64_t, 9> c;  // per corner: codes, in triangle order
   std::array<float, 9> f;
@@ -76,7 +76,8 @@ std::size_t DeltaTracker::triangle_key(const SurfaceMesh& mesh, std::size_t t, C
     for (std::size_t j = 0; j < 3; ++j)
       if (c[3 * a + j] != c[3 * b + j]) return c[3 * a + j] < c[3 * b + j];
     for (std::size_t j = 0; j < 3; ++j)
-      if (float_bits(f[3 * a + j]) != float_bits(f[3 * b + j])) return float_bits(f[3 * a + j]) < float_bits(f[3 * b + j]);
+      if (float_bits(f[3 * a + j]) != float_bits(f[3 * b + j]))
+        return float_bits(f[3 * a + j]) < float_bits(f[3 * b + j]);
     return false;
   };
   std::size_t first = 0;
@@ -133,11 +134,15 @@ void DeltaTracker::reset() {
 }
 
 std::string encode_binary(const MeshDelta& d) {
-  const std::uint32_t header[6] = {0x44525456u /* "VTRD" */, d.full ? 1u : 0u, d.version, d.base,
+  const std::uint32_t header[6] = {0x44525456u /* "VTRD" */,
+                                   d.full ? 1u : 0u,
+                                   d.version,
+                                   d.base,
                                    static_cast<std::uint32_t>(d.removed.size()),
                                    static_cast<std::uint32_t>(d.added.size())};
   std::string out;
-  out.reserve(sizeof header + 4 * (d.removed.size() + d.added.size() + d.positions.size() + d.normals.size()));
+  out.reserve(sizeof header +
+              4 * (d.removed.size() + d.added.size() + d.positions.size() + d.normals.size()));
   append_raw(out, header, 6);
   append_raw(out, d.removed.data(), d.removed.size());
   append_raw(out, d.added.data(), d.added.size());

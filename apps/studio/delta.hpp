@@ -19,9 +19,9 @@
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include <array>
+#include <cstddef>
 #include <cstdint>
 #include <string>
-#include <cstddef>
 #include <unordered_map>
 #include <vector>
 
@@ -29,9 +29,9 @@ namespace vitri::studio {
 
 /// What changed between the mesh a client holds (version `base`) and the current one (`version`).
 struct MeshDelta {
-  std::uint32_t base = 0;     ///< client version this applies to (0 with `full`: start from nothing)
-  std::uint32_t version = 0;  ///< version the client holds after applying it
-  bool full = false;          ///< the client must drop every triangle it holds first
+  std::uint32_t base = 0;              ///< client version this applies to (0 with `full`: start from nothing)
+  std::uint32_t version = 0;           ///< version the client holds after applying it
+  bool full = false;                   ///< the client must drop every triangle it holds first
   std::vector<std::uint32_t> removed;  ///< ids of the triangles to remove
   std::vector<std::uint32_t> added;    ///< ids of the new triangles
   std::vector<float> positions;        ///< 9 per added triangle: corners, CCW seen from outside

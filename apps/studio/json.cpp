@@ -10,14 +10,29 @@ namespace {
 
 const char* type_name(Json::Type t) {
   switch (t) {
-    case Json::Type::Null: return "null";
-    case Json::Type::Bool: return "a boolean";
-    case Json::Type::Number: return "a number";
-    case Json::Type::String: return "a string";
-    case Json::Type::Array: return "an array";
-    case Json::Type::Object: return "an object";
+    case Json::Type::Null:
+      return "null";
+    case Json::Type::Bool:
+      return "a boolean";
+    case Json::Type::Number:
+      return "a number";
+    case Json::Type::String:
+      return "a string";
+    case Json::Type::Array:
+      return "an array";
+    case Json::Type::Object:
+      return "an object";
   }
   return "?";
+}
+
+/// The character a one-letter escape stands for (\" \\ \/ \b \f \n \r \t), or 0 for another letter.
+char simple_escape(char e) {
+  constexpr char kFrom[] = "\"\\/bfnrt";
+  constexpr char kTo[] = "\"\\/\b\f\n\r\t";
+  for (std::size_t k = 0; k + 1 < sizeof kFrom; ++k)
+    if (kFrom[k] == e) return kTo[k];
+  return 0;
 }
 
 /// Parser state: the text and the read position.
@@ -103,8 +118,10 @@ class Parser {
       return pos_ - d;
     };
     if (s_[pos_] == '-') ++pos_;
-    if (pos_ < s_.size() && s_[pos_] == '0') ++pos_;
-    else if (digits() == 0) fail("bad number");
+    if (pos_ < s_.size() && s_[pos_] == '0')
+      ++pos_;
+    else if (digits() == 0)
+      fail("bad number");
     if (pos_ < s_.size() && s_[pos_] == '.') {
       ++pos_;
       if (digits() == 0) fail("bad number: no digit after '.'");
@@ -126,19 +143,26 @@ class Parser {
     for (int k = 0; k < 4; ++k) {
       const char c = s_[pos_++];
       v <<= 4;
-      if (c >= '0' && c <= '9') v |= static_cast<unsigned>(c - '0');
-      else if (c >= 'a' && c <= 'f') v |= static_cast<unsigned>(c - 'a' + 10);
-      else if (c >= 'A' && c <= 'F') v |= static_cast<unsigned>(c - 'A' + 10);
-      else fail("bad \\u escape");
+      if (c >= '0' && c <= '9')
+        v |= static_cast<unsigned>(c - '0');
+      else if (c >= 'a' && c <= 'f')
+        v |= static_cast<unsigned>(c - 'a' + 10);
+      else if (c >= 'A' && c <= 'F')
+        v |= static_cast<unsigned>(c - 'A' + 10);
+      else
+        fail("bad \\u escape");
     }
     return v;
   }
 
   static void append_utf8(std::string& out, unsigned cp) {
     auto byte = [&](unsigned b) { out.push_back(static_cast<char>(b)); };
-    if (cp < 0x80) byte(cp);
-    else if (cp < 0x800) byte(0xC0 | (cp >> 6)), byte(0x80 | (cp & 0x3F));
-    else if (cp < 0x10000) byte(0xE0 | (cp >> 12)), byte(0x80 | ((cp >> 6) & 0x3F)), byte(0x80 | (cp & 0x3F));
+    if (cp < 0x80)
+      byte(cp);
+    else if (cp < 0x800)
+      byte(0xC0 | (cp >> 6)), byte(0x80 | (cp & 0x3F));
+    else if (cp < 0x10000)
+      byte(0xE0 | (cp >> 12)), byte(0x80 | ((cp >> 6) & 0x3F)), byte(0x80 | (cp & 0x3F));
     else
       byte(0xF0 | (cp >> 18)), byte(0x80 | ((cp >> 12) & 0x3F)), byte(0x80 | ((cp >> 6) & 0x3F)),
           byte(0x80 | (cp & 0x3F));
@@ -172,18 +196,13 @@ class Parser {
       }
       if (pos_ >= s_.size()) fail("unterminated string");
       const char e = s_[pos_++];
-      switch (e) {
-        case '"': out.push_back('"'); break;
-        case '\\': out.push_back('\\'); break;
-        case '/': out.push_back('/'); break;
-        case 'b': out.push_back('\b'); break;
-        case 'f': out.push_back('\f'); break;
-        case 'n': out.push_back('\n'); break;
-        case 'r': out.push_back('\r'); break;
-        case 't': out.push_back('\t'); break;
-        case 'u': append_utf8(out, escaped_code_point()); break;
-        default: fail(std::string("bad escape '\\") + e + "'");
+      if (e == 'u') {
+        append_utf8(out, escaped_code_point());
+        continue;
       }
+      const char c2 = simple_escape(e);
+      if (!c2) fail(std::string("bad escape '\\") + e + "'");
+      out.push_back(c2);
     }
   }
 
@@ -195,7 +214,9 @@ void dump_to(const Json& v, std::string& out);
 
 }  // namespace
 
-Json Json::parse(std::string_view text) { return Parser(text).document(); }
+Json Json::parse(std::string_view text) {
+  return Parser(text).document();
+}
 
 bool Json::as_bool(const std::string& what) const {
   if (type_ != Type::Bool) throw JsonError(what + " must be a boolean, got " + type_name(type_));
@@ -226,11 +247,21 @@ std::string json_quote(std::string_view s) {
   std::string out = "\"";
   for (const char c : s) {
     switch (c) {
-      case '"': out += "\\\""; break;
-      case '\\': out += "\\\\"; break;
-      case '\n': out += "\\n"; break;
-      case '\r': out += "\\r"; break;
-      case '\t': out += "\\t"; break;
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
       default:
         if (static_cast<unsigned char>(c) < 0x20) {
           char buf[8];
@@ -247,8 +278,10 @@ std::string json_quote(std::string_view s) {
 std::string json_number(double d) {
   if (!std::isfinite(d)) throw JsonError("cannot write a non-finite number as JSON");
   char buf[32];
-  if (d == std::floor(d) && std::fabs(d) < 1e15) std::snprintf(buf, sizeof buf, "%.0f", d);
-  else std::snprintf(buf, sizeof buf, "%.17g", d);
+  if (d == std::floor(d) && std::fabs(d) < 1e15)
+    std::snprintf(buf, sizeof buf, "%.0f", d);
+  else
+    std::snprintf(buf, sizeof buf, "%.17g", d);
   return buf;
 }
 
@@ -256,10 +289,18 @@ namespace {
 
 void dump_to(const Json& v, std::string& out) {
   switch (v.type()) {
-    case Json::Type::Null: out += "null"; return;
-    case Json::Type::Bool: out += v.as_bool("") ? "true" : "false"; return;
-    case Json::Type::Number: out += json_number(v.as_number("")); return;
-    case Json::Type::String: out += json_quote(v.as_string("")); return;
+    case Json::Type::Null:
+      out += "null";
+      return;
+    case Json::Type::Bool:
+      out += v.as_bool("") ? "true" : "false";
+      return;
+    case Json::Type::Number:
+      out += json_number(v.as_number(""));
+      return;
+    case Json::Type::String:
+      out += json_quote(v.as_string(""));
+      return;
     case Json::Type::Array: {
       out.push_back('[');
       bool first = true;

@@ -39,7 +39,8 @@ class Json {
 
   /// Parses a whole document (surrounding white space allowed). @throws JsonError with the byte offset.
   static Json parse(std::string_view text);
-  /// Compact text; numbers with 17 significant digits (round trip). @throws JsonError for a non-finite number.
+  /// Compact text; numbers with 17 significant digits (round trip). @throws JsonError for a non-finite
+  /// number.
   std::string dump() const;
 
   Type type() const { return type_; }

@@ -15,7 +15,8 @@ namespace {
 void answer(httplib::Response& res, const ApiResponse& r) {
   res.status = r.status;
   res.set_header("Cache-Control", "no-store");
-  if (!r.download.empty()) res.set_header("Content-Disposition", "attachment; filename=\"" + r.download + "\"");
+  if (!r.download.empty())
+    res.set_header("Content-Disposition", "attachment; filename=\"" + r.download + "\"");
   res.set_content(r.body, r.content_type.c_str());
 }
 
@@ -81,7 +82,9 @@ Server::Server(Api& api, const ServerOptions& options) : impl_(std::make_unique<
   });
 }
 
-Server::~Server() { stop(); }
+Server::~Server() {
+  stop();
+}
 
 int Server::bind() {
   if (options_.port == 0) {
@@ -96,7 +99,9 @@ int Server::bind() {
   return port_;
 }
 
-void Server::run() { impl_->http.listen_after_bind(); }
+void Server::run() {
+  impl_->http.listen_after_bind();
+}
 
 void Server::stop() {
   if (impl_) impl_->http.stop();

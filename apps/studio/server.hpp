@@ -10,10 +10,10 @@
 namespace vitri::studio {
 
 struct ServerOptions {
-  std::string host = "127.0.0.1";  ///< address to bind; another one exposes the studio to the network
-  int port = 8080;                 ///< 0: any free port (see Server::port())
-  std::string web_dir;             ///< folder with index.html, studio.js, studio.css
-  std::string three_dir;           ///< three.js installation (build/three.min.js, examples/js/controls/)
+  std::string host = "127.0.0.1";    ///< address to bind; another one exposes the studio to the network
+  int port = 8080;                   ///< 0: any free port (see Server::port())
+  std::string web_dir;               ///< folder with index.html, studio.js, studio.css
+  std::string three_dir;             ///< three.js installation (build/three.min.js, examples/js/controls/)
   std::size_t max_body = 64u << 20;  ///< largest request body (an uploaded file); larger gets 413
 };
 

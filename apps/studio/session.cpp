@@ -13,14 +13,17 @@ namespace vitri::studio {
 namespace {
 
 double now_ms() {
-  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch()).count();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now().time_since_epoch())
+      .count();
 }
 
 }  // namespace
 
-Session::Session(Constraints constraints, std::string name, const SessionOptions& options) : options_(options) {
+Session::Session(Constraints constraints, std::string name, const SessionOptions& options)
+    : options_(options) {
   if (!(options.precision > 0) || !std::isfinite(options.precision))
-    throw InvalidArgument("studio: precision must be positive and finite, got " + std::to_string(options.precision));
+    throw InvalidArgument("studio: precision must be positive and finite, got " +
+                          std::to_string(options.precision));
   target_ = options.precision;
   load(std::move(constraints), std::move(name));
 }
@@ -28,8 +31,8 @@ Session::Session(Constraints constraints, std::string name, const SessionOptions
 void Session::load(Constraints constraints, std::string name) {
   if (constraints.size() == 0) throw InvalidArgument(name + ": no constraints");
   if (constraints.size() > options_.max_constraints)
-    throw LimitError(name + ": " + std::to_string(constraints.size()) + " constraints, the studio holds at most " +
-                     std::to_string(options_.max_constraints));
+    throw LimitError(name + ": " + std::to_string(constraints.size()) +
+                     " constraints, the studio holds at most " + std::to_string(options_.max_constraints));
   auto mesher = std::make_unique<Mesher>(constraints, options_.mesher);  // throws before anything changes
   mesher_ = std::move(mesher);
   name_ = std::move(name);
@@ -81,7 +84,8 @@ Edit Session::apply(const Edit& e) {
   switch (e.op) {
     case Edit::Op::Add:
       if (ids_.size() >= options_.max_constraints)
-        throw LimitError("the studio holds at most " + std::to_string(options_.max_constraints) + " constraints");
+        throw LimitError("the studio holds at most " + std::to_string(options_.max_constraints) +
+                         " constraints");
       check_position(e.position);
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
       timed_edit([&] { mesher_->add_constraint(e.position, e.value); });
@@ -198,7 +202,8 @@ bool Session::refine_step(const KeepGoing& keep_going) {
   const double level = std::isinf(current_) ? target_ * std::ldexp(1.0, options_.coarse_levels)
                                             : std::max(target_, 0.5 * current_);
   const double t0 = now_ms();
-  const bool done = mesher_->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); });
+  const bool done =
+      mesher_->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); });
   times_.edit_ms = now_ms() - t0;
   mesh_timed_ = false;
   ++revision_;

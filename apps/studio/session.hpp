@@ -44,7 +44,7 @@ struct Edit {
   enum class Op { Add, Move, Remove, SetValue };
   Op op = Op::Add;
   std::uint64_t id = 0;
-  Point3 position;  ///< Add, Move
+  Point3 position;   ///< Add, Move
   double value = 0;  ///< Add, SetValue
 };
 

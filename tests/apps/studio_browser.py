@@ -71,11 +71,15 @@ class Server:
             return json.loads(r.read())
 
     def stop(self):
+        """Stops the server (SIGTERM: a clean shutdown); a sanitizer report or a crash fails the test."""
         self.proc.terminate()
         try:
-            self.proc.wait(timeout=20)
+            rest, _ = self.proc.communicate(timeout=60)
         except subprocess.TimeoutExpired:
             self.proc.kill()
+            raise Failure("vitri studio did not stop on SIGTERM")
+        if self.proc.returncode != 0:
+            raise Failure("vitri studio exited with %d:\n%s" % (self.proc.returncode, rest))
 
 
 def edges_closed(mesh):

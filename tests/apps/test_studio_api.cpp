@@ -9,8 +9,8 @@
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 
-#include <catch2/catch.hpp>
 #include <httplib.h>
+#include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -60,7 +60,8 @@ struct Running {
         thread((server.bind(), [this] { server.run(); })),
         client("127.0.0.1", server.port()) {
     client.set_read_timeout(120, 0);
-    for (int i = 0; i < 200 && !client.Get("/api/stats"); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    for (int i = 0; i < 200 && !client.Get("/api/stats"); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   ~Running() {
     server.stop();
@@ -97,12 +98,15 @@ struct Running {
   }
 };
 
-double number(const Json& j, const char* key) { return j.find(key)->as_number(key); }
+double number(const Json& j, const char* key) {
+  return j.find(key)->as_number(key);
+}
 
 MeshMetrics metrics_of_indexed(const Json& m) {
   SurfaceMesh s;
   for (const Json& v : m.find("vertices")->as_array(""))
-    s.vertices.push_back({v.as_array("")[0].as_number(""), v.as_array("")[1].as_number(""), v.as_array("")[2].as_number("")});
+    s.vertices.push_back(
+        {v.as_array("")[0].as_number(""), v.as_array("")[1].as_number(""), v.as_array("")[2].as_number("")});
   for (const Json& t : m.find("triangles")->as_array(""))
     s.triangles.push_back({static_cast<std::uint32_t>(t.as_array("")[0].as_number("")),
                            static_cast<std::uint32_t>(t.as_array("")[1].as_number("")),
@@ -175,7 +179,9 @@ TEST_CASE("studio api: edits, undo, redo; the mesh stays closed and comes back",
   // Undoing the removal appended constraint 3 at the end: same constraints, as a set.
   Json::Array after = r.get("/api/state").find("constraint_list")->as_array("");
   Json::Array expect = Json::parse(before).as_array("");
-  const auto key = [](const Json& c) { return c.find("id")->dump() + c.find("position")->dump() + c.find("value")->dump(); };
+  const auto key = [](const Json& c) {
+    return c.find("id")->dump() + c.find("position")->dump() + c.find("value")->dump();
+  };
   std::vector<std::string> a, b;
   for (const Json& c : after) a.push_back(key(c));
   for (const Json& c : expect) b.push_back(key(c));
@@ -216,7 +222,8 @@ TEST_CASE("studio api: refine, precision, export, load", "[studio][api]") {
     const auto e = r.client.Get((std::string("/api/export?format=") + format).c_str());
     REQUIRE(e);
     CHECK(e->status == 200);
-    CHECK(e->get_header_value("Content-Disposition") == std::string("attachment; filename=\"small.") + format + "\"");
+    CHECK(e->get_header_value("Content-Disposition") ==
+          std::string("attachment; filename=\"small.") + format + "\"");
     const TriangleMesh tm = parse_input(e->body, std::string("x.") + format).mesh;
     CHECK(static_cast<double>(tm.V.rows()) == vertices);
   }
@@ -342,10 +349,18 @@ TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]
       const std::size_t i = surface_index();
       const Point3 p = session.mesher().constraints().points[i];
       switch (rng() % 4) {
-        case 0: session.add({0.9 * u(rng), 0.7 * u(rng), 0.5 * u(rng)}, 0.0); break;
-        case 1: session.move(i, {p.x + 0.1 * u(rng), p.y + 0.1 * u(rng), p.z + 0.1 * u(rng)}, rng() % 2 == 0); break;
-        case 2: session.remove(i); break;
-        default: session.set_value(i, 0.05 * u(rng)); break;
+        case 0:
+          session.add({0.9 * u(rng), 0.7 * u(rng), 0.5 * u(rng)}, 0.0);
+          break;
+        case 1:
+          session.move(i, {p.x + 0.1 * u(rng), p.y + 0.1 * u(rng), p.z + 0.1 * u(rng)}, rng() % 2 == 0);
+          break;
+        case 2:
+          session.remove(i);
+          break;
+        default:
+          session.set_value(i, 0.05 * u(rng));
+          break;
       }
       ++edits;
     } catch (const Error&) {
@@ -366,7 +381,8 @@ TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]
     return out;
   };
   std::vector<ConstraintInfo> start;
-  for (std::size_t i = 0; i < original.size(); ++i) start.push_back({i, 0, original.points[i], original.values[i]});
+  for (std::size_t i = 0; i < original.size(); ++i)
+    start.push_back({i, 0, original.points[i], original.values[i]});
   CHECK(sorted(session.constraints()) == sorted(start));
   while (session.redo()) REQUIRE(test::metrics_of(session.surface()).watertight());
   CHECK(sorted(session.constraints()) == sorted(edited));

@@ -17,7 +17,8 @@ using namespace vitri;
 using namespace vitri::studio;
 
 TEST_CASE("json: valid documents parse to the right values", "[studio][json]") {
-  const Json j = Json::parse(R"( {"a": [1, -2.5e3, 0.125, true, false, null], "s": "x\"\\\/\n\u00e9\ud83d\ude00",
+  const Json j =
+      Json::parse(R"( {"a": [1, -2.5e3, 0.125, true, false, null], "s": "x\"\\\/\n\u00e9\ud83d\ude00",
                                   "o": {}} )");
   const Json::Array& a = j.find("a")->as_array("a");
   REQUIRE(a.size() == 6);
@@ -33,11 +34,31 @@ TEST_CASE("json: valid documents parse to the right values", "[studio][json]") {
 }
 
 TEST_CASE("json: malformed documents are rejected with the byte offset", "[studio][json]") {
-  const char* bad[] = {"",          "{",          "{\"a\":1,}", "[1,]",        "[01]",         "[1.]",
-                       "[.5]",      "[+1]",       "[NaN]",      "[Infinity]",  "[1e999]",      "[0x10]",
-                       "{'a':1}",   "{\"a\" 1}",  "{\"a\":1 \"b\":2}",          "{\"a\":1,\"a\":2}",
-                       "\"\\x\"",   "\"\\ud800\"", "\"\\udc00x\"",              "\"a\nb\"",     "[1] 2",
-                       "tru",       "nul",        "{1:2}",      "\"unterminated"};
+  const char* bad[] = {"",
+                       "{",
+                       "{\"a\":1,}",
+                       "[1,]",
+                       "[01]",
+                       "[1.]",
+                       "[.5]",
+                       "[+1]",
+                       "[NaN]",
+                       "[Infinity]",
+                       "[1e999]",
+                       "[0x10]",
+                       "{'a':1}",
+                       "{\"a\" 1}",
+                       "{\"a\":1 \"b\":2}",
+                       "{\"a\":1,\"a\":2}",
+                       "\"\\x\"",
+                       "\"\\ud800\"",
+                       "\"\\udc00x\"",
+                       "\"a\nb\"",
+                       "[1] 2",
+                       "tru",
+                       "nul",
+                       "{1:2}",
+                       "\"unterminated"};
   for (const char* text : bad) {
     INFO("text: " << text);
     CHECK_THROWS_AS(Json::parse(text), JsonError);
@@ -87,8 +108,10 @@ struct Client {
   std::uint32_t version = 0;
 
   void apply(const MeshDelta& d) {
-    if (d.full) triangles.clear();
-    else REQUIRE(d.base == version);
+    if (d.full)
+      triangles.clear();
+    else
+      REQUIRE(d.base == version);
     for (const std::uint32_t id : d.removed) REQUIRE(triangles.erase(id) == 1);
     REQUIRE(d.positions.size() == 9 * d.added.size());
     REQUIRE(d.normals.size() == 9 * d.added.size());

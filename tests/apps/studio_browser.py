@@ -307,10 +307,12 @@ def bench(driver, server, out_dir):
     stats = server.get("/api/stats")
     adds = run_js("studio.benchAdd({count: 12})")
     drag = run_js("studio.benchDrag({moves: 60})")
+    drag_async = run_js("studio.benchDrag({moves: 60, sync: false})")
     driver.save_screenshot(os.path.join(out_dir, "studio-bench.png"))
     print("BENCH " + json.dumps({"model": stats["name"], "load_average": os.getloadavg()[0], "constraints": stats["constraints"],
                                  "triangles": stats["triangles"], "vertices": stats["vertices"],
-                                 "add": adds, "drag": drag}))
+                                 "add": adds, "drag": drag,
+                                 "drag_async_updates_per_second": drag_async["updates_per_second"]}))
     return 0
 
 

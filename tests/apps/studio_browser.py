@@ -289,6 +289,23 @@ def run(args):
               % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
         check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
               "the page draws the server's mesh after the deltas")
+        # 4. Open a file through the page (uploaded as the request body, parsed from memory).
+        upload = os.path.abspath(os.path.join(args.out, "studio-upload.xyzv"))
+        with open(upload, "w") as f:
+            f.write("0 0 0 -1\n")
+            for i in range(12):
+                a = 2 * math.pi * i / 12
+                f.write("%r %r %r 0\n" % (math.cos(a), math.sin(a), 0.5 * (-1) ** i))
+            f.write("0 0 1.2 0\n0 0 -1.2 0\n")
+        driver.find_element("id", "open").send_keys(upload)
+        wait_for("the upload", lambda: server.get("/api/stats")["name"] == "studio-upload.xyzv")
+        wait_for("the page to be idle", lambda: page_idle(driver))
+        s4 = server.get("/api/stats")
+        check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
+        check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
+        check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
+              "the page draws the uploaded model")
+        shot("studio-4-opened.png")
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         check(not errors, "no error in the browser console " + (json.dumps(errors) if errors else ""))
         check(driver.execute_script("return document.getElementById('error').hidden"), "no error shown")

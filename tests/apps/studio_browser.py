@@ -213,6 +213,79 @@ def api_bench(server):
     return 0
 
 
+def click_drag_undo(driver, server, shot, s0, m0):
+    """Adds a constraint by clicking the surface, drags it, undoes both; checks the mesh each time."""
+    # 1. Click on the surface (middle of the view: the model is framed there): on-surface constraint.
+    canvas = driver.find_element("css selector", "#view canvas")
+    ActionChains(driver).move_to_element(canvas).click().perform()
+    wait_for("the new constraint", lambda: server.get("/api/stats")["constraints"] == s0["constraints"] + 1)
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    shot("studio-1-added.png")
+    s1 = server.get("/api/state")
+    added = s1["constraint_list"][-1]
+    check(added["value"] == 0, "the click added an on-surface constraint (value 0)")
+    m1 = server.get("/api/mesh?format=indexed")
+    check(m1 != m0, "the mesh changed after the click")
+    check(edges_closed(m1), "the mesh is closed after the click")
+
+    # 2. Drag the new constraint across the screen in small steps.
+    p = driver.execute_script("return studio.screenOf(arguments[0])", added["index"])
+    pointer_to(driver, p["x"], p["y"])
+    ActionChains(driver).click_and_hold().perform()
+    for k in range(1, 11):
+        pointer_to(driver, p["x"] + 6 * k, p["y"] - 4 * k)
+        time.sleep(0.03)
+    ActionChains(driver).release().perform()
+    wait_for("the drag to end", lambda: page_idle(driver))
+    shot("studio-2-dragged.png")
+    s2 = server.get("/api/state")
+    moved = s2["constraint_list"][added["index"]]
+    check(moved["position"] != added["position"], "the drag moved the constraint")
+    check(s2["undo"] == s1["undo"] + 1, "the drag is one undo step")
+    m2 = server.get("/api/mesh?format=indexed")
+    check(m2 != m1, "the mesh followed the drag")
+    check(edges_closed(m2), "the mesh is closed after the drag")
+
+    # 3. Undo the drag (Ctrl+Z) and the click (the Undo button).
+    ActionChains(driver).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
+    wait_for("undo of the drag", lambda: server.get("/api/stats")["undo"] == s1["undo"])
+    driver.find_element("id", "undo").click()
+    wait_for("undo of the click", lambda: server.get("/api/stats")["constraints"] == s0["constraints"])
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    shot("studio-3-undone.png")
+    s3 = server.get("/api/state")
+    check(s3["constraint_list"] == s0["constraint_list"], "the constraints came back exactly")
+    m3 = server.get("/api/mesh?format=indexed")
+    check(edges_closed(m3), "the mesh is closed after the undos")
+    tol = 2 * s0["precision"] * s0["unit"]
+    d = max(max_vertex_distance(m3, m0), max_vertex_distance(m0, m3))
+    check(d <= tol, "the mesh came back (vertex distance %.3g <= %.3g, %d vs %d triangles)"
+          % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
+    check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
+          "the page draws the server's mesh after the deltas")
+
+
+def open_file(driver, server, shot, out_dir):
+    """Opens a .xyzv file through the page's file input."""
+    # 4. Open a file through the page (uploaded as the request body, parsed from memory).
+    upload = os.path.abspath(os.path.join(out_dir, "studio-upload.xyzv"))
+    with open(upload, "w") as f:
+        f.write("0 0 0 -1\n")
+        for i in range(12):
+            a = 2 * math.pi * i / 12
+            f.write("%r %r %r 0\n" % (math.cos(a), math.sin(a), 0.5 * (-1) ** i))
+        f.write("0 0 1.2 0\n0 0 -1.2 0\n")
+    driver.find_element("id", "open").send_keys(upload)
+    wait_for("the upload", lambda: server.get("/api/stats")["name"] == "studio-upload.xyzv")
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    s4 = server.get("/api/stats")
+    check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
+    check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
+    check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
+          "the page draws the uploaded model")
+    shot("studio-4-opened.png")
+
+
 def run(args):
     server = Server(args.vitri, ([args.model] if args.model else []) + ["--precision", str(args.precision)] +
                     args.studio_args.split())
@@ -241,71 +314,8 @@ def run(args):
         if args.bench:
             return bench(driver, server, args.out)
 
-        # 1. Click on the surface (middle of the view: the model is framed there): on-surface constraint.
-        canvas = driver.find_element("css selector", "#view canvas")
-        ActionChains(driver).move_to_element(canvas).click().perform()
-        wait_for("the new constraint", lambda: server.get("/api/stats")["constraints"] == s0["constraints"] + 1)
-        wait_for("the page to be idle", lambda: page_idle(driver))
-        shot("studio-1-added.png")
-        s1 = server.get("/api/state")
-        added = s1["constraint_list"][-1]
-        check(added["value"] == 0, "the click added an on-surface constraint (value 0)")
-        m1 = server.get("/api/mesh?format=indexed")
-        check(m1 != m0, "the mesh changed after the click")
-        check(edges_closed(m1), "the mesh is closed after the click")
-
-        # 2. Drag the new constraint across the screen in small steps.
-        p = driver.execute_script("return studio.screenOf(arguments[0])", added["index"])
-        pointer_to(driver, p["x"], p["y"])
-        ActionChains(driver).click_and_hold().perform()
-        for k in range(1, 11):
-            pointer_to(driver, p["x"] + 6 * k, p["y"] - 4 * k)
-            time.sleep(0.03)
-        ActionChains(driver).release().perform()
-        wait_for("the drag to end", lambda: page_idle(driver))
-        shot("studio-2-dragged.png")
-        s2 = server.get("/api/state")
-        moved = s2["constraint_list"][added["index"]]
-        check(moved["position"] != added["position"], "the drag moved the constraint")
-        check(s2["undo"] == s1["undo"] + 1, "the drag is one undo step")
-        m2 = server.get("/api/mesh?format=indexed")
-        check(m2 != m1, "the mesh followed the drag")
-        check(edges_closed(m2), "the mesh is closed after the drag")
-
-        # 3. Undo the drag (Ctrl+Z) and the click (the Undo button).
-        ActionChains(driver).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
-        wait_for("undo of the drag", lambda: server.get("/api/stats")["undo"] == s1["undo"])
-        driver.find_element("id", "undo").click()
-        wait_for("undo of the click", lambda: server.get("/api/stats")["constraints"] == s0["constraints"])
-        wait_for("the page to be idle", lambda: page_idle(driver))
-        shot("studio-3-undone.png")
-        s3 = server.get("/api/state")
-        check(s3["constraint_list"] == s0["constraint_list"], "the constraints came back exactly")
-        m3 = server.get("/api/mesh?format=indexed")
-        check(edges_closed(m3), "the mesh is closed after the undos")
-        tol = 2 * s0["precision"] * s0["unit"]
-        d = max(max_vertex_distance(m3, m0), max_vertex_distance(m0, m3))
-        check(d <= tol, "the mesh came back (vertex distance %.3g <= %.3g, %d vs %d triangles)"
-              % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
-        check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
-              "the page draws the server's mesh after the deltas")
-        # 4. Open a file through the page (uploaded as the request body, parsed from memory).
-        upload = os.path.abspath(os.path.join(args.out, "studio-upload.xyzv"))
-        with open(upload, "w") as f:
-            f.write("0 0 0 -1\n")
-            for i in range(12):
-                a = 2 * math.pi * i / 12
-                f.write("%r %r %r 0\n" % (math.cos(a), math.sin(a), 0.5 * (-1) ** i))
-            f.write("0 0 1.2 0\n0 0 -1.2 0\n")
-        driver.find_element("id", "open").send_keys(upload)
-        wait_for("the upload", lambda: server.get("/api/stats")["name"] == "studio-upload.xyzv")
-        wait_for("the page to be idle", lambda: page_idle(driver))
-        s4 = server.get("/api/stats")
-        check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
-        check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
-        check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
-              "the page draws the uploaded model")
-        shot("studio-4-opened.png")
+        click_drag_undo(driver, server, shot, s0, m0)
+        open_file(driver, server, shot, args.out)
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         check(not errors, "no error in the browser console " + (json.dumps(errors) if errors else ""))
         check(driver.execute_script("return document.getElementById('error').hidden"), "no error shown")

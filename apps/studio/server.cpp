@@ -6,6 +6,8 @@
 
 #include <httplib.h>
 
+#include <sys/socket.h>
+
 #include <fstream>
 #include <sstream>
 
@@ -48,6 +50,12 @@ struct Server::Impl {
 Server::Server(Api& api, const ServerOptions& options) : impl_(std::make_unique<Impl>()), options_(options) {
   httplib::Server& http = impl_->http;
   http.set_payload_max_length(options.max_body);
+  // SO_REUSEADDR only: cpp-httplib's default also sets SO_REUSEPORT, with which a second studio on the
+  // same port binds too and the two share the requests.
+  http.set_socket_options([](socket_t sock) {
+    int yes = 1;
+    setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
+  });
   http.set_tcp_nodelay(true);  // small responses go out at once (Nagle + delayed ACK cost ~40 ms each)
   const auto to_api = [&api](const httplib::Request& req, httplib::Response& res) {
     ApiRequest r;

@@ -120,6 +120,15 @@ TEST_CASE("studio server binds the loopback address by default", "[studio][api]"
   CHECK(ServerOptions{}.host == "127.0.0.1");
 }
 
+TEST_CASE("studio server: a port in use is an error, not a shared port", "[studio][api]") {
+  Running r;
+  ServerOptions o = Running::options(1024);
+  o.port = r.server.port();
+  Server second(r.api, o);
+  CHECK_THROWS_AS(second.bind(), Error);
+  CHECK(r.get("/api/stats").find("constraints")->as_number("") == 25);  // the first one still serves
+}
+
 TEST_CASE("studio api: stats, state, mesh", "[studio][api]") {
   Running r;
   const Json stats = r.get("/api/stats");

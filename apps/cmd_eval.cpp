@@ -1,6 +1,7 @@
 // `vitri eval INPUT --at QUERY.xyz`: fits the variational implicit function of INPUT and prints
 // `f gx gy gz` (full precision, %.17g) for each query point, one line per point, in query order.
 #include "commands.hpp"
+#include "input.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/rbf/constraints.hpp"
@@ -48,25 +49,6 @@ T parse_unsigned(const std::string& flag, const std::string& s) {
 
 }  // namespace
 
-Constraints constraints_of_input(const std::string& path, const ConstraintBuildOptions& opt) {
-  const Input in = read_input(path);
-  switch (in.kind) {
-    case InputKind::Constraints:
-      return Constraints{in.constraints.points, in.constraints.values};
-    case InputKind::OrientedPoints:
-      return constraints_from_oriented_points(in.points.points, in.points.normals, opt);
-    case InputKind::Points:
-      try {
-        return constraints_from_points(in.points.points, opt);
-      } catch (const InvalidArgument& e) {  // say which file (the message names the point)
-        throw InvalidArgument(path + ": points without normals: " + e.what());
-      }
-    case InputKind::Mesh:
-      return constraints_from_mesh(in.mesh.V, in.mesh.F, opt);
-  }
-  throw InvalidArgument(path + ": unsupported input");
-}
-
 int run_eval(const Args& args) {
   std::string input, query;
   ConstraintBuildOptions opt;
@@ -100,7 +82,7 @@ int run_eval(const Args& args) {
     std::cerr << "usage: vitri eval INPUT --at QUERY.xyz (try vitri eval --help)\n";
     return 2;
   }
-  const Constraints c = constraints_of_input(input, opt);
+  const Constraints c = constraints_of(read_input(input), input, opt);
   Rbf f(c);
   if (f.report().warning) std::cerr << "vitri eval: warning: " << f.report().message << "\n";
   const OrientedPoints q = read_points(query);

@@ -1,6 +1,7 @@
 // `vitri mesh`: fit the implicit surface of an input, mesh it at one or more levels of detail, and
 // optionally replay an edit script (the paper's Tables 1, 2 and 3).
 #include "commands.hpp"
+#include "input.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
@@ -244,7 +245,7 @@ int run_mesh(const Args& args) {
   }
 
   const auto t_start = Clock::now();
-  const Constraints constraints = constraints_of_input(input, options.constraint_build);
+  const Constraints constraints = constraints_of(read_input(input), input, options.constraint_build);
   const bool announce_fit = !quiet && constraints.size() >= kFitProgressConstraints;
   if (announce_fit)
     std::fprintf(stderr, "fitting the implicit function to %zu constraints...\n", constraints.size());

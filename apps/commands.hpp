@@ -22,10 +22,6 @@ struct Command {
 /// All subcommands, in the order `vitri --help` lists them (defined in main.cpp).
 const std::vector<Command>& commands();
 
-/// Constraints of any input file (cmd_eval.cpp): .xyzv as is; oriented points, unoriented points (normals
-/// estimated and oriented, options.normals) and closed meshes through the builders of vitri::rbf.
-Constraints constraints_of_input(const std::string& path, const ConstraintBuildOptions& options);
-
 /// True when args holds -h or --help.
 bool wants_help(const Args& args);
 

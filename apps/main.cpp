@@ -18,6 +18,10 @@ int run_eval(const Args& args);  // cmd_eval.cpp
 const char* eval_usage();
 int run_mesh(const Args& args);  // cmd_mesh.cpp
 const char* mesh_usage();
+#ifdef VITRI_HAVE_STUDIO
+int run_studio(const Args& args);  // cmd_studio.cpp (built when cpp-httplib is found)
+const char* studio_usage();
+#endif
 const std::vector<Command>& commands() {
   static const std::vector<Command> table = {
       {"eval", "fit the implicit function of an input and print f and its gradient at query points", eval_usage(),
@@ -25,6 +29,10 @@ const std::vector<Command>& commands() {
       {"mesh", "mesh the implicit surface of constraints, oriented points or a mesh at levels of detail; replay edits",
        mesh_usage(), run_mesh},
       {"render", "draw meshes to a PNG picture (software renderer)", render_usage(), run_render},
+#ifdef VITRI_HAVE_STUDIO
+      {"studio", "model a variational surface interactively in the browser (local web server)", studio_usage(),
+       run_studio},
+#endif
       {"tetrahedralize", "exact Delaunay tetrahedralization of a point file in a box", tetrahedralize_usage(),
        run_tetrahedralize},
   };

@@ -3,10 +3,7 @@
 # Usage: bash tools/example.sh   (meshes written to out/hand-0.obj, out/hand-1.obj, out/hand-2.obj)
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/deps.sh cmake make g++ libeigen3-dev catch2 libstb-dev
-jobs=$(nproc 2>/dev/null || echo 2)
-cmake -S . -B build-release -DCMAKE_BUILD_TYPE=Release -DVITRI_BUILD_TESTS=OFF -DVITRI_BUILD_BENCH=OFF
-cmake --build build-release -j"$jobs" --target vitri_cli
+bash tools/build_release.sh
 mkdir -p out
 ./build-release/apps/vitri mesh data/hand.off -o out/hand.obj --precision 0.04 --precision 0.02 --precision 0.01
 echo "meshes written: $(ls out/hand-*.obj | tr '\n' ' ')"

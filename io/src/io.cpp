@@ -437,24 +437,31 @@ Input point_cloud(TriangleMesh m) {
 
 }  // namespace
 
-Input read_input(const std::string& path) {
-  const std::string e = file_extension(path);
+Input parse_input(std::string_view bytes, const std::string& name) {
+  const std::string e = file_extension(name);
   Input in;
   if (e == "xyzv") {
     in.kind = InputKind::Constraints;
-    in.constraints = read_xyzv(path);
+    in.constraints = parse_xyzv(bytes, name);
   } else if (e == "xyz" || e == "pwn") {
-    in.points = read_points(path);
+    in.points = parse_points(bytes, name, e == "pwn");
     in.kind = in.points.has_normals() ? InputKind::OrientedPoints : InputKind::Points;
   } else if (e == "off" || e == "obj" || e == "ply") {
     in.kind = InputKind::Mesh;
-    in.mesh = read_mesh(path);
+    in.mesh = e == "off" ? parse_off(bytes, name) : e == "obj" ? parse_obj(bytes, name) : parse_ply(bytes, name);
     if (in.mesh.F.rows() == 0) in = point_cloud(std::move(in.mesh));  // vertices only: a point cloud
   } else {
-    throw ParseError(path, 0,
+    throw ParseError(name, 0,
                      "unknown input extension '." + e + "' (expected .xyzv, .xyz, .pwn, .off, .obj or .ply)");
   }
   return in;
+}
+
+Input read_input(const std::string& path) {
+  const std::string e = file_extension(path);
+  if (e != "xyzv" && e != "xyz" && e != "pwn" && e != "off" && e != "obj" && e != "ply")
+    return parse_input({}, path);  // the unknown-extension error, before the file is opened
+  return parse_input(io_detail::slurp(path), path);
 }
 
 }  // namespace vitri

@@ -8,6 +8,7 @@
 #include <dirent.h>
 #include <cstdio>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -168,6 +169,27 @@ TEST_CASE("io reads the bundled models", "[io][data]") {
     CHECK(in.mesh.F.minCoeff() >= 0);
     CHECK(in.mesh.F.maxCoeff() < in.mesh.V.rows());
   }
+}
+
+TEST_CASE("io parse_input reads bytes in memory as read_input reads the file", "[io]") {
+  const std::string dir = VITRI_DATA_DIR;
+  for (const char* m : {"hand.off", "sphere926.pwn"}) {
+    std::ifstream f(dir + "/" + m, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(f)), std::istreambuf_iterator<char>());
+    const Input a = read_input(dir + "/" + m), b = parse_input(bytes, m);
+    CHECK(a.kind == b.kind);
+    CHECK(a.mesh.V == b.mesh.V);
+    CHECK(a.mesh.F == b.mesh.F);
+    CHECK(a.points.points == b.points.points);
+    CHECK(a.points.normals == b.points.normals);
+  }
+  const Input c = parse_input("0 0 0 -1\n1 0 0 0.5\n", "upload.XYZV");  // extension case ignored
+  CHECK(c.kind == InputKind::Constraints);
+  CHECK(c.constraints.values == std::vector<double>{-1, 0.5});
+  CHECK(parse_input("0 0 0\n1 0 0\n", "p.xyz").kind == InputKind::Points);
+  CHECK_THROWS_AS(parse_input("1 2 3 4 5 6\n", "p.exe"), ParseError);
+  CHECK_THROWS_WITH(parse_input("0 0 x 1\n", "bad.xyzv"), Catch::Contains("bad.xyzv"));
+  CHECK_THROWS_AS(parse_input("1 2 3\n", "only3.pwn"), ParseError);  // .pwn needs normals
 }
 
 TEST_CASE("io text variants: comments, header counts, NOFF, polygons, OBJ index forms, PLY extras", "[io]") {

@@ -112,6 +112,10 @@ struct Input {
 /// vertices have them (PLY nx ny nz, NOFF, OBJ vn).
 /// @throws ParseError for an unknown extension (line 0) or a malformed file.
 Input read_input(const std::string& path);
+/// Parses the bytes of any supported input held in memory; the kind is detected by the extension of
+/// `name` (a file name used for the detection and in messages, never opened). read_input() = this on the
+/// file's contents. @throws as read_input.
+Input parse_input(std::string_view bytes, const std::string& name);
 
 /// Lower-case extension of path without the dot ("" when none).
 std::string file_extension(const std::string& path);

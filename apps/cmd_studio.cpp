@@ -1,0 +1,164 @@
+// `vitri studio`: the interactive modeler in the browser (apps/studio/, docs/studio.md).
+#include "commands.hpp"
+#include "input.hpp"
+#include "studio/server.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <pthread.h>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <thread>
+
+#ifndef VITRI_STUDIO_WEB_DIR
+#error "VITRI_STUDIO_WEB_DIR must name the folder of the studio's page"
+#endif
+#ifndef VITRI_THREE_DIR
+#error "VITRI_THREE_DIR must name the three.js installation"
+#endif
+
+namespace vitri::cli {
+namespace {
+
+const char* const kUsage =
+    "usage: vitri studio [INPUT] [--port N] [--host ADDR] [--precision P] [--function F]\n"
+    "                    [--offset D] [--sides both|inside|outside]\n"
+    "\n"
+    "Starts the interactive modeler: a local web server; open the printed address in a browser. Click\n"
+    "the surface to add a constraint, shift+click / alt+click for an outside / inside one, drag a\n"
+    "constraint to move it; undo, redo, delete, change a value, precision slider, open a file, save the\n"
+    "constraints (.xyzv), export the mesh (OBJ, PLY, OFF). The page and its HTTP/JSON API: docs/studio.md.\n"
+    "\n"
+    "INPUT             any input of vitri mesh (.xyzv, .pwn, .xyz with normals, .off, .obj, .ply);\n"
+    "                  without it, a blob of 25 constraints\n"
+    "  --port N        TCP port (default 8080; 0: any free port)\n"
+    "  --host ADDR     address to bind (default 127.0.0.1, this machine only; 0.0.0.0 exposes the\n"
+    "                  studio and its edits to the network)\n"
+    "  --precision P   target relative precision (default 0.02); the mesh starts 4x coarser and is\n"
+    "                  refined while the page is idle\n"
+    "  --function F    implicit function: global (the RBF of the paper; the only one in this build)\n"
+    "  --offset D, --sides S   as vitri mesh, for oriented points and meshes\n"
+    "\n"
+    "Stops on Ctrl-C. Exit status: 0 stopped, 1 bad input, 2 usage error.\n";
+
+int usage_error(const std::string& what) {
+  std::cerr << "vitri studio: " << what << "\n(try vitri studio --help)\n";
+  return 2;
+}
+
+bool parse_number(const std::string& s, double& out) {
+  char* e = nullptr;
+  out = std::strtod(s.c_str(), &e);
+  return !s.empty() && *e == '\0' && std::isfinite(out);
+}
+
+/// The default model: 24 on-surface points on a lumpy sphere around one inside constraint.
+Constraints default_blob() {
+  Constraints c;
+  c.add({0, 0, 0}, -1.0);
+  for (int i = 0; i < 24; ++i) {
+    const double z = 1 - (2 * i + 1) / 24.0, r = std::sqrt(1 - z * z), a = 2.399963 * i;
+    const double s = 1 + 0.15 * std::sin(3 * a) * r;
+    c.add({s * r * std::cos(a), s * r * std::sin(a), 0.8 * s * z}, 0.0);
+  }
+  return c;
+}
+
+struct StudioArgs {
+  std::string input;
+  studio::SessionOptions session;
+  studio::ServerOptions server;
+};
+
+/// Parses the arguments into `out`; returns an empty string or the usage error.
+std::string parse_args(const Args& args, StudioArgs& out) {
+  for (std::size_t i = 0; i < args.size(); ++i) {
+    const std::string& a = args[i];
+    const bool has_value = i + 1 < args.size();
+    const std::string v = has_value ? args[i + 1] : std::string();
+    double d = 0;
+    if (a == "--port" || a == "--host" || a == "--precision" || a == "--function" || a == "--offset" ||
+        a == "--sides") {
+      if (!has_value) return a + " needs a value";
+      ++i;
+    }
+    if (a == "--port") {
+      if (!parse_number(v, d) || d < 0 || d > 65535 || d != std::floor(d)) return "--port needs 0..65535";
+      out.server.port = static_cast<int>(d);
+    } else if (a == "--host") {
+      out.server.host = v;
+    } else if (a == "--precision") {
+      if (!parse_number(v, d) || !(d > 0) || d > 1) return "--precision needs a number in (0, 1], got " + v;
+      out.session.precision = d;
+    } else if (a == "--function") {
+      // The implicit function choice passes through to MesherOptions once the Mesher offers more than one.
+      if (v != "global") return "--function: only 'global' is available in this build, got '" + v + "'";
+    } else if (a == "--offset") {
+      if (!parse_number(v, d) || !(d > 0)) return "--offset needs a positive number";
+      out.session.mesher.constraint_build.offset = d;
+    } else if (a == "--sides") {
+      if (v == "both")
+        out.session.mesher.constraint_build.sides = OffSurface::Both;
+      else if (v == "inside")
+        out.session.mesher.constraint_build.sides = OffSurface::Inside;
+      else if (v == "outside")
+        out.session.mesher.constraint_build.sides = OffSurface::Outside;
+      else
+        return "--sides must be both, inside or outside, got '" + v + "'";
+    } else if (!a.empty() && a[0] == '-') {
+      return "unknown option '" + a + "'";
+    } else if (out.input.empty()) {
+      out.input = a;
+    } else {
+      return "more than one input ('" + out.input + "', '" + a + "')";
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+const char* studio_usage() {
+  return kUsage;
+}
+
+int run_studio(const Args& args) {
+  StudioArgs sa;
+  sa.server.web_dir = VITRI_STUDIO_WEB_DIR;
+  sa.server.three_dir = VITRI_THREE_DIR;
+  if (const char* web = std::getenv("VITRI_STUDIO_WEB_DIR")) sa.server.web_dir = web;
+  const std::string bad = parse_args(args, sa);
+  if (!bad.empty()) return usage_error(bad);
+  const ConstraintBuildOptions& build = sa.session.mesher.constraint_build;
+  Constraints constraints =
+      sa.input.empty() ? default_blob() : constraints_of(read_input(sa.input), sa.input, build);
+  std::fprintf(stderr, "fitting %zu constraints...\n", constraints.size());
+  studio::Session session(std::move(constraints), sa.input.empty() ? "blob" : sa.input, sa.session);
+  studio::Api api(session, build);
+  studio::Server server(api, sa.server);
+  // Ctrl-C / SIGTERM: a thread waits for them and stops the server (no work inside a signal handler).
+  sigset_t stop_signals;
+  sigemptyset(&stop_signals);
+  sigaddset(&stop_signals, SIGINT);
+  sigaddset(&stop_signals, SIGTERM);
+  pthread_sigmask(SIG_BLOCK, &stop_signals, nullptr);
+  const int port = server.bind();
+  std::printf("vitri studio: %s, %zu constraints; open http://%s:%d/  (Ctrl-C stops)\n",
+              session.name().c_str(), session.size(),
+              sa.server.host == "0.0.0.0" ? "127.0.0.1" : sa.server.host.c_str(), port);
+  std::fflush(stdout);
+  std::thread waiter([&] {
+    int sig = 0;
+    sigwait(&stop_signals, &sig);
+    server.stop();
+  });
+  server.run();
+  pthread_kill(waiter.native_handle(), SIGTERM);  // wakes the waiter when run() ended on its own
+  waiter.join();
+  return 0;
+}
+
+}  // namespace vitri::cli

@@ -1,0 +1,31 @@
+#include "input.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <utility>
+
+namespace vitri::cli {
+
+Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build) {
+  switch (in.kind) {
+    case InputKind::Constraints: {
+      Constraints c;
+      c.points = std::move(in.constraints.points);
+      c.values = std::move(in.constraints.values);
+      return c;
+    }
+    case InputKind::OrientedPoints:
+      return constraints_from_oriented_points(in.points.points, in.points.normals, build);
+    case InputKind::Mesh:
+      return constraints_from_mesh(in.mesh.V, in.mesh.F, build);
+    case InputKind::Points:
+      try {
+        return constraints_from_points(in.points.points, build);
+      } catch (const InvalidArgument& e) {  // say which file (the message names the point)
+        throw InvalidArgument(name + ": points without normals: " + e.what());
+      }
+  }
+  throw InvalidArgument(name + ": unsupported input");
+}
+
+}  // namespace vitri::cli

@@ -1,0 +1,19 @@
+#pragma once
+// Turning any input the CLI reads (constraints, oriented points, a closed mesh) into the constraints the
+// Mesher fits: shared by `vitri mesh`, `vitri eval` and `vitri studio`.
+#include "vitri/io/io.hpp"
+#include "vitri/rbf/constraints.hpp"
+
+#include <string>
+
+namespace vitri::cli {
+
+/// The constraints of an input: as read (.xyzv), or built from oriented points, unoriented points (normals
+/// estimated and oriented, build.normals) or a closed mesh exactly as Mesher::from_oriented_points /
+/// from_points / from_mesh build them (surface points first, then the off-surface constraints; see
+/// constraints_from_oriented_points). `name` is used in messages.
+/// @throws InvalidArgument where the normals of unoriented points cannot be oriented (names the file and
+/// the point); as constraints_from_mesh / _oriented_points.
+Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build);
+
+}  // namespace vitri::cli

@@ -1,0 +1,338 @@
+// The studio's HTTP/JSON API: parsing and validating requests, calling the session, writing JSON.
+#include "api.hpp"
+
+#include "input.hpp"
+#include "json.hpp"
+
+#include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
+
+#include <unistd.h>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+namespace vitri::studio {
+namespace {
+
+/// A bad request: answered with 400 and the message.
+class BadRequest : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+ApiResponse json_response(std::string body) {
+  ApiResponse r;
+  r.body = std::move(body);
+  return r;
+}
+
+Json parse_body(const std::string& body) {
+  if (body.empty()) return Json(Json::Object{});
+  Json j = Json::parse(body);
+  j.as_object("the request body");
+  return j;
+}
+
+/// Rejects keys other than `allowed` (a typo must not be silently ignored).
+void check_keys(const Json& o, std::initializer_list<const char*> allowed) {
+  for (const auto& [key, value] : o.as_object("the request body")) {
+    bool ok = false;
+    for (const char* a : allowed) ok = ok || key == a;
+    if (!ok) throw BadRequest("unknown key \"" + key + "\"");
+  }
+}
+
+const Json& member(const Json& o, const char* key) {
+  const Json* v = o.find(key);
+  if (!v) throw BadRequest(std::string("missing \"") + key + "\"");
+  return *v;
+}
+
+double finite_number(const Json& o, const char* key) {
+  const double d = member(o, key).as_number(std::string("\"") + key + "\"");
+  if (!std::isfinite(d)) throw BadRequest(std::string("\"") + key + "\" must be finite");
+  return d;
+}
+
+std::size_t index_member(const Json& o, const char* key) {
+  const double d = finite_number(o, key);
+  if (d < 0 || d != std::floor(d) || d > 9007199254740992.0)
+    throw BadRequest(std::string("\"") + key + "\" must be a non-negative integer");
+  return static_cast<std::size_t>(d);
+}
+
+Point3 point_member(const Json& o, const char* key) {
+  const Json::Array& a = member(o, key).as_array(std::string("\"") + key + "\"");
+  if (a.size() != 3) throw BadRequest(std::string("\"") + key + "\" must hold 3 numbers");
+  Point3 p;
+  for (std::size_t k = 0; k < 3; ++k) {
+    p[k] = a[k].as_number(std::string("\"") + key + "\"[" + std::to_string(k) + "]");
+    if (!std::isfinite(p[k])) throw BadRequest(std::string("\"") + key + "\" must be finite");
+  }
+  return p;
+}
+
+bool bool_member(const Json& o, const char* key, bool fallback) {
+  const Json* v = o.find(key);
+  return v ? v->as_bool(std::string("\"") + key + "\"") : fallback;
+}
+
+std::string param(const ApiRequest& r, const std::string& key, const std::string& fallback = {}) {
+  const auto it = r.params.find(key);
+  return it == r.params.end() ? fallback : it->second;
+}
+
+std::uint32_t version_param(const ApiRequest& r) {
+  const std::string s = param(r, "since", "0");
+  char* end = nullptr;
+  const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
+  if (s.empty() || *end != '\0' || s[0] == '-' || v > 0xffffffffull)
+    throw BadRequest("\"since\" must be a mesh version (a non-negative integer), got '" + s + "'");
+  return static_cast<std::uint32_t>(v);
+}
+
+std::string points_json(const std::vector<Point3>& pts) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (i) out.push_back(',');
+    out += "[" + json_number(pts[i].x) + "," + json_number(pts[i].y) + "," + json_number(pts[i].z) + "]";
+  }
+  return out + "]";
+}
+
+/// The current mesh as {"vertices": [[x,y,z]..], "triangles": [[a,b,c]..]} (for scripts and tests).
+std::string indexed_mesh_json(const SurfaceMesh& m) {
+  std::string out = "{\"vertices\":" + points_json(m.vertices) + ",\"triangles\":[";
+  for (std::size_t t = 0; t < m.triangles.size(); ++t) {
+    if (t) out.push_back(',');
+    const auto& f = m.triangles[t];
+    out += "[" + std::to_string(f[0]) + "," + std::to_string(f[1]) + "," + std::to_string(f[2]) + "]";
+  }
+  return out + "]}";
+}
+
+std::string read_whole_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+/// A download name: the session name's stem (letters, digits, '-', '_' kept) and the extension.
+std::string download_name(const std::string& name, const std::string& ext) {
+  std::string stem = name.substr(0, name.find_last_of('.'));
+  const std::size_t slash = stem.find_last_of("/\\");
+  if (slash != std::string::npos) stem = stem.substr(slash + 1);
+  std::string clean;
+  for (const char c : stem)
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') clean.push_back(c);
+  return (clean.empty() ? "model" : clean) + "." + ext;
+}
+
+}  // namespace
+
+ApiResponse error_response(int status, const std::string& what) {
+  ApiResponse r;
+  r.status = status;
+  r.body = "{\"error\":" + json_quote(what) + "}";
+  return r;
+}
+
+Api::Api(Session& session, const ConstraintBuildOptions& build) : session_(session), build_(build) {
+  const char* tmp = std::getenv("TMPDIR");
+  std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/vitri-studio-XXXXXX";
+  if (!mkdtemp(pattern.data())) throw Error("studio: cannot create a private temporary directory");
+  temp_dir_ = pattern;
+}
+
+Api::~Api() {
+  for (const char* ext : {"xyzv", "obj", "ply", "off"}) std::remove(temp_path(ext).c_str());
+  rmdir(temp_dir_.c_str());
+}
+
+std::string Api::temp_path(const std::string& ext) const {
+  return temp_dir_ + "/export." + ext;
+}
+
+bool Api::is_api_path(const std::string& path) {
+  return path.rfind("/api/", 0) == 0;
+}
+
+ApiResponse Api::handle(const ApiRequest& request) {
+  try {
+    if (request.path == "/api/refine") {  // yields to waiting requests, so it does not count as one
+      std::lock_guard<std::mutex> lock(mutex_);
+      return route(request);
+    }
+    ++waiting_;
+    std::unique_lock<std::mutex> lock(mutex_);
+    --waiting_;
+    return route(request);
+  } catch (const BadRequest& e) {
+    return error_response(400, e.what());
+  } catch (const JsonError& e) {
+    return error_response(400, e.what());
+  } catch (const LimitError& e) {
+    return error_response(413, e.what());
+  } catch (const Error& e) {
+    return error_response(400, e.what());
+  } catch (const std::exception& e) {
+    return error_response(500, std::string("internal error: ") + e.what());
+  }
+}
+
+ApiResponse Api::route(const ApiRequest& r) {
+  const std::string& p = r.path;
+  const char* method =
+      p == "/api/stats" || p == "/api/state" || p == "/api/mesh" || p == "/api/export" ? "GET"
+      : p == "/api/edit" || p == "/api/undo" || p == "/api/redo" || p == "/api/refine" || p == "/api/load"
+          ? "POST"
+          : nullptr;
+  if (!method) return error_response(404, "no such endpoint: " + p);
+  if (r.method != method) return error_response(405, p + " takes " + method + ", not " + r.method);
+  if (p == "/api/stats") return stats();
+  if (p == "/api/state") return state();
+  if (p == "/api/mesh") return mesh(r);
+  if (p == "/api/export") return export_file(r);
+  if (p == "/api/edit") return edit(r);
+  if (p == "/api/refine") return refine(r);
+  if (p == "/api/load") return load(r);
+  check_keys(parse_body(r.body), {});
+  const bool done = p == "/api/undo" ? session_.undo() : session_.redo();
+  return json_response(stats_json(std::string("\"done\":") + (done ? "true" : "false")));
+}
+
+std::string Api::stats_json(const std::string& extra) {
+  const SurfaceMesh& m = session_.surface();
+  const MesherStats s = session_.mesher().stats();
+  const double current = session_.current_precision();
+  std::string out = "{";
+  if (!extra.empty()) out += extra + ",";
+  out += "\"name\":" + json_quote(session_.name()) + ",\"constraints\":" + std::to_string(session_.size()) +
+         ",\"vertices\":" + std::to_string(m.vertices.size()) +
+         ",\"triangles\":" + std::to_string(m.triangles.size()) +
+         ",\"precision\":" + (std::isfinite(current) ? json_number(current) : std::string("null")) +
+         ",\"target_precision\":" + json_number(session_.target_precision()) +
+         ",\"refined\":" + (session_.refined() ? "true" : "false") +
+         ",\"unit\":" + json_number(session_.unit()) +
+         ",\"edit_ms\":" + json_number(session_.last_update().edit_ms) +
+         ",\"rbf_ms\":" + json_number(s.edit_rbf_seconds * 1e3) +
+         ",\"extract_ms\":" + json_number(session_.last_update().extract_ms) +
+         ",\"delaunay_vertices\":" + std::to_string(s.polygonizer.vertices) +
+         ",\"rebuilds\":" + std::to_string(s.rebuilds) +
+         ",\"undo\":" + std::to_string(session_.undo_depth()) +
+         ",\"redo\":" + std::to_string(session_.redo_depth()) +
+         ",\"revision\":" + std::to_string(session_.revision()) + "}";
+  return out;
+}
+
+ApiResponse Api::stats() {
+  return json_response(stats_json());
+}
+
+ApiResponse Api::state() {
+  std::string list = "[";
+  for (const ConstraintInfo& c : session_.constraints()) {
+    if (list.size() > 1) list.push_back(',');
+    list += "{\"index\":" + std::to_string(c.index) + ",\"id\":" + std::to_string(c.id) + ",\"position\":[" +
+            json_number(c.position.x) + "," + json_number(c.position.y) + "," + json_number(c.position.z) +
+            "],\"value\":" + json_number(c.value) + "}";
+  }
+  return json_response(stats_json("\"constraint_list\":" + list + "]"));
+}
+
+ApiResponse Api::mesh(const ApiRequest& r) {
+  const std::string format = param(r, "format", "binary");
+  if (format == "indexed") return json_response(indexed_mesh_json(session_.surface()));
+  if (format != "binary" && format != "json")
+    throw BadRequest("\"format\" must be binary, json or indexed, got '" + format + "'");
+  const std::string exact = param(r, "exact", "1");
+  if (exact != "0" && exact != "1") throw BadRequest("\"exact\" must be 0 or 1, got '" + exact + "'");
+  const MeshDelta d = session_.delta(version_param(r), exact == "1");
+  if (format == "json") return json_response(encode_json(d));
+  ApiResponse out;
+  out.content_type = "application/octet-stream";
+  out.body = encode_binary(d);
+  return out;
+}
+
+ApiResponse Api::edit(const ApiRequest& r) {
+  const Json body = parse_body(r.body);
+  const std::string op = member(body, "op").as_string("\"op\"");
+  std::string extra = "\"op\":" + json_quote(op);
+  if (op == "add") {
+    check_keys(body, {"op", "position", "value"});
+    const std::size_t i = session_.add(point_member(body, "position"), finite_number(body, "value"));
+    extra += ",\"index\":" + std::to_string(i);
+  } else if (op == "move") {
+    check_keys(body, {"op", "index", "position", "merge"});
+    session_.move(index_member(body, "index"), point_member(body, "position"),
+                  bool_member(body, "merge", false));
+  } else if (op == "remove") {
+    check_keys(body, {"op", "index"});
+    session_.remove(index_member(body, "index"));
+  } else if (op == "value") {
+    check_keys(body, {"op", "index", "value"});
+    session_.set_value(index_member(body, "index"), finite_number(body, "value"));
+  } else {
+    throw BadRequest("unknown edit \"" + op + "\" (add, move, remove, value)");
+  }
+  return json_response(stats_json(extra));
+}
+
+ApiResponse Api::refine(const ApiRequest& r) {
+  const Json body = parse_body(r.body);
+  check_keys(body, {"precision", "all"});
+  if (body.find("precision")) {
+    const double p = finite_number(body, "precision");
+    if (!(p > 0) || p > 1) throw BadRequest("\"precision\" must be in (0, 1] (a fraction of the diagonal)");
+    session_.set_precision(p);
+  }
+  bool stepped = false;
+  if (bool_member(body, "all", false)) {
+    while (session_.refine_step()) stepped = true;
+  } else {
+    stepped = session_.refine_step([this] { return waiting_.load() == 0; });
+  }
+  return json_response(stats_json(std::string("\"stepped\":") + (stepped ? "true" : "false")));
+}
+
+ApiResponse Api::load(const ApiRequest& r) {
+  const std::string name = param(r, "name");
+  if (name.empty() || name.size() > 200) throw BadRequest("\"name\" (the uploaded file's name) is required");
+  const std::string ext = file_extension(name);
+  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "off" && ext != "obj" && ext != "ply")
+    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .off, .obj, .ply)");
+  if (r.body.empty()) throw BadRequest(name + ": empty file");
+  // Parsed from memory: the server never opens a path a client names.
+  Constraints c = cli::constraints_of(parse_input(r.body, name), name, build_);
+  session_.load(std::move(c), name);
+  return json_response(stats_json());
+}
+
+ApiResponse Api::export_file(const ApiRequest& r) {
+  const std::string format = param(r, "format");
+  const std::string path = temp_path(format);
+  if (format == "xyzv") {
+    const Constraints& c = session_.mesher().constraints();
+    write_xyzv(path, PointValues{c.points, c.values});
+  } else if (format == "obj" || format == "ply" || format == "off") {
+    TriangleMesh tm;
+    session_.mesher().mesh(tm.V, tm.F, tm.N);
+    write_mesh(path, tm);
+  } else {
+    throw BadRequest("\"format\" must be xyzv, obj, ply or off, got '" + format + "'");
+  }
+  ApiResponse out;
+  out.content_type = format == "ply" ? "application/octet-stream" : "text/plain";
+  out.body = read_whole_file(path);
+  std::remove(path.c_str());
+  out.download = download_name(session_.name(), format);
+  return out;
+}
+
+}  // namespace vitri::studio

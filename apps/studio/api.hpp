@@ -1,0 +1,66 @@
+#pragma once
+// The studio's HTTP/JSON API, independent of the HTTP library: a request (method, path, query
+// parameters, body) goes in, a response (status, type, body, download name) comes out. Every request is
+// validated before the session changes; a bad one gets a 4xx status and {"error": "..."} and changes
+// nothing. Endpoints and formats: docs/studio.md.
+#include "session.hpp"
+
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <string>
+
+namespace vitri::studio {
+
+struct ApiRequest {
+  std::string method;                         ///< "GET", "POST", ...
+  std::string path;                           ///< e.g. "/api/edit"
+  std::map<std::string, std::string> params;  ///< query parameters
+  std::string body;
+};
+
+struct ApiResponse {
+  int status = 200;
+  std::string content_type = "application/json";
+  std::string body;
+  std::string download;  ///< non-empty: offer the body as a file of this name (Content-Disposition)
+};
+
+/// A response {"error": what} with the given status.
+ApiResponse error_response(int status, const std::string& what);
+
+/// Serves the API over one session. Thread-safe: requests are serialized; a refinement step in progress
+/// gives way to a waiting edit (it stops between insertions and resumes on the next refine request).
+class Api {
+ public:
+  /// `build` turns an uploaded mesh or oriented points into constraints (vitri mesh's --offset, --sides).
+  Api(Session& session, const ConstraintBuildOptions& build = {});
+  ~Api();
+  Api(const Api&) = delete;
+  Api& operator=(const Api&) = delete;
+
+  /// Answers one request; never throws.
+  ApiResponse handle(const ApiRequest& request);
+  /// True when the path is an API route (the server serves the page's files for the others).
+  static bool is_api_path(const std::string& path);
+
+ private:
+  ApiResponse route(const ApiRequest& request);
+  ApiResponse stats();
+  ApiResponse state();
+  ApiResponse mesh(const ApiRequest& request);
+  ApiResponse edit(const ApiRequest& request);
+  ApiResponse refine(const ApiRequest& request);
+  ApiResponse load(const ApiRequest& request);
+  ApiResponse export_file(const ApiRequest& request);
+  std::string stats_json(const std::string& extra = {});
+  std::string temp_path(const std::string& ext) const;
+
+  Session& session_;
+  ConstraintBuildOptions build_;
+  std::mutex mutex_;
+  std::atomic<int> waiting_{0};  // requests waiting for the mutex (a refinement step yields to them)
+  std::string temp_dir_;         // private (0700) directory for exports, removed by the destructor
+};
+
+}  // namespace vitri::studio

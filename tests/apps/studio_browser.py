@@ -1,0 +1,367 @@
+#!/usr/bin/env python3
+"""End-to-end test of vitri studio in a real browser (headless Chromium driven by Selenium).
+
+Starts `vitri studio` on a free port, opens the page, adds a constraint by clicking on the surface, drags
+it, undoes both edits, and checks through the HTTP API that the mesh changed, stayed closed (every edge
+shared by exactly two triangles) and came back. Screenshots go to --out (kept as test artifacts).
+
+Usage: studio_browser.py --vitri PATH/TO/vitri --out DIR [--model FILE] [--bench]
+Exit status: 0 pass, 1 fail, 77 skipped (no browser, driver or selenium installed).
+--bench measures the edit-to-screen latency and drag rate in the page and prints them (docs/benchmarks.md).
+"""
+import argparse
+import json
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+
+SKIP = 77
+
+
+def skip(why):
+    print("SKIP: " + why + " (Debian: apt-get install chromium chromium-driver python3-selenium)")
+    sys.exit(SKIP)
+
+
+try:
+    from selenium import webdriver
+    from selenium.webdriver.chrome.service import Service
+    from selenium.webdriver.common.action_chains import ActionChains
+    from selenium.webdriver.common.actions.action_builder import ActionBuilder
+    from selenium.webdriver.common.keys import Keys
+except ImportError:
+    skip("python3-selenium is not installed")
+
+
+class Failure(Exception):
+    pass
+
+
+def check(cond, what):
+    if not cond:
+        raise Failure(what)
+    print("ok: " + what)
+
+
+class Server:
+    """`vitri studio` as a child process on a free port."""
+
+    def __init__(self, vitri, args):
+        self.proc = subprocess.Popen([vitri, "studio", "--port", "0"] + args, stdout=subprocess.PIPE,
+                                     stderr=subprocess.STDOUT, text=True)
+        deadline = time.time() + 120
+        while time.time() < deadline:
+            line = self.proc.stdout.readline()
+            if not line:
+                raise Failure("vitri studio exited before serving")
+            m = re.search(r"http://([0-9.]+):(\d+)/", line)
+            if m:
+                self.url = "http://%s:%s" % (m.group(1), m.group(2))
+                return
+        raise Failure("vitri studio did not print its address")
+
+    def get(self, path):
+        with urllib.request.urlopen(self.url + path, timeout=120) as r:
+            return json.loads(r.read())
+
+    def stop(self):
+        """Stops the server (SIGTERM: a clean shutdown); a sanitizer report or a crash fails the test."""
+        self.proc.terminate()
+        try:
+            rest, _ = self.proc.communicate(timeout=60)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            raise Failure("vitri studio did not stop on SIGTERM")
+        if self.proc.returncode != 0:
+            raise Failure("vitri studio exited with %d:\n%s" % (self.proc.returncode, rest))
+
+
+def edges_closed(mesh):
+    """True when every undirected edge is used by exactly two triangles, in opposite directions."""
+    count = {}
+    for a, b, c in mesh["triangles"]:
+        for u, v in ((a, b), (b, c), (c, a)):
+            count[(u, v)] = count.get((u, v), 0) + 1
+    for (u, v), n in count.items():
+        if n != 1 or count.get((v, u), 0) != 1:
+            return False
+    return len(mesh["triangles"]) > 0
+
+
+def max_vertex_distance(a, b):
+    """Largest distance from a vertex of mesh a to the nearest vertex of mesh b (uniform grid)."""
+    vb = b["vertices"]
+    lo = [min(p[k] for p in vb) for k in range(3)]
+    hi = [max(p[k] for p in vb) for k in range(3)]
+    cell = max(hi[k] - lo[k] for k in range(3)) / 40 or 1.0
+    grid = {}
+    for p in vb:
+        grid.setdefault(tuple(int((p[k] - lo[k]) // cell) for k in range(3)), []).append(p)
+    worst = 0.0
+    for p in a["vertices"]:
+        c = [int((p[k] - lo[k]) // cell) for k in range(3)]
+        best, r = math.inf, 0
+        while best == math.inf or (r - 1) * cell < best:
+            for i in range(c[0] - r, c[0] + r + 1):
+                for j in range(c[1] - r, c[1] + r + 1):
+                    for k in range(c[2] - r, c[2] + r + 1):
+                        if max(abs(i - c[0]), abs(j - c[1]), abs(k - c[2])) != r:
+                            continue
+                        for q in grid.get((i, j, k), ()):
+                            best = min(best, math.dist(p, q))
+            r += 1
+            if r > 200:
+                break
+        worst = max(worst, best)
+    return worst
+
+
+def launch_browser(out_dir, window="1280,800"):
+    chromium = shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
+    driver_path = shutil.which("chromedriver") or "/usr/bin/chromedriver"
+    if not chromium:
+        skip("no chromium binary")
+    if not os.path.exists(driver_path):
+        skip("no chromedriver")
+    opts = webdriver.ChromeOptions()
+    opts.binary_location = chromium
+    profile = tempfile.mkdtemp(prefix="vitri-studio-chromium-", dir=out_dir)
+    for flag in ["--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-dev-shm-usage",
+                 "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--window-size=" + window,
+                 "--user-data-dir=" + profile]:
+        opts.add_argument(flag)
+    opts.set_capability("goog:loggingPrefs", {"browser": "ALL"})
+    driver = webdriver.Chrome(service=Service(driver_path), options=opts)
+    driver.set_script_timeout(600)
+    return driver, profile
+
+
+def wait_for(what, fn, timeout=120):
+    deadline = time.time() + timeout
+    while time.time() < deadline:
+        v = fn()
+        if v:
+            return v
+        time.sleep(0.1)
+    raise Failure("timed out waiting for " + what)
+
+
+def page_idle(driver):
+    """The page's edit queue is empty (no request in flight) and no drag is going on."""
+    return driver.execute_async_script(
+        "const done = arguments[arguments.length - 1];"
+        "window.studio.busy.then(() => done(window.studio.drag === null));")
+
+
+def pointer_to(driver, x, y):
+    ab = ActionBuilder(driver)
+    ab.pointer_action.move_to_location(int(round(x)), int(round(y)))
+    ab.perform()
+
+
+def api_bench(server):
+    """Edit + delta round trips from a script (no browser): the server's and the transfer's share."""
+    def post(path, body):
+        req = urllib.request.Request(server.url + path, data=json.dumps(body).encode(), method="POST")
+        with urllib.request.urlopen(req, timeout=600) as r:
+            return json.loads(r.read())
+
+    def pull(version, exact):
+        with urllib.request.urlopen("%s/api/mesh?since=%d&exact=%d" % (server.url, version, exact)) as r:
+            data = r.read()
+        return int.from_bytes(data[8:12], "little")
+
+    def median(v):
+        v = sorted(v)
+        return {"median": v[len(v) // 2], "p90": v[min(len(v) - 1, int(0.9 * len(v)))]}
+
+    post("/api/refine", {"all": True})
+    state = server.get("/api/state")
+    unit, version = state["unit"], pull(0, 1)
+    index = next(c["index"] for c in state["constraint_list"] if c["value"] == 0)
+    c = state["constraint_list"][index]["position"]
+    drag, server_ms = [], []
+    for k in range(1, 61):
+        a = 2 * math.pi * k / 60
+        t0 = time.perf_counter()
+        s = post("/api/edit", {"op": "move", "index": index, "merge": k > 1,
+                               "position": [c[0] + 0.01 * unit * math.sin(a), c[1] + 0.01 * unit * (1 - math.cos(a)), c[2]]})
+        version = pull(version, 0)
+        drag.append(1e3 * (time.perf_counter() - t0))
+        server_ms.append(s["edit_ms"] + s["extract_ms"])
+    post("/api/undo", {})
+    version = pull(version, 1)
+    add = []
+    for k in range(12):
+        t0 = time.perf_counter()
+        post("/api/edit", {"op": "add", "value": 0, "position": [c[0] + 0.004 * unit * (k - 5.5), c[1], c[2]]})
+        version = pull(version, 1)
+        add.append(1e3 * (time.perf_counter() - t0))
+        post("/api/undo", {})
+        version = pull(version, 1)
+    print("API_BENCH " + json.dumps({"model": state["name"], "load_average": os.getloadavg()[0],
+                                     "triangles": state["triangles"], "drag": median(drag),
+                                     "drag_server_edit_extract": median(server_ms),
+                                     "drag_updates_per_second": 1e3 * len(drag) / sum(drag), "add": median(add)}))
+    return 0
+
+
+def click_drag_undo(driver, server, shot, s0, m0):
+    """Adds a constraint by clicking the surface, drags it, undoes both; checks the mesh each time."""
+    # 1. Click on the surface (middle of the view: the model is framed there): on-surface constraint.
+    canvas = driver.find_element("css selector", "#view canvas")
+    ActionChains(driver).move_to_element(canvas).click().perform()
+    wait_for("the new constraint", lambda: server.get("/api/stats")["constraints"] == s0["constraints"] + 1)
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    shot("studio-1-added.png")
+    s1 = server.get("/api/state")
+    added = s1["constraint_list"][-1]
+    check(added["value"] == 0, "the click added an on-surface constraint (value 0)")
+    m1 = server.get("/api/mesh?format=indexed")
+    check(m1 != m0, "the mesh changed after the click")
+    check(edges_closed(m1), "the mesh is closed after the click")
+
+    # 2. Drag the new constraint across the screen in small steps.
+    p = driver.execute_script("return studio.screenOf(arguments[0])", added["index"])
+    pointer_to(driver, p["x"], p["y"])
+    ActionChains(driver).click_and_hold().perform()
+    for k in range(1, 11):
+        pointer_to(driver, p["x"] + 6 * k, p["y"] - 4 * k)
+        time.sleep(0.03)
+    ActionChains(driver).release().perform()
+    wait_for("the drag to end", lambda: page_idle(driver))
+    shot("studio-2-dragged.png")
+    s2 = server.get("/api/state")
+    moved = s2["constraint_list"][added["index"]]
+    check(moved["position"] != added["position"], "the drag moved the constraint")
+    check(s2["undo"] == s1["undo"] + 1, "the drag is one undo step")
+    m2 = server.get("/api/mesh?format=indexed")
+    check(m2 != m1, "the mesh followed the drag")
+    check(edges_closed(m2), "the mesh is closed after the drag")
+
+    # 3. Undo the drag (Ctrl+Z) and the click (the Undo button).
+    ActionChains(driver).key_down(Keys.CONTROL).send_keys("z").key_up(Keys.CONTROL).perform()
+    wait_for("undo of the drag", lambda: server.get("/api/stats")["undo"] == s1["undo"])
+    driver.find_element("id", "undo").click()
+    wait_for("undo of the click", lambda: server.get("/api/stats")["constraints"] == s0["constraints"])
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    shot("studio-3-undone.png")
+    s3 = server.get("/api/state")
+    check(s3["constraint_list"] == s0["constraint_list"], "the constraints came back exactly")
+    m3 = server.get("/api/mesh?format=indexed")
+    check(edges_closed(m3), "the mesh is closed after the undos")
+    tol = 2 * s0["precision"] * s0["unit"]
+    d = max(max_vertex_distance(m3, m0), max_vertex_distance(m0, m3))
+    check(d <= tol, "the mesh came back (vertex distance %.3g <= %.3g, %d vs %d triangles)"
+          % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
+    check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
+          "the page draws the server's mesh after the deltas")
+
+
+def open_file(driver, server, shot, out_dir):
+    """Opens a .xyzv file through the page's file input."""
+    # 4. Open a file through the page (uploaded as the request body, parsed from memory).
+    upload = os.path.abspath(os.path.join(out_dir, "studio-upload.xyzv"))
+    with open(upload, "w") as f:
+        f.write("0 0 0 -1\n")
+        for i in range(12):
+            a = 2 * math.pi * i / 12
+            f.write("%r %r %r 0\n" % (math.cos(a), math.sin(a), 0.5 * (-1) ** i))
+        f.write("0 0 1.2 0\n0 0 -1.2 0\n")
+    driver.find_element("id", "open").send_keys(upload)
+    wait_for("the upload", lambda: server.get("/api/stats")["name"] == "studio-upload.xyzv")
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    s4 = server.get("/api/stats")
+    check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
+    check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
+    check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
+          "the page draws the uploaded model")
+    shot("studio-4-opened.png")
+
+
+def run(args):
+    server = Server(args.vitri, ([args.model] if args.model else []) + ["--precision", str(args.precision)] +
+                    args.studio_args.split())
+    driver = None
+    profile = None
+    try:
+        if args.api_bench:
+            return api_bench(server)
+        driver, profile = launch_browser(args.out, args.window)
+        driver.get(server.url + "/" + ("?aa=0" if args.no_antialias else ""))
+        wait_for("the page to start", lambda: driver.execute_script("return !!(window.studio && studio.ready)"))
+        webgl = driver.execute_script("return !!studio.renderer.getContext()")
+        check(webgl, "the page has a WebGL context")
+        # Progressive refinement runs while the page is idle: wait until it reached the target.
+        wait_for("refinement to the target precision", lambda: server.get("/api/stats")["refined"], 300)
+        wait_for("the page to be idle", lambda: page_idle(driver))
+        time.sleep(0.5)
+        wait_for("the page to be idle", lambda: page_idle(driver))
+        shot = lambda name: driver.save_screenshot(os.path.join(args.out, name))
+        shot("studio-0-loaded.png")
+        s0 = server.get("/api/state")
+        m0 = server.get("/api/mesh?format=indexed")
+        check(edges_closed(m0), "the loaded mesh is closed (%d triangles)" % len(m0["triangles"]))
+        check(driver.execute_script("return studio.slots.triangles") == len(m0["triangles"]),
+              "the page draws as many triangles as the server holds")
+        if args.bench:
+            return bench(driver, server, args.out)
+
+        click_drag_undo(driver, server, shot, s0, m0)
+        open_file(driver, server, shot, args.out)
+        errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+        check(not errors, "no error in the browser console " + (json.dumps(errors) if errors else ""))
+        check(driver.execute_script("return document.getElementById('error').hidden"), "no error shown")
+        return 0
+    finally:
+        if driver:
+            driver.quit()
+        server.stop()
+        if profile:
+            shutil.rmtree(profile, ignore_errors=True)
+
+
+def bench(driver, server, out_dir):
+    run_js = lambda code: driver.execute_async_script(
+        "const done = arguments[arguments.length - 1];" + code + ".then(done, (e) => done({error: String(e)}));")
+    stats = server.get("/api/stats")
+    adds = run_js("studio.benchAdd({count: 12})")
+    drag = run_js("studio.benchDrag({moves: 60})")
+    drag_async = run_js("studio.benchDrag({moves: 60, sync: false})")
+    driver.save_screenshot(os.path.join(out_dir, "studio-bench.png"))
+    print("BENCH " + json.dumps({"model": stats["name"], "load_average": os.getloadavg()[0], "constraints": stats["constraints"],
+                                 "triangles": stats["triangles"], "vertices": stats["vertices"],
+                                 "add": adds, "drag": drag,
+                                 "drag_async_updates_per_second": drag_async["updates_per_second"]}))
+    return 0
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--vitri", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--model", default="")
+    ap.add_argument("--precision", type=float, default=0.03)
+    ap.add_argument("--bench", action="store_true")
+    ap.add_argument("--api-bench", action="store_true", help="measure edit + delta round trips without a browser")
+    ap.add_argument("--window", default="1280,800", help="browser window size W,H")
+    ap.add_argument("--no-antialias", action="store_true", help="WebGL without antialiasing (page ?aa=0)")
+    ap.add_argument("--studio-args", default="", help="more vitri studio arguments (space-separated)")
+    args = ap.parse_args()
+    os.makedirs(args.out, exist_ok=True)
+    try:
+        return run(args)
+    except Failure as e:
+        print("FAIL: " + str(e))
+        return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

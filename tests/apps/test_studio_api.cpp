@@ -1,0 +1,398 @@
+// vitri studio's HTTP/JSON API, in process: a Session, an Api and a Server on a free port of 127.0.0.1,
+// driven by httplib::Client. Every endpoint, good and bad requests; after a bad request the state is
+// unchanged and the server keeps answering. The session alone: undo/redo of random edits returns the
+// constraints exactly, and every mesh on the way is closed.
+#include "studio/json.hpp"
+#include "studio/server.hpp"
+#include "support/surface_metrics.hpp"
+
+#include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
+
+#include <httplib.h>
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+using namespace vitri;
+using namespace vitri::studio;
+
+namespace {
+
+/// 25 constraints: the center of an ellipsoid (value -0.5), 18 points of its surface, 6 outside (+1).
+Constraints small_model() {
+  Constraints c;
+  c.add({0, 0, 0}, -0.5);
+  const double pi = 3.14159265358979323846, golden = pi * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < 18; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / 18.0, r = std::sqrt(1.0 - z * z), phi = golden * i;
+    c.add({r * std::cos(phi), 0.8 * r * std::sin(phi), 0.6 * z}, 0.0);
+  }
+  for (int k = 0; k < 3; ++k)
+    for (const double s : {-2.0, 2.0}) c.add({k == 0 ? s : 0.0, k == 1 ? s : 0.0, k == 2 ? s : 0.0}, 1.0);
+  return c;
+}
+
+SessionOptions fast_options() {
+  SessionOptions o;
+  o.precision = 0.06;
+  o.coarse_levels = 1;
+  return o;
+}
+
+/// The server of one test, serving on its own thread until destroyed.
+struct Running {
+  Session session;
+  Api api;
+  Server server;
+  std::thread thread;
+  httplib::Client client;
+
+  explicit Running(std::size_t max_body = 1u << 20)
+      : session(small_model(), "small", fast_options()),
+        api(session),
+        server(api, options(max_body)),
+        thread((server.bind(), [this] { server.run(); })),
+        client("127.0.0.1", server.port()) {
+    client.set_read_timeout(120, 0);
+    for (int i = 0; i < 200 && !client.Get("/api/stats"); ++i)
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  ~Running() {
+    server.stop();
+    thread.join();
+  }
+  static ServerOptions options(std::size_t max_body) {
+    ServerOptions o;
+    o.port = 0;
+    o.max_body = max_body;
+    o.web_dir = VITRI_STUDIO_WEB_DIR;
+    o.three_dir = "/nonexistent-three";
+    return o;
+  }
+
+  /// Status and parsed JSON body of a request.
+  Json get(const std::string& path, int status = 200) { return check(client.Get(path.c_str()), status); }
+  Json post(const std::string& path, const std::string& body, int status = 200) {
+    return check(client.Post(path.c_str(), body, "application/json"), status);
+  }
+  static Json check(const httplib::Result& r, int status) {
+    REQUIRE(r);
+    INFO("body: " << r->body);
+    CHECK(r->status == status);
+    CHECK(r->get_header_value("Content-Type") == "application/json");
+    return Json::parse(r->body);
+  }
+  /// The model as the API shows it (constraints, mesh size, undo depth), without timings.
+  std::string fingerprint() {
+    const Json s = get("/api/state");
+    std::string out = Json(s.find("constraint_list")->as_array("")).dump();
+    for (const char* k : {"constraints", "vertices", "triangles", "undo", "redo", "revision", "precision"})
+      out += std::string(" ") + k + "=" + s.find(k)->dump();
+    return out;
+  }
+};
+
+double number(const Json& j, const char* key) {
+  return j.find(key)->as_number(key);
+}
+
+MeshMetrics metrics_of_indexed(const Json& m) {
+  SurfaceMesh s;
+  for (const Json& v : m.find("vertices")->as_array(""))
+    s.vertices.push_back(
+        {v.as_array("")[0].as_number(""), v.as_array("")[1].as_number(""), v.as_array("")[2].as_number("")});
+  for (const Json& t : m.find("triangles")->as_array(""))
+    s.triangles.push_back({static_cast<std::uint32_t>(t.as_array("")[0].as_number("")),
+                           static_cast<std::uint32_t>(t.as_array("")[1].as_number("")),
+                           static_cast<std::uint32_t>(t.as_array("")[2].as_number(""))});
+  return vitri::test::metrics_of(s);
+}
+
+}  // namespace
+
+TEST_CASE("studio server binds the loopback address by default", "[studio][api]") {
+  CHECK(ServerOptions{}.host == "127.0.0.1");
+}
+
+TEST_CASE("studio server: a port in use is an error, not a shared port", "[studio][api]") {
+  Running r;
+  ServerOptions o = Running::options(1024);
+  o.port = r.server.port();
+  Server second(r.api, o);
+  CHECK_THROWS_AS(second.bind(), Error);
+  CHECK(r.get("/api/stats").find("constraints")->as_number("") == 25);  // the first one still serves
+}
+
+TEST_CASE("studio api: stats, state, mesh", "[studio][api]") {
+  Running r;
+  const Json stats = r.get("/api/stats");
+  CHECK(number(stats, "constraints") == 25);
+  CHECK(number(stats, "triangles") > 0);
+  CHECK(stats.find("name")->as_string("") == "small");
+  const Json state = r.get("/api/state");
+  const Json::Array& list = state.find("constraint_list")->as_array("");
+  REQUIRE(list.size() == 25);
+  CHECK(list[0].find("value")->as_number("") == -0.5);
+  CHECK(list[0].find("index")->as_number("") == 0);
+
+  const Json indexed = r.get("/api/mesh?format=indexed");
+  const MeshMetrics m = metrics_of_indexed(indexed);
+  CHECK(m.watertight());
+  CHECK(m.consistently_oriented());
+  CHECK(static_cast<double>(m.triangles) == number(stats, "triangles"));
+
+  const Json full = r.get("/api/mesh?format=json&since=0");
+  CHECK(full.find("full")->as_bool(""));
+  CHECK(full.find("added")->as_array("").size() == m.triangles);
+  CHECK(full.find("positions")->as_array("").size() == 9 * m.triangles);
+  const double version = number(full, "version");
+  const Json none = r.get("/api/mesh?format=json&since=" + std::to_string(static_cast<int>(version)));
+  CHECK_FALSE(none.find("full")->as_bool(""));
+  CHECK(none.find("added")->as_array("").empty());
+
+  const auto bin = r.client.Get("/api/mesh?since=0");
+  REQUIRE(bin);
+  CHECK(bin->status == 200);
+  CHECK(bin->get_header_value("Content-Type") == "application/octet-stream");
+  CHECK(bin->body.size() == 24 + 4 * 19 * m.triangles);
+}
+
+TEST_CASE("studio api: edits, undo, redo; the mesh stays closed and comes back", "[studio][api]") {
+  Running r;
+  const std::string before = r.get("/api/state").find("constraint_list")->dump();
+  const Json mesh0 = r.get("/api/mesh?format=indexed");
+
+  Json s = r.post("/api/edit", R"({"op": "add", "position": [0, 0, 0.75], "value": 0})");
+  CHECK(number(s, "index") == 25);
+  CHECK(number(s, "constraints") == 26);
+  CHECK(metrics_of_indexed(r.get("/api/mesh?format=indexed")).watertight());
+  s = r.post("/api/edit", R"({"op": "move", "index": 25, "position": [0, 0.1, 0.8]})");
+  s = r.post("/api/edit", R"({"op": "move", "index": 25, "position": [0, 0.2, 0.8], "merge": true})");
+  CHECK(number(s, "undo") == 2);  // the merged moves are one step
+  s = r.post("/api/edit", R"({"op": "value", "index": 25, "value": 0.05})");
+  s = r.post("/api/edit", R"({"op": "remove", "index": 3})");
+  CHECK(number(s, "constraints") == 25);
+  CHECK(number(s, "undo") == 4);
+  const Json mesh1 = r.get("/api/mesh?format=indexed");
+  CHECK(metrics_of_indexed(mesh1).watertight());
+  CHECK(mesh1.dump() != mesh0.dump());
+
+  for (int k = 0; k < 4; ++k) CHECK(r.post("/api/undo", "{}").find("done")->as_bool(""));
+  CHECK_FALSE(r.post("/api/undo", "").find("done")->as_bool(""));
+  // Undoing the removal appended constraint 3 at the end: same constraints, as a set.
+  Json::Array after = r.get("/api/state").find("constraint_list")->as_array("");
+  Json::Array expect = Json::parse(before).as_array("");
+  const auto key = [](const Json& c) {
+    return c.find("id")->dump() + c.find("position")->dump() + c.find("value")->dump();
+  };
+  std::vector<std::string> a, b;
+  for (const Json& c : after) a.push_back(key(c));
+  for (const Json& c : expect) b.push_back(key(c));
+  std::sort(a.begin(), a.end());
+  std::sort(b.begin(), b.end());
+  CHECK(a == b);
+  const MeshMetrics back = metrics_of_indexed(r.get("/api/mesh?format=indexed"));
+  CHECK(back.watertight());
+  CHECK(static_cast<double>(back.triangles) ==
+        Approx(static_cast<double>(metrics_of_indexed(mesh0).triangles)).epsilon(0.25));
+
+  for (int k = 0; k < 4; ++k) CHECK(r.post("/api/redo", "{}").find("done")->as_bool(""));
+  CHECK_FALSE(r.post("/api/redo", "{}").find("done")->as_bool(""));
+  s = r.get("/api/stats");
+  CHECK(number(s, "constraints") == 25);
+  CHECK(number(s, "undo") == 4);
+}
+
+TEST_CASE("studio api: refine, precision, export, load", "[studio][api]") {
+  Running r;
+  Json s = r.get("/api/stats");
+  CHECK_FALSE(s.find("refined")->as_bool(""));
+  const double coarse = number(s, "triangles");
+  s = r.post("/api/refine", "{}");
+  CHECK(s.find("stepped")->as_bool(""));
+  CHECK(s.find("refined")->as_bool(""));
+  CHECK(number(s, "triangles") > coarse);
+  CHECK_FALSE(r.post("/api/refine", "").find("stepped")->as_bool(""));
+  s = r.post("/api/refine", R"({"precision": 0.03, "all": true})");
+  CHECK(number(s, "precision") == 0.03);
+  CHECK(s.find("refined")->as_bool(""));
+  s = r.post("/api/refine", R"({"precision": 0.1})");  // coarser: rebuilt, starts coarse again
+  CHECK(number(s, "target_precision") == 0.1);
+
+  // Exports as downloads; each parses back to the current mesh or constraints.
+  const double vertices = number(r.get("/api/stats"), "vertices");
+  for (const char* format : {"obj", "ply", "off"}) {
+    const auto e = r.client.Get((std::string("/api/export?format=") + format).c_str());
+    REQUIRE(e);
+    CHECK(e->status == 200);
+    CHECK(e->get_header_value("Content-Disposition") ==
+          std::string("attachment; filename=\"small.") + format + "\"");
+    const TriangleMesh tm = parse_input(e->body, std::string("x.") + format).mesh;
+    CHECK(static_cast<double>(tm.V.rows()) == vertices);
+  }
+  const auto x = r.client.Get("/api/export?format=xyzv");
+  REQUIRE(x);
+  const PointValues pv = parse_xyzv(x->body);
+  CHECK(pv.points.size() == 25);
+  CHECK(pv.values[0] == -0.5);
+
+  // Load: the exported constraints, then an OFF mesh (normal constraints built from it).
+  s = r.check(r.client.Post("/api/load?name=again.xyzv", x->body, "application/octet-stream"), 200);
+  CHECK(s.find("name")->as_string("") == "again.xyzv");
+  CHECK(number(s, "undo") == 0);
+  const std::string tetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+  s = r.check(r.client.Post("/api/load?name=tetra.off", tetra, "application/octet-stream"), 200);
+  CHECK(number(s, "constraints") == 12);  // 4 surface points, an outside and an inside one each
+  CHECK(r.get("/api/mesh?format=json&since=5").find("full")->as_bool(""));
+}
+
+TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[studio][api]") {
+  Running r(4096);
+  r.post("/api/edit", R"({"op": "move", "index": 2, "position": [0.1, 0.2, 0.5]})");  // something to undo
+  const std::string before = r.fingerprint();
+  struct Bad {
+    const char* path;
+    const char* body;
+    int status;
+    const char* says;
+  };
+  const Bad bad[] = {
+      {"/api/edit", "{\"op\": \"add\", ", 400, "malformed JSON"},
+      {"/api/edit", "[1, 2]", 400, "must be an object"},
+      {"/api/edit", R"({"op": "grow"})", 400, "unknown edit"},
+      {"/api/edit", R"({"position": [0, 0, 0], "value": 0})", 400, "missing \"op\""},
+      {"/api/edit", R"({"op": "add", "position": [0, 0], "value": 0})", 400, "3 numbers"},
+      {"/api/edit", R"({"op": "add", "position": [0, 0, "z"], "value": 0})", 400, "must be a number"},
+      {"/api/edit", R"({"op": "add", "position": [0, 0, 1e999], "value": 0})", 400, "out of range"},
+      {"/api/edit", R"({"op": "add", "position": [0, 0, 100], "value": 0})", 400, "diagonals"},
+      {"/api/edit", R"({"op": "add", "position": [0, 0, 0], "value": 0})", 400, "duplicate"},
+      {"/api/edit", R"({"op": "add", "position": [0, 0, 0.5], "value": 0, "extra": 1})", 400, "unknown key"},
+      {"/api/edit", R"({"op": "move", "index": 99, "position": [0, 0, 0.5]})", 400, "out of range"},
+      {"/api/edit", R"({"op": "move", "index": -1, "position": [0, 0, 0.5]})", 400, "non-negative integer"},
+      {"/api/edit", R"({"op": "move", "index": 1.5, "position": [0, 0, 0.5]})", 400, "non-negative integer"},
+      {"/api/edit", R"({"op": "move", "index": 1, "position": [0, 0, 0.5], "merge": 1})", 400, "boolean"},
+      {"/api/edit", R"({"op": "remove", "index": 25})", 400, "out of range"},
+      {"/api/edit", R"({"op": "value", "index": 0})", 400, "missing \"value\""},
+      {"/api/refine", R"({"precision": 0})", 400, "precision"},
+      {"/api/refine", R"({"precision": -1})", 400, "precision"},
+      {"/api/refine", R"({"all": "yes"})", 400, "boolean"},
+      {"/api/undo", R"({"steps": 2})", 400, "unknown key"},
+      {"/api/load?name=x.exe", "data", 400, "cannot open"},
+      {"/api/load", "0 0 0 0\n", 400, "name"},
+      {"/api/load?name=bad.xyzv", "0 0 zero 0\n", 400, "bad.xyzv"},
+      {"/api/load?name=empty.off", "", 400, "empty"},
+      {"/api/load?name=open.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 400, "boundary"},
+      {"/api/load?name=flat.xyz", "0 0 0\n1 0 0\n0 1 0\n", 400, "normals"},
+  };
+  for (const Bad& b : bad) {
+    INFO(b.path << " " << b.body);
+    const Json e = r.post(b.path, b.body, b.status);
+    CHECK_THAT(e.find("error")->as_string(""), Catch::Contains(b.says));
+    CHECK(r.fingerprint() == before);
+  }
+  const auto get_error = [&](const std::string& path, int status, const char* says) {
+    INFO(path);
+    const Json e = r.get(path, status);
+    CHECK_THAT(e.find("error")->as_string(""), Catch::Contains(says));
+    CHECK(r.fingerprint() == before);
+  };
+  get_error("/api/mesh?since=-1", 400, "since");
+  get_error("/api/mesh?since=abc", 400, "since");
+  get_error("/api/mesh?since=99999999999", 400, "since");
+  get_error("/api/mesh?format=svg", 400, "format");
+  get_error("/api/mesh?exact=2", 400, "exact");
+  get_error("/api/export?format=stl", 400, "format");
+  get_error("/api/export", 400, "format");
+  get_error("/api/nothing", 404, "no such endpoint");
+  get_error("/api/edit", 405, "takes POST");
+  get_error("/etc/passwd", 404, "not found");
+  get_error("/../../etc/passwd", 404, "not found");
+  r.post("/api/stats", "{}", 405);
+  Running::check(r.client.Delete("/api/stats"), 405);
+  // Over the body limit of this server (4096 bytes): 413, JSON error, nothing read.
+  const std::string big(10000, ' ');
+  const Json e = r.post("/api/load?name=big.xyzv", big, 413);
+  CHECK_THAT(e.find("error")->as_string(""), Catch::Contains("too large"));
+  CHECK(r.fingerprint() == before);
+  // Still serving, and still editing.
+  CHECK(number(r.post("/api/undo", "{}"), "undo") == 0);
+}
+
+TEST_CASE("studio api: the page's files are served, three.js missing is a clear error", "[studio][api]") {
+  Running r;
+  const auto page = r.client.Get("/");
+  REQUIRE(page);
+  CHECK(page->status == 200);
+  CHECK_THAT(page->body, Catch::Contains("studio.js"));
+  const auto js = r.client.Get("/studio.js");
+  REQUIRE(js);
+  CHECK(js->status == 200);
+  CHECK(js->get_header_value("Content-Type").rfind("application/javascript", 0) == 0);
+  const Json e = r.get("/three/three.min.js", 500);
+  CHECK_THAT(e.find("error")->as_string(""), Catch::Contains("/nonexistent-three/build/three.min.js"));
+}
+
+TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]") {
+  Session session(small_model(), "small", fast_options());
+  const Constraints original = session.mesher().constraints();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1, 1);
+  // Edits that keep a closed surface inside the domain: on-surface constraints (value 0 at load) are
+  // added near the ellipsoid, moved a little, removed or given a small value; the center and the six
+  // outside constraints stay (changing those can open the surface at the domain's box).
+  const auto surface_index = [&] {
+    for (;;) {
+      const std::size_t i = rng() % session.size();
+      if (std::abs(session.mesher().constraints().values[i]) < 0.2) return i;
+    }
+  };
+  std::size_t edits = 0;
+  for (int step = 0; step < 24; ++step) {
+    try {
+      const std::size_t i = surface_index();
+      const Point3 p = session.mesher().constraints().points[i];
+      switch (rng() % 4) {
+        case 0:
+          session.add({0.9 * u(rng), 0.7 * u(rng), 0.5 * u(rng)}, 0.0);
+          break;
+        case 1:
+          session.move(i, {p.x + 0.1 * u(rng), p.y + 0.1 * u(rng), p.z + 0.1 * u(rng)}, rng() % 2 == 0);
+          break;
+        case 2:
+          session.remove(i);
+          break;
+        default:
+          session.set_value(i, 0.05 * u(rng));
+          break;
+      }
+      ++edits;
+    } catch (const Error&) {
+      // A rejected edit (e.g. a degenerate fit) changes nothing; the checks below still hold.
+    }
+    const MeshMetrics m = test::metrics_of(session.surface());
+    INFO("step " << step << ": " << m.triangles << " triangles, " << m.boundary_edges << " boundary edges, "
+                 << m.non_manifold_edges << " non-manifold edges");
+    REQUIRE(m.watertight());
+  }
+  REQUIRE(edits > 0);
+  const std::vector<ConstraintInfo> edited = session.constraints();
+  while (session.undo()) REQUIRE(test::metrics_of(session.surface()).watertight());
+  const auto sorted = [](std::vector<ConstraintInfo> c) {
+    std::vector<std::tuple<double, double, double, double>> out;
+    for (const auto& x : c) out.emplace_back(x.position.x, x.position.y, x.position.z, x.value);
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  std::vector<ConstraintInfo> start;
+  for (std::size_t i = 0; i < original.size(); ++i)
+    start.push_back({i, 0, original.points[i], original.values[i]});
+  CHECK(sorted(session.constraints()) == sorted(start));
+  while (session.redo()) REQUIRE(test::metrics_of(session.surface()).watertight());
+  CHECK(sorted(session.constraints()) == sorted(edited));
+}

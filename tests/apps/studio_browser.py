@@ -284,6 +284,18 @@ def open_file(driver, server, shot, out_dir):
     check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
           "the page draws the uploaded model")
     shot("studio-4-opened.png")
+    # Shift+click: an outside constraint (value +depth); alt+click: an inside one (value -depth).
+    canvas = driver.find_element("css selector", "#view canvas")
+    wait_for("refinement of the uploaded model", lambda: server.get("/api/stats")["refined"], 300)
+    for key, sign, what, dx, dy in ((Keys.SHIFT, 1, "outside", -70, 50), (Keys.ALT, -1, "inside", 60, -40)):
+        n = server.get("/api/stats")["constraints"]
+        ActionChains(driver).move_to_element_with_offset(canvas, dx, dy).key_down(key).click().key_up(key).perform()
+        wait_for("the %s constraint" % what, lambda: server.get("/api/stats")["constraints"] == n + 1)
+        wait_for("the page to be idle", lambda: page_idle(driver))
+        value = server.get("/api/state")["constraint_list"][-1]["value"]
+        check(value * sign > 0, "modifier click added an %s constraint (value %g)" % (what, value))
+    check(edges_closed(server.get("/api/mesh?format=indexed")), "the mesh is closed after them")
+    shot("studio-5-modifiers.png")
 
 
 def run(args):

@@ -729,7 +729,8 @@ TEST_CASE("delaunay: insert_in_conflict inserts circumcenters without location")
   CHECK(tet_set(tr, b.label) == tet_set(direct.tr, direct.label));
   // A tetrahedron that is not in conflict, or dead, is refused.
   const TetId t = tr.live_tetrahedra().front();
-  const Point3 far = tr.tet_point(t, 0) == Point3{0, 0, 0} ? Point3{0.99, 0.99, 0.99} : Point3{0.01, 0.01, 0.01};
+  const Point3 far =
+      tr.tet_point(t, 0) == Point3{0, 0, 0} ? Point3{0.99, 0.99, 0.99} : Point3{0.01, 0.01, 0.01};
   if (insphere_sos(tr.tet_point(t, 0), tr.tet_point(t, 1), tr.tet_point(t, 2), tr.tet_point(t, 3), far) !=
       Sign::Positive)
     CHECK_THROWS_AS(tr.insert_in_conflict(far, t), InvalidArgument);
@@ -890,7 +891,8 @@ void random_edit(Triangulation& tr, std::mt19937_64& rng, std::vector<std::int64
     const std::vector<TetId> live = tr.live_tetrahedra();
     const TetId t = live[rng() % live.size()];
     const Point3 c = tr.circumcenter(t);
-    const Point3 p{std::clamp(c.x, 0.001, 0.999), std::clamp(c.y, 0.001, 0.999), std::clamp(c.z, 0.001, 0.999)};
+    const Point3 p{std::clamp(c.x, 0.001, 0.999), std::clamp(c.y, 0.001, 0.999),
+                   std::clamp(c.z, 0.001, 0.999)};
     if (insphere_sos(tr.tet_point(t, 0), tr.tet_point(t, 1), tr.tet_point(t, 2), tr.tet_point(t, 3), p) ==
         Sign::Positive)
       r = tr.insert_in_conflict(p, t, 0.0, &ch);
@@ -954,5 +956,38 @@ TEST_CASE("delaunay: operations are deterministic and use no state left behind b
     CHECK(observable_state(a) == observable_state(c));
     check(c);
     if (var.history && var.rebuild < 1.0) CHECK(a.history_rebuilds() > 0);
+  }
+}
+
+TEST_CASE("delaunay: location hints that went stale (vertices removed or moved far) still locate exactly") {
+  // A dense cluster fills the grid cells of one corner of the box with hints; then every cluster vertex
+  // is moved to the opposite corner or removed. Locations in the emptied corner start from hints that
+  // are far away or gone, and must fall back to the history (or the walk from the last tetrahedron).
+  for (const bool history : {true, false}) {
+    INFO("history " << history);
+    Triangulation tr(kUnitBox, TriangulationOptions{history});
+    tr.insert_points(uniform_points(500, 41));
+    std::vector<VertexId> cluster;
+    for (const Point3& p : uniform_points(3000, 42, 0.01, 0.2)) {
+      const InsertResult r = tr.insert(p);
+      if (r.status == InsertStatus::Inserted) cluster.push_back(r.vertex);
+    }
+    std::mt19937_64 rng(43);
+    std::uniform_real_distribution<double> far(0.8, 0.99);
+    for (std::size_t i = 0; i < cluster.size(); ++i) {
+      if (i % 2)
+        tr.remove(cluster[i]);
+      else
+        tr.move(cluster[i], {far(rng), far(rng), far(rng)});
+    }
+    check(tr);
+    for (const Point3& p : uniform_points(300, 44, 0.01, 0.2)) {
+      const TetId t = tr.locate(p);
+      REQUIRE(tr.is_live(t));
+      REQUIRE(contains_closed(tr, t, p));
+    }
+    for (const Point3& p : uniform_points(200, 45, 0.01, 0.2))
+      REQUIRE(tr.insert(p).status == InsertStatus::Inserted);
+    check(tr);
   }
 }

@@ -39,7 +39,9 @@ const char* const kUsage =
     "                  studio and its edits to the network)\n"
     "  --precision P   target relative precision (default 0.02); the mesh starts 4x coarser and is\n"
     "                  refined while the page is idle\n"
-    "  --function F    implicit function: global (the RBF of the paper; the only one in this build)\n"
+    "  --function F    implicit function: global (the RBF of the paper), local (partition of unity:\n"
+    "                  local edits, 10^5+ constraints) or auto (default: global up to 4000\n"
+    "                  constraints, local above; docs/local_rbf.md)\n"
     "  --offset D, --sides S   as vitri mesh, for oriented points and meshes\n"
     "\n"
     "Stops on Ctrl-C. Exit status: 0 stopped, 1 bad input, 2 usage error.\n";
@@ -75,6 +77,7 @@ struct StudioArgs {
 
 /// Parses the arguments into `out`; returns an empty string or the usage error.
 std::string parse_args(const Args& args, StudioArgs& out) {
+  out.session.mesher.function = FunctionKind::Auto;  // as vitri mesh
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const bool has_value = i + 1 < args.size();
@@ -94,8 +97,10 @@ std::string parse_args(const Args& args, StudioArgs& out) {
       if (!parse_number(v, d) || !(d > 0) || d > 1) return "--precision needs a number in (0, 1], got " + v;
       out.session.precision = d;
     } else if (a == "--function") {
-      // The implicit function choice passes through to MesherOptions once the Mesher offers more than one.
-      if (v != "global") return "--function: only 'global' is available in this build, got '" + v + "'";
+      if (v == "global") out.session.mesher.function = FunctionKind::Global;
+      else if (v == "local") out.session.mesher.function = FunctionKind::Local;
+      else if (v == "auto") out.session.mesher.function = FunctionKind::Auto;
+      else return "--function must be global, local or auto, got '" + v + "'";
     } else if (a == "--offset") {
       if (!parse_number(v, d) || !(d > 0)) return "--offset needs a positive number";
       out.session.mesher.constraint_build.offset = d;

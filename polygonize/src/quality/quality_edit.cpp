@@ -195,12 +195,14 @@ void QualityMesher::function_changed() {
 }
 
 void QualityMesher::function_changed(const Box3& region) {
+  edge_probes_.clear();  // probes of the old f
   if (region.empty()) return;
   std::vector<VertexId> ids;
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
     if (tri_.is_vertex(v) && on_surface_[v] && region.contains(tri_.point(v))) ids.push_back(v);
   project_vertices(ids);
   old_facets_.clear();  // roots and probes of the old f
+  edge_probes_.clear();
   // Circumcentres inside the region get new values (their tetrahedra are classified again). A facet whose
   // two circumcentres are outside keeps its sign test (f did not change there); it is classified again
   // only when its ball centre, a root of the old f on its Voronoi edge, is inside the region.

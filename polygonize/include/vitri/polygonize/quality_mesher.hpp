@@ -182,6 +182,7 @@ class QualityMesher {
   };
 
   FacetKey key_of(TetId t, int i) const;
+  static std::uint64_t edge_key(VertexId a, VertexId b);
   bool inside_domain(const Point3& p) const;  // strictly inside the box
   void grow_tet_arrays();
   void evaluate_circumcenters(const std::vector<TetId>& tets);
@@ -234,6 +235,7 @@ class QualityMesher {
   std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
   std::priority_queue<QueueItem> queue_;
   std::vector<FacetKey> unprobed_;  // facets that meet every criterion but wait for their probes
+  std::unordered_map<std::uint64_t, double> edge_probes_;  // per edge: largest distance at its probes
   /// What a facet keeps when its record is erased by an insertion: it may come back (a facet on the
   /// boundary of the cavity) with the same ball centre (same dual line) and the same probes (same triangle).
   struct OldFacet {

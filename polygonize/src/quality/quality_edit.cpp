@@ -195,14 +195,17 @@ void QualityMesher::function_changed() {
 }
 
 void QualityMesher::function_changed(const Box3& region) {
+  edge_probes_.clear();  // probes of the old f
   if (region.empty()) return;
   std::vector<VertexId> ids;
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
     if (tri_.is_vertex(v) && on_surface_[v] && region.contains(tri_.point(v))) ids.push_back(v);
   project_vertices(ids);
   old_facets_.clear();  // roots and probes of the old f
-  // Circumcentres inside the region get new values; a facet whose Voronoi edge meets the region (its
-  // bounding box does) is classified again.
+  edge_probes_.clear();
+  // Circumcentres inside the region get new values (their tetrahedra are classified again). A facet whose
+  // two circumcentres are outside keeps its sign test (f did not change there); it is classified again
+  // only when its ball centre, a root of the old f on its Voronoi edge, is inside the region.
   grow_tet_arrays();
   tri_.for_each_tetrahedron([&](TetId t) {
     if (std::isnan(cvalue_[t])) return;  // not evaluated yet (already pending)
@@ -211,18 +214,8 @@ void QualityMesher::function_changed(const Box3& region) {
       mark_pending(t);
     }
   });
-  tri_.for_each_tetrahedron([&](TetId t) {
-    for (int i = 0; i < 4 && !pending_[t]; ++i) {
-      const TetId n = tri_.tet_neighbor(t, i);
-      if (n == kNoTet || std::isnan(cvalue_[n])) continue;
-      Box3 edge;
-      edge.extend(ccenter_[t]);
-      edge.extend(ccenter_[n]);
-      const bool meets = edge.lo.x <= region.hi.x && edge.hi.x >= region.lo.x && edge.lo.y <= region.hi.y &&
-                         edge.hi.y >= region.lo.y && edge.lo.z <= region.hi.z && edge.hi.z >= region.lo.z;
-      if (meets) mark_pending(t);
-    }
-  });
+  for (const auto& kv : facets_)
+    if (region.contains(kv.second.center)) mark_pending(kv.second.t);
 }
 
 }  // namespace vitri

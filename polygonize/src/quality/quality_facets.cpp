@@ -78,6 +78,10 @@ void QualityMesher::flag_facet(TetId t, int i) {
     if (tri_.tet_neighbor(n, j) == t) rflags_[n] = std::uint8_t(rflags_[n] | (1u << j));
 }
 
+std::uint64_t QualityMesher::edge_key(VertexId a, VertexId b) {
+  return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
+}
+
 QualityMesher::FacetKey QualityMesher::key_of(TetId t, int i) const {
   FacetKey k{};
   int n = 0;
@@ -299,22 +303,40 @@ bool QualityMesher::needs_probes(const FacetRecord& r) const {
 }
 
 // The first-order distance |f| / |grad f| at the probes of the facets `keys` (one batch): the points of
-// the barycentric grid of QualityOptions::distance_probes steps, vertices excepted, and the centroid.
+// the barycentric grid of QualityOptions::distance_probes steps, vertices excepted, and the centroid. The
+// probes on an edge are evaluated once for its two facets (edge_probes_, kept until f or a vertex moves).
 // Facets beyond the distance bound are queued. Probes are evaluated only for facets that meet every
 // other criterion, once nothing else is queued: most facets of an unfinished mesh are refined anyway.
 void QualityMesher::probe_facets(const std::vector<FacetKey>& keys) {
+  // Slots of probes: one per facet (its interior grid points and centroid), then one per edge not probed
+  // before (its steps - 1 grid points; an edge's probes serve both of its facets, edge_probes_ keeps them).
   const int steps = options_.distance_probes;
-  const std::size_t per_facet = std::size_t((steps + 1) * (steps + 2) / 2 - 3 + 1);
   std::vector<Point3> probe;
-  for (const FacetKey& k : keys) {
+  std::vector<std::size_t> slot_of;  // per probe
+  std::unordered_map<std::uint64_t, std::size_t> new_edges;
+  for (std::size_t m = 0; m < keys.size(); ++m) {
+    const FacetKey& k = keys[m];
     const Point3& a = tri_.point(k.v[0]);
     const Point3& b = tri_.point(k.v[1]);
     const Point3& c = tri_.point(k.v[2]);
-    for (int i = 0; i <= steps; ++i)
-      for (int j = 0; i + j <= steps; ++j)
-        if (i != steps && j != steps && i + j != 0)
-          probe.push_back(a + (double(i) / steps) * (b - a) + (double(j) / steps) * (c - a));
+    for (int i = 1; i < steps; ++i)
+      for (int j = 1; i + j < steps; ++j) {
+        probe.push_back(a + (double(i) / steps) * (b - a) + (double(j) / steps) * (c - a));
+        slot_of.push_back(m);
+      }
     probe.push_back((a + b + c) / 3.0);
+    slot_of.push_back(m);
+    for (int e = 0; e < 3; ++e) {
+      const VertexId u = k.v[std::size_t(e)], w = k.v[std::size_t((e + 1) % 3)];
+      const std::uint64_t edge = edge_key(u, w);
+      if (edge_probes_.count(edge) || new_edges.count(edge)) continue;
+      const std::size_t slot = keys.size() + new_edges.size();
+      new_edges.emplace(edge, slot);
+      for (int i = 1; i < steps; ++i) {
+        probe.push_back(tri_.point(u) + (double(i) / steps) * (tri_.point(w) - tri_.point(u)));
+        slot_of.push_back(slot);
+      }
+    }
   }
   if (probe.empty()) return;
   std::vector<double> value(probe.size());
@@ -322,14 +344,20 @@ void QualityMesher::probe_facets(const std::vector<FacetKey>& keys) {
   f_.values_gradients(probe.data(), probe.size(), value.data(), grad.data());
   stats_.function_evaluations += probe.size();
   stats_.probe_evaluations += probe.size();
+  std::vector<double> slot_distance(keys.size() + new_edges.size(), 0.0);
+  for (std::size_t p = 0; p < probe.size(); ++p) {
+    const double g = norm(grad[p]);
+    const double d = g > 0.0 ? std::abs(value[p]) / g : std::numeric_limits<double>::infinity();
+    slot_distance[slot_of[p]] = std::max(slot_distance[slot_of[p]], d);
+  }
+  for (const auto& kv : new_edges) edge_probes_[kv.first] = slot_distance[kv.second];
   for (std::size_t m = 0; m < keys.size(); ++m) {
     FacetRecord& r = facets_.at(keys[m]);
-    r.probe_distance = 0.0;
-    for (std::size_t e = per_facet * m; e < per_facet * (m + 1); ++e) {
-      const double g = norm(grad[e]);
-      const double d = g > 0.0 ? std::abs(value[e]) / g : std::numeric_limits<double>::infinity();
-      r.probe_distance = std::max(r.probe_distance, d);
-    }
+    r.probe_distance = slot_distance[m];
+    for (int e = 0; e < 3; ++e)
+      r.probe_distance =
+          std::max(r.probe_distance,
+                   edge_probes_.at(edge_key(keys[m].v[std::size_t(e)], keys[m].v[std::size_t((e + 1) % 3)])));
     if (r.probe_distance > options_.max_distance) push(keys[m], r, false);
   }
 }

@@ -71,6 +71,7 @@ void QualityMesher::validate(const QualityOptions& o) {
 
 void QualityMesher::set_options(const QualityOptions& options) {
   validate(options);
+  if (options.distance_probes != options_.distance_probes) edge_probes_.clear();
   options_ = options;
 }
 
@@ -117,6 +118,7 @@ void QualityMesher::forget_all_facets() {
   queue_ = {};
   unprobed_.clear();
   old_facets_.clear();
+  edge_probes_.clear();
   grow_tet_arrays();
   grow_vertex_arrays();
   std::fill(cvalue_.begin(), cvalue_.end(), std::numeric_limits<double>::quiet_NaN());

@@ -4,8 +4,8 @@
 /// Oudot 2005) on vitri's own Delaunay tree, for any ImplicitFunction. Every output triangle has its
 /// smallest angle >= QualityOptions::min_angle_degrees (up to 30), the distance between each triangle and
 /// the surface is <= max_distance at its surface Delaunay ball centre and its probes (small triangles where
-/// the surface bends, large where it is flat), and the mesh is a closed, outward, 2-manifold. Method, guarantee and its
-/// conditions: docs/quality.md.
+/// the surface bends, large where it is flat), and the mesh is a closed, outward, 2-manifold. Method,
+/// guarantee and its conditions: docs/quality.md.
 ///
 ///   vitri::TorusFunction f({0, 0, 0}, 1.0, 0.4);
 ///   const vitri::Box3 box{{-2, -2, -1}, {2, 2, 1}};
@@ -132,7 +132,8 @@ class QualityMesher {
   /// @note A change that moves no vertex (a new component away from the mesh) is not seen.
   void function_changed();
   /// f changed inside `region` only (closed box): only the vertices inside it are re-projected, only
-  /// circumcentres inside it re-evaluated, and only facets whose Voronoi edge meets it re-classified.
+  /// circumcentres inside it re-evaluated, and only the facets with a circumcentre or their ball centre
+  /// inside it classified again (a facet with both circumcentres outside keeps its sign test).
   void function_changed(const Box3& region);
 
   const Triangulation& triangulation() const { return tri_; }
@@ -181,6 +182,7 @@ class QualityMesher {
   };
 
   FacetKey key_of(TetId t, int i) const;
+  static std::uint64_t edge_key(VertexId a, VertexId b);
   bool inside_domain(const Point3& p) const;  // strictly inside the box
   void grow_tet_arrays();
   void evaluate_circumcenters(const std::vector<TetId>& tets);
@@ -233,6 +235,7 @@ class QualityMesher {
   std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
   std::priority_queue<QueueItem> queue_;
   std::vector<FacetKey> unprobed_;  // facets that meet every criterion but wait for their probes
+  std::unordered_map<std::uint64_t, double> edge_probes_;  // per edge: largest distance at its probes
   /// What a facet keeps when its record is erased by an insertion: it may come back (a facet on the
   /// boundary of the cavity) with the same ball centre (same dual line) and the same probes (same triangle).
   struct OldFacet {

@@ -21,8 +21,11 @@ struct SessionOptions {
   double precision = 0.02;
   /// The first mesh after a load is this many halvings coarser than the target (levels of detail).
   int coarse_levels = 2;
-  /// Most constraints a session holds (the fit is O(N^3), an edit O(N^2)). @throws LimitError beyond.
+  /// Most constraints a session holds with the global function (its fit is O(N^3), an edit O(N^2)).
+  /// @throws LimitError beyond.
   std::size_t max_constraints = 20000;
+  /// Most constraints a session holds with the local function (O(N) fit, local edits).
+  std::size_t max_local_constraints = 2000000;
   /// An edited constraint must lie within this many load diagonals of the load box's center.
   double max_reach = 4.0;
   /// Grid cell of approximate mesh deltas (during drags), relative to the load diagonal (delta.hpp).

@@ -68,6 +68,11 @@ int main(int argc, char** argv) {
   const bool global = argc > 3 && std::strcmp(argv[3], "--global") == 0;
   std::vector<vitri::Point3> p, nrm;
   sample_mesh(mesh, points, p, nrm);
+  if (const char* out = std::getenv("VITRI_WRITE_PWN")) {  // the samples, for other tools (vitri studio)
+    vitri::OrientedPoints op{p, nrm};
+    vitri::write_points(out, op);
+    return 0;
+  }
   auto t = Clock::now();
   const vitri::Constraints c = vitri::constraints_from_oriented_points(p, nrm);
   const double build_s = since(t);

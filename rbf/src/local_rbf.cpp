@@ -128,6 +128,9 @@ struct LocalRbf::Impl {
   void fit_leaves(const std::vector<std::uint32_t>& leaves);
   void link(const std::vector<std::uint32_t>& created);
   void unlink(std::uint32_t c);
+  void refresh_records(std::uint32_t leaf);
+  /// Leaves whose records may be out of date (candidate list or a candidate's fit changed) during an edit.
+  std::vector<std::uint32_t> stale_records;
   void restructure(std::uint32_t c, const Point3& q, std::vector<Ball>& removed, std::vector<std::uint32_t>& created);
   void fill_report();
 
@@ -220,6 +223,10 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   refine_cell(0, created);
   link(created);
   fit_leaves(created);
+  parallel_chunks(created.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) refresh_records(created[k]);
+  });
+  stale_records.clear();
   for (std::size_t c2 = tree.capacity(); c2-- > 0;)  // children after parents: reach bottom-up
     if (tree.cell(static_cast<std::uint32_t>(c2)).alive) {
       Cell& cell = tree.cell(static_cast<std::uint32_t>(c2));
@@ -323,6 +330,7 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created) {
                                        [&](auto x, auto y) { return cell_before(tree.cell(x), tree.cell(y)); });
       cand.insert(at, n);
       tree.cell(n).listed_in.push_back(m);
+      stale_records.push_back(m);
     }
   }
 }
@@ -336,11 +344,22 @@ void LocalRbf::Impl::unlink(std::uint32_t c) {
   for (std::uint32_t l : cell.listed_in) {
     auto& cand = tree.cell(l).candidates;
     cand.erase(std::remove(cand.begin(), cand.end(), c), cand.end());
+    stale_records.push_back(l);
   }
   cell.candidates.clear();
+  cell.records.clear();
   cell.listed_in.clear();
   cell.coef.clear();
   cell.terms = 0;
+}
+
+void LocalRbf::Impl::refresh_records(std::uint32_t leaf) {
+  Cell& cell = tree.cell(leaf);
+  cell.records.resize(cell.candidates.size());
+  for (std::size_t k = 0; k < cell.candidates.size(); ++k) {
+    const Cell& p = tree.cell(cell.candidates[k]);
+    cell.records[k] = PatchRecord{p.center, p.radius * p.radius, 1.0 / p.radius, p.coef.data(), p.terms};
+  }
 }
 
 void LocalRbf::Impl::fill_report() {
@@ -369,23 +388,22 @@ double LocalRbf::Impl::evaluate_inside(const Point3& x, Point3* grad) const {
   const Cell& leaf = tree.cell(tree.locate(x));
   double sw = 0, swf = 0;
   Point3 gsw{0, 0, 0}, gswf{0, 0, 0};
-  for (std::uint32_t l : leaf.candidates) {
-    const Cell& p = tree.cell(l);
+  for (const PatchRecord& p : leaf.records) {
     const Point3 d = x - p.center;
     const double d2 = squared_norm(d);
-    if (!(d2 < p.radius * p.radius)) continue;
-    const double inv = 1.0 / p.radius;
+    if (!(d2 < p.radius2)) continue;
+    const double inv = p.inv_radius;
     const Point3 u = d * inv;
     const double r = std::sqrt(d2) * inv;
     const double w = wendland(r);
     if (!grad) {
-      const double fp = patch_value(p.coef.data(), p.terms, u, nullptr);
+      const double fp = patch_value(p.coef, p.terms, u, nullptr);
       sw += w;
       swf += w * fp;
       continue;
     }
     Point3 gu;
-    const double fp = patch_value(p.coef.data(), p.terms, u, &gu);
+    const double fp = patch_value(p.coef, p.terms, u, &gu);
     const Point3 dw = (wendland_derivative_over_r(r) * inv * inv) * d;
     sw += w;
     swf += w * fp;
@@ -492,7 +510,17 @@ ChangedRegion LocalRbf::Impl::change(std::optional<Point3> old_pos, std::optiona
     fit_all(before, tree.root_box());
     throw;
   }
-  for (std::uint32_t c : touched) tree.update_reach(c);
+  for (std::uint32_t c : touched) {
+    tree.update_reach(c);
+    stale_records.push_back(c);  // created leaves have new candidate lists
+    const auto& back = tree.cell(c).listed_in;
+    stale_records.insert(stale_records.end(), back.begin(), back.end());
+  }
+  std::sort(stale_records.begin(), stale_records.end());
+  stale_records.erase(std::unique(stale_records.begin(), stale_records.end()), stale_records.end());
+  for (std::uint32_t c : stale_records)
+    if (is_leaf(c)) refresh_records(c);
+  stale_records.clear();
   ChangedRegion region;
   region.balls = std::move(removed);
   for (std::uint32_t c : touched) region.balls.push_back({tree.cell(c).center, tree.cell(c).radius});

@@ -24,6 +24,16 @@ namespace vitri::local_detail {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
 
+/// What evaluation reads of one candidate patch, stored contiguously in the leaf that lists it (no visit
+/// of the candidate's cell). Refreshed whenever the candidate list or a candidate's fit changes.
+struct PatchRecord {
+  Point3 center;
+  double radius2 = 0;
+  double inv_radius = 0;
+  const double* coef = nullptr;
+  std::uint32_t terms = 0;
+};
+
 struct Cell {
   Point3 center;
   double half = 0;  ///< half side of the cube
@@ -37,6 +47,7 @@ struct Cell {
   std::uint32_t terms = 0;  ///< kernel terms in coef (0: linear patch)
   std::vector<double> coef;
   std::vector<std::uint32_t> candidates;
+  std::vector<PatchRecord> records;  ///< records[k] describes candidates[k] (see PatchRecord)
   std::vector<std::uint32_t> listed_in;
   double fit_reach = 0;
   bool leaf() const { return first_child == kNone; }

@@ -326,7 +326,7 @@ Point3 extreme_direction(std::size_t a) {
 /// with its seed: the extreme points of a component lie on its convex hull, where the outward normal of
 /// a closed surface has a positive component along the extreme direction; the one whose estimated normal
 /// is the most aligned with its direction gives the most certain start (a building's highest roof point
-/// rather than the edge of its overhang).
+/// rather than the edge of a flat roof that sticks out farthest).
 std::vector<Component> find_components(const DistinctPoints& d, const std::vector<Id>& comp,
                                        const std::vector<Point3>& n) {
   std::vector<Component> c(comp.size());

@@ -6,8 +6,9 @@
 /// neighbourhood covariance), then the normals are oriented consistently by propagation along a minimum
 /// spanning tree of the k-nearest-neighbour graph, from one seed per connected component whose
 /// orientation is known (its extreme points along +-x, +-y, +-z lie on the convex hull of the component,
-/// where the outward normal points along the extreme direction). The result feeds constraints_from_oriented_points()
-/// (constraints_from_points() in constraints.hpp does both). Method, checks and limits: docs/normals.md.
+/// where the outward normal points along the extreme direction). The result feeds
+/// constraints_from_oriented_points() (constraints_from_points() in constraints.hpp does both). Method,
+/// checks and limits: docs/normals.md.
 
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"

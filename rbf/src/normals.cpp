@@ -13,8 +13,9 @@
 // 0.5 (|n_i . e| + |n_j . e|), e the unit edge direction: an edge between two close sheets of a thin
 // part joins nearly parallel normals (cost ~0 by Hoppe's measure) but runs along them, and crossing it
 // would flip one sheet; with the penalty (~1 for such an edge, ~0 along a surface) the tree goes around.
-// The seed of each connected component is its point of largest x (ties: smallest index), on the convex
-// hull of the component, where the outward normal of a closed surface points to +x.
+// The seed of each connected component is one of its six extreme points (largest and smallest x, y, z), on
+// the convex hull of the component, where the outward normal of a closed surface points along the extreme
+// direction: the one whose estimated normal is the most aligned with it.
 // Two checks turn a guessed orientation into an error naming a point (docs/normals.md gives the
 // measurements behind their thresholds): a tree edge across nearly perpendicular normals (the sign of
 // everything beyond it is a guess), and, after the fact, too many neighbour pairs along the surface with
@@ -27,6 +28,7 @@
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -43,7 +45,7 @@ namespace {
 
 using Id = PointIndex::Id;
 
-/// |n_x| below this at a seed: the orientation of its component is undetermined.
+/// |n . direction| below this at a seed: the orientation of its component is undetermined.
 constexpr double kMinSeedAlignment = 0.1;
 
 /// The distinct positions of the input and the map between the two numberings.
@@ -304,37 +306,79 @@ Disagreement disagreement(const DistinctPoints& d, const NeighbourTable& t, cons
   return out;
 }
 
+/// A connected component of the neighbour graph and the seed its orientation starts from.
+struct Component {
+  std::size_t size = 0;
+  /// Its extreme points along +x, -x, +y, -y, +z, -z (ties: smallest id).
+  std::array<Id, 6> extreme{};
+  Id seed = PointIndex::kNoId;  ///< The extreme point whose normal is the most aligned with its direction.
+  Point3 outward;               ///< That direction: the seed's normal is made to point along it.
+};
+
+/// The unit direction of extreme point a (0: +x, 1: -x, 2: +y, ... 5: -z).
+Point3 extreme_direction(std::size_t a) {
+  Point3 dir;
+  dir[a / 2] = a % 2 ? -1.0 : 1.0;
+  return dir;
+}
+
+/// The components by representative (components() numbering; size 0 for non-representatives), each
+/// with its seed: the extreme points of a component lie on its convex hull, where the outward normal of
+/// a closed surface has a positive component along the extreme direction; the one whose estimated normal
+/// is the most aligned with its direction gives the most certain start (a building's highest roof point
+/// rather than the edge of a flat roof that sticks out farthest).
+std::vector<Component> find_components(const DistinctPoints& d, const std::vector<Id>& comp,
+                                       const std::vector<Point3>& n) {
+  std::vector<Component> c(comp.size());
+  for (std::size_t u = 0; u < comp.size(); ++u) {
+    Component& k = c[comp[u]];
+    for (std::size_t a = 0; a < 6; ++a) {
+      const Point3 dir = extreme_direction(a);
+      if (k.size == 0 || dot(d.points[u], dir) > dot(d.points[k.extreme[a]], dir))
+        k.extreme[a] = static_cast<Id>(u);
+    }
+    ++k.size;
+  }
+  for (Component& k : c) {
+    if (k.size == 0) continue;
+    Point3 extent;  // of the component along each axis
+    for (std::size_t axis = 0; axis < 3; ++axis)
+      extent[axis] = d.points[k.extreme[2 * axis]][axis] - d.points[k.extreme[2 * axis + 1]][axis];
+    double best = -1;
+    for (std::size_t a = 0; a < 6; ++a) {
+      // A flat component has no extreme point across its plane (all of them are): skip that axis.
+      if (!(extent[a / 2] > 1e-9 * norm(extent))) continue;
+      const double align = std::abs(dot(n[k.extreme[a]], extreme_direction(a)));
+      if (align > best) best = align, k.seed = k.extreme[a], k.outward = extreme_direction(a);
+    }
+  }
+  return c;
+}
+
 /// Orients the normals of the distinct points, every component from its own seed.
 OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable& t, std::vector<Point3>& n,
                                   const NormalOptions& opt) {
   const NeighbourGraph g(t);
   const std::vector<Id> comp = components(g);
+  const std::vector<Component> parts = find_components(d, comp, n);
   const std::size_t min_size = opt.min_component ? opt.min_component : 2 * (opt.k + 1);
-  // Seed (largest x, then smallest id) and size of every component, by representative.
-  std::vector<Id> seed(g.size(), PointIndex::kNoId);
-  std::vector<std::size_t> size(g.size(), 0);
-  for (std::size_t u = 0; u < g.size(); ++u) {
-    const Id r = comp[u];
-    ++size[r];
-    if (seed[r] == PointIndex::kNoId || d.points[u].x > d.points[seed[r]].x) seed[r] = static_cast<Id>(u);
-  }
   OrientationReport rep;
   std::vector<char> done(g.size(), 0);
-  for (std::size_t r = 0; r < g.size(); ++r) {
-    if (comp[r] != r) continue;
-    const Id s = seed[r];
-    if (size[r] < min_size)
+  for (const Component& part : parts) {
+    if (part.size == 0) continue;
+    const Id s = part.seed;
+    if (part.size < min_size)
       throw OrientationError(d.first[s],
-                             "isolated group of " + std::to_string(size[r]) + " points (fewer than " +
+                             "isolated group of " + std::to_string(part.size) + " points (fewer than " +
                                  std::to_string(min_size) +
                                  ", see NormalOptions::min_component) not connected to the rest "
                                  "by nearest neighbours: outliers, or a part too sparse to orient");
-    if (std::abs(n[s].x) < kMinSeedAlignment)
+    if (std::abs(dot(n[s], part.outward)) < kMinSeedAlignment)
       throw OrientationError(d.first[s],
-                             "the point of largest x of its component has a normal nearly "
-                             "perpendicular to x: the component does not look like a closed "
-                             "surface (flat or open part), its outside is undetermined");
-    if (n[s].x < 0) {
+                             "the extreme points of its component (largest and smallest x, y, z) all have "
+                             "normals nearly perpendicular to their direction: the component does not look "
+                             "like a closed surface (flat or open part), its outside is undetermined");
+    if (dot(n[s], part.outward) < 0) {
       n[s] = -n[s];
       ++rep.flipped;
     }

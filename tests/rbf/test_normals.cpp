@@ -131,6 +131,33 @@ TEST_CASE("normals: sphere and torus, PCA direction and orientation on every poi
   }
 }
 
+TEST_CASE("normals: a closed box down to a thin plate, every point, sharp edges included", "[rbf][normals]") {
+  // The box [0, 4] x [0, 4] x [0, h] sampled on a grid of spacing 0.1 on each face, the face normals as the
+  // truth. At h = 0.15 the plate is 1.5 samples thick: the neighbourhoods of its rim reach both sheets,
+  // and the tree must still go around (the edge-alignment penalty) rather than across.
+  const double h = GENERATE(1.0, 0.15), step = 0.1;
+  INFO("h = " << h);
+  Samples s;
+  auto face = [&](std::size_t axis, double at, double sign, double a_end, double b_end) {
+    Point3 n;
+    n[axis] = sign;
+    for (double a = step / 2; a < a_end; a += step)
+      for (double b = step / 2; b < b_end; b += step) {
+        Point3 q;
+        q[axis] = at, q[(axis + 1) % 3] = a, q[(axis + 2) % 3] = b;
+        s.points.push_back(q);
+        s.normals.push_back(n);
+      }
+  };
+  face(2, h, 1, 4, 4), face(2, 0, -1, 4, 4);  // top, bottom: (x, y)
+  face(0, 4, 1, 4, h), face(0, 0, -1, 4, h);  // x faces: (y, z)
+  face(1, 4, 1, h, 4), face(1, 0, -1, h, 4);  // y faces: (z, x)
+  OrientationReport rep;
+  const auto n = estimate_oriented_normals(s.points, {}, &rep);
+  CHECK(wrong_sides(n, s.normals) == 0);
+  CHECK(rep.components == 1);
+}
+
 TEST_CASE("normals: real models with their normals dropped, orientation right on every point",
           "[rbf][normals]") {
   // Models sampled finely enough for their thinnest parts (see docs/normals.md for the coarse ones).

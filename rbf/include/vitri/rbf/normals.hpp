@@ -5,9 +5,10 @@
 /// (principal component analysis: the normal is the eigenvector of the smallest eigenvalue of the
 /// neighbourhood covariance), then the normals are oriented consistently by propagation along a minimum
 /// spanning tree of the k-nearest-neighbour graph, from one seed per connected component whose
-/// orientation is known (its point of largest x lies on the convex hull of the component, where the
-/// outward normal points to +x). The result feeds constraints_from_oriented_points()
-/// (constraints_from_points() in constraints.hpp does both). Method, checks and limits: docs/normals.md.
+/// orientation is known (its extreme points along +-x, +-y, +-z lie on the convex hull of the component,
+/// where the outward normal points along the extreme direction). The result feeds
+/// constraints_from_oriented_points() (constraints_from_points() in constraints.hpp does both). Method,
+/// checks and limits: docs/normals.md.
 
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"
@@ -85,11 +86,13 @@ struct OrientationReport {
 
 /// Orients unit normals consistently (flips signs only), in place: minimum spanning tree of the
 /// symmetric k-nearest-neighbour graph with edge cost 1 - |n_i . n_j| plus a penalty for edges that leave
-/// the tangent planes (see docs/normals.md), Prim's algorithm from the point of largest x of each
-/// component, whose normal is made to point to +x. Exact duplicate positions get the same normal.
+/// the tangent planes (see docs/normals.md), Prim's algorithm from a seed per component: of its six
+/// extreme points (largest and smallest x, y, z), the one whose normal is the most aligned with its
+/// direction, made to point along it. Exact duplicate positions get the same normal.
 /// @throws InvalidArgument for mismatched sizes or too few points; InvalidPoint (index) for non-finite
 ///         data or a zero normal; OrientationError (index) for a component smaller than
-///         options.min_component, a seed whose normal is nearly perpendicular to x, a point whose
+///         options.min_component, extreme points whose normals are all nearly perpendicular to their
+///         directions (a flat or open part), a point whose
 ///         sign would be decided across normals less aligned than options.min_link, or a result whose
 ///         disagreement exceeds options.max_disagreement.
 OrientationReport orient_normals(const std::vector<Point3>& points, std::vector<Point3>& normals,

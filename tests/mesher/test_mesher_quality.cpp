@@ -76,3 +76,24 @@ TEST_CASE("quality mode: bad quality options are rejected before the fit", "[mes
   c.add({1.0, 0.0, 0.0}, 0.0);
   REQUIRE_THROWS_AS(Mesher(c, o), InvalidArgument);
 }
+
+TEST_CASE("quality mode with the local function: guarantees before and after an edit", "[mesher][local]") {
+  // Every vertex of knot1 (9600 constraints): the partition-of-unity function.
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  o.mode = MeshMode::Quality;
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  REQUIRE(mesher.local_function() != nullptr);
+  const double diag = mesher.diagonal();
+  QualityOptions q = mesher.options().quality;
+  q.max_distance = 0.003 * diag;
+  mesher.set_quality_options(q);
+  REQUIRE(mesher.refine(0.03 * diag));
+  test::require_quality(mesher.surface(), mesher.function(), q, 0, 1, 1.25, 1e-7 * diag);
+  const double edited =
+      1.001 * q.edit_tolerance * mesher.quality_mesher()->triangulation().box().diagonal();
+  const Point3 p = mesher.constraints().points[100];
+  mesher.move_constraint(100, p + Point3{0.005 * diag, 0.0, 0.0});
+  test::require_quality(mesher.surface(), mesher.function(), q, 0, 1, 1.25, edited);
+}

@@ -143,6 +143,9 @@ struct LocalRbf::Impl {
                        const std::function<void()>& apply, const std::function<void()>& undo);
   ChangedRegion refit_everything(const Constraints& c);
   void compact_if_sparse();
+  /// Marks a slot dead (its constraint removed) or alive again, keeping the index and counts in step.
+  void kill_slot(std::uint32_t slot);
+  void revive_slot(std::uint32_t slot);
 };
 
 // ----- fit -------------------------------------------------------------------------------------------------
@@ -556,6 +559,22 @@ void LocalRbf::Impl::compact_if_sparse() {
   index.build(slot_point);
 }
 
+void LocalRbf::Impl::kill_slot(std::uint32_t slot) {
+  index.erase(slot);
+  slot_alive[slot] = 0;
+  ranks.set_dead(slot);
+  --live;
+  nonzero -= slot_value[slot] != 0;
+}
+
+void LocalRbf::Impl::revive_slot(std::uint32_t slot) {
+  index.insert(slot, slot_point[slot]);
+  slot_alive[slot] = 1;
+  ranks.set_alive(slot);
+  ++live;
+  nonzero += slot_value[slot] != 0;
+}
+
 // ----- public API ------------------------------------------------------------------------------------------
 
 LocalRbf::LocalRbf() : impl_(std::make_unique<Impl>()) {}
@@ -717,13 +736,7 @@ ChangedRegion LocalRbf::add_constraint(const Point3& p, double value) {
         ++m.live;
         m.nonzero += value != 0;
       },
-      [&] {
-        m.index.erase(slot);
-        m.slot_alive[slot] = 0;
-        m.ranks.set_dead(slot);
-        --m.live;
-        m.nonzero -= value != 0;
-      });
+      [&] { m.kill_slot(slot); });
 }
 
 ChangedRegion LocalRbf::move_constraint(std::size_t i, const Point3& p) {
@@ -758,20 +771,7 @@ ChangedRegion LocalRbf::remove_constraint(std::size_t i) {
   const Point3 old = m.slot_point[slot];
   ChangedRegion region = m.change(
       old, std::nullopt,
-      [&] {
-        m.index.erase(slot);
-        m.slot_alive[slot] = 0;
-        m.ranks.set_dead(slot);
-        --m.live;
-        m.nonzero -= value != 0;
-      },
-      [&] {
-        m.index.insert(slot, old);
-        m.slot_alive[slot] = 1;
-        m.ranks.set_alive(slot);
-        ++m.live;
-        m.nonzero += value != 0;
-      });
+      [&] { m.kill_slot(slot); }, [&] { m.revive_slot(slot); });
   m.compact_if_sparse();
   return region;
 }

@@ -73,48 +73,36 @@ std::uint32_t LocalTree::locate(const Point3& p) const {
   return c;
 }
 
-void LocalTree::leaves_meeting_cube(const Cell& target, std::vector<std::uint32_t>& out) const {
+template <class Enter, class Take>
+void LocalTree::collect_leaves(const Enter& enter, const Take& take, std::vector<std::uint32_t>& out) const {
   out.clear();
   std::vector<std::uint32_t> stack{0};
   while (!stack.empty()) {
     const std::uint32_t c = stack.back();
     stack.pop_back();
     const Cell& cell = cells_[c];
-    if (!(cube_distance2(target, cell.center) < cell.radius * cell.radius)) continue;
-    if (cell.leaf()) out.push_back(c);
-    else
-      for (int k = 0; k < 8; ++k) stack.push_back(child(c, k));
-  }
-}
-
-void LocalTree::leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const {
-  out.clear();
-  std::vector<std::uint32_t> stack{0};
-  while (!stack.empty()) {
-    const std::uint32_t c = stack.back();
-    stack.pop_back();
-    const Cell& cell = cells_[c];
-    if (!(cube_distance2(cell, center) < radius * radius)) continue;
-    if (cell.leaf()) out.push_back(c);
-    else
-      for (int k = 0; k < 8; ++k) stack.push_back(child(c, k));
-  }
-}
-
-void LocalTree::leaves_fitting(const Point3& q, std::vector<std::uint32_t>& out) const {
-  out.clear();
-  std::vector<std::uint32_t> stack{0};
-  while (!stack.empty()) {
-    const std::uint32_t c = stack.back();
-    stack.pop_back();
-    const Cell& cell = cells_[c];
-    const double d2 = squared_distance(q, cell.center);
     if (cell.leaf()) {
-      if (d2 <= cell.fit_r2) out.push_back(c);
-    } else if (std::sqrt(d2) <= cell.fit_reach * (1 + 1e-12)) {
+      if (take(cell)) out.push_back(c);
+    } else if (enter(cell)) {
       for (int k = 0; k < 8; ++k) stack.push_back(child(c, k));
     }
   }
+}
+
+void LocalTree::leaves_meeting_cube(const Cell& target, std::vector<std::uint32_t>& out) const {
+  // Balls nest (child inside parent), so a cell whose ball misses the cube has no leaf below that meets it.
+  const auto meets = [&](const Cell& cell) { return cube_distance2(target, cell.center) < cell.radius * cell.radius; };
+  collect_leaves(meets, meets, out);
+}
+
+void LocalTree::leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const {
+  const auto meets = [&](const Cell& cell) { return cube_distance2(cell, center) < radius * radius; };
+  collect_leaves(meets, meets, out);
+}
+
+void LocalTree::leaves_fitting(const Point3& q, std::vector<std::uint32_t>& out) const {
+  collect_leaves([&](const Cell& cell) { return distance(q, cell.center) <= cell.fit_reach * (1 + 1e-12); },
+                 [&](const Cell& cell) { return squared_distance(q, cell.center) <= cell.fit_r2; }, out);
 }
 
 void LocalTree::update_reach(std::uint32_t c) {

@@ -106,6 +106,10 @@ class LocalTree {
   void validate() const;
 
  private:
+  /// Leaves below the root reached through inner cells with enter(cell), kept when take(leaf).
+  template <class Enter, class Take>
+  void collect_leaves(const Enter& enter, const Take& take, std::vector<std::uint32_t>& out) const;
+
   std::vector<Cell> cells_;
   std::vector<std::uint32_t> free_blocks_;
 };

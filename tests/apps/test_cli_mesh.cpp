@@ -240,6 +240,20 @@ TEST_CASE("vitri mesh: unoriented points (.xyz, PLY without faces) get estimated
   }
 }
 
+TEST_CASE("vitri mesh without --precision: the data's resolution", "[cli][mesh]") {
+  // 2000 oriented points on the unit sphere, spacing about sqrt(4 pi / 2000) = 0.079: the default is
+  // 2.5 spacings (relative to the diagonal 2 sqrt 3), and the mesh has about as many vertices as points.
+  const std::string in = write_sphere_points("mesh_default.pwn", 2000), out = kDir + "/mesh_default.obj";
+  std::remove(out.c_str());
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out, o, e) == 0);
+  INFO(o << e);
+  REQUIRE(e.find("median spacing") != std::string::npos);
+  const long v = check_mesh(out);
+  CHECK(v > 1000);
+  CHECK(v < 6000);
+}
+
 TEST_CASE("vitri mesh: unoriented points that cannot be oriented, and a fit too large for memory",
           "[cli][mesh][normals][errors]") {
   std::string o, e;
@@ -291,7 +305,7 @@ TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why o
       REQUIRE(run(in + " -o " + out + " --precision " + p, o, e) == 2);
       REQUIRE(e.find("--precision") != std::string::npos);
     }
-    REQUIRE(run(in + " -o " + out, o, e) == 2);
+    REQUIRE(run(in + " -o " + out + " --precision", o, e) == 2);  // the option without its value
     REQUIRE(e.find("--precision") != std::string::npos);
   }
   SECTION("precisions not coarse to fine: increasing or repeated, with nothing written") {

@@ -193,6 +193,12 @@ class Mesher {
   MesherStats stats_;
 };
 
+/// The data's resolution: the median distance from a surface constraint (value 0; all constraints when
+/// none is 0) to its nearest other one, over at most 100,000 of them taken evenly. Exact duplicates are
+/// skipped. The CLI's default precision (docs/guide.md). O(n log n).
+/// @throws InvalidArgument when fewer than 2 distinct positions are given.
+double median_spacing(const Constraints& constraints);
+
 /// One call: fits the RBF to the constraints, refines to `precision` (absolute) and extracts the mesh.
 /// @throws as Mesher::Mesher and Mesher::refine.
 SurfaceMesh mesh_points(const Constraints& constraints, double precision, const MesherOptions& options = {});

@@ -66,6 +66,10 @@ const Constraints& Mesher::constraints() const { return rbf_ ? rbf_->constraints
 
 std::size_t Mesher::size() const { return rbf_ ? rbf_->size() : local_->size(); }
 
+Point3 Mesher::constraints_point(std::size_t i) const {
+  return rbf_ ? rbf_->constraints().points[i] : local_->point(i);
+}
+
 double Mesher::value_of(std::size_t i) const { return rbf_ ? rbf_->constraints().values[i] : local_->value_of(i); }
 
 Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
@@ -90,6 +94,8 @@ void Mesher::build() {
   const Box3 domain = Polygonizer::domain_for(c.points, options_.box_factor);
   poly_ = std::make_unique<Polygonizer>(function(), domain, c.points, c.values, options_.polygonizer);
   vertex_of_ = poly_->seed_vertices();
+  zero_index_ = PointIndex();
+  for (std::size_t i = 0; i < c.size(); ++i) track_zero(vertex_of_[i], c.points[i], c.values[i]);
   quality_.reset();
   mesh_valid_ = false;
 }
@@ -132,9 +138,28 @@ void Mesher::set_quality_options(const QualityOptions& quality) {
   options_.quality = quality;
 }
 
+void Mesher::track_zero(VertexId v, const Point3& p, double value) {
+  if (v == kNoVertex) return;
+  if (zero_index_.contains(v)) zero_index_.erase(v);
+  if (value == 0) zero_index_.insert(v, p);
+}
+
 const SurfaceMesh& Mesher::surface() {
   if (!mesh_valid_) {
     mesh_ = quality_ ? quality_->extract() : poly_->extract();
+    stats_.dropped_components = 0;
+    if (!options_.keep_unsupported_components && !zero_index_.empty() && std::isfinite(precision_)) {
+      const double reach2 = std::pow(2.5 * precision_, 2);
+      std::vector<PointIndex::Id> ids;
+      std::vector<double> d2;
+      mesh_ = keep_supported_components(
+          mesh_,
+          [&](const Point3& p) {
+            zero_index_.nearest(p, 1, ids, &d2);
+            return !d2.empty() && d2[0] <= reach2;
+          },
+          &stats_.dropped_components);
+    }
     mesh_valid_ = true;
   }
   return mesh_;
@@ -181,6 +206,7 @@ std::size_t Mesher::add_constraint(const Point3& p, double value) {
   const double t_rbf = now_seconds() - t0;
   if (rebuild_if_outside(p, t0, t_rbf)) return size() - 1;
   vertex_of_.push_back(poly_->insert_vertex(p, value, VertexKind::Seed));
+  track_zero(vertex_of_.back(), p, value);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
   return size() - 1;
 }
@@ -194,6 +220,7 @@ void Mesher::move_constraint(std::size_t i, const Point3& p) {
   if (rebuild_if_outside(p, t0, t_rbf)) return;
   const double value = value_of(i);
   const VertexId v = vertex_of_[i];
+  track_zero(v, p, 1.0);  // out of the index; back in below under the vertex it ends with
   if (v != kNoVertex) {
     if (!poly_->move_vertex(v, p, value)) {
       // p duplicates another constraint's vertex: this constraint lives in the RBF only.
@@ -203,6 +230,7 @@ void Mesher::move_constraint(std::size_t i, const Point3& p) {
   } else {
     vertex_of_[i] = poly_->insert_vertex(p, value, VertexKind::Seed);
   }
+  track_zero(vertex_of_[i], p, value);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 
@@ -214,6 +242,7 @@ void Mesher::remove_constraint(std::size_t i) {
   const double t_rbf = now_seconds() - t0;
   const VertexId v = vertex_of_[i];
   vertex_of_.erase(vertex_of_.begin() + static_cast<std::ptrdiff_t>(i));
+  if (v != kNoVertex && zero_index_.contains(v)) zero_index_.erase(v);
   if (v != kNoVertex) poly_->remove_vertex(v);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
@@ -225,6 +254,7 @@ void Mesher::set_value(std::size_t i, double value) {
   else region = local_->set_value(i, value);
   const double t_rbf = now_seconds() - t0;
   if (vertex_of_[i] != kNoVertex) poly_->set_vertex_value(vertex_of_[i], value);
+  track_zero(vertex_of_[i], constraints_point(i), value);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 

@@ -12,6 +12,45 @@
 
 namespace vitri {
 
+SurfaceMesh keep_supported_components(const SurfaceMesh& mesh, const std::function<bool(const Point3&)>& supported,
+                                      std::size_t* dropped) {
+  const std::size_t n = mesh.vertices.size();
+  std::vector<std::uint32_t> parent(n);
+  std::iota(parent.begin(), parent.end(), 0u);
+  auto find = [&](std::uint32_t v) {
+    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    return v;
+  };
+  for (const auto& t : mesh.triangles)
+    for (int k = 1; k < 3; ++k) {
+      const std::uint32_t a = find(t[0]), b = find(t[static_cast<std::size_t>(k)]);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<std::uint8_t> keep(n, 0), used(n, 0);
+  for (const auto& t : mesh.triangles)
+    for (std::uint32_t v : t) used[v] = 1;
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (used[v] && supported(mesh.vertices[v])) keep[find(v)] = 1;
+  std::size_t components = 0, kept = 0;
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (used[v] && find(v) == v) {
+      ++components;
+      kept += keep[v];
+    }
+  if (dropped) *dropped = components - kept;
+  SurfaceMesh out;
+  std::vector<std::uint32_t> renumber(n, 0xffffffffu);
+  for (std::uint32_t v = 0; v < n; ++v)
+    if (used[v] && keep[find(v)]) {
+      renumber[v] = static_cast<std::uint32_t>(out.vertices.size());
+      out.vertices.push_back(mesh.vertices[v]);
+      if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
+    }
+  for (const auto& t : mesh.triangles)
+    if (keep[find(t[0])]) out.triangles.push_back({renumber[t[0]], renumber[t[1]], renumber[t[2]]});
+  return out;
+}
+
 void to_eigen(const SurfaceMesh& mesh, Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd* N) {
   V.resize(static_cast<Eigen::Index>(mesh.vertices.size()), 3);
   for (std::size_t i = 0; i < mesh.vertices.size(); ++i)

@@ -73,3 +73,38 @@ TEST_CASE("local function: edits keep the mesh closed and the vertex values exac
   }
   REQUIRE(checked > 100);
 }
+
+TEST_CASE("unsupported components are dropped unless the whole zero set is asked for", "[mesher]") {
+  // A sphere of normal constraints, and far from it a blob given only by off-surface values (-0.5 inside,
+  // +0.5 around): its zero set is a component no on-surface constraint supports.
+  std::vector<Point3> p, n;
+  const double pi = 3.14159265358979323846;
+  for (int i = 0; i < 300; ++i) {
+    const double z = 1 - (2 * i + 1.0) / 300, r = std::sqrt(1 - z * z), phi = i * pi * (3 - std::sqrt(5.0));
+    p.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    n.push_back(p.back());
+  }
+  Constraints c = constraints_from_oriented_points(p, n);
+  const Point3 far{5, 0, 0};
+  c.add(far, -0.5);
+  for (int a = 0; a < 3; ++a)
+    for (double s : {-0.6, 0.6}) {
+      Point3 q = far;
+      q[a] += s;
+      c.add(q, 0.5);
+    }
+  for (const bool keep : {false, true}) {
+    MesherOptions o;
+    o.keep_unsupported_components = keep;
+    Mesher mesher(c, o);
+    mesher.refine(0.05);
+    const MeshMetrics mm = test::metrics_of(mesher.surface());
+    INFO("keep " << keep << ": components " << mm.components << ", dropped " << mesher.stats().dropped_components);
+    REQUIRE(mm.closed_manifold());
+    REQUIRE(mm.components == (keep ? 2u : 1u));
+    REQUIRE(mesher.stats().dropped_components == (keep ? 0u : 1u));
+    // What is kept is the supported sphere: every vertex near the unit sphere.
+    if (!keep)
+      for (const Point3& v : mesher.surface().vertices) REQUIRE(std::abs(norm(v) - 1.0) < 0.1);
+  }
+}

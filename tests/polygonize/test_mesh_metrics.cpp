@@ -1,6 +1,7 @@
 // Tests of vitri/polygonize/mesh_metrics.hpp: exact counts on meshes built by hand whose topology is
 // known (tetrahedron, cube, torus, open box, bowtie, flipped faces, degenerate triangles).
 #include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/polygonize/surface_mesh.hpp"
 
 #include "vitri/core/error.hpp"
 
@@ -8,6 +9,7 @@
 
 #include <cmath>
 #include <limits>
+#include <array>
 #include <vector>
 
 namespace {
@@ -352,4 +354,36 @@ TEST_CASE("mesh_metrics: surface_distance", "[mesh_metrics]") {
   Eigen::MatrixXd bad = V;
   bad(1, 0) = std::numeric_limits<double>::infinity();
   CHECK_THROWS_AS(vitri::surface_distance(bad, f), vitri::InvalidPoint);
+}
+
+TEST_CASE("keep_supported_components keeps the components with a supported vertex", "[mesh_metrics]") {
+  using vitri::keep_supported_components;
+  using vitri::Point3;
+  using vitri::SurfaceMesh;
+  // Two tetrahedra surfaces (8 vertices, 8 triangles), the second shifted by 10 in x, plus an unused vertex.
+  SurfaceMesh m;
+  for (double dx : {0.0, 10.0}) {
+    const auto base = static_cast<std::uint32_t>(m.vertices.size());
+    m.vertices.push_back({dx, 0, 0});
+    m.vertices.push_back({dx + 1, 0, 0});
+    m.vertices.push_back({dx, 1, 0});
+    m.vertices.push_back({dx, 0, 1});
+    for (const auto& t : std::vector<std::array<std::uint32_t, 3>>{{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}})
+      m.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+  }
+  m.vertices.push_back({50, 50, 50});
+  for (const Point3& v : m.vertices) m.normals.push_back(v);
+  std::size_t dropped = 7;
+  const SurfaceMesh kept = keep_supported_components(m, [](const Point3& p) { return p.x > 10.5; }, &dropped);
+  REQUIRE(dropped == 1);
+  REQUIRE(kept.vertices.size() == 4);
+  REQUIRE(kept.triangles.size() == 4);
+  REQUIRE(kept.vertices[0] == Point3{10, 0, 0});
+  REQUIRE(kept.normals.size() == 4);
+  for (const auto& t : kept.triangles)
+    for (std::uint32_t v : t) REQUIRE(v < 4);
+  REQUIRE(kept.triangles[0] == std::array<std::uint32_t, 3>{0, 2, 1});
+  const SurfaceMesh none = keep_supported_components(m, [](const Point3&) { return false; }, &dropped);
+  REQUIRE(dropped == 2);
+  REQUIRE(none.triangles.empty());
 }

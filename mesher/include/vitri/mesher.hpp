@@ -23,6 +23,7 @@
 #include "vitri/polygonize/surface_mesh.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/local_rbf.hpp"
+#include "vitri/rbf/point_index.hpp"
 #include "vitri/rbf/rbf.hpp"
 
 #include <Eigen/Core>
@@ -67,6 +68,11 @@ struct MesherOptions {
   MeshMode mode = MeshMode::Fast;
   /// Criteria of the quality mode (absolute lengths), used when mode == Quality.
   QualityOptions quality;
+  /// surface() keeps only the mesh components supported by data: those with a vertex within 2.5 x the
+  /// precision of an on-surface (value 0) constraint; a component far from every on-surface constraint
+  /// (a phantom sheet of the function's zero set) is dropped and counted in MesherStats. true keeps the
+  /// whole zero set. Without any on-surface constraint nothing is dropped.
+  bool keep_unsupported_components = false;
   /// Refinement and extraction options (queue order, root finder, sampling, zero-vertex snapping).
   PolygonizerOptions polygonizer;
   /// Fit and edit options of the RBF.
@@ -95,6 +101,8 @@ struct MesherStats {
   double edit_rbf_seconds = 0;     ///< last edit: RBF update
   double edit_refine_seconds = 0;  ///< last edit: Delaunay update, re-evaluation, refinement, cleanup
   std::size_t rebuilds = 0;        ///< edits that needed a new domain box (full rebuild)
+  /// Last surface(): components dropped as unsupported (MesherOptions::keep_unsupported_components).
+  std::size_t dropped_components = 0;
   QualityStats quality;            ///< quality mode: counters of the QualityMesher (zero otherwise)
 };
 
@@ -178,8 +186,11 @@ class Mesher {
   void after_edit(double rbf_seconds, double t_start, const ChangedRegion* region = nullptr);
   bool rebuild_if_outside(const Point3& p, double t_start, double t_rbf);
   double value_of(std::size_t i) const;
+  Point3 constraints_point(std::size_t i) const;
   void refine_quality();
   bool inside_domain(const Point3& p) const;
+  /// Keeps zero_index_ in step with constraint i's Delaunay vertex, position and value.
+  void track_zero(VertexId v, const Point3& p, double value);
 
   MesherOptions options_;
   std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer
@@ -187,6 +198,7 @@ class Mesher {
   std::unique_ptr<Polygonizer> poly_;
   std::unique_ptr<QualityMesher> quality_;  // quality mode, built by the first refine()
   std::vector<VertexId> vertex_of_;  // Delaunay vertex of each constraint (kNoVertex: duplicate position)
+  PointIndex zero_index_;            // on-surface constraints, keyed by their Delaunay vertex (support test)
   double precision_;
   SurfaceMesh mesh_;
   bool mesh_valid_ = false;

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <functional>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -24,6 +25,12 @@ struct SurfaceMesh {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::vector<Point3> normals;
 };
+
+/// The connected components (through shared vertices) of `mesh` that hold at least one vertex v with
+/// supported(v), the others dropped; vertices renumbered in their original order, normals kept. Returns
+/// the number of components dropped through `dropped` when given. O(V + F).
+SurfaceMesh keep_supported_components(const SurfaceMesh& mesh, const std::function<bool(const Point3&)>& supported,
+                                      std::size_t* dropped = nullptr);
 
 /// Copies the mesh into Eigen arrays: V (#V x 3), F (#F x 3), N (#V x 3, or 0 x 3 without normals).
 void to_eigen(const SurfaceMesh& mesh, Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd* N = nullptr);

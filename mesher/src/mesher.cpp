@@ -138,10 +138,13 @@ void Mesher::set_quality_options(const QualityOptions& quality) {
   options_.quality = quality;
 }
 
+void Mesher::forget_zero(VertexId v) {
+  if (v != kNoVertex && zero_index_.contains(v)) zero_index_.erase(v);
+}
+
 void Mesher::track_zero(VertexId v, const Point3& p, double value) {
-  if (v == kNoVertex) return;
-  if (zero_index_.contains(v)) zero_index_.erase(v);
-  if (value == 0) zero_index_.insert(v, p);
+  forget_zero(v);
+  if (v != kNoVertex && value == 0) zero_index_.insert(v, p);
 }
 
 const SurfaceMesh& Mesher::surface() {
@@ -220,7 +223,7 @@ void Mesher::move_constraint(std::size_t i, const Point3& p) {
   if (rebuild_if_outside(p, t0, t_rbf)) return;
   const double value = value_of(i);
   const VertexId v = vertex_of_[i];
-  track_zero(v, p, 1.0);  // out of the index; back in below under the vertex it ends with
+  forget_zero(v);  // back in below under the vertex it ends with
   if (v != kNoVertex) {
     if (!poly_->move_vertex(v, p, value)) {
       // p duplicates another constraint's vertex: this constraint lives in the RBF only.
@@ -242,7 +245,7 @@ void Mesher::remove_constraint(std::size_t i) {
   const double t_rbf = now_seconds() - t0;
   const VertexId v = vertex_of_[i];
   vertex_of_.erase(vertex_of_.begin() + static_cast<std::ptrdiff_t>(i));
-  if (v != kNoVertex && zero_index_.contains(v)) zero_index_.erase(v);
+  forget_zero(v);
   if (v != kNoVertex) poly_->remove_vertex(v);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }

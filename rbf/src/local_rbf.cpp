@@ -118,6 +118,8 @@ struct LocalRbf::Impl {
 
   unsigned threads() const { return opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency()); }
   double duplicate_tolerance2() const;
+  /// True when two constraints at squared distance d2 are (near-)duplicates.
+  bool too_close(double d2) const;
 
   /// Fits everything; the root cube comes from `domain` when not empty, else from the constraints' box.
   void fit_all(const Constraints& c, const Box3& domain);
@@ -155,10 +157,10 @@ double LocalRbf::Impl::duplicate_tolerance2() const {
   return tol * tol;
 }
 
+bool LocalRbf::Impl::too_close(double d2) const { return d2 == 0 || d2 < duplicate_tolerance2(); }
+
 void LocalRbf::Impl::check_duplicates() const {
-  const double tol2 = duplicate_tolerance2();
-  std::atomic<std::size_t> worst{std::numeric_limits<std::size_t>::max()};
-  std::atomic<std::size_t> partner{0};
+  std::size_t worst = std::numeric_limits<std::size_t>::max(), partner = 0;  // the later index of a pair
   std::mutex m;
   parallel_chunks(slot_point.size(), threads(), 4096, [&](std::size_t b, std::size_t e) {
     std::vector<PointIndex::Id> ids;
@@ -166,20 +168,17 @@ void LocalRbf::Impl::check_duplicates() const {
     for (std::size_t i = b; i < e; ++i) {
       index.nearest(slot_point[i], 2, ids, &d2);
       for (std::size_t k = 0; k < ids.size(); ++k) {
-        if (ids[k] == i || !(d2[k] <= tol2)) continue;
-        if (d2[k] == 0 || d2[k] < tol2) {
-          const std::size_t later = std::max<std::size_t>(i, ids[k]);
-          std::lock_guard<std::mutex> lock(m);
-          if (later < worst) {
-            worst = later;
-            partner = std::min<std::size_t>(i, ids[k]);
-          }
+        if (ids[k] == i || !too_close(d2[k])) continue;
+        std::lock_guard<std::mutex> lock(m);
+        if (std::max<std::size_t>(i, ids[k]) < worst) {
+          worst = std::max<std::size_t>(i, ids[k]);
+          partner = std::min<std::size_t>(i, ids[k]);
         }
       }
     }
   });
   if (worst != std::numeric_limits<std::size_t>::max())
-    throw InvalidPoint(worst, "duplicates constraint " + std::to_string(partner.load()) + " (closer than " +
+    throw InvalidPoint(worst, "duplicates constraint " + std::to_string(partner) + " (closer than " +
                                   std::to_string(opt.duplicate_tolerance) + " x the bounding-box diagonal)");
 }
 
@@ -231,16 +230,7 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   });
   stale_records.clear();
   for (std::size_t c2 = tree.capacity(); c2-- > 0;)  // children after parents: reach bottom-up
-    if (tree.cell(static_cast<std::uint32_t>(c2)).alive) {
-      Cell& cell = tree.cell(static_cast<std::uint32_t>(c2));
-      double reach = cell.leaf() ? std::max(cell.radius, std::sqrt(cell.fit_r2)) : 0.0;
-      if (!cell.leaf())
-        for (int k = 0; k < 8; ++k) {
-          const Cell& ch = tree.cell(tree.child(static_cast<std::uint32_t>(c2), k));
-          reach = std::max(reach, distance(ch.center, cell.center) + ch.fit_reach);
-        }
-      cell.fit_reach = reach;
-    }
+    if (tree.cell(static_cast<std::uint32_t>(c2)).alive) tree.compute_reach(static_cast<std::uint32_t>(c2));
   fitted = true;
   fill_report();
   report.refitted = created.size();
@@ -442,10 +432,9 @@ void LocalRbf::Impl::check_new_position(const Point3& p, std::size_t idx, std::o
   std::vector<PointIndex::Id> ids;
   std::vector<double> d2;
   index.nearest(p, 2, ids, &d2);
-  const double tol2 = duplicate_tolerance2();
   for (std::size_t k = 0; k < ids.size(); ++k) {
     if (moving && ids[k] == *moving) continue;
-    if (d2[k] == 0 || d2[k] < tol2)
+    if (too_close(d2[k]))
       throw InvalidPoint(idx, "duplicates constraint " + std::to_string(ranks.rank(ids[k])) + " at " +
                                   format_point(slot_point[ids[k]]));
   }

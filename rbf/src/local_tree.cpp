@@ -105,18 +105,19 @@ void LocalTree::leaves_fitting(const Point3& q, std::vector<std::uint32_t>& out)
                  [&](const Cell& cell) { return squared_distance(q, cell.center) <= cell.fit_r2; }, out);
 }
 
+void LocalTree::compute_reach(std::uint32_t c) {
+  Cell& cell = cells_[c];
+  double reach = cell.leaf() ? std::max(cell.radius, std::sqrt(cell.fit_r2)) : 0.0;
+  if (!cell.leaf())
+    for (int k = 0; k < 8; ++k) {
+      const Cell& ch = cells_[child(c, k)];
+      reach = std::max(reach, distance(ch.center, cell.center) + ch.fit_reach);
+    }
+  cell.fit_reach = reach;
+}
+
 void LocalTree::update_reach(std::uint32_t c) {
-  while (c != kNone) {
-    Cell& cell = cells_[c];
-    double reach = cell.leaf() ? std::max(cell.radius, std::sqrt(cell.fit_r2)) : 0.0;
-    if (!cell.leaf())
-      for (int k = 0; k < 8; ++k) {
-        const Cell& ch = cells_[child(c, k)];
-        reach = std::max(reach, distance(ch.center, cell.center) + ch.fit_reach);
-      }
-    cell.fit_reach = reach;
-    c = cell.parent;
-  }
+  for (; c != kNone; c = cells_[c].parent) compute_reach(c);
 }
 
 std::vector<std::uint32_t> LocalTree::leaves() const {

@@ -96,6 +96,8 @@ class LocalTree {
   void leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const;
   /// Leaves with |q - center|^2 <= fit_r2.
   void leaves_fitting(const Point3& q, std::vector<std::uint32_t>& out) const;
+  /// Recomputes fit_reach of c from its patch (leaf) or its children's reaches (inner cell).
+  void compute_reach(std::uint32_t c);
   /// Recomputes fit_reach of c and of its ancestors.
   void update_reach(std::uint32_t c);
   /// All alive leaves, in storage order.

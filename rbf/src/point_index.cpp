@@ -78,6 +78,11 @@ void PointIndex::build(const std::vector<Point3>& points) {
 std::uint32_t PointIndex::make_subtree(Id* first, Id* last) {
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   nodes_.emplace_back();
+  fill_node(index, first, last);
+  return index;
+}
+
+void PointIndex::fill_node(std::uint32_t index, Id* first, Id* last) {
   Point3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
             std::numeric_limits<double>::infinity()};
   Point3 hi = -lo;
@@ -92,34 +97,25 @@ std::uint32_t PointIndex::make_subtree(Id* first, Id* last) {
   if (count <= kBucket || !(extent[axis] > 0)) {  // small, or all points at one position
     nodes_[index].bucket.assign(first, last);
     for (Id* it = first; it != last; ++it) leaf_of_[*it] = index;
-    return index;
+    return;
   }
+  auto coordinate = [&](Id a) { return position_[a][axis]; };
   Id* middle = first + count / 2;
-  std::nth_element(first, middle, last, [&](Id a, Id b) {
-    const double pa = position_[a][axis], pb = position_[b][axis];
-    return pa < pb || (pa == pb && a < b);
-  });
-  // Every id equal to the split value goes right, so that the left side is strictly below it.
-  const double split = position_[*middle][axis];
-  middle = std::partition(first, last, [&](Id a) { return position_[a][axis] < split; });
-  if (middle == first) {  // the lower half is all at `split`: split just above it instead
-    middle = std::partition(first, last, [&](Id a) { return !(position_[a][axis] > split); });
-    if (middle == last) {  // cannot happen with extent > 0, kept for safety
-      nodes_[index].bucket.assign(first, last);
-      for (Id* it = first; it != last; ++it) leaf_of_[*it] = index;
-      return index;
-    }
-  }
-  const double cut = middle == first ? split : position_[*std::min_element(middle, last, [&](Id a, Id b) {
-    return position_[a][axis] < position_[b][axis];
-  })][axis];
+  std::nth_element(first, middle, last, [&](Id a, Id b) { return coordinate(a) < coordinate(b); });
+  // Left: strictly below the median value; when nothing is (the lower half sits at the median), left:
+  // at most the median. Both sides are non-empty since the extent along the axis is positive.
+  const double median = coordinate(*middle);
+  middle = std::partition(first, last, [&](Id a) { return coordinate(a) < median; });
+  if (middle == first) middle = std::partition(first, last, [&](Id a) { return !(coordinate(a) > median); });
+  double cut = coordinate(*middle);  // the smallest coordinate on the right: left < cut <= right
+  for (Id* it = middle; it != last; ++it) cut = std::min(cut, coordinate(*it));
+  nodes_[index].bucket.clear();
   nodes_[index].axis = static_cast<std::uint8_t>(axis);
   nodes_[index].split = cut;
   const std::uint32_t left = make_subtree(first, middle);
   const std::uint32_t right = make_subtree(middle, last);
   nodes_[index].children[0] = left;
   nodes_[index].children[1] = right;
-  return index;
 }
 
 void PointIndex::ensure_id(Id id) {
@@ -153,29 +149,7 @@ void PointIndex::insert(Id id, const Point3& p) {
 
 void PointIndex::split_leaf(std::uint32_t node) {
   std::vector<Id> ids = std::move(nodes_[node].bucket);
-  nodes_[node].bucket.clear();
-  const Point3 lo = nodes_[node].lo, hi = nodes_[node].hi;
-  const std::uint32_t sub = make_subtree(ids.data(), ids.data() + ids.size());
-  if (nodes_[sub].leaf()) {  // all at one position: keep one leaf (the node itself)
-    nodes_[node].bucket = std::move(nodes_[sub].bucket);
-    for (Id id : nodes_[node].bucket) leaf_of_[id] = node;
-    nodes_.pop_back();
-    return;
-  }
-  // Move the new root into `node` (its children were appended after it).
-  Node moved = std::move(nodes_[sub]);
-  moved.lo = lo;
-  moved.hi = hi;
-  nodes_[node] = std::move(moved);
-  nodes_.erase(nodes_.begin() + sub);  // sub is the last-but-children slot: shift indices after it
-  for (std::size_t n = sub; n < nodes_.size(); ++n)
-    for (auto& child : nodes_[n].children)
-      if (child != kNoNode && child > sub) --child;
-  for (auto& child : nodes_[node].children)
-    if (child != kNoNode && child > sub) --child;
-  for (std::size_t n = sub; n < nodes_.size(); ++n)
-    if (nodes_[n].leaf())
-      for (Id id : nodes_[n].bucket) leaf_of_[id] = static_cast<std::uint32_t>(n);
+  fill_node(node, ids.data(), ids.data() + ids.size());  // stays a leaf when all ids share one position
 }
 
 void PointIndex::erase(Id id) {

@@ -161,7 +161,10 @@ TEST_CASE("LocalRbf and the global Rbf have close zero sets near the data", "[lo
   vitri::Rbf global(c);
   // Near the data (within the off-surface distance d of an on-surface constraint), the two functions
   // agree to a small fraction of d: both interpolate the same constraints 0, +d, -d there.
-  const double d = 0.01 * 2.7 * 1.0;  // offset x diagonal of the torus' box (about 2.7 x 2.7 x 0.7)
+  vitri::Box3 box;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (c.values[i] == 0) box.extend(c.points[i]);
+  const double d = vitri::ConstraintBuildOptions{}.offset * box.diagonal();  // the off-surface distance
   std::mt19937 rng(8);
   std::uniform_real_distribution<double> u(-1, 1);
   double worst = 0;
@@ -315,4 +318,25 @@ TEST_CASE("LocalRbf with fewer constraints than a patch wants", "[local_rbf]") {
   f.validate();
   REQUIRE(max_residual(f, c) < 1e-12);
   REQUIRE(region.contains({0, 0, 0}));
+}
+
+TEST_CASE("LocalRbf compacts its slots after many removals and stays equal to a fresh fit", "[local_rbf]") {
+  // 5000 constraints added then removed leave more dead slots than live ones (and more than 4096): the
+  // slots are renumbered; the function must not change (fits follow constraint order, not slot numbers).
+  Constraints c = sphere_constraints(150);
+  LocalRbf f(c);
+  const auto probes = random_points(500, 1.5, 3);
+  std::vector<double> before(probes.size()), after(probes.size());
+  f.values(probes.data(), probes.size(), before.data());
+  for (int k = 0; k < 5000; ++k) {
+    const double t = 0.001 * k;
+    f.add_constraint({0.3 * std::cos(t * 37), 0.3 * std::sin(t * 37), -0.5 + 0.0002 * k}, -0.2);
+  }
+  for (int k = 0; k < 5000; ++k) f.remove_constraint(c.size());
+  f.validate();
+  REQUIRE(f.constraints().points == c.points);
+  f.values(probes.data(), probes.size(), after.data());
+  REQUIRE(after == before);
+  f.move_constraint(3, c.points[3] + Point3{0.01, 0, 0});  // edits still work after the renumbering
+  f.validate();
 }

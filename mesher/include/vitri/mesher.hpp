@@ -191,6 +191,8 @@ class Mesher {
   bool inside_domain(const Point3& p) const;
   /// Keeps zero_index_ in step with constraint i's Delaunay vertex, position and value.
   void track_zero(VertexId v, const Point3& p, double value);
+  /// Takes Delaunay vertex v out of zero_index_ (no-op when it is not there).
+  void forget_zero(VertexId v);
 
   MesherOptions options_;
   std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer

@@ -74,7 +74,10 @@ class PointIndex {
   };
   struct NearestState;
 
+  /// Appends a node holding ids [first, last) (split recursively); returns its index.
   std::uint32_t make_subtree(Id* first, Id* last);
+  /// Makes node `index` hold ids [first, last): a leaf, or an inner node whose children are appended.
+  void fill_node(std::uint32_t index, Id* first, Id* last);
   void split_leaf(std::uint32_t node);
   void ensure_id(Id id);
   void nearest_recurse(std::uint32_t node, NearestState& state) const;

@@ -29,8 +29,8 @@ SurfaceMesh keep_supported_components(const SurfaceMesh& mesh, const std::functi
   std::vector<std::uint8_t> keep(n, 0), used(n, 0);
   for (const auto& t : mesh.triangles)
     for (std::uint32_t v : t) used[v] = 1;
-  for (std::uint32_t v = 0; v < n; ++v)
-    if (used[v] && supported(mesh.vertices[v])) keep[find(v)] = 1;
+  for (std::uint32_t v = 0; v < n; ++v)  // a component is asked about until one vertex supports it
+    if (used[v] && !keep[find(v)] && supported(mesh.vertices[v])) keep[find(v)] = 1;
   std::size_t components = 0, kept = 0;
   for (std::uint32_t v = 0; v < n; ++v)
     if (used[v] && find(v) == v) {

@@ -173,8 +173,7 @@ void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { 
 void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion* region) {
   const double t1 = now_seconds();
   if (region && !region->everywhere) {
-    const Box3 bounds = region->bounds();
-    poly_->function_changed([&](const Point3& p) { return bounds.contains(p) && region->contains(p); });
+    poly_->function_changed(region->balls);  // the vertices near the balls only (no scan)
   } else {
     poly_->function_changed();
   }

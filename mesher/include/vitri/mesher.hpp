@@ -34,6 +34,8 @@
 
 namespace vitri {
 
+class SupportFilter;
+
 /// Which variational function the Mesher fits (docs/local_rbf.md).
 enum class FunctionKind {
   Global,  ///< vitri::Rbf: one dense cubic RBF over all constraints (O(N^2) memory, O(N^3) fit, global edits)
@@ -141,8 +143,15 @@ class Mesher {
   /// @return false when the progress callback cancelled. @throws InvalidArgument for precision <= 0.
   bool refine(double precision, const ProgressCallback& progress = {});
 
-  /// The current mesh (extracted on demand, cached until the next refine or edit).
+  /// The current mesh (extracted on demand, cached until the next refine or edit), compact.
   const SurfaceMesh& surface();
+  /// Brings the live mesh (live_surface()) up to date and returns what changed in it since the previous
+  /// call: only the changed triangles (polygonizer's incremental extraction, then the support filter kept
+  /// incrementally, docs/mesher.md). The first call returns a full delta, so does every call in the
+  /// quality mode (its mesh is rebuilt). Until this is first called, surface() drops the records.
+  MeshDelta update_surface();
+  /// The current mesh with stable ids, as of the last update_surface() or surface().
+  const LiveMesh& live_surface() const;
   /// The current mesh as Eigen arrays: V #V x 3, F #F x 3 (CCW seen from outside), N #V x 3 unit
   /// outward normals (gradient of f).
   void mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N);
@@ -193,6 +202,8 @@ class Mesher {
   void track_zero(VertexId v, const Point3& p, double value);
   /// Takes Delaunay vertex v out of zero_index_ (no-op when it is not there).
   void forget_zero(VertexId v);
+  /// Brings the filtered live mesh up to date (keeps its delta record for update_surface()).
+  void sync_surface();
 
   MesherOptions options_;
   std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer
@@ -204,6 +215,9 @@ class Mesher {
   double precision_;
   SurfaceMesh mesh_;
   bool mesh_valid_ = false;
+  std::unique_ptr<SupportFilter> filter_;  // the live mesh without unsupported components
+  double filter_precision_ = 0;             // precision of its last support check
+  bool deltas_wanted_ = false;              // update_surface() was called: keep the records
   MesherStats stats_;
 };
 

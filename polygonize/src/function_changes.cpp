@@ -17,7 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <unordered_set>
+
 
 namespace vitri {
 
@@ -59,36 +59,51 @@ void Polygonizer::function_changed(const std::vector<Ball>& changed) {
 
 double Polygonizer::crossing_reach() const { return surface_->max_edge_length(); }
 
-// Live vertices within `pad` of a ball, sorted.
-std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls, double pad) const {
-  std::vector<VertexId> out;
-  std::unordered_set<TetId> seen;
-  std::vector<TetId> stack;
+// Live vertices within `pad` of a ball, sorted. One walk from the tetrahedra holding the balls' centers
+// (clamped into the domain), entering a tetrahedron when its bounding box meets a dilated ball.
+std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls, double pad) {
+  std::vector<Ball> grown;
   const Box3& box = tri_.box();
   for (const Ball& b : balls) {
     const double r = b.radius + pad;
-    if (squared_distance_to_box(b.center, box.lo, box.hi) > r * r) continue;
-    // Start from the point of the domain nearest the center, nudged strictly inside.
-    Point3 start;
+    if (squared_distance_to_box(b.center, box.lo, box.hi) <= r * r) grown.push_back({b.center, r});
+  }
+  std::vector<VertexId> out;
+  if (grown.empty()) return out;
+  if (walk_stamp_.size() < tri_.tet_capacity()) walk_stamp_.resize(2 * tri_.tet_capacity(), 0);
+  const std::uint32_t mark = ++walk_epoch_;
+  const auto first_visit = [&](TetId t) {
+    if (walk_stamp_[t] == mark) return false;
+    walk_stamp_[t] = mark;
+    return true;
+  };
+  std::vector<TetId> stack;
+  for (const Ball& b : grown) {
+    Point3 start;  // the point of the domain nearest the center, nudged strictly inside
     for (std::size_t k = 0; k < 3; ++k) {
       const double margin = 1e-9 * (box.hi[k] - box.lo[k]);
       start[k] = std::clamp(b.center[k], box.lo[k] + margin, box.hi[k] - margin);
     }
-    seen.clear();
-    stack.assign(1, tri_.locate(start));
-    seen.insert(stack[0]);
-    while (!stack.empty()) {
-      const TetId t = stack.back();
-      stack.pop_back();
-      Box3 tb;
-      for (const VertexId v : tri_.tet_vertices(t)) tb.extend(tri_.point(v));
-      if (squared_distance_to_box(b.center, tb.lo, tb.hi) > r * r) continue;
-      for (const VertexId v : tri_.tet_vertices(t))
-        if (squared_distance(tri_.point(v), b.center) <= r * r) out.push_back(v);
-      for (int i = 0; i < 4; ++i) {
-        const TetId n = tri_.tet_neighbor(t, i);
-        if (n != kNoTet && seen.insert(n).second) stack.push_back(n);
-      }
+    const TetId t = tri_.locate(start);
+    if (first_visit(t)) stack.push_back(t);
+  }
+  const auto meets = [&](const Point3& lo, const Point3& hi) {
+    for (const Ball& b : grown)
+      if (squared_distance_to_box(b.center, lo, hi) <= b.radius * b.radius) return true;
+    return false;
+  };
+  while (!stack.empty()) {
+    const TetId t = stack.back();
+    stack.pop_back();
+    Box3 tb;
+    const auto v = tri_.tet_vertices(t);
+    for (const VertexId u : v) tb.extend(tri_.point(u));
+    if (!meets(tb.lo, tb.hi)) continue;
+    for (const VertexId u : v)
+      if (meets(tri_.point(u), tri_.point(u))) out.push_back(u);
+    for (int i = 0; i < 4; ++i) {
+      const TetId n = tri_.tet_neighbor(t, i);
+      if (n != kNoTet && first_visit(n)) stack.push_back(n);
     }
   }
   std::sort(out.begin(), out.end());

@@ -306,7 +306,7 @@ class Polygonizer {
   void check_thin(const std::vector<TetId>& tets, double min_length);
   bool insert_thin_point(double min_distance, std::vector<TetId>& created);
   void reevaluate(const std::vector<VertexId>& ids);
-  std::vector<VertexId> vertices_near(const std::vector<Ball>& balls, double pad) const;
+  std::vector<VertexId> vertices_near(const std::vector<Ball>& balls, double pad);
   void note_thin_vertex(VertexId v);
   void note_thin_tets(const std::vector<TetId>& tets);
   std::vector<TetId> thin_recheck_set();
@@ -352,6 +352,8 @@ class Polygonizer {
   // repeated ids; checked when collected).
   std::vector<VertexId> idle_;
   std::size_t idle_compacted_ = 0;
+  std::vector<std::uint32_t> walk_stamp_;  // vertices_near(): per tetrahedron, the walk that visited it
+  std::uint32_t walk_epoch_ = 0;
 };
 
 }  // namespace vitri

@@ -150,8 +150,11 @@ class Mesher {
   /// incrementally, docs/mesher.md). The first call returns a full delta, so does every call in the
   /// quality mode (its mesh is rebuilt). Until this is first called, surface() drops the records.
   MeshDelta update_surface();
-  /// The current mesh with stable ids, as of the last update_surface() or surface().
+  /// The current mesh with stable ids, as of the last update_surface(), sync_surface() or surface().
   const LiveMesh& live_surface() const;
+  /// Brings live_surface() up to date without taking its delta (the next update_surface() returns the
+  /// changes since the previous one, these included). Cost as update_surface().
+  void sync_surface();
   /// The current mesh as Eigen arrays: V #V x 3, F #F x 3 (CCW seen from outside), N #V x 3 unit
   /// outward normals (gradient of f).
   void mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N);
@@ -202,8 +205,6 @@ class Mesher {
   void track_zero(VertexId v, const Point3& p, double value);
   /// Takes Delaunay vertex v out of zero_index_ (no-op when it is not there).
   void forget_zero(VertexId v);
-  /// Brings the filtered live mesh up to date (keeps its delta record for update_surface()).
-  void sync_surface();
 
   MesherOptions options_;
   std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer

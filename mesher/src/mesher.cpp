@@ -203,7 +203,7 @@ void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion*
     poly_->function_changed();
   }
   if (std::isfinite(precision_)) poly_->refine(precision_);
-  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction);
+  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction, options_.garbage_per_edit);
   if (quality_) {
     quality_->function_changed();
     quality_->refine();

@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 
 namespace vitri {
@@ -134,7 +135,7 @@ void Polygonizer::reevaluate(const std::vector<VertexId>& ids) {
   settle_zeros({});
 }
 
-std::size_t Polygonizer::collect_garbage(double min_fraction) {
+std::size_t Polygonizer::collect_garbage(double min_fraction, std::size_t max_removals) {
   const auto is_idle = [&](VertexId v) {
     return tri_.is_vertex(v) && kind_[v] == static_cast<std::uint8_t>(VertexKind::Refinement) && tcount_[v] == 0;
   };
@@ -144,24 +145,34 @@ std::size_t Polygonizer::collect_garbage(double min_fraction) {
     idle_.erase(std::remove_if(idle_.begin(), idle_.end(), [&](VertexId v) { return !is_idle(v); }), idle_.end());
     idle_compacted_ = idle_.size();
   };
-  if (min_fraction > 0.0) {
-    // idle_ bounds the candidates from above. It is compacted (O(its size)) when nothing was added since
-    // the last compaction (the count is then exact) or when the additions reach 1/8 of it, so the check is
-    // amortized O(1) per event; the candidates may exceed the threshold by that eighth before they go.
-    const double limit = min_fraction * static_cast<double>(tri_.num_vertices());
-    if (static_cast<double>(idle_.size()) <= limit) return 0;
-    const std::size_t added = idle_.size() - std::min(idle_.size(), idle_compacted_);
-    if (added > 0 && added * 8 < idle_compacted_) return 0;
-    compact();
-    if (static_cast<double>(idle_.size()) <= limit) return 0;
-  } else {
-    compact();
+  const std::size_t inserted = stats_.insertions - insertions_at_collect_;
+  insertions_at_collect_ = stats_.insertions;
+  if (!draining_) {
+    if (min_fraction > 0.0) {
+      // idle_ bounds the candidates from above. It is compacted (O(its size)) when nothing was added
+      // since the last compaction (the count is then exact) or when the additions reach 1/8 of it, so the
+      // check is amortized O(1) per event; the candidates may exceed the threshold by that eighth first.
+      const double limit = min_fraction * static_cast<double>(tri_.num_vertices());
+      if (static_cast<double>(idle_.size()) <= limit) return 0;
+      const std::size_t added = idle_.size() - std::min(idle_.size(), idle_compacted_);
+      if (added > 0 && added * 8 < idle_compacted_) return 0;
+      compact();
+      if (static_cast<double>(idle_.size()) <= limit) return 0;
+    } else {
+      compact();
+    }
+    draining_ = true;
   }
+  // Removals outpace what the edits add: the bound plus the points inserted since the last call.
+  const std::size_t budget =
+      max_removals > std::numeric_limits<std::size_t>::max() - inserted ? max_removals : max_removals + inserted;
   std::size_t removed = 0;
-  // A removal may renumber the tetrahedra, which refills idle_: iterate a copy, keep what comes.
+  // A removal may renumber the tetrahedra, which refills idle_: take the list, keep what comes.
   std::vector<VertexId> candidates, kept;
   candidates.swap(idle_);
-  for (const VertexId v : candidates) {
+  std::size_t next = 0;
+  for (; next < candidates.size() && removed < budget; ++next) {
+    const VertexId v = candidates[next];
     if (!is_idle(v)) continue;
     // Keep the refinement of the stars of lone zeros (they are active; removing would redo it).
     bool serves = lpos_[v] != kNotListed;
@@ -174,6 +185,8 @@ std::size_t Polygonizer::collect_garbage(double min_fraction) {
     remove_vertex(v);
     ++removed;
   }
+  draining_ = next < candidates.size();  // candidates left for the next calls
+  idle_.insert(idle_.end(), candidates.begin() + static_cast<std::ptrdiff_t>(next), candidates.end());
   idle_.insert(idle_.end(), kept.begin(), kept.end());
   idle_compacted_ = idle_.size();
   stats_.removed_steiner += removed;

@@ -92,6 +92,9 @@ struct MesherOptions {
   /// 0: after every edit. The Delaunay vertex count then stays within about (1 + this) of a session
   /// that collects after every edit.
   double garbage_fraction = 0.1;
+  /// Once collecting, at most this many removals per edit plus as many as the edit inserted, the rest at
+  /// the next edits: no edit pays for a whole batch (Polygonizer::collect_garbage).
+  std::size_t garbage_per_edit = 64;
 };
 
 /// Counters and timings (seconds). `polygonizer` holds the refinement/extraction numbers.

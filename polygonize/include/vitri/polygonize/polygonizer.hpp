@@ -32,6 +32,7 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <queue>
@@ -247,11 +248,16 @@ class Polygonizer {
   double crossing_reach() const;
   /// Removes Refinement vertices that no transverse tetrahedron touches (they no longer serve the
   /// surface; those in the star of a lone zero are kept). Removing such a vertex never creates a
-  /// transverse tetrahedron. Returns how many.
+  /// transverse tetrahedron. Returns how many. Candidates come from events (no scan of the vertices).
   /// @param min_fraction  do nothing (return 0) unless such vertices are more than this fraction of the
   ///        live vertices: removals are expensive, and vertices left by one edit often serve the next
   ///        one (a constraint moved back and forth), so a session can collect in batches. 0: always.
-  std::size_t collect_garbage(double min_fraction = 0.0);
+  /// @param max_removals  once collecting, remove at most max_removals + the points inserted since the
+  ///        previous call, and go on at the next calls (whatever min_fraction) until no candidate is
+  ///        left: an interactive session never pays for a whole batch in one edit, and removals outpace
+  ///        what edits add. Default: no bound (all at once).
+  std::size_t collect_garbage(double min_fraction = 0.0,
+                              std::size_t max_removals = std::numeric_limits<std::size_t>::max());
 
   // ---- Queries ---------------------------------------------------------------------------------------
   const Triangulation& triangulation() const { return tri_; }
@@ -352,6 +358,8 @@ class Polygonizer {
   // repeated ids; checked when collected).
   std::vector<VertexId> idle_;
   std::size_t idle_compacted_ = 0;
+  bool draining_ = false;                // collect_garbage() is removing a batch over several calls
+  std::size_t insertions_at_collect_ = 0;
   std::vector<std::uint32_t> walk_stamp_;  // vertices_near(): per tetrahedron, the walk that visited it
   std::uint32_t walk_epoch_ = 0;
 };

@@ -1,0 +1,280 @@
+#!/usr/bin/python3
+"""vitri against Open3D's screened Poisson reconstruction on oriented points sampled from the shared
+models (issue 12, "Comparison"; results in docs/benchmarks.md, "Against Poisson (Open3D)").
+
+For each model and size: samples oriented points (area-uniform, true face normals, fixed seed) into a
+binary PLY; runs Open3D's Poisson at each depth and `vitri mesh --function local` at its default
+precision and at precisions matched to Poisson's vertex counts (and `--function global` with --global),
+each in its own process under /usr/bin/time -v (wall time, peak resident memory); then measures every
+output against the true model: two-sided distance (exact point-to-triangle, relative to the model's
+bounding-box diagonal), closed, components, Euler characteristic, vertex count. A run that fails, aborts
+or times out becomes a row saying so. Writes OUT.md (markdown tables) and OUT.csv.
+
+Usage: /usr/bin/python3 bench/compare/poisson/compare.py [--quick] [--models bear,man] [--sizes 10000]
+       [--depths 8,9,10] [--vitri build-rel/apps/vitri] [--global] [--work DIR] [--out PREFIX]
+Setup (Debian packages, Release build of the CLI): bash tools/bench_poisson.sh [these options]."""
+import argparse
+import csv
+import math
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+import geometry as geo
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[2]
+DATA = Path(os.environ.get("VITRI_SHARED_DATA", ROOT.parent / "shared" / "data"))
+REFERENCE_SEED = 20261124  # the dense reference samples; the inputs use their size as seed
+OUTPUT_SAMPLE_SEED = 7
+
+
+def parse_args():
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--quick", action="store_true", help="10^4 and 10^5 points only")
+    p.add_argument("--models", default="bear,elephant,turbine,man", help="OFF files of the shared data")
+    p.add_argument("--sizes", default=None, help="point counts (default 10000,100000,1000000)")
+    p.add_argument("--depths", default="8,9,10", help="Poisson octree depths")
+    p.add_argument("--reference", type=int, default=1_000_000, help="dense model samples for distances")
+    p.add_argument("--output-samples", type=int, default=1_000_000, help="samples on each output")
+    p.add_argument("--vitri", default=str(ROOT / "build-rel" / "apps" / "vitri"))
+    p.add_argument("--global", dest="use_global", action="store_true",
+                   help="also vitri --function global (refused or very slow beyond ~10^4 points)")
+    p.add_argument("--no-match", action="store_true", help="vitri at its default precision only")
+    p.add_argument("--match-max", type=int, default=1_000_000,
+                   help="largest input size for the vitri runs matched to Poisson's vertex counts")
+    p.add_argument("--timeout", type=float, default=600.0, help="seconds per run")
+    p.add_argument("--work", default=str(ROOT / "build-poisson"), help="samples and meshes (not committed)")
+    p.add_argument("--out", default=str(HERE.parent / "results" / "poisson"), help="writes OUT.md, OUT.csv")
+    a = p.parse_args()
+    a.sizes = [int(s) for s in (a.sizes or ("10000,100000" if a.quick else "10000,100000,1000000")).split(",")]
+    a.depths = [int(d) for d in a.depths.split(",")]
+    a.models = a.models.split(",")
+    return a
+
+
+def run_measured(cmd, timeout, log):
+    """Runs cmd under /usr/bin/time -v in its own process group. Returns (status, wall s, peak MB, text):
+    status 'ok', 'exit N', 'signal N' or 'timeout'; text = the command's stdout and stderr."""
+    timing = log.with_suffix(".time")
+    start = time.perf_counter()
+    with open(log, "w") as out:
+        proc = subprocess.Popen(["/usr/bin/time", "-v", "-o", str(timing)] + [str(c) for c in cmd],
+                                stdout=out, stderr=subprocess.STDOUT, start_new_session=True)
+        try:
+            proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+    wall = time.perf_counter() - start
+    text = log.read_text(errors="replace")
+    report = timing.read_text(errors="replace") if timing.exists() else ""
+    rss = re.search(r"Maximum resident set size \(kbytes\): (\d+)", report)
+    peak_mb = int(rss.group(1)) / 1024.0 if rss else float("nan")
+    killed = re.search(r"Command terminated by signal (\d+)", report)
+    if proc.returncode == -signal.SIGKILL and not killed:
+        return "timeout", wall, peak_mb, text
+    if killed:
+        return f"signal {killed.group(1)}", wall, peak_mb, text
+    code = re.search(r"Exit status: (\d+)", report)
+    status = "ok" if code and code.group(1) == "0" else f"exit {code.group(1) if code else proc.returncode}"
+    return status, wall, peak_mb, text
+
+
+def failure_note(status, text):
+    """The status and the last meaningful line of a failed run's output (the error message)."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip() and not ln.startswith("Command ")]
+    return f"{status}: {lines[-1][:160]}" if lines else status
+
+
+class Model:
+    """A shared model: its triangles (outward), diagonal, topology, distance frame and dense samples."""
+
+    def __init__(self, name, n_reference):
+        self.name = name
+        V, F = geo.read_off(DATA / f"{name}.off")
+        if geo.signed_volume(V, F) < 0:
+            F = F[:, [0, 2, 1]]  # wound inward: turn every triangle so the normals point out
+        self.V, self.F = V, F
+        self.diag = geo.diagonal(V)
+        self.topology = geo.topology(V, F, self.diag)
+        if self.topology["boundary_edges"] or self.topology["nonmanifold_edges"]:
+            raise SystemExit(f"{name}.off is not a closed manifold mesh: no true model to measure against")
+        self.frame = geo.Normalized(V)
+        self.reference, _ = geo.sample_surface(V, F, n_reference, REFERENCE_SEED)
+
+
+class Sweep:
+    """The runs of one invocation and their rows."""
+
+    def __init__(self, args):
+        self.args = args
+        self.work = Path(args.work)
+        self.work.mkdir(parents=True, exist_ok=True)
+        self.rows = []
+
+    def points_file(self, model, n):
+        path = self.work / f"{model.name}_{n}.ply"
+        if not path.exists():
+            points, normals = geo.sample_surface(model.V, model.F, n, seed=n)
+            geo.write_oriented_ply(path, points, normals)
+        return path
+
+    def measure(self, model, n, method, param, cmd, mesh_path, extra=None):
+        """Runs cmd, measures its output mesh against the model, appends and returns the row."""
+        if mesh_path.exists():
+            mesh_path.unlink()
+        load = os.getloadavg()[0]
+        status, wall, peak, text = run_measured(cmd, self.args.timeout, mesh_path.with_suffix(".log"))
+        row = {"model": model.name, "points": n, "method": method, "param": param, "status": status,
+               "wall_s": wall, "peak_mb": peak, "load": load, "model_euler": model.topology["euler"],
+               "model_components": model.topology["components"], "output": text}
+        row.update(extra(text) if extra and status == "ok" else {})
+        if status == "ok" and not mesh_path.exists():
+            row["status"] = "no output file"
+        if row["status"] != "ok":
+            row["status"] = failure_note(row["status"], text)
+        else:
+            V, F = geo.read_mesh(mesh_path)
+            if len(F) == 0:
+                row["status"] = "empty mesh"
+            else:
+                row.update(geo.topology(V, F, model.diag))
+                row.update(geo.two_sided_distance(model.frame, (model.V, model.F), model.reference, (V, F),
+                                                  self.args.output_samples, OUTPUT_SAMPLE_SEED))
+        self.rows.append(row)
+        print(one_line(row), flush=True)
+        return row
+
+    def poisson(self, model, n, points, depth):
+        out = self.work / f"{model.name}_{n}_poisson{depth}.ply"
+        cmd = ["/usr/bin/python3", HERE / "poisson_run.py", points, depth, out]
+        return self.measure(model, n, f"Poisson depth {depth}", f"depth {depth}", cmd, out, poisson_extra)
+
+    def vitri(self, model, n, points, function, precision=None, label="default"):
+        out = self.work / f"{model.name}_{n}_vitri_{function}_{label.replace(' ', '')}.ply"
+        cmd = [self.args.vitri, "mesh", points, "-o", out, "--function", function]
+        if precision is not None:
+            cmd += ["--precision", f"{precision:.6g}"]
+        return self.measure(model, n, f"vitri {function} {label}", precision, cmd, out, vitri_extra)
+
+    def model_size(self, model, n):
+        points = self.points_file(model, n)
+        poisson_rows = [self.poisson(model, n, points, d) for d in self.args.depths]
+        base = self.vitri(model, n, points, "local")
+        if base["status"] == "ok" and base["param"] and not self.args.no_match and n <= self.args.match_max:
+            for row in poisson_rows:
+                target = row.get("vertices")
+                if not target or abs(target / base["vertices"] - 1) < 0.2:
+                    continue  # Poisson failed, or the default precision already matches it
+                precision = base["param"] * math.sqrt(base["vertices"] / target)
+                self.vitri(model, n, points, "local", precision, f"~{row['param']}")
+        if self.args.use_global:
+            self.vitri(model, n, points, "global", base["param"] if base["status"] == "ok" else None)
+
+
+def poisson_extra(text):
+    m = re.search(r"poisson_s=([\d.]+)", text)
+    return {"core_s": float(m.group(1))} if m else {}
+
+
+def vitri_extra(text):
+    """The precision vitri chose (no --precision) and its own total for refinement + extraction."""
+    extra = {}
+    m = re.search(r"median spacing, ([\d.eE+-]+)", text)
+    if m:
+        extra["param"] = float(m.group(1))
+    m = re.search(r"^\s*0\s+([\d.eE+-]+)\s+\d+\s+\d+\s+[\d.]+\s+[\d.]+\s+([\d.]+)", text, re.M)
+    if m:
+        extra["param"] = float(m.group(1))
+        extra["core_s"] = float(m.group(2)) / 1000.0
+    return extra
+
+
+def fmt(v, spec):
+    return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else format(v, spec)
+
+
+def one_line(r):
+    if not r["status"] == "ok":
+        return f"{r['model']} {r['points']} {r['method']}: {r['status']} ({r['wall_s']:.1f} s)"
+    return (f"{r['model']} {r['points']} {r['method']}: {r['wall_s']:.1f} s, {r['peak_mb']:.0f} MB, "
+            f"V {r['vertices']}, chi {r['euler']} ({r['model_euler']}), {r['components']} comp, "
+            f"boundary {r['boundary_edges']}, mean {r['out_to_model_mean']:.2e}/{r['model_to_out_mean']:.2e}")
+
+
+COLUMNS = ["points", "method", "param", "wall s", "core s", "peak MB", "load", "V", "closed", "comp", "chi",
+           "mean out->model", "mean model->out", "p99 (both)", "max (both)"]
+
+
+def markdown_row(r):
+    param = r["param"] if isinstance(r["param"], str) else "P " + fmt(r["param"], ".3g")
+    head = [str(r["points"]), r["method"], param, fmt(r["wall_s"], ".1f"), fmt(r.get("core_s"), ".1f"),
+            fmt(r["peak_mb"], ".0f"), fmt(r["load"], ".1f")]
+    if r["status"] != "ok":
+        return head + [f"**{r['status']}**"] + [""] * (len(COLUMNS) - len(head) - 1)
+    closed = "yes" if r["boundary_edges"] == 0 and r["nonmanifold_edges"] == 0 else (
+        f"**no** ({r['boundary_edges']} boundary, {r['nonmanifold_edges']} non-manifold edges)")
+    comp = str(r["components"]) if r["components"] == r["model_components"] else f"**{r['components']}**"
+    chi = str(r["euler"]) if r["euler"] == r["model_euler"] else f"**{r['euler']}**"
+    return head + [str(r["vertices"]), closed, comp, chi, fmt(r["out_to_model_mean"], ".2e"),
+                   fmt(r["model_to_out_mean"], ".2e"),
+                   fmt(max(r["out_to_model_p99"], r["model_to_out_p99"]), ".2e"),
+                   fmt(max(r["out_to_model_max"], r["model_to_out_max"]), ".2e")]
+
+
+def write_results(args, rows, header):
+    lines = header + [""]
+    for name in args.models:
+        sel = [r for r in rows if r["model"] == name]
+        if not sel:
+            continue
+        lines += [f"#### {name} (model: Euler characteristic {sel[0]['model_euler']}, "
+                  f"{sel[0]['model_components']} component)", "",
+                  "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+        lines += ["| " + " | ".join(markdown_row(r)) + " |" for r in sel]
+        lines.append("")
+    Path(args.out + ".md").write_text("\n".join(lines) + "\n")
+    keys = [k for k in rows[0] if k != "output"] if rows else []
+    for r in rows:
+        keys += [k for k in r if k not in keys and k != "output"]
+    with open(args.out + ".csv", "w", newline="") as f:
+        w = csv.DictWriter(f, fieldnames=keys, extrasaction="ignore")
+        w.writeheader()
+        w.writerows(rows)
+
+
+def machine():
+    cpu = subprocess.run(["lscpu"], capture_output=True, text=True).stdout
+    m = re.search(r"Model name:\s*(.*)", cpu)
+    return f"{m.group(1).strip() if m else '?'}, {os.cpu_count()} CPUs"
+
+
+def main():
+    args = parse_args()
+    if not Path(args.vitri).exists():
+        sys.exit(f"compare.py: no vitri binary at {args.vitri} (bash tools/bench_poisson.sh builds it)")
+    import open3d
+    header = [f"Date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}", "",
+              f"Machine: {machine()}; Open3D {open3d.__version__}; load average before: "
+              f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", "",
+              "Command: /usr/bin/python3 bench/compare/poisson/compare.py " + " ".join(sys.argv[1:])]
+    sweep = Sweep(args)
+    for name in args.models:
+        model = Model(name, args.reference)
+        for n in args.sizes:
+            sweep.model_size(model, n)
+            write_results(args, sweep.rows, header)  # partial results survive an interrupted sweep
+    header.append(f"\nLoad average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    write_results(args, sweep.rows, header)
+    print(f"wrote {args.out}.md and {args.out}.csv")
+
+
+if __name__ == "__main__":
+    main()

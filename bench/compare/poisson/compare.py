@@ -15,6 +15,7 @@ Usage: /usr/bin/python3 bench/compare/poisson/compare.py [--quick] [--models bea
 Setup (Debian packages, Release build of the CLI): bash tools/bench_poisson.sh [these options]."""
 import argparse
 import csv
+import json
 import math
 import os
 import re
@@ -25,6 +26,7 @@ import time
 from pathlib import Path
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 import geometry as geo
 
@@ -33,6 +35,7 @@ ROOT = HERE.parents[2]
 DATA = Path(os.environ.get("VITRI_SHARED_DATA", ROOT.parent / "shared" / "data"))
 REFERENCE_SEED = 20261124  # the dense reference samples; the inputs use their size as seed
 OUTPUT_SAMPLE_SEED = 7
+NEAR_DUPLICATE = 2e-6  # x the model's diagonal: vitri refuses points closer than 1e-6 of its box's
 
 
 def parse_args():
@@ -47,21 +50,23 @@ def parse_args():
     p.add_argument("--global", dest="use_global", action="store_true",
                    help="also vitri --function global (refused or very slow beyond ~10^4 points)")
     p.add_argument("--no-match", action="store_true", help="vitri at its default precision only")
-    p.add_argument("--match-max", type=int, default=1_000_000,
-                   help="largest input size for the vitri runs matched to Poisson's vertex counts")
+    p.add_argument("--match-max", type=int, default=100_000,
+                   help="above this many points, vitri is matched to the deepest Poisson run only")
     p.add_argument("--timeout", type=float, default=600.0, help="seconds per run")
     p.add_argument("--work", default=str(ROOT / "build-poisson"), help="samples and meshes (not committed)")
     p.add_argument("--out", default=str(HERE.parent / "results" / "poisson"), help="writes OUT.md, OUT.csv")
     a = p.parse_args()
-    a.sizes = [int(s) for s in (a.sizes or ("10000,100000" if a.quick else "10000,100000,1000000")).split(",")]
+    sizes = a.sizes or ("10000,100000" if a.quick else "10000,100000,1000000")
+    a.sizes = [int(s) for s in sizes.split(",")]
     a.depths = [int(d) for d in a.depths.split(",")]
     a.models = a.models.split(",")
     return a
 
 
 def run_measured(cmd, timeout, log):
-    """Runs cmd under /usr/bin/time -v in its own process group. Returns (status, wall s, peak MB, text):
-    status 'ok', 'exit N', 'signal N' or 'timeout'; text = the command's stdout and stderr."""
+    """Runs cmd under /usr/bin/time -v in its own process group. Returns (status, wall s, CPU s, peak MB,
+    text): status 'ok', 'exit N', 'signal N' or 'timeout'; CPU = user + system seconds; text = the
+    command's stdout and stderr."""
     timing = log.with_suffix(".time")
     start = time.perf_counter()
     with open(log, "w") as out:
@@ -77,14 +82,16 @@ def run_measured(cmd, timeout, log):
     report = timing.read_text(errors="replace") if timing.exists() else ""
     rss = re.search(r"Maximum resident set size \(kbytes\): (\d+)", report)
     peak_mb = int(rss.group(1)) / 1024.0 if rss else float("nan")
+    seconds = re.findall(r"(?:User|System) time \(seconds\): ([\d.]+)", report)
+    cpu = sum(float(x) for x in seconds) if seconds else float("nan")
     killed = re.search(r"Command terminated by signal (\d+)", report)
     if proc.returncode == -signal.SIGKILL and not killed:
-        return "timeout", wall, peak_mb, text
+        return "timeout", wall, cpu, peak_mb, text
     if killed:
-        return f"signal {killed.group(1)}", wall, peak_mb, text
+        return f"signal {killed.group(1)}", wall, cpu, peak_mb, text
     code = re.search(r"Exit status: (\d+)", report)
     status = "ok" if code and code.group(1) == "0" else f"exit {code.group(1) if code else proc.returncode}"
-    return status, wall, peak_mb, text
+    return status, wall, cpu, peak_mb, text
 
 
 def failure_note(status, text):
@@ -94,20 +101,19 @@ def failure_note(status, text):
 
 
 class Model:
-    """A shared model: its triangles (outward), diagonal, topology, distance frame and dense samples."""
+    """A shared model: its triangles (outward), diagonal, topology, and the file of its dense samples."""
 
-    def __init__(self, name, n_reference):
+    def __init__(self, name, n_reference, work):
         self.name = name
-        V, F = geo.read_off(DATA / f"{name}.off")
-        if geo.signed_volume(V, F) < 0:
-            F = F[:, [0, 2, 1]]  # wound inward: turn every triangle so the normals point out
-        self.V, self.F = V, F
-        self.diag = geo.diagonal(V)
-        self.topology = geo.topology(V, F, self.diag)
+        self.path = DATA / f"{name}.off"
+        self.V, self.F = geo.read_closed_model(self.path)
+        self.diag = geo.diagonal(self.V)
+        self.topology = geo.topology(self.V, self.F, self.diag)
         if self.topology["boundary_edges"] or self.topology["nonmanifold_edges"]:
             raise SystemExit(f"{name}.off is not a closed manifold mesh: no true model to measure against")
-        self.frame = geo.Normalized(V)
-        self.reference, _ = geo.sample_surface(V, F, n_reference, REFERENCE_SEED)
+        self.reference = Path(work) / f"{name}_reference_{n_reference}.npy"
+        if not self.reference.exists():
+            np.save(self.reference, geo.sample_surface(self.V, self.F, n_reference, REFERENCE_SEED)[0])
 
 
 class Sweep:
@@ -120,63 +126,91 @@ class Sweep:
         self.rows = []
 
     def points_file(self, model, n):
+        """The sampled input (a PLY, made once) and, when some samples lie within NEAR_DUPLICATE x the
+        diagonal of an earlier one, a copy without those (for vitri, which refuses duplicates closer than
+        1e-6 of its constraints' diagonal) and how many it drops; else (path, None, 0)."""
         path = self.work / f"{model.name}_{n}.ply"
+        thinned = self.work / f"{model.name}_{n}_thinned.ply"
+        points, normals = geo.sample_surface(model.V, model.F, n, seed=n)
         if not path.exists():
-            points, normals = geo.sample_surface(model.V, model.F, n, seed=n)
             geo.write_oriented_ply(path, points, normals)
-        return path
+        pairs = cKDTree(points).query_pairs(NEAR_DUPLICATE * model.diag, output_type="ndarray")
+        later = np.unique(pairs.max(axis=1)) if len(pairs) else np.empty(0, dtype=np.int64)
+        if len(later) == 0:
+            return path, None, 0
+        if not thinned.exists():
+            keep = np.setdiff1d(np.arange(n), later)
+            geo.write_oriented_ply(thinned, points[keep], normals[keep])
+        return path, thinned, len(later)
 
     def measure(self, model, n, method, param, cmd, mesh_path, extra=None):
         """Runs cmd, measures its output mesh against the model, appends and returns the row."""
         if mesh_path.exists():
             mesh_path.unlink()
         load = os.getloadavg()[0]
-        status, wall, peak, text = run_measured(cmd, self.args.timeout, mesh_path.with_suffix(".log"))
+        status, wall, cpu, peak, text = run_measured(cmd, self.args.timeout, mesh_path.with_suffix(".log"))
         row = {"model": model.name, "points": n, "method": method, "param": param, "status": status,
-               "wall_s": wall, "peak_mb": peak, "load": load, "model_euler": model.topology["euler"],
-               "model_components": model.topology["components"], "output": text}
+               "wall_s": wall, "cpu_s": cpu, "peak_mb": peak, "load": load,
+               "model_euler": model.topology["euler"], "model_components": model.topology["components"],
+               "output": text}
         row.update(extra(text) if extra and status == "ok" else {})
         if status == "ok" and not mesh_path.exists():
             row["status"] = "no output file"
         if row["status"] != "ok":
             row["status"] = failure_note(row["status"], text)
         else:
-            V, F = geo.read_mesh(mesh_path)
-            if len(F) == 0:
-                row["status"] = "empty mesh"
-            else:
-                row.update(geo.topology(V, F, model.diag))
-                row.update(geo.two_sided_distance(model.frame, (model.V, model.F), model.reference, (V, F),
-                                                  self.args.output_samples, OUTPUT_SAMPLE_SEED))
+            self.measure_mesh(model, mesh_path, row)
         self.rows.append(row)
         print(one_line(row), flush=True)
         return row
+
+    def measure_mesh(self, model, mesh_path, row):
+        """Adds the output's topology and distances to row (measure.py, in its own process)."""
+        cmd = ["/usr/bin/python3", HERE / "measure.py", model.path, model.reference, mesh_path,
+               self.args.output_samples, OUTPUT_SAMPLE_SEED]
+        done = subprocess.run([str(c) for c in cmd], capture_output=True, text=True)
+        if done.returncode != 0:
+            failed = f"measuring failed (exit {done.returncode})"
+            row["status"] = failure_note(failed, done.stdout + done.stderr)
+        else:
+            row.update(json.loads(done.stdout.strip().splitlines()[-1]))
 
     def poisson(self, model, n, points, depth):
         out = self.work / f"{model.name}_{n}_poisson{depth}.ply"
         cmd = ["/usr/bin/python3", HERE / "poisson_run.py", points, depth, out]
         return self.measure(model, n, f"Poisson depth {depth}", f"depth {depth}", cmd, out, poisson_extra)
 
-    def vitri(self, model, n, points, function, precision=None, label="default"):
-        out = self.work / f"{model.name}_{n}_vitri_{function}_{label.replace(' ', '')}.ply"
+    def vitri(self, model, n, points, function, precision=None, label="default", tag="default"):
+        out = self.work / f"{model.name}_{n}_vitri_{function}_{tag}.ply"
         cmd = [self.args.vitri, "mesh", points, "-o", out, "--function", function]
         if precision is not None:
             cmd += ["--precision", f"{precision:.6g}"]
         return self.measure(model, n, f"vitri {function} {label}", precision, cmd, out, vitri_extra)
 
     def model_size(self, model, n):
-        points = self.points_file(model, n)
+        """Poisson at every depth, vitri local at its default precision (again on the thinned copy if it
+        refuses near-duplicates), matched to Poisson's vertex counts (only the deepest above --match-max
+        points), and global with --global."""
+        points, thinned, dropped = self.points_file(model, n)
         poisson_rows = [self.poisson(model, n, points, d) for d in self.args.depths]
         base = self.vitri(model, n, points, "local")
-        if base["status"] == "ok" and base["param"] and not self.args.no_match and n <= self.args.match_max:
-            for row in poisson_rows:
+        note = ""
+        if base["status"] != "ok" and thinned is not None:
+            points, note = thinned, f", {dropped} near-duplicates dropped"
+            base = self.vitri(model, n, points, "local", label="default" + note, tag="default_thinned")
+        if base["status"] == "ok" and base["param"] and not self.args.no_match:
+            matched = [base["vertices"]]
+            for row in poisson_rows if n <= self.args.match_max else poisson_rows[-1:]:
                 target = row.get("vertices")
-                if not target or abs(target / base["vertices"] - 1) < 0.2:
-                    continue  # Poisson failed, or the default precision already matches it
+                if not target or min(abs(target / v - 1) for v in matched) < 0.2:
+                    continue  # Poisson failed, or a run at about this size was already made
+                matched.append(target)
                 precision = base["param"] * math.sqrt(base["vertices"] / target)
-                self.vitri(model, n, points, "local", precision, f"~{row['param']}")
+                label, tag = f"~{row['param']}{note}", "d" + row["param"].split()[-1]
+                self.vitri(model, n, points, "local", precision, label, tag)
         if self.args.use_global:
-            self.vitri(model, n, points, "global", base["param"] if base["status"] == "ok" else None)
+            precision = base["param"] if base["status"] == "ok" else None
+            self.vitri(model, n, points, "global", precision, "default" + note)
 
 
 def poisson_extra(text):
@@ -209,14 +243,15 @@ def one_line(r):
             f"boundary {r['boundary_edges']}, mean {r['out_to_model_mean']:.2e}/{r['model_to_out_mean']:.2e}")
 
 
-COLUMNS = ["points", "method", "param", "wall s", "core s", "peak MB", "load", "V", "closed", "comp", "chi",
-           "mean out->model", "mean model->out", "p99 (both)", "max (both)"]
+COLUMNS = ["points", "method", "param", "wall s", "CPU s", "core s", "peak MB", "load", "V", "closed", "comp",
+           "chi", "mean out->model", "mean model->out", "p99 (both)", "max (both)"]
 
 
 def markdown_row(r):
     param = r["param"] if isinstance(r["param"], str) else "P " + fmt(r["param"], ".3g")
-    head = [str(r["points"]), r["method"], param, fmt(r["wall_s"], ".1f"), fmt(r.get("core_s"), ".1f"),
-            fmt(r["peak_mb"], ".0f"), fmt(r["load"], ".1f")]
+    head = [str(r["points"]), r["method"], param] + [
+        fmt(v, spec) for v, spec in ((r["wall_s"], ".1f"), (r["cpu_s"], ".1f"), (r.get("core_s"), ".1f"),
+                                     (r["peak_mb"], ".0f"), (r["load"], ".1f"))]
     if r["status"] != "ok":
         return head + [f"**{r['status']}**"] + [""] * (len(COLUMNS) - len(head) - 1)
     closed = "yes" if r["boundary_edges"] == 0 and r["nonmanifold_edges"] == 0 else (
@@ -267,7 +302,7 @@ def main():
               "Command: /usr/bin/python3 bench/compare/poisson/compare.py " + " ".join(sys.argv[1:])]
     sweep = Sweep(args)
     for name in args.models:
-        model = Model(name, args.reference)
+        model = Model(name, args.reference, args.work)
         for n in args.sizes:
             sweep.model_size(model, n)
             write_results(args, sweep.rows, header)  # partial results survive an interrupted sweep

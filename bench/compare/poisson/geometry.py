@@ -125,10 +125,15 @@ class Normalized:
 
 
 def distance_to_mesh(frame, V, F, queries):
-    """Exact distances (relative to frame's diagonal) from the query points to the triangles (V, F)."""
+    """Exact distances (relative to frame's diagonal) from the query points to the triangles (V, F).
+    Triangles that are degenerate in float32 (zero cross product: a segment or a point) are left out:
+    Debian's Open3D aborts on an Eigen assertion when its closest-point query meets one (Poisson's outputs
+    have a few), and in a closed mesh the segment is covered by the edges of the neighbouring triangles."""
     import open3d as o3d
+    W = frame(V)
+    flat = ~np.any(np.cross(W[F[:, 1]] - W[F[:, 0]], W[F[:, 2]] - W[F[:, 0]]), axis=1)
     scene = o3d.t.geometry.RaycastingScene()
-    scene.add_triangles(o3d.core.Tensor(frame(V)), o3d.core.Tensor(F.astype(np.uint32)))
+    scene.add_triangles(o3d.core.Tensor(W), o3d.core.Tensor(F[~flat].astype(np.uint32)))
     return scene.compute_distance(o3d.core.Tensor(frame(queries))).numpy().astype(np.float64)
 
 
@@ -154,3 +159,9 @@ def read_mesh(path):
     import open3d as o3d
     mesh = o3d.io.read_triangle_mesh(str(path), enable_post_processing=False, print_progress=False)
     return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.triangles, dtype=np.int64)
+
+
+def read_closed_model(path):
+    """(V, F) of a closed OFF model, its triangles turned outward (positive signed volume) if needed."""
+    V, F = read_off(path)
+    return (V, F[:, [0, 2, 1]]) if signed_volume(V, F) < 0 else (V, F)

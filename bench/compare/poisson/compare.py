@@ -224,10 +224,14 @@ def vitri_extra(text):
     m = re.search(r"median spacing, ([\d.eE+-]+)", text)
     if m:
         extra["param"] = float(m.group(1))
-    m = re.search(r"^\s*0\s+([\d.eE+-]+)\s+\d+\s+\d+\s+[\d.]+\s+[\d.]+\s+([\d.]+)", text, re.M)
+    m = re.search(r"(local|global) fit (\d+) ms, initial tetrahedralization (\d+) ms", text)
+    if m:
+        extra["fit_s"], extra["tetrahedralization_s"] = float(m.group(2)) / 1e3, float(m.group(3)) / 1e3
+    m = re.search(r"^\s*0\s+([\d.eE+-]+)\s+\d+\s+\d+\s+([\d.]+)\s+([\d.]+)\s+([\d.]+)", text, re.M)
     if m:
         extra["param"] = float(m.group(1))
-        extra["core_s"] = float(m.group(2)) / 1000.0
+        extra["refine_s"], extra["extract_s"] = float(m.group(2)) / 1e3, float(m.group(3)) / 1e3
+        extra["core_s"] = float(m.group(4)) / 1000.0  # from reading the input to the extracted mesh
     return extra
 
 
@@ -264,6 +268,21 @@ def markdown_row(r):
                    fmt(max(r["out_to_model_max"], r["model_to_out_max"]), ".2e")]
 
 
+def phase_table(rows):
+    """vitri's own phase times (from its output) for every successful vitri run, in seconds."""
+    phases = ["fit_s", "tetrahedralization_s", "refine_s", "extract_s", "core_s"]
+    sel = [r for r in rows if r["method"].startswith("vitri") and all(k in r for k in phases)]
+    if not sel:
+        return []
+    lines = ["#### vitri phases (s; total = from reading the input to the extracted mesh)", "",
+             "| model | points | method | fit | initial tetrahedralization | refine | extract | total |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in sel:
+        lines.append(f"| {r['model']} | {r['points']} | {r['method']} | "
+                     + " | ".join(f"{r[k]:.1f}" for k in phases) + " |")
+    return lines + [""]
+
+
 def write_results(args, rows, header):
     lines = header + [""]
     for name in args.models:
@@ -275,6 +294,7 @@ def write_results(args, rows, header):
                   "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
         lines += ["| " + " | ".join(markdown_row(r)) + " |" for r in sel]
         lines.append("")
+    lines += phase_table(rows)
     Path(args.out + ".md").write_text("\n".join(lines) + "\n")
     keys = [k for k in rows[0] if k != "output"] if rows else []
     for r in rows:

@@ -119,8 +119,9 @@ class Model:
 class Sweep:
     """The runs of one invocation and their rows."""
 
-    def __init__(self, args):
+    def __init__(self, args, header):
         self.args = args
+        self.header = header
         self.work = Path(args.work)
         self.work.mkdir(parents=True, exist_ok=True)
         self.rows = []
@@ -162,6 +163,7 @@ class Sweep:
             self.measure_mesh(model, mesh_path, row)
         self.rows.append(row)
         print(one_line(row), flush=True)
+        write_results(self.args, self.rows, self.header)  # partial results survive an interrupted sweep
         return row
 
     def measure_mesh(self, model, mesh_path, row):
@@ -320,12 +322,11 @@ def main():
               f"Machine: {machine()}; Open3D {open3d.__version__}; load average before: "
               f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}", "",
               "Command: /usr/bin/python3 bench/compare/poisson/compare.py " + " ".join(sys.argv[1:])]
-    sweep = Sweep(args)
+    sweep = Sweep(args, header)
     for name in args.models:
         model = Model(name, args.reference, args.work)
         for n in args.sizes:
             sweep.model_size(model, n)
-            write_results(args, sweep.rows, header)  # partial results survive an interrupted sweep
     header.append(f"\nLoad average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     write_results(args, sweep.rows, header)
     print(f"wrote {args.out}.md and {args.out}.csv")

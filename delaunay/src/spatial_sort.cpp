@@ -34,16 +34,7 @@ std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   return key;
 }
 
-// BRIO: a fixed-seed shuffle cut into rounds of growing size (each 8x the previous), each round sorted
-// along a Hilbert curve. Rounds keep the randomness that bounds the cavity sizes; the sort keeps walks
-// short.
-std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3& box) {
-  const std::size_t n = pts.size();
-  std::vector<std::uint32_t> idx(n);
-  std::iota(idx.begin(), idx.end(), 0u);
-  std::mt19937_64 rng(0x5eedf00dULL);
-  for (std::size_t i = n; i > 1; --i) std::swap(idx[i - 1], idx[rng() % i]);
-  std::vector<std::uint64_t> key(n);
+std::uint64_t point_key(const Point3& p, const Box3& box) {
   const Point3 lo = box.lo;
   const Point3 ext = box.extent();
   const double scale = double((1u << 21) - 1);
@@ -52,17 +43,36 @@ std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3
     f = std::min(std::max(f, 0.0), scale);
     return static_cast<std::uint32_t>(f);
   };
-  for (std::size_t i = 0; i < n; ++i)
-    key[i] =
-        hilbert_key(grid(pts[i].x, lo.x, ext.x), grid(pts[i].y, lo.y, ext.y), grid(pts[i].z, lo.z, ext.z));
+  return hilbert_key(grid(p.x, lo.x, ext.x), grid(p.y, lo.y, ext.y), grid(p.z, lo.z, ext.z));
+}
+
+// BRIO: a fixed-seed shuffle cut into rounds of growing size (each 8x the previous), each round sorted
+// along a Hilbert curve. Rounds keep the randomness that bounds the cavity sizes; the sort keeps walks
+// short.
+BrioOrder brio_rounds(const std::vector<Point3>& pts, const Box3& box) {
+  const std::size_t n = pts.size();
+  BrioOrder b;
+  b.order.resize(n);
+  std::iota(b.order.begin(), b.order.end(), 0u);
+  std::mt19937_64 rng(0x5eedf00dULL);
+  for (std::size_t i = n; i > 1; --i) std::swap(b.order[i - 1], b.order[rng() % i]);
+  b.key.resize(n);
+  for (std::size_t i = 0; i < n; ++i) b.key[i] = point_key(pts[i], box);
   std::size_t e = n;
+  b.rounds.push_back(n);
   while (e > 0) {
-    const std::size_t b = e > 64 ? e / 8 : 0;
-    std::sort(idx.begin() + std::ptrdiff_t(b), idx.begin() + std::ptrdiff_t(e),
-              [&](std::uint32_t a, std::uint32_t c) { return key[a] < key[c]; });
-    e = b;
+    const std::size_t s = e > 64 ? e / 8 : 0;
+    std::sort(b.order.begin() + std::ptrdiff_t(s), b.order.begin() + std::ptrdiff_t(e),
+              [&](std::uint32_t a, std::uint32_t c) { return b.key[a] < b.key[c]; });
+    b.rounds.push_back(s);
+    e = s;
   }
-  return idx;
+  std::reverse(b.rounds.begin(), b.rounds.end());
+  return b;
+}
+
+std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3& box) {
+  return brio_rounds(pts, box).order;
 }
 
 }  // namespace detail

@@ -91,7 +91,7 @@ unsigned Triangulation::bulk_threads(std::size_t n, double min_distance, const C
 
 void Triangulation::insert_parallel(const std::vector<Point3>& points, std::vector<InsertResult>& results) {
   Bulk b;
-  b.brio = detail::brio_rounds(points, box_);
+  b.brio = detail::brio_rounds(points, box_, threads_);
   b.workers.resize(threads_);
   b.prefix = bulk_prefix(b);
   reserve_bulk(points.size());
@@ -224,7 +224,9 @@ void Triangulation::bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pe
                                               [&](std::uint32_t r) { return b.key[b.pid(r)] < b.splits[k]; }) -
                          pending.begin());
   }
-  for (std::size_t q = 0; q < b.part.size(); ++q) b.part[q] = std::uint8_t(arc_of(b.splits, b.key[q]));
+  detail::parallel_slices(b.part.size(), unsigned(T), [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t q = lo; q < hi; ++q) b.part[q] = std::uint8_t(arc_of(b.splits, b.key[q]));
+  });
   for (std::size_t k = 0; k < T; ++k) {
     Worker& w = b.workers[k];
     w.owner = {b.part.data(), std::uint8_t(k)};

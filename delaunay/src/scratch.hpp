@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -70,7 +71,11 @@ struct BrioOrder {
   std::vector<std::uint64_t> key;    // by input index
   std::vector<std::size_t> rounds;   // round r is order[rounds[r], rounds[r + 1]); last = size
 };
-BrioOrder brio_rounds(const std::vector<Point3>& pts, const Box3& box);
+BrioOrder brio_rounds(const std::vector<Point3>& pts, const Box3& box, unsigned threads = 1);
+
+/// Calls fn(lo, hi) on `threads` consecutive slices of [0, n), each on its own thread (the caller's thread
+/// takes the first); rethrows the first exception after all have finished.
+void parallel_slices(std::size_t n, unsigned threads, const std::function<void(std::size_t, std::size_t)>& fn);
 
 /// Parallel bulk insertion: each point id belongs to one partition (`part`, by point id) and thread k
 /// owns exactly the tetrahedra whose four vertices are in partition k. Two threads never touch the same

@@ -54,12 +54,12 @@ struct Triangulation::Worker {
   TetId free_head = kNoTet;  // its free list (slots it killed, and fresh ones kept from earlier passes)
   TetId free_tail = kNoTet;
   std::size_t free_count = 0;
-  TetId fresh = 0, fresh_end = 0;  // [fresh, fresh_end): its block of unused records (flagged dead)
-  TetId last = kNoTet;             // its last created tetrahedron (owned while its pass runs)
-  std::ptrdiff_t tets_delta = 0;  // live tetrahedra created minus killed in this pass
-  std::size_t inserted = 0;       // vertices inserted in this pass
-  std::vector<std::uint32_t> todo;                // ranks of its arc in this pass
-  std::vector<std::uint32_t> deferred;            // ranks left to the next pass
+  TetId fresh = 0, fresh_end = 0;       // [fresh, fresh_end): its block of unused records (flagged dead)
+  TetId last = kNoTet;                  // its last created tetrahedron (owned while its pass runs)
+  std::ptrdiff_t tets_delta = 0;        // live tetrahedra created minus killed in this pass
+  std::size_t inserted = 0;             // vertices inserted in this pass
+  std::vector<std::uint32_t> todo;      // ranks of its arc in this pass
+  std::vector<std::uint32_t> deferred;  // ranks left to the next pass
   std::vector<std::pair<PointId, PointId>> dups;  // (rejected point, the live vertex it duplicates)
   std::exception_ptr error;
   double cpu_seconds = 0;  // thread CPU time of its last pass
@@ -70,10 +70,10 @@ struct Triangulation::Worker {
 // The batch: its order, the point ids given to it, and the partition of the current pass.
 struct Triangulation::Bulk {
   detail::BrioOrder brio;
-  std::size_t prefix = 0;            // ranks [0, prefix) are inserted serially first
-  PointId base = 0;                  // rank r >= prefix has the point id base + r - prefix
-  std::vector<std::uint64_t> key;    // by point id: Hilbert key
-  std::vector<std::uint8_t> part;    // by point id: partition in the current pass
+  std::size_t prefix = 0;             // ranks [0, prefix) are inserted serially first
+  PointId base = 0;                   // rank r >= prefix has the point id base + r - prefix
+  std::vector<std::uint64_t> key;     // by point id: Hilbert key
+  std::vector<std::uint8_t> part;     // by point id: partition in the current pass
   std::vector<std::uint64_t> splits;  // partition k holds the keys in [splits[k], splits[k + 1]) (circular)
   std::vector<Worker> workers;
   std::vector<std::pair<PointId, PointId>> dups;  // all rejected duplicates of the batch
@@ -144,8 +144,7 @@ void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
     bulk_partition(b, pending, pass);
     for (Worker& w : b.workers) bulk_give_room(b, w, w.todo.size());
     std::vector<std::thread> threads;
-    for (std::size_t k = 1; k < T; ++k)
-      threads.emplace_back([&, k] { bulk_work(b, b.workers[k]); });
+    for (std::size_t k = 1; k < T; ++k) threads.emplace_back([&, k] { bulk_work(b, b.workers[k]); });
     bulk_work(b, b.workers[0]);
     for (std::thread& t : threads) t.join();
     next.clear();
@@ -220,9 +219,10 @@ void Triangulation::bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pe
   std::vector<std::size_t> cut(T);
   for (std::size_t k = 0; k < T; ++k) {
     b.splits[k] = b.key[b.pid(pending[std::size_t((double(k) + phase) * double(n) / double(T))])];
-    cut[k] = std::size_t(std::partition_point(pending.begin(), pending.end(),
-                                              [&](std::uint32_t r) { return b.key[b.pid(r)] < b.splits[k]; }) -
-                         pending.begin());
+    cut[k] =
+        std::size_t(std::partition_point(pending.begin(), pending.end(),
+                                         [&](std::uint32_t r) { return b.key[b.pid(r)] < b.splits[k]; }) -
+                    pending.begin());
   }
   detail::parallel_slices(b.part.size(), unsigned(T), [&](std::size_t lo, std::size_t hi) {
     for (std::size_t q = lo; q < hi; ++q) b.part[q] = std::uint8_t(arc_of(b.splits, b.key[q]));
@@ -407,7 +407,8 @@ std::vector<Triangulation::PointId> Triangulation::bulk_relabel(Bulk& b) {
   return final_id;
 }
 
-InsertResult Triangulation::bulk_result(const Bulk& b, const std::vector<PointId>& final_id, PointId q) const {
+InsertResult Triangulation::bulk_result(const Bulk& b, const std::vector<PointId>& final_id,
+                                        PointId q) const {
   if (final_id.empty()) return {InsertStatus::Inserted, q, kNoVertex};
   if (final_id[q] != kNoVertex) return {InsertStatus::Inserted, final_id[q], kNoVertex};
   const PointId group = b.label[b.target[q] != kNoVertex ? b.target[q] : q];

@@ -75,7 +75,8 @@ BrioOrder brio_rounds(const std::vector<Point3>& pts, const Box3& box, unsigned 
 
 /// Calls fn(lo, hi) on `threads` consecutive slices of [0, n), each on its own thread (the caller's thread
 /// takes the first); rethrows the first exception after all have finished.
-void parallel_slices(std::size_t n, unsigned threads, const std::function<void(std::size_t, std::size_t)>& fn);
+void parallel_slices(std::size_t n, unsigned threads,
+                     const std::function<void(std::size_t, std::size_t)>& fn);
 
 /// Parallel bulk insertion: each point id belongs to one partition (`part`, by point id) and thread k
 /// owns exactly the tetrahedra whose four vertices are in partition k. Two threads never touch the same

@@ -2,9 +2,9 @@
 #include "scratch.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <numeric>
 #include <random>
-#include <exception>
 #include <thread>
 
 namespace vitri {
@@ -51,7 +51,8 @@ std::uint64_t point_key(const Point3& p, const Box3& box) {
 // BRIO: a fixed-seed shuffle cut into rounds of growing size (each 8x the previous), each round sorted
 // along a Hilbert curve. Rounds keep the randomness that bounds the cavity sizes; the sort keeps walks
 // short.
-void parallel_slices(std::size_t n, unsigned threads, const std::function<void(std::size_t, std::size_t)>& fn) {
+void parallel_slices(std::size_t n, unsigned threads,
+                     const std::function<void(std::size_t, std::size_t)>& fn) {
   const std::size_t T = std::max<std::size_t>(1, std::min<std::size_t>(threads, n));
   std::vector<std::exception_ptr> errors(T);
   auto run = [&](std::size_t k) {
@@ -73,16 +74,21 @@ namespace {
 // Sorts [first, last) by key, then index: a total order, so that the result does not depend on the sort
 // (the parallel bulk insertion must give the points the ids that the serial one gives them). Large
 // ranges are cut into `threads` slices sorted concurrently, then merged.
-void sort_by_key(std::uint32_t* first, std::uint32_t* last, const std::vector<std::uint64_t>& key, unsigned threads) {
-  auto less = [&](std::uint32_t a, std::uint32_t c) { return key[a] < key[c] || (key[a] == key[c] && a < c); };
+void sort_by_key(std::uint32_t* first, std::uint32_t* last, const std::vector<std::uint64_t>& key,
+                 unsigned threads) {
+  auto less = [&](std::uint32_t a, std::uint32_t c) {
+    return key[a] < key[c] || (key[a] == key[c] && a < c);
+  };
   const std::size_t n = std::size_t(last - first);
   if (threads <= 1 || n < 16384) {
     std::sort(first, last, less);
     return;
   }
-  parallel_slices(n, threads, [&](std::size_t lo, std::size_t hi) { std::sort(first + lo, first + hi, less); });
+  parallel_slices(n, threads,
+                  [&](std::size_t lo, std::size_t hi) { std::sort(first + lo, first + hi, less); });
   const std::size_t T = std::min<std::size_t>(threads, n);
-  for (std::size_t k = 1; k < T; ++k) std::inplace_merge(first, first + k * n / T, first + (k + 1) * n / T, less);
+  for (std::size_t k = 1; k < T; ++k)
+    std::inplace_merge(first, first + k * n / T, first + (k + 1) * n / T, less);
 }
 }  // namespace
 

@@ -2,6 +2,8 @@
 // and the same results, as the serial build, on inputs where the parallel passes defer many points.
 #include "vitri/delaunay/triangulation.hpp"
 
+#include "test_points.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -33,11 +35,7 @@ TriangulationOptions no_history(unsigned threads) {
 }
 
 std::vector<Point3> uniform(std::size_t n, unsigned seed) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(0.0, 1.0);
-  std::vector<Point3> p(n);
-  for (auto& q : p) q = {u(rng), u(rng), u(rng)};
-  return p;
+  return test::uniform_points(n, seed, 0.0, 1.0);
 }
 
 // Three tight Gaussian clusters: very non-uniform density.
@@ -56,10 +54,7 @@ std::vector<Point3> clusters(std::size_t n, unsigned seed) {
 // The m^3 integer grid, shuffled (exactly cospherical everywhere), with `dups` exact copies of grid
 // points mixed in: the serial build keeps the first copy in its order and rejects the others.
 std::vector<Point3> grid_with_duplicates(int m, std::size_t dups, unsigned seed) {
-  std::vector<Point3> p;
-  for (int x = 0; x < m; ++x)
-    for (int y = 0; y < m; ++y)
-      for (int z = 0; z < m; ++z) p.push_back({double(x), double(y), double(z)});
+  std::vector<Point3> p = test::grid_points(m);
   std::mt19937_64 rng(seed);
   for (std::size_t i = 0; i < dups; ++i) p.push_back(p[rng() % p.size()]);
   std::shuffle(p.begin(), p.end(), rng);
@@ -68,7 +63,8 @@ std::vector<Point3> grid_with_duplicates(int m, std::size_t dups, unsigned seed)
 
 // Builds `batches` serially and with `threads`, one insert_points call per batch, and requires the same
 // results, vertices and tetrahedra; the parallel build must have used its passes and deferred points.
-void require_same_as_serial(const Box3& box, const std::vector<std::vector<Point3>>& batches, unsigned threads) {
+void require_same_as_serial(const Box3& box, const std::vector<std::vector<Point3>>& batches,
+                            unsigned threads) {
   Triangulation serial(box, no_history(1)), par(box, no_history(threads));
   for (const auto& batch : batches) {
     const auto rs = serial.insert_points(batch);
@@ -85,7 +81,8 @@ void require_same_as_serial(const Box3& box, const std::vector<std::vector<Point
     REQUIRE(rs.size() == rp.size());
     std::size_t differ = 0, rejected = 0;
     for (std::size_t i = 0; i < rs.size(); ++i) {
-      differ += rp[i].status != rs[i].status || rp[i].vertex != rs[i].vertex || rp[i].nearest != rs[i].nearest;
+      differ +=
+          rp[i].status != rs[i].status || rp[i].vertex != rs[i].vertex || rp[i].nearest != rs[i].nearest;
       rejected += rs[i].status == InsertStatus::TooClose;
     }
     INFO(rejected << " points rejected by the serial build");
@@ -107,7 +104,9 @@ TEST_CASE("delaunay: parallel bulk insertion gives the serial tetrahedra, ids an
     require_same_as_serial(unit, {uniform(30000, 1)}, 2);
     require_same_as_serial(unit, {uniform(30000, 2)}, 3);
   }
-  SECTION("clusters") { require_same_as_serial(unit, {clusters(30000, 3)}, 2); }
+  SECTION("clusters") {
+    require_same_as_serial(unit, {clusters(30000, 3)}, 2);
+  }
   SECTION("shuffled integer grid with exact duplicates (cospherical, rejected points)") {
     const Box3 box{{-1, -1, -1}, {28, 28, 28}};
     require_same_as_serial(box, {grid_with_duplicates(27, 400, 4)}, 2);

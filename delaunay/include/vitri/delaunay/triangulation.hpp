@@ -401,7 +401,7 @@ class Triangulation {
   std::size_t edit_tets_ = 0;       // tetrahedra created by removals and moves since the last rebuild
   std::size_t excess_levels_ = 0;   // levels descended beyond 6 log2 n + 64 by insert() and move()
   std::size_t rebuilds_ = 0;
-  unsigned threads_ = 1;              // TriangulationOptions::threads (resolved: >= 1)
+  unsigned threads_ = 1;  // TriangulationOptions::threads (resolved: >= 1)
   BulkStats bulk_stats_;
   detail::VertexGrid grid_;           // location hints: the last vertex inserted in each cell
   Store root_;                        // the 8-corner triangulation, for reset_to_corners()

@@ -40,7 +40,7 @@
 namespace vitri {
 
 namespace {
-constexpr std::size_t kPrefixPerThread = 1000;  // serial BRIO rounds up to about this many points per thread
+constexpr std::size_t kPrefixPerThread = 250;   // serial BRIO rounds up to about this many points per thread
 constexpr std::size_t kMinPerThread = 256;      // a smaller pass is inserted serially
 constexpr std::size_t kMaxPasses = 12;          // per round; what is still deferred is inserted serially
 constexpr std::size_t kRoomPerPoint = 8;        // fresh records per point (6.75 live per vertex on average)

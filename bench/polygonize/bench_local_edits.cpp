@@ -94,6 +94,12 @@ int main(int argc, char** argv) {
     update_ms.push_back(1e3 * up);
     total_ms.push_back(1e3 * (e + up));
     changed.push_back(static_cast<double>(d.added_triangles.size() + d.removed_triangles.size() + d.moved_vertices.size()));
+    if (total_ms.back() > 100.0)  // an outlier: say where its time went
+      std::printf("  edit %d: %.1f ms (function edit %.1f, re-evaluation %.1f, refinement %.1f, update_surface %.1f; "
+                  "%s delta, %zu history rebuilds so far, %zu Steiner vertices removed so far)\n",
+                  k, total_ms.back(), rbf_ms.back(), reeval_ms.back(), refine_ms.back(), update_ms.back(),
+                  d.full ? "full" : "partial", mesher.polygonizer().triangulation().history_rebuilds(),
+                  st.polygonizer.removed_steiner);
   }
   std::printf("%d edits: total median %.2f ms, p90 %.2f, max %.2f | move_constraint median %.2f ms | update_surface "
               "median %.2f ms | delta median %.0f elements (of %zu triangles); peak %.0f MB\n",

@@ -197,13 +197,19 @@ void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { 
 
 void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion* region) {
   const double t1 = now_seconds();
+  const std::size_t insertions = poly_->stats().insertions;
   if (region && !region->everywhere) {
     poly_->function_changed(region->balls);  // the vertices near the balls only (no scan)
   } else {
     poly_->function_changed();
   }
   if (std::isfinite(precision_)) poly_->refine(precision_);
-  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction, options_.garbage_per_edit);
+  if (options_.collect_garbage) {
+    // At most garbage_per_edit removals plus as many as this edit inserted: removals outpace insertions,
+    // and no edit pays for a whole batch.
+    const std::size_t inserted = poly_->stats().insertions - insertions;
+    poly_->collect_garbage(options_.garbage_fraction, options_.garbage_per_edit + inserted);
+  }
   if (quality_) {
     quality_->function_changed();
     quality_->refine();

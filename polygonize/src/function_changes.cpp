@@ -83,9 +83,27 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
     const TetId t = tri_.locate(start);
     if (first_visit(t)) stack.push_back(t);
   }
+  // Does the box [lo, hi] meet a grown ball? The balls (the patches refitted by an edit, ~10-20) overlap
+  // and the walk is spatially coherent: reject outside the balls' bounding box first, then try the ball
+  // that answered last before the others.
+  Box3 reach;
+  for (const Ball& b : grown) {
+    reach.extend(b.center - Point3{b.radius, b.radius, b.radius});
+    reach.extend(b.center + Point3{b.radius, b.radius, b.radius});
+  }
+  std::size_t last = 0;
   const auto meets = [&](const Point3& lo, const Point3& hi) {
-    for (const Ball& b : grown)
-      if (squared_distance_to_box(b.center, lo, hi) <= b.radius * b.radius) return true;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (hi[k] < reach.lo[k] || lo[k] > reach.hi[k]) return false;
+    const auto hit = [&](std::size_t i) {
+      return squared_distance_to_box(grown[i].center, lo, hi) <= grown[i].radius * grown[i].radius;
+    };
+    if (hit(last)) return true;
+    for (std::size_t i = 0; i < grown.size(); ++i)
+      if (i != last && hit(i)) {
+        last = i;
+        return true;
+      }
     return false;
   };
   while (!stack.empty()) {

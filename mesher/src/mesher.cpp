@@ -96,7 +96,7 @@ void Mesher::build() {
   poly_ = std::make_unique<Polygonizer>(function(), domain, c.points, c.values, options_.polygonizer);
   filter_ = std::make_unique<SupportFilter>();  // a new polygonizer: the next delta is full
   filter_precision_ = 0;
-  vertex_of_ = poly_->seed_vertices();
+  vertex_of_.assign(poly_->seed_vertices());
   zero_index_ = PointIndex();
   for (std::size_t i = 0; i < c.size(); ++i) track_zero(vertex_of_[i], c.points[i], c.values[i]);
   quality_.reset();
@@ -267,6 +267,16 @@ void Mesher::move_constraint(std::size_t i, const Point3& p) {
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 
+void Mesher::ConstraintVertices::erase(std::size_t i) {
+  ranks_.set_dead(ranks_.select(i));
+  --live_;
+  if (slots_.size() - live_ <= live_ + 1024) return;
+  std::vector<VertexId> live;  // compact: keep the live slots in order
+  live.reserve(live_);
+  for (std::size_t k = 0; k < live_; ++k) live.push_back(slots_[ranks_.select(k)]);
+  assign(std::move(live));
+}
+
 void Mesher::remove_constraint(std::size_t i) {
   const double t0 = now_seconds();
   ChangedRegion region;  // throws on a bad index or an impossible removal
@@ -274,7 +284,7 @@ void Mesher::remove_constraint(std::size_t i) {
   else region = local_->remove_constraint(i);
   const double t_rbf = now_seconds() - t0;
   const VertexId v = vertex_of_[i];
-  vertex_of_.erase(vertex_of_.begin() + static_cast<std::ptrdiff_t>(i));
+  vertex_of_.erase(i);
   forget_zero(v);
   if (v != kNoVertex) poly_->remove_vertex(v);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);

@@ -70,6 +70,11 @@ int main(int argc, char** argv) {
               s.fit_seconds, build - s.fit_seconds, refine, extract, s.polygonizer.vertices,
               mesher.live_surface().num_vertices(), mesher.live_surface().num_triangles(), peak_mb());
   (void)first;
+  std::printf("first extraction: polygons %.2f s, placement %.2f s, collapses %.2f s, live mesh %.2f s; "
+              "polygonizer %.2f s, support filter and delta %.2f s\n",
+              s.polygonizer.extract_polygons_seconds, s.polygonizer.extract_placement_seconds,
+              s.polygonizer.extract_snapping_seconds, s.polygonizer.extract_mesh_seconds,
+              s.polygonizer.extract_seconds, extract - s.polygonizer.extract_seconds);
   std::mt19937_64 rng(99);
   const std::size_t surface = mesher.size() / 3;  // the first third are the surface points (f = 0)
   std::uniform_int_distribution<std::size_t> pick(0, surface - 1);

@@ -14,6 +14,7 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <queue>
@@ -90,17 +91,28 @@ void SurfaceTracker::update(const TrackerInput& in) {
   for (const VertexId v : touched_) snap_target_.erase(v);
   if (rebuild_) snap_target_.clear();
   Work w;
+  using Clock = std::chrono::steady_clock;
+  auto lap = [t = Clock::now()]() mutable {
+    const auto now = Clock::now();
+    const double s = std::chrono::duration<double>(now - t).count();
+    t = now;
+    return s;
+  };
   if (rebuild_)
     reset_all(in, w);
   else
     collect_tets(in, w);
   rebuild_polygons(in, w);
+  report_.polygons_seconds = lap();
   place_edges(in, w);
+  report_.placement_seconds = lap();
   split_polygons(w);
   decide_snapping(in, w);
+  report_.snapping_seconds = lap();
   remesh_polygons(in, w);
   retire_triangles(w);
   refresh_vertices(in, w);
+  report_.mesh_seconds = lap();
   killed_.clear();
   created_.clear();
   touched_.clear();

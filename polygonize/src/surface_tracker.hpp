@@ -53,6 +53,9 @@ struct TrackerReport {
   std::size_t snapped = 0;              ///< vertices whose anchored crossings are collapsed (all of them)
   std::size_t offset = 0;               ///< vertices with anchored crossings left in place (all of them)
   std::size_t placed_edges = 0;         ///< crossings placed by this update
+  // Seconds of the update's steps: which tetrahedra and polygons changed, root placement (function
+  // evaluations), collapse decisions, the live mesh's edits (triangles and vertices).
+  double polygons_seconds = 0, placement_seconds = 0, snapping_seconds = 0, mesh_seconds = 0;
 };
 
 class SurfaceTracker {

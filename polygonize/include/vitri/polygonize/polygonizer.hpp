@@ -148,6 +148,10 @@ struct PolygonizerStats {
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
   double refine_seconds = 0;            ///< last refine() call
   double extract_seconds = 0;           ///< last extract() call
+  /// Of the last extraction: finding the changed polygons, placing crossings (evaluations of f),
+  /// deciding collapses, editing the live mesh (they add up to about extract_seconds).
+  double extract_polygons_seconds = 0, extract_placement_seconds = 0, extract_snapping_seconds = 0,
+         extract_mesh_seconds = 0;
   double update_seconds = 0;            ///< last function_changed() call
 };
 

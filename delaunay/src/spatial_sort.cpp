@@ -10,19 +10,6 @@
 namespace vitri {
 namespace detail {
 
-namespace {
-// The 21 low bits of x moved to bits 0, 3, 6, ..., 60 (the others zero), by halving shifts and masks.
-std::uint64_t spread_bits(std::uint32_t x) {
-  std::uint64_t v = x & 0x1fffffu;
-  v = (v | v << 32) & 0x1f00000000ffffull;
-  v = (v | v << 16) & 0x1f0000ff0000ffull;
-  v = (v | v << 8) & 0x100f00f00f00f00full;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ull;
-  v = (v | v << 2) & 0x1249249249249249ull;
-  return v;
-}
-}  // namespace
-
 // Skilling's transpose algorithm, then bit interleaving.
 std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   constexpr int kBits = 21;
@@ -43,8 +30,10 @@ std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   for (std::uint32_t q = m; q > 1; q >>= 1)
     if (X[2] & q) t ^= q - 1;
   for (int i = 0; i < 3; ++i) X[i] ^= t;
-  // Bit b of X[0], X[1], X[2] goes to bit 3b + 2, 3b + 1, 3b of the key.
-  return spread_bits(X[0]) << 2 | spread_bits(X[1]) << 1 | spread_bits(X[2]);
+  std::uint64_t key = 0;
+  for (int b = kBits - 1; b >= 0; --b)
+    for (int i = 0; i < 3; ++i) key = (key << 1) | ((X[i] >> b) & 1u);
+  return key;
 }
 
 std::uint64_t point_key(const Point3& p, const Box3& box) {

@@ -179,12 +179,8 @@ class TetStore {
   /// Asks the cache for t's record and flag (a hint, no effect on the contents): the cavity growth and
   /// the walk read the records of neighbours in an order the hardware cannot guess.
   void prefetch(Id t) const {
-#if defined(__GNUC__) || defined(__clang__)
-    __builtin_prefetch(slots_.data() + slot(t, 0));
+    __builtin_prefetch(slots_.data() + slot(t, 0));  // GCC and Clang, the supported compilers
     __builtin_prefetch(flags_.data() + checked(t));
-#else
-    (void)t;
-#endif
   }
 
   // ---- Flags ---------------------------------------------------------------------------------------

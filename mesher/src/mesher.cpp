@@ -110,8 +110,13 @@ double Mesher::diagonal() const {
 }
 
 bool Mesher::inside_domain(const Point3& p) const {
+  // Inside the box and, when the polygonizer closes the surface by the box, out of the band where it
+  // changes the function (a constraint there could not be met: rebuild with a box around it instead).
   const Box3& b = poly_->triangulation().box();
-  return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+  const double band = poly_->closing_band();
+  for (std::size_t k = 0; k < 3; ++k)
+    if (!(p[k] > b.lo[k] + band && p[k] < b.hi[k] - band)) return false;
+  return true;
 }
 
 bool Mesher::refine(double precision, const ProgressCallback& progress) {

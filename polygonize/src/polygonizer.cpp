@@ -98,9 +98,25 @@ Box3 Polygonizer::domain_for(const std::vector<Point3>& points, double factor) {
   return b.scaled(factor);
 }
 
+namespace {
+
+// The closing band of close_at_box: a fraction of the smallest side (validated here, before the function
+// is built from it).
+double box_band(const Box3& domain, const PolygonizerOptions& options) {
+  if (!(options.box_band_fraction > 0.0 && options.box_band_fraction < 0.5))
+    throw InvalidArgument("PolygonizerOptions::box_band_fraction must be in (0, 0.5)");
+  double smallest = domain.hi.x - domain.lo.x;
+  smallest = std::min({smallest, domain.hi.y - domain.lo.y, domain.hi.z - domain.lo.z});
+  return options.box_band_fraction * smallest;
+}
+
+}  // namespace
+
 Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                          const std::vector<double>& seed_values, const PolygonizerOptions& options)
-    : f_(f),
+    : closed_(options.close_at_box ? std::make_unique<BoxClosedFunction>(f, domain, box_band(domain, options))
+                                   : nullptr),
+      f_(closed_ ? *closed_ : f),
       options_(options),
       tri_(domain),
       precision_(std::numeric_limits<double>::infinity()),

@@ -186,3 +186,42 @@ TEST_CASE("local function: edits send small deltas that keep a client's copy exa
     REQUIRE(canonical(s) == canonical(keep_supported_components(all, supported)));
   }
 }
+
+// An open scan (a saddle patch of oriented points): the zero set of either function runs out to the
+// domain box. The polygonizer meshes it closed by the box (PolygonizerOptions::close_at_box), so the mesh
+// is one closed, outward component (the region under the saddle, closed by sheets inside the box faces;
+// its genus is the function's: the global RBF's far sheets may add a handle) and every data point is on
+// it; without the closure it has a border on the box.
+TEST_CASE("an open scan gives a closed mesh, closed by the domain box", "[mesher]") {
+  std::mt19937 rng(1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Point3> points, normals;
+  for (int i = 0; i < 400; ++i) {
+    const double x = u(rng), y = u(rng);
+    points.push_back({x, y, 0.3 * (x * x - y * y)});
+    const Point3 n{-0.6 * x, 0.6 * y, 1.0};  // up: f < 0 below the sheet
+    normals.push_back(n / norm(n));
+  }
+  for (const FunctionKind kind : {FunctionKind::Global, FunctionKind::Local}) {
+    INFO((kind == FunctionKind::Global ? "global" : "local"));
+    MesherOptions o;
+    o.function = kind;
+    Mesher mesher = Mesher::from_oriented_points(points, normals, o);
+    const double precision = 0.02 * mesher.diagonal();
+    REQUIRE(mesher.refine(precision));
+    const SurfaceMesh& m = mesher.surface();
+    const MeshMetrics mm = test::metrics_of(m);
+    INFO("V " << mm.vertices << " boundary " << mm.boundary_edges << " components " << mm.components << " chi "
+              << mm.euler_characteristic);
+    REQUIRE(mm.closed_manifold());
+    REQUIRE(mm.signed_volume > 0.0);
+    REQUIRE(mm.components == 1);
+    const MeshDistance md(m);
+    for (const Point3& p : points) REQUIRE(md.distance(p) <= precision);
+    // The same without the closure: a border where the sheet meets the box.
+    o.polygonizer.close_at_box = false;
+    Mesher open = Mesher::from_oriented_points(points, normals, o);
+    REQUIRE(open.refine(precision));
+    REQUIRE(test::metrics_of(open.surface()).boundary_edges > 0);
+  }
+}

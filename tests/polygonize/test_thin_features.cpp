@@ -86,7 +86,9 @@ TEST_CASE("thin features: two spheres with a narrow gap stay two spheres", "[pol
 TEST_CASE("box hull: fallback points for hull tetrahedra, dropped ones counted", "[polygonize]") {
   const SphereFunction f({0.0, 0.0, 0.0}, 1.2);
   const Box3 box{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
-  Polygonizer poly(f, box);
+  PolygonizerOptions open;
+  open.close_at_box = false;  // f itself reaches the hull (the default closes it inside, see below)
+  Polygonizer poly(f, box, {}, {}, open);
   const double precision = 0.1;
   REQUIRE(poly.refine(precision));
   const PolygonizerStats s = poly.stats();
@@ -101,6 +103,26 @@ TEST_CASE("box hull: fallback points for hull tetrahedra, dropped ones counted",
   const MeshMetrics mm = metrics_of(m);
   REQUIRE(mm.closed_manifold());
   for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3);
+
+  // Closed by the box (default): the surface is the sphere inside, then a sheet `band` inside each box
+  // face where the sphere would leave; no hull tetrahedron is active, the mesh is closed, one component.
+  Polygonizer closed(f, box);
+  REQUIRE(closed.refine(precision));
+  REQUIRE(closed.stats().boundary_coarse == 0);
+  const SurfaceMesh c = closed.extract();
+  const MeshMetrics mc = metrics_of(c);
+  REQUIRE(mc.closed_manifold());
+  REQUIRE(mc.components == 1);
+  REQUIRE(mc.euler_characteristic == 2);
+  const double band = PolygonizerOptions{}.box_band_fraction * 2.0;  // x the smallest side
+  std::size_t on_sheet = 0;
+  for (const Point3& p : c.vertices) {
+    const double to_face = std::min({1.0 - std::abs(p.x), 1.0 - std::abs(p.y), 1.0 - std::abs(p.z)});
+    const bool on_sphere = std::abs(f.value(p)) <= 1e-3, on_band = std::abs(to_face - band) <= 1e-3;
+    REQUIRE((on_sphere || on_band));
+    on_sheet += on_band && !on_sphere;
+  }
+  REQUIRE(on_sheet > 0);
 
   // A surface well inside the box: no hull tetrahedron is active, the status is clean.
   const SphereFunction g({0.0, 0.0, 0.0}, 0.5);

@@ -25,6 +25,7 @@
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/delaunay/triangulation.hpp"
+#include "vitri/polygonize/box_closure.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
@@ -108,6 +109,14 @@ struct PolygonizerOptions {
   /// constraints). false restores the plain rule (only transverse tetrahedra are refined). See
   /// docs/polygonize.md.
   bool refine_lone_zeros = true;
+  /// Mesh f closed by the domain box (BoxClosedFunction, box_closure.hpp): within
+  /// `box_band_fraction` (0.1, in (0, 0.5)) x the box's smallest side of its boundary the function is
+  /// made positive (keep seeds out of that band: closing_band()), so a
+  /// zero set that reaches the box (an open scan, a sheet of the global RBF) ends in a closing sheet there
+  /// instead of an open border, and the 8 corners are outside: every mesh is closed. false meshes f
+  /// itself; the mesh is then open where f < 0 at a box corner (the paper's behaviour).
+  bool close_at_box = true;
+  double box_band_fraction = 0.1;
   /// Thin features: also refine where a Delaunay edge whose two ends have the same sign is probably
   /// crossed twice by the surface (two sheets closer than the edge, e.g. two fingers, or a thin wall),
   /// which marching tetrahedra would otherwise bridge or punch through (a spurious handle). An edge is
@@ -268,7 +277,11 @@ class Polygonizer {
 
   // ---- Queries ---------------------------------------------------------------------------------------
   const Triangulation& triangulation() const { return tri_; }
+  /// The function meshed: the caller's, closed by the box unless options().close_at_box is false.
   const ImplicitFunction& function() const { return f_; }
+  /// Width of the band inside the box faces where the meshed function is made positive (close_at_box;
+  /// 0 without). A seed or an edit there would not be met: keep them out of it.
+  double closing_band() const { return closed_ ? closed_->band() : 0.0; }
   /// The stored value at vertex v (f(v) or its fixed value).
   double vertex_value(VertexId v) const { return values_[v]; }
   VertexKind vertex_kind(VertexId v) const { return static_cast<VertexKind>(kind_[v]); }
@@ -324,7 +337,8 @@ class Polygonizer {
   void note_thin_tets(const std::vector<TetId>& tets);
   std::vector<TetId> thin_recheck_set();
 
-  const ImplicitFunction& f_;
+  std::unique_ptr<BoxClosedFunction> closed_;  // f closed by the box (options_.close_at_box), or null
+  const ImplicitFunction& f_;                  // what is meshed: *closed_, or the caller's function
   PolygonizerOptions options_;
   Triangulation tri_;
   double precision_;

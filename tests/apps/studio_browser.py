@@ -263,6 +263,9 @@ def click_drag_undo(driver, server, shot, s0, m0):
           % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
     check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
           "the page draws the server's mesh after the deltas")
+    check(page_constraints_match(driver, server), "the page's constraint list is the server's after the edits")
+    check(full_constraint_fetches(driver) == 1,
+          "the page took the constraint list once (at load), then only the changes of each edit")
 
 
 def open_file(driver, server, shot, out_dir):
@@ -280,6 +283,7 @@ def open_file(driver, server, shot, out_dir):
     wait_for("the page to be idle", lambda: page_idle(driver))
     s4 = server.get("/api/stats")
     check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
+    check(page_constraints_match(driver, server), "the page holds the uploaded model's constraints")
     check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
     check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
           "the page draws the uploaded model")
@@ -294,6 +298,7 @@ def open_file(driver, server, shot, out_dir):
         wait_for("the page to be idle", lambda: page_idle(driver))
         value = server.get("/api/state")["constraint_list"][-1]["value"]
         check(value * sign > 0, "modifier click added an %s constraint (value %g)" % (what, value))
+        check(page_constraints_match(driver, server), "the page's constraint list is the server's")
     check(edges_closed(server.get("/api/mesh?format=indexed")), "the mesh is closed after them")
     shot("studio-5-modifiers.png")
 
@@ -341,18 +346,47 @@ def run(args):
 
 
 def bench(driver, server, out_dir):
-    run_js = lambda code: driver.execute_async_script(
-        "const done = arguments[arguments.length - 1];" + code + ".then(done, (e) => done({error: String(e)}));")
+    """In-page latencies (apps/studio/web/studio_bench.js): clicks that add a constraint (each undone),
+    a drag waiting for each frame, and a live drag (one pointer move per animation frame)."""
+    def run_js(code):
+        r = driver.execute_async_script(
+            "const done = arguments[arguments.length - 1];" + code + ".then(done, (e) => done({error: String(e)}));")
+        if "error" in r:
+            raise Failure(code + ": " + r["error"])
+        return r
     stats = server.get("/api/stats")
+    load = [os.getloadavg()[0]]
     adds = run_js("studio.benchAdd({count: 12})")
     drag = run_js("studio.benchDrag({moves: 60})")
-    drag_async = run_js("studio.benchDrag({moves: 60, sync: false})")
+    live = run_js("studio.benchDrag({moves: 120, live: true})")
+    load.append(os.getloadavg()[0])
     driver.save_screenshot(os.path.join(out_dir, "studio-bench.png"))
-    print("BENCH " + json.dumps({"model": stats["name"], "load_average": os.getloadavg()[0], "constraints": stats["constraints"],
+    print("BENCH " + json.dumps({"model": stats["name"], "load_average": load, "constraints": stats["constraints"],
                                  "triangles": stats["triangles"], "vertices": stats["vertices"],
-                                 "add": adds, "drag": drag,
-                                 "drag_async_updates_per_second": drag_async["updates_per_second"]}))
+                                 "browser": driver.capabilities.get("browserVersion"),
+                                 "webgl": driver.execute_script(WEBGL_RENDERER),
+                                 "add": adds["add"], "undo": adds["undo"], "drag": drag, "live_drag": live}, indent=1))
     return 0
+
+
+WEBGL_RENDERER = """const gl = studio.renderer.getContext(), e = gl.getExtension('WEBGL_debug_renderer_info');
+return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);"""
+
+
+def page_constraints_match(driver, server):
+    """The page's constraint list (kept from deltas) equals the server's, value for value."""
+    page = driver.execute_script(
+        "const c = studio.constraints, out = [];"
+        "for (let i = 0; i < c.count; ++i) out.push(c.position(i).concat([c.value(i)]));"
+        "return out;")
+    server_list = [c["position"] + [c["value"]] for c in server.get("/api/state")["constraint_list"]]
+    return page == server_list
+
+
+def full_constraint_fetches(driver):
+    """How many times the page asked for the constraint list with /api/constraints (a load, or out of step)."""
+    return driver.execute_script(
+        "return performance.getEntriesByType('resource').filter((e) => e.name.includes('/api/constraints')).length")
 
 
 def main():

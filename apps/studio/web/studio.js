@@ -44,6 +44,7 @@ class MeshSlots {
     this.mesh = new THREE.Mesh(this.geometry, shaded);
     this.wire = new THREE.Mesh(this.geometry, new THREE.MeshBasicMaterial({ color: 0x20242c, wireframe: true }));
     this.wire.visible = false;
+    this.mesh.frustumCulled = this.wire.frustumCulled = false;
     scene.add(this.mesh, this.wire);
   }
 
@@ -103,7 +104,9 @@ class MeshSlots {
       }
     }
     this.geometry.setDrawRange(0, 3 * this.used);
-    this.geometry.computeBoundingSphere();
+    // No bounding sphere per delta (a pass over the whole mesh): the mesh is never frustum-culled, and a
+    // raycast computes the sphere when it is null.
+    this.geometry.boundingSphere = null;
     this.version = version;
     this.triangles = this.slotOf.size;
     return nRemoved + nAdded;
@@ -119,6 +122,7 @@ class MeshSlots {
 
 // ------------------------------------------------------------------------------------- constraints
 const KIND_COLORS = { on: new THREE.Color(0xf2c94c), in: new THREE.Color(0x4c9bf2), out: new THREE.Color(0xf2584c) };
+const SELECTED_COLOR = new THREE.Color(0xffffff);
 const kindOf = (value) => (value === 0 ? 'on' : value < 0 ? 'in' : 'out');
 
 function discTexture() {
@@ -131,42 +135,143 @@ function discTexture() {
   return new THREE.CanvasTexture(c);
 }
 
+// The constraint list the page holds (version `version` of the server's): positions (float64, as sent),
+// values and ids in typed arrays, drawn from a float32 copy. Changes from the server's constraint deltas
+// (docs/studio.md) are applied in place; only the range of points that changed is uploaded.
 class ConstraintPoints {
   constructor(scene) {
-    this.list = [];
+    this.count = 0;
+    this.capacity = 0;
+    this.version = 0;
     this.selected = -1;
     this.material = new THREE.PointsMaterial({ size: 11 * window.devicePixelRatio, vertexColors: THREE.VertexColors,
                                                map: discTexture(), alphaTest: 0.5, sizeAttenuation: false });
     this.points = new THREE.Points(new THREE.BufferGeometry(), this.material);
     this.points.renderOrder = 1;
+    this.points.frustumCulled = false;  // (no bounding sphere to keep up to date)
     scene.add(this.points);
+    this.grow(256);
   }
 
-  set(list) {
-    this.list = list;
-    const n = list.length, pos = new Float32Array(3 * n), col = new Float32Array(3 * n);
-    list.forEach((c, i) => {
-      pos.set(c.position, 3 * i);
-      const color = i === this.selected ? new THREE.Color(0xffffff) : KIND_COLORS[kindOf(c.value)];
-      col.set([color.r, color.g, color.b], 3 * i);
-    });
+  grow(capacity) {
+    const old = this.capacity ? { xyz: this.xyz, values: this.values, ids: this.ids } : null;
+    this.xyz = new Float64Array(3 * capacity);
+    this.values = new Float64Array(capacity);
+    this.ids = new Float64Array(capacity);
+    if (old) { this.xyz.set(old.xyz); this.values.set(old.values); this.ids.set(old.ids); }
     const g = this.points.geometry;
-    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    g.setAttribute('color', new THREE.BufferAttribute(col, 3));
-    g.computeBoundingSphere();
+    const pos = new Float32Array(3 * capacity), col = new Float32Array(3 * capacity);
+    if (old) { pos.set(g.attributes.position.array); col.set(g.attributes.color.array); }
+    for (const [name, array] of [['position', pos], ['color', col]]) {
+      const attribute = new THREE.BufferAttribute(array, 3);
+      attribute.setUsage(THREE.DynamicDrawUsage);
+      g.setAttribute(name, attribute);
+    }
+    this.capacity = capacity;
+    this.dirty = [0, this.count];
+  }
+
+  position(i) { return [this.xyz[3 * i], this.xyz[3 * i + 1], this.xyz[3 * i + 2]]; }
+  value(i) { return this.values[i]; }
+
+  // Constraint i's point and colour into the drawn buffers.
+  write(i) {
+    const pos = this.points.geometry.attributes.position.array, col = this.points.geometry.attributes.color.array;
+    for (let k = 0; k < 3; ++k) pos[3 * i + k] = this.xyz[3 * i + k];
+    const color = i === this.selected ? SELECTED_COLOR : KIND_COLORS[kindOf(this.values[i])];
+    col[3 * i] = color.r; col[3 * i + 1] = color.g; col[3 * i + 2] = color.b;
+    this.touch(i, i + 1);
+  }
+
+  touch(lo, hi) {
+    this.dirty = this.dirty ? [Math.min(this.dirty[0], lo), Math.max(this.dirty[1], hi)] : [lo, hi];
+  }
+
+  // One change {op: add|remove|update, index, id, position, value}. Throws when it does not fit the
+  // list held (the caller then asks for the whole list).
+  change(c) {
+    const i = c.index;
+    if (c.op === 'add') {
+      if (i !== this.count) throw new Error('constraint delta out of order');
+      if (this.count === this.capacity) this.grow(2 * this.capacity);
+      ++this.count;
+    } else if (!(i >= 0 && i < this.count)) {
+      throw new Error('constraint delta names index ' + i + ' of ' + this.count);
+    }
+    if (c.op === 'remove') {  // later constraints shift down by one, as on the server
+      const g = this.points.geometry.attributes;
+      this.xyz.copyWithin(3 * i, 3 * i + 3, 3 * this.count);
+      g.position.array.copyWithin(3 * i, 3 * i + 3, 3 * this.count);
+      g.color.array.copyWithin(3 * i, 3 * i + 3, 3 * this.count);
+      this.values.copyWithin(i, i + 1, this.count);
+      this.ids.copyWithin(i, i + 1, this.count);
+      this.touch(i, this.count);
+      --this.count;
+      if (this.selected === i) this.selected = -1;
+      else if (this.selected > i) --this.selected;
+      return;
+    }
+    this.xyz.set(c.position, 3 * i);
+    this.values[i] = c.value;
+    this.ids[i] = c.id;
+    this.write(i);
+  }
+
+  // A constraint delta {base, version, full, changes}. Returns false when it does not apply to the list
+  // held (another base version): the caller asks for the changes since the version held.
+  apply(delta) {
+    if (!delta.full && delta.base !== this.version) return false;
+    if (delta.full) { this.count = 0; this.selected = -1; }
+    try {
+      for (const c of delta.changes) this.change(c);
+    } catch (e) {
+      this.version = 0;  // out of step: the next sync takes the whole list
+      return false;
+    }
+    this.version = delta.version;
+    this.upload();
+    return true;
+  }
+
+  // Uploads the range of points that changed.
+  upload() {
+    const g = this.points.geometry;
+    if (this.dirty && this.dirty[1] > this.dirty[0]) {
+      for (const name of ['position', 'color']) {
+        const a = g.attributes[name];
+        a.updateRange.offset = 3 * this.dirty[0];
+        a.updateRange.count = 3 * (this.dirty[1] - this.dirty[0]);
+        a.needsUpdate = true;
+      }
+    }
+    this.dirty = null;
+    g.setDrawRange(0, this.count);
     // Discs of 11 pixels for a few constraints, down to 5 for thousands (so that the surface shows).
-    this.material.size = Math.max(5, Math.min(11, 60 / Math.sqrt(Math.max(n, 1)))) * window.devicePixelRatio;
+    this.material.size = Math.max(5, Math.min(11, 60 / Math.sqrt(Math.max(this.count, 1)))) * window.devicePixelRatio;
+  }
+
+  select(index) {
+    const old = this.selected;
+    this.selected = index;
+    if (old >= 0 && old < this.count) this.write(old);
+    if (index >= 0) this.write(index);
+    this.upload();
   }
 
   moveLocally(index, p) {
-    const a = this.points.geometry.attributes.position;
-    a.setXYZ(index, p.x, p.y, p.z);
-    a.needsUpdate = true;
-    this.list[index].position = [p.x, p.y, p.z];
+    this.xyz[3 * index] = p.x; this.xyz[3 * index + 1] = p.y; this.xyz[3 * index + 2] = p.z;
+    this.write(index);
+    this.upload();
   }
 }
 
 // ------------------------------------------------------------------------------------------ studio
+// Milliseconds the server spent on a response (its Server-Timing header; 0 when absent).
+function serverMs(response) {
+  const m = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
+  return m ? parseFloat(m[1]) : 0;
+}
+
 class Studio {
   constructor() {
     this.view = document.getElementById('view');
@@ -182,19 +287,21 @@ class Studio {
     this.camera.add(light);
     this.scene.add(this.camera);
     this.controls = new THREE.OrbitControls(this.camera, this.renderer.domElement);
-    this.controls.addEventListener('change', () => this.render());
+    this.controls.addEventListener('change', () => this.present());
     this.slots = new MeshSlots(this.scene);
     this.constraints = new ConstraintPoints(this.scene);
     this.raycaster = new THREE.Raycaster();
     this.stats = null;
-    this.latency = null;     // ms from sending the last edit to its picture on screen
-    this.latencies = [];
-    this.drawTimes = [];
+    this.latency = null;  // ms from the last edit's pointer event to its frame
+    // Timing of every edit (see present()); benchmarks read and clear it.
+    this.timings = [];
+    this.waiting = [];    // timings of updates applied, waiting for their frame
+    this.frame = null;    // promise of the next frame, while one is requested
     this.busy = Promise.resolve();  // edits run one after the other
     this.drag = null;
     this.pixel = new Uint8Array(4);
-    // Benchmarks wait for each frame to be drawn, so that a latency includes the drawing; otherwise the
-    // next request goes out while the GPU draws.
+    // Benchmarks wait for each frame to be drawn (a pixel read back), so that the draw time is the GPU's
+    // (here the software rasterizer's), not only the submission of the commands.
     this.syncDraw = false;
     this.idleTimer = 0;
     this.ready = false;
@@ -211,6 +318,34 @@ class Studio {
   }
 
   render() { this.renderer.render(this.scene, this.camera); }
+
+  // Draws in the next animation frame (several updates within one frame are drawn once). `timing`: an
+  // edit's record, completed when its frame is drawn: {event, sent, server, received, applied, frame,
+  // drawn} (performance.now() ms; server: ms the server spent on the edit and its delta). Returns a
+  // promise resolved after the frame.
+  present(timing) {
+    if (timing) {
+      timing.applied = performance.now();
+      this.waiting.push(timing);
+    }
+    if (!this.frame) {
+      this.frame = new Promise((resolve) => requestAnimationFrame(() => {
+        const t = performance.now();
+        this.render();
+        if (this.syncDraw) this.waitForDraw();
+        const drawn = performance.now();
+        for (const w of this.waiting) {
+          Object.assign(w, { frame: t, drawn });
+          this.latency = drawn - w.event;
+          this.timings.push(w);
+        }
+        this.waiting = [];
+        this.frame = null;
+        resolve();
+      }));
+    }
+    return this.frame;
+  }
 
   // Blocks until the last frame is drawn: reading a pixel back waits for the GPU (gl.finish() may not).
   waitForDraw() {
@@ -233,27 +368,26 @@ class Studio {
     this.errorTimer = setTimeout(() => { box.hidden = true; }, 6000);
   }
 
-  // Fetches the mesh delta since the version held, applies it and draws. `t0`: when the edit was sent.
+  // Fetches the mesh delta since the version held and applies it (not drawn yet: present()).
   // `approximate`: during a drag, triangles that moved less than the drag tolerance are not resent.
-  async pull(t0, approximate) {
+  async pull(timing, approximate) {
     const r = await api.request('GET', '/api/mesh?since=' + this.slots.version + (approximate ? '&exact=0' : ''));
-    const buffer = await r.arrayBuffer(), t1 = performance.now();
-    this.slots.apply(buffer);
-    this.render();
-    if (this.syncDraw) this.waitForDraw();
-    if (t0 !== undefined) {
-      const t2 = performance.now();
-      this.latency = t2 - t0;
-      this.latencies.push(this.latency);
-      this.drawTimes.push(t2 - t1);  // of which: applying the delta and drawing (when syncDraw)
+    const buffer = await r.arrayBuffer();
+    if (timing) {
+      timing.server += serverMs(r);
+      timing.received = performance.now();
+      timing.bytes = buffer.byteLength;
     }
+    const changed = this.slots.apply(buffer);
+    if (timing) timing.changed = changed;
   }
 
-  async refreshState() {
-    const s = await api.json('GET', '/api/state');
-    this.constraints.set(s.constraint_list);
-    delete s.constraint_list;
-    this.showStats(s);
+  // Brings the constraint list up to date: `delta` (from an edit's answer) when it follows the version
+  // held, else the changes since that version (the whole list after a load or when too far behind).
+  async syncConstraints(delta) {
+    if (delta && this.constraints.apply(delta)) return;
+    const r = await api.request('GET', '/api/constraints?since=' + this.constraints.version);
+    if (!this.constraints.apply(await r.json())) throw new Error('constraint list out of step with the server');
   }
 
   showStats(s) {
@@ -275,28 +409,31 @@ class Studio {
     this.updateSelection();
   }
 
-  // One edit: POST it, then bring the mesh up to date (approximately while `dragging`), and the
-  // constraint list unless `dragging` (the page moved the dragged point itself).
-  edit(body, dragging) {
+  // Sends a POST (an edit, undo or redo), applies the mesh delta and the constraint changes it brought,
+  // and draws. `event`: the time of the pointer or key event that caused it (the latency's start).
+  update(path, body, { event, approximate = false } = {}) {
     return this.queue(async () => {
-      const t0 = performance.now();
-      const s = await api.json('POST', '/api/edit', body);
-      await this.pull(t0, dragging);
-      if (dragging) this.showStats(s); else await this.refreshState();
+      const timing = { event: event === undefined ? performance.now() : event, sent: performance.now(), server: 0 };
+      const r = await api.request('POST', path, body === undefined ? undefined : JSON.stringify(body));
+      timing.server += serverMs(r);
+      const s = await r.json();
+      await this.pull(timing, approximate);
+      await this.syncConstraints(s.constraint_delta);
+      this.present(timing);
+      this.showStats(s);
       this.scheduleRefine();
       return s;
     });
   }
 
-  command(path) {
-    return this.queue(async () => {
-      const t0 = performance.now();
-      await api.json('POST', path);
-      this.select(-1);
-      await this.pull(t0);
-      await this.refreshState();
-      this.scheduleRefine();
-    });
+  // One edit (docs/studio.md); `dragging`: approximate mesh delta.
+  edit(body, dragging, event) {
+    return this.update('/api/edit', body, { event, approximate: dragging });
+  }
+
+  command(path, event) {
+    this.select(-1);
+    return this.update(path, undefined, { event });
   }
 
   // Progressive refinement: while the user is idle, ask the server for the next level.
@@ -308,6 +445,7 @@ class Studio {
       this.queue(async () => {
         const s = await api.json('POST', '/api/refine');
         await this.pull();
+        this.present();
         this.showStats(s);
         this.scheduleRefine(50);
       });
@@ -319,24 +457,32 @@ class Studio {
     return this.queue(async () => {
       const s = await api.json('POST', '/api/refine', { precision: p });
       await this.pull();
+      this.present();
       this.showStats(s);
       this.scheduleRefine(50);
     });
+  }
+
+  // The whole state after a start or a load: the mesh from nothing, the whole constraint list.
+  async reload() {
+    this.select(-1);
+    await this.pull();
+    await this.syncConstraints();
+    this.showStats(await api.json('GET', '/api/stats'));
   }
 
   async load(file) {
     const bytes = await file.arrayBuffer();
     await this.queue(async () => {
       await api.request('POST', '/api/load?name=' + encodeURIComponent(file.name), bytes);
-      this.select(-1);
-      await this.pull();
-      await this.refreshState();
-      this.frame();
+      await this.reload();
+      this.frameModel();
       this.scheduleRefine();
     });
   }
 
-  frame() {
+  frameModel() {
+    this.slots.geometry.computeBoundingSphere();
     const sphere = this.slots.geometry.boundingSphere;
     const r = sphere && sphere.radius > 0 ? sphere.radius : 1;
     const c = sphere ? sphere.center : new THREE.Vector3();
@@ -351,21 +497,21 @@ class Studio {
   }
 
   select(index) {
-    this.constraints.selected = index;
-    this.constraints.set(this.constraints.list);
+    this.constraints.select(index);
     this.updateSelection();
-    this.render();
+    this.present();
   }
 
   updateSelection() {
-    const i = this.constraints.selected, c = this.constraints.list[i];
-    document.getElementById('selection').hidden = !c;
-    document.getElementById('delete').disabled = !c;
-    if (!c) return;
+    const i = this.constraints.selected, has = i >= 0 && i < this.constraints.count;
+    document.getElementById('selection').hidden = !has;
+    document.getElementById('delete').disabled = !has;
+    if (!has) return;
+    const value = this.constraints.value(i);
     document.getElementById('sel-index').textContent = i;
-    document.getElementById('sel-kind').textContent = { on: 'on-surface', in: 'inside', out: 'outside' }[kindOf(c.value)];
+    document.getElementById('sel-kind').textContent = { on: 'on-surface', in: 'inside', out: 'outside' }[kindOf(value)];
     const input = document.getElementById('sel-value');
-    if (document.activeElement !== input) input.value = c.value;
+    if (document.activeElement !== input) input.value = value;
   }
 
   depth() {
@@ -385,19 +531,33 @@ Studio.prototype.ray = function (event) {
   return this.raycaster;
 };
 
-// The constraint drawn nearest to the pointer (within 8 pixels), the front-most when several are.
+// Window coordinates and depth (NDC z) of constraint i.
+Studio.prototype.screenOf = function (i, rect = this.renderer.domElement.getBoundingClientRect()) {
+  const p = new THREE.Vector3().fromArray(this.constraints.position(i)).project(this.camera);
+  return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height, z: p.z };
+};
+
+// The constraint drawn nearest to the pointer (within 8 pixels), the front-most when several are. One
+// projection per constraint (a few ms for 10^5), with the camera's matrix applied by hand.
 Studio.prototype.pickConstraint = function (event) {
   if (!this.constraints.points.visible) return -1;
-  const r = this.renderer.domElement.getBoundingClientRect(), v = new THREE.Vector3();
+  const r = this.renderer.domElement.getBoundingClientRect();
+  const m = new THREE.Matrix4().multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).elements;
+  const xyz = this.constraints.xyz, px = event.clientX, py = event.clientY;
   let best = -1, bestDepth = Infinity;
-  this.constraints.list.forEach((c, i) => {
-    v.fromArray(c.position).project(this.camera);
-    const x = r.left + ((v.x + 1) / 2) * r.width, y = r.top + ((1 - v.y) / 2) * r.height;
-    if (v.z < 1 && Math.hypot(x - event.clientX, y - event.clientY) <= 8 && v.z < bestDepth) {
+  for (let i = 0; i < this.constraints.count; ++i) {
+    const x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    if (!(w > 0)) continue;
+    const nz = (m[2] * x + m[6] * y + m[10] * z + m[14]) / w;
+    if (nz >= 1 || nz >= bestDepth) continue;
+    const sx = r.left + (((m[0] * x + m[4] * y + m[8] * z + m[12]) / w + 1) / 2) * r.width;
+    const sy = r.top + ((1 - (m[1] * x + m[5] * y + m[9] * z + m[13]) / w) / 2) * r.height;
+    if (Math.hypot(sx - px, sy - py) <= 8) {
       best = i;
-      bestDepth = v.z;
+      bestDepth = nz;
     }
-  });
+  }
   return best;
 };
 
@@ -413,10 +573,10 @@ Studio.prototype.onPointerDown = function (event) {
   if (index < 0) return;
   this.controls.enabled = false;  // this drag moves a constraint, not the camera
   this.select(index);
-  const p = new THREE.Vector3().fromArray(this.constraints.list[index].position);
+  const p = new THREE.Vector3().fromArray(this.constraints.position(index));
   const normal = this.camera.getWorldDirection(new THREE.Vector3());
   this.drag = { index, plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, p), pending: null,
-                inFlight: false, first: true, ended: false };
+                event: 0, inFlight: false, first: true, ended: false };
 };
 
 Studio.prototype.onPointerMove = function (event) {
@@ -425,6 +585,7 @@ Studio.prototype.onPointerMove = function (event) {
   const p = this.ray(event).ray.intersectPlane(d.plane, new THREE.Vector3());
   if (!p) return;
   this.constraints.moveLocally(d.index, p);
+  if (!d.pending) d.event = event.timeStamp;  // the oldest move not sent yet: the latency's start
   d.pending = p;
   this.pumpDrag();
 };
@@ -440,7 +601,7 @@ Studio.prototype.pumpDrag = function () {
   const p = d.pending;
   d.pending = null;
   d.inFlight = true;
-  this.edit({ op: 'move', index: d.index, position: [p.x, p.y, p.z], merge: !d.first }, true).finally(() => {
+  this.edit({ op: 'move', index: d.index, position: [p.x, p.y, p.z], merge: !d.first }, true, d.event).finally(() => {
     d.first = false;
     d.inFlight = false;
     this.pumpDrag();
@@ -451,7 +612,7 @@ Studio.prototype.endDrag = function () {
   this.drag = null;
   this.queue(async () => {
     await this.pull();  // exact again
-    await this.refreshState();
+    this.present();
   });
 };
 
@@ -472,65 +633,7 @@ Studio.prototype.onPointerUp = function (event) {
   let p = hit.point, value = 0;
   if (event.shiftKey) { p = p.clone().addScaledVector(n, depth); value = depth; }
   else if (event.altKey || event.ctrlKey) { p = p.clone().addScaledVector(n, -depth); value = -depth; }
-  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }).then((s) => s && this.select(s.index));
-};
-
-// ------------------------------------------------------------------------------- measurements
-function summary(values) {
-  const v = values.slice().sort((a, b) => a - b);
-  const at = (q) => v[Math.min(v.length - 1, Math.floor(q * v.length))];
-  return { count: v.length, median: at(0.5), p90: at(0.9), max: v[v.length - 1] };
-}
-
-// Drags constraint `index` (default: the first on-surface one) along a small circle: `moves` updates one
-// after the other, as a user's drag when the server keeps up; then undoes the drag. Latency = edit sent
-// -> picture drawn when `sync` (each frame waited for), else -> frame submitted (the page's normal mode,
-// which gives the drag rate a user sees).
-Studio.prototype.benchDrag = async function ({ index = -1, moves = 40, radius = 0.01, sync = true } = {}) {
-  if (index < 0) index = this.constraints.list.findIndex((c) => c.value === 0);  // an on-surface one
-  const c = this.constraints.list[index].position.slice(), r = radius * this.stats.unit;
-  this.latencies = [];
-  this.drawTimes = [];
-  this.syncDraw = sync;
-  const t0 = performance.now();
-  for (let k = 1; k <= moves; ++k) {
-    const a = (2 * Math.PI * k) / moves;
-    await this.edit({ op: 'move', index, position: [c[0] + r * Math.sin(a), c[1] + r * (1 - Math.cos(a)), c[2]],
-                      merge: k > 1 }, true);
-  }
-  const seconds = (performance.now() - t0) / 1000;
-  this.syncDraw = false;
-  await this.queue(() => this.pull());
-  const result = Object.assign(summary(this.latencies), { updates_per_second: moves / seconds,
-                                                          draw_median: summary(this.drawTimes).median,
-                                                          triangles: this.stats.triangles });
-  await this.command('/api/undo');
-  return result;
-};
-
-// Adds `count` on-surface constraints at mesh triangle centers (each undone after); edit-to-screen latency.
-Studio.prototype.benchAdd = async function ({ count = 10 } = {}) {
-  const lat = [];
-  this.drawTimes = [];
-  this.syncDraw = true;
-  for (let k = 0; k < count; ++k) {
-    const P = this.slots.geometry.attributes.position.array, slots = Array.from(this.slots.slotOf.values());
-    const s = slots[Math.floor(((k + 0.5) / count) * slots.length)];
-    const p = [0, 1, 2].map((j) => (P[9 * s + j] + P[9 * s + 3 + j] + P[9 * s + 6 + j]) / 3);
-    await this.edit({ op: 'add', position: p, value: 0 });
-    lat.push(this.latency);
-    await this.command('/api/undo');
-  }
-  this.syncDraw = false;
-  return Object.assign(summary(lat), { draw_median: summary(this.drawTimes.filter((_, k) => k % 2 === 0)).median,
-                                       triangles: this.stats.triangles });
-};
-
-// Window coordinates of constraint i (for the browser test).
-Studio.prototype.screenOf = function (i) {
-  const p = new THREE.Vector3().fromArray(this.constraints.list[i].position).project(this.camera);
-  const r = this.renderer.domElement.getBoundingClientRect();
-  return { x: r.left + ((p.x + 1) / 2) * r.width, y: r.top + ((1 - p.y) / 2) * r.height };
+  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }, false, event.timeStamp).then((s) => s && this.select(s.index));
 };
 
 // ------------------------------------------------------------------------------------------ wiring
@@ -551,17 +654,17 @@ async function main() {
   window.addEventListener('pointermove', (e) => studio.onPointerMove(e));
   window.addEventListener('pointerup', (e) => studio.onPointerUp(e));
   const byId = (id) => document.getElementById(id);
-  const deleteSelected = () => {
+  const deleteSelected = (e) => {
     const i = studio.constraints.selected;
     if (i < 0) return;
     studio.select(-1);
-    studio.edit({ op: 'remove', index: i });
+    studio.edit({ op: 'remove', index: i }, false, e ? e.timeStamp : undefined);
   };
-  byId('undo').onclick = () => studio.command('/api/undo');
-  byId('redo').onclick = () => studio.command('/api/redo');
+  byId('undo').onclick = (e) => studio.command('/api/undo', e.timeStamp);
+  byId('redo').onclick = (e) => studio.command('/api/redo', e.timeStamp);
   byId('delete').onclick = deleteSelected;
-  byId('wireframe').onchange = (e) => { studio.slots.wire.visible = e.target.checked; studio.render(); };
-  byId('show-constraints').onchange = (e) => { studio.constraints.points.visible = e.target.checked; studio.render(); };
+  byId('wireframe').onchange = (e) => { studio.slots.wire.visible = e.target.checked; studio.present(); };
+  byId('show-constraints').onchange = (e) => { studio.constraints.points.visible = e.target.checked; studio.present(); };
   byId('precision').oninput = (e) => { byId('precision-value').textContent = sliderToPrecision(+e.target.value).toPrecision(3); };
   byId('precision').onchange = (e) => studio.setPrecision(sliderToPrecision(+e.target.value));
   const showDepth = () => { byId('depth-value').textContent = (byId('depth').value / 100 * 0.05).toPrecision(2) + ' x diagonal'; };
@@ -569,7 +672,7 @@ async function main() {
   showDepth();
   const applyValue = () => {
     const v = parseFloat(byId('sel-value').value), i = studio.constraints.selected;
-    if (i >= 0 && Number.isFinite(v)) studio.edit({ op: 'value', index: i, value: v });
+    if (i >= 0 && Number.isFinite(v)) studio.edit({ op: 'value', index: i, value: v }, false);
   };
   byId('sel-apply').onclick = applyValue;
   byId('sel-value').onkeydown = (e) => { if (e.key === 'Enter') applyValue(); };
@@ -579,18 +682,15 @@ async function main() {
   window.addEventListener('keydown', (e) => {
     if (e.target.tagName === 'INPUT' && e.target.type !== 'checkbox' && e.target.type !== 'range') return;
     const key = e.key.toLowerCase(), mod = e.ctrlKey || e.metaKey;
-    if (mod && key === 'z' && !e.shiftKey) studio.command('/api/undo');
-    else if (mod && (key === 'y' || (key === 'z' && e.shiftKey))) studio.command('/api/redo');
-    else if (key === 'delete' || key === 'backspace') deleteSelected();
+    if (mod && key === 'z' && !e.shiftKey) studio.command('/api/undo', e.timeStamp);
+    else if (mod && (key === 'y' || (key === 'z' && e.shiftKey))) studio.command('/api/redo', e.timeStamp);
+    else if (key === 'delete' || key === 'backspace') deleteSelected(e);
     else if (key === 'w' && !mod) { byId('wireframe').click(); }
     else return;
     e.preventDefault();
   });
-  await studio.queue(async () => {
-    await studio.pull();
-    await studio.refreshState();
-  });
-  studio.frame();
+  await studio.queue(() => studio.reload());
+  studio.frameModel();
   studio.ready = true;
   studio.scheduleRefine();
 }

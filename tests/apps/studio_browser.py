@@ -5,7 +5,8 @@ Starts `vitri studio` on a free port, opens the page, adds a constraint by click
 it, undoes both edits, and checks through the HTTP API that the mesh changed, stayed closed (every edge
 shared by exactly two triangles) and came back. Screenshots go to --out (kept as test artifacts).
 
-Usage: studio_browser.py --vitri PATH/TO/vitri --out DIR [--model FILE] [--bench]
+Usage: studio_browser.py --vitri PATH/TO/vitri --out DIR [--model FILE] [--bench | --api-bench]
+                         [--precision P] [--studio-args "..."] [--window W,H] [--query "aa=1&lowres=0"]
 Exit status: 0 pass, 1 fail, 77 skipped (no browser, driver or selenium installed).
 --bench measures the edit-to-screen latency and drag rate in the page and prints them (docs/benchmarks.md).
 """
@@ -285,12 +286,16 @@ def open_file(driver, server, shot, out_dir):
     check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
     check(page_constraints_match(driver, server), "the page holds the uploaded model's constraints")
     check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
-    check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
+    # Refinement goes on while the page is idle: compare the page's mesh with the server's once it ended.
+    wait_for("refinement of the uploaded model", lambda: server.get("/api/stats")["refined"], 300)
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    time.sleep(0.5)
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    check(driver.execute_script("return studio.slots.triangles") == server.get("/api/stats")["triangles"],
           "the page draws the uploaded model")
     shot("studio-4-opened.png")
     # Shift+click: an outside constraint (value +depth); alt+click: an inside one (value -depth).
     canvas = driver.find_element("css selector", "#view canvas")
-    wait_for("refinement of the uploaded model", lambda: server.get("/api/stats")["refined"], 300)
     for key, sign, what, dx, dy in ((Keys.SHIFT, 1, "outside", -70, 50), (Keys.ALT, -1, "inside", 60, -40)):
         n = server.get("/api/stats")["constraints"]
         ActionChains(driver).move_to_element_with_offset(canvas, dx, dy).key_down(key).click().key_up(key).perform()
@@ -312,7 +317,8 @@ def run(args):
         if args.api_bench:
             return api_bench(server)
         driver, profile = launch_browser(args.out, args.window)
-        driver.get(server.url + "/" + ("?aa=0" if args.no_antialias else ""))
+        query = "&".join(q for q in (["aa=0"] if args.no_antialias else []) + ([args.query] if args.query else []))
+        driver.get(server.url + "/" + ("?" + query if query else ""))
         wait_for("the page to start", lambda: driver.execute_script("return !!(window.studio && studio.ready)"))
         webgl = driver.execute_script("return !!studio.renderer.getContext()")
         check(webgl, "the page has a WebGL context")
@@ -365,6 +371,8 @@ def bench(driver, server, out_dir):
                                  "triangles": stats["triangles"], "vertices": stats["vertices"],
                                  "browser": driver.capabilities.get("browserVersion"),
                                  "webgl": driver.execute_script(WEBGL_RENDERER),
+                                 "antialias": driver.execute_script("return studio.renderer.getContextAttributes().antialias"),
+                                 "low_res_interaction": driver.execute_script("return studio.lowResInteraction"),
                                  "add": adds["add"], "undo": adds["undo"], "drag": drag, "live_drag": live}, indent=1))
     return 0
 
@@ -399,6 +407,7 @@ def main():
     ap.add_argument("--api-bench", action="store_true", help="measure edit + delta round trips without a browser")
     ap.add_argument("--window", default="1280,800", help="browser window size W,H")
     ap.add_argument("--no-antialias", action="store_true", help="WebGL without antialiasing (page ?aa=0)")
+    ap.add_argument("--query", default="", help="more page options, e.g. aa=1&lowres=0 (docs/studio.md)")
     ap.add_argument("--studio-args", default="", help="more vitri studio arguments (space-separated)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)

@@ -123,6 +123,7 @@ class MeshSlots {
 // ------------------------------------------------------------------------------------- constraints
 const KIND_COLORS = { on: new THREE.Color(0xf2c94c), in: new THREE.Color(0x4c9bf2), out: new THREE.Color(0xf2584c) };
 const SELECTED_COLOR = new THREE.Color(0xffffff);
+const PLAIN_POINTS_ABOVE = 5000;
 const kindOf = (value) => (value === 0 ? 'on' : value < 0 ? 'in' : 'out');
 
 function discTexture() {
@@ -144,8 +145,10 @@ class ConstraintPoints {
     this.capacity = 0;
     this.version = 0;
     this.selected = -1;
-    this.material = new THREE.PointsMaterial({ size: 11 * window.devicePixelRatio, vertexColors: THREE.VertexColors,
-                                               map: discTexture(), alphaTest: 0.5, sizeAttenuation: false });
+    this.disc = discTexture();
+    this.size = 11;  // CSS pixels (Studio.render() scales it to the drawing buffer)
+    this.material = new THREE.PointsMaterial({ size: 11, vertexColors: THREE.VertexColors, map: this.disc,
+                                               alphaTest: 0.5, sizeAttenuation: false });
     this.points = new THREE.Points(new THREE.BufferGeometry(), this.material);
     this.points.renderOrder = 1;
     this.points.frustumCulled = false;  // (no bounding sphere to keep up to date)
@@ -247,7 +250,16 @@ class ConstraintPoints {
     this.dirty = null;
     g.setDrawRange(0, this.count);
     // Discs of 11 pixels for a few constraints, down to 5 for thousands (so that the surface shows).
-    this.material.size = Math.max(5, Math.min(11, 60 / Math.sqrt(Math.max(this.count, 1)))) * window.devicePixelRatio;
+    this.size = Math.max(5, Math.min(11, 60 / Math.sqrt(Math.max(this.count, 1))));
+    // Many constraints: small plain squares. A textured disc is cut out per fragment (alpha test), which
+    // a software rasterizer pays for dearly (about 1 s a frame for 10^5 constraints, docs/benchmarks.md).
+    const plain = this.count > PLAIN_POINTS_ABOVE;
+    if (plain !== (this.material.map === null)) {
+      this.material.map = plain ? null : this.disc;
+      this.material.alphaTest = plain ? 0 : 0.5;
+      this.material.needsUpdate = true;
+    }
+    if (plain) this.size = 3;
   }
 
   select(index) {
@@ -272,10 +284,26 @@ function serverMs(response) {
   return m ? parseFloat(m[1]) : 0;
 }
 
+// True when WebGL is drawn by a software rasterizer (SwiftShader, llvmpipe): a probe context's renderer.
+function softwareWebGL() {
+  const gl = document.createElement('canvas').getContext('webgl');
+  if (!gl) return false;
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  const lose = gl.getExtension('WEBGL_lose_context');
+  if (lose) lose.loseContext();
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+
 class Studio {
   constructor() {
     this.view = document.getElementById('view');
-    this.renderer = new THREE.WebGLRenderer({ antialias: !/[?&]aa=0/.test(location.search) });
+    // A software rasterizer (no GPU) pays for every pixel on the CPU; multisampling doubles the cost of a
+    // frame there (docs/benchmarks.md), so it is off unless asked for (?aa=1); ?aa=0 turns it off anywhere.
+    this.software = softwareWebGL();
+    const aa = /[?&]aa=([01])/.exec(location.search);
+    this.renderer = new THREE.WebGLRenderer({ antialias: aa ? aa[1] === '1' : !this.software });
+    this.lowResInteraction = this.software && !/[?&]lowres=0/.test(location.search);
     this.renderer.setPixelRatio(window.devicePixelRatio);
     this.renderer.setClearColor(0x2b2f37);
     this.view.appendChild(this.renderer.domElement);
@@ -304,6 +332,7 @@ class Studio {
     // (here the software rasterizer's), not only the submission of the commands.
     this.syncDraw = false;
     this.idleTimer = 0;
+    this.holdIdle = false;  // benchmarks: no idle work between the updates they time
     this.ready = false;
     window.addEventListener('resize', () => this.resize());
     this.resize();
@@ -317,7 +346,15 @@ class Studio {
     this.render();
   }
 
-  render() { this.renderer.render(this.scene, this.camera); }
+  // Draws the scene. `interactive`: a frame for an edit or a drag; a software rasterizer draws those at
+  // half resolution (a quarter of the pixels; ?lowres=0 turns it off), the next other frame (the exact
+  // mesh when idle, orbiting, selecting) at full resolution again.
+  render(interactive = false) {
+    const ratio = window.devicePixelRatio * (interactive && this.lowResInteraction ? 0.5 : 1);
+    if (this.renderer.getPixelRatio() !== ratio) this.renderer.setPixelRatio(ratio);
+    this.constraints.material.size = this.constraints.size * ratio;
+    this.renderer.render(this.scene, this.camera);
+  }
 
   // Draws in the next animation frame (several updates within one frame are drawn once). `timing`: an
   // edit's record, completed when its frame is drawn: {event, sent, server, received, applied, frame,
@@ -331,7 +368,7 @@ class Studio {
     if (!this.frame) {
       this.frame = new Promise((resolve) => requestAnimationFrame(() => {
         const t = performance.now();
-        this.render();
+        this.render(this.waiting.length > 0 || this.drag !== null);
         if (this.syncDraw) this.waitForDraw();
         const drawn = performance.now();
         for (const w of this.waiting) {
@@ -379,6 +416,7 @@ class Studio {
       timing.bytes = buffer.byteLength;
     }
     const changed = this.slots.apply(buffer);
+    this.slots.approximate = !!approximate;
     if (timing) timing.changed = changed;
   }
 
@@ -410,8 +448,10 @@ class Studio {
   }
 
   // Sends a POST (an edit, undo or redo), applies the mesh delta and the constraint changes it brought,
-  // and draws. `event`: the time of the pointer or key event that caused it (the latency's start).
-  update(path, body, { event, approximate = false } = {}) {
+  // and draws. `event`: the time of the pointer or key event that caused it (the latency's start). The
+  // mesh delta is approximate (vertices that moved less than the drag tolerance are not resent: with the
+  // global function an edit moves every root a little); the exact mesh follows when the user is idle.
+  update(path, body, { event, approximate = true } = {}) {
     return this.queue(async () => {
       const timing = { event: event === undefined ? performance.now() : event, sent: performance.now(), server: 0 };
       const r = await api.request('POST', path, body === undefined ? undefined : JSON.stringify(body));
@@ -426,9 +466,9 @@ class Studio {
     });
   }
 
-  // One edit (docs/studio.md); `dragging`: approximate mesh delta.
-  edit(body, dragging, event) {
-    return this.update('/api/edit', body, { event, approximate: dragging });
+  // One edit (docs/studio.md).
+  edit(body, event) {
+    return this.update('/api/edit', body, { event });
   }
 
   command(path, event) {
@@ -436,17 +476,24 @@ class Studio {
     return this.update(path, undefined, { event });
   }
 
-  // Progressive refinement: while the user is idle, ask the server for the next level.
+  // While the user is idle: the exact mesh after approximate updates, then progressive refinement (the
+  // server's next level, one request at a time).
   scheduleRefine(delay = 300) {
     clearTimeout(this.idleTimer);
-    if (this.stats && this.stats.refined) return;
+    if (this.stats && this.stats.refined && !this.slots.approximate) return;
     this.idleTimer = setTimeout(() => {
-      if (this.drag) return this.scheduleRefine();
+      if (this.drag || this.holdIdle) return this.scheduleRefine();
       this.queue(async () => {
-        const s = await api.json('POST', '/api/refine');
-        await this.pull();
-        this.present();
-        this.showStats(s);
+        if (this.slots.approximate) {
+          await this.pull();
+          this.present();
+        }
+        if (!this.stats.refined) {
+          const s = await api.json('POST', '/api/refine');
+          await this.pull();
+          this.present();
+          this.showStats(s);
+        }
         this.scheduleRefine(50);
       });
     }, delay);
@@ -601,7 +648,7 @@ Studio.prototype.pumpDrag = function () {
   const p = d.pending;
   d.pending = null;
   d.inFlight = true;
-  this.edit({ op: 'move', index: d.index, position: [p.x, p.y, p.z], merge: !d.first }, true, d.event).finally(() => {
+  this.edit({ op: 'move', index: d.index, position: [p.x, p.y, p.z], merge: !d.first }, d.event).finally(() => {
     d.first = false;
     d.inFlight = false;
     this.pumpDrag();
@@ -610,10 +657,7 @@ Studio.prototype.pumpDrag = function () {
 
 Studio.prototype.endDrag = function () {
   this.drag = null;
-  this.queue(async () => {
-    await this.pull();  // exact again
-    this.present();
-  });
+  this.scheduleRefine(0);  // the exact mesh again
 };
 
 Studio.prototype.onPointerUp = function (event) {
@@ -633,7 +677,7 @@ Studio.prototype.onPointerUp = function (event) {
   let p = hit.point, value = 0;
   if (event.shiftKey) { p = p.clone().addScaledVector(n, depth); value = depth; }
   else if (event.altKey || event.ctrlKey) { p = p.clone().addScaledVector(n, -depth); value = -depth; }
-  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }, false, event.timeStamp).then((s) => s && this.select(s.index));
+  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }, event.timeStamp).then((s) => s && this.select(s.index));
 };
 
 // ------------------------------------------------------------------------------------------ wiring
@@ -658,7 +702,7 @@ async function main() {
     const i = studio.constraints.selected;
     if (i < 0) return;
     studio.select(-1);
-    studio.edit({ op: 'remove', index: i }, false, e ? e.timeStamp : undefined);
+    studio.edit({ op: 'remove', index: i }, e ? e.timeStamp : undefined);
   };
   byId('undo').onclick = (e) => studio.command('/api/undo', e.timeStamp);
   byId('redo').onclick = (e) => studio.command('/api/redo', e.timeStamp);
@@ -672,7 +716,7 @@ async function main() {
   showDepth();
   const applyValue = () => {
     const v = parseFloat(byId('sel-value').value), i = studio.constraints.selected;
-    if (i >= 0 && Number.isFinite(v)) studio.edit({ op: 'value', index: i, value: v }, false);
+    if (i >= 0 && Number.isFinite(v)) studio.edit({ op: 'value', index: i, value: v });
   };
   byId('sel-apply').onclick = applyValue;
   byId('sel-value').onkeydown = (e) => { if (e.key === 'Enter') applyValue(); };

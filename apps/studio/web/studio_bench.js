@@ -59,7 +59,7 @@ Studio.prototype.benchAdd = async function ({ count = 12 } = {}) {
   await this.settled();
   const shown = this.constraints.points.visible;
   this.constraints.points.visible = false;
-  this.syncDraw = true;
+  this.syncDraw = this.holdIdle = true;
   const adds = [], undos = [];
   for (const p of this.surfacePixels(count)) {
     this.timings = [];
@@ -74,7 +74,7 @@ Studio.prototype.benchAdd = async function ({ count = 12 } = {}) {
     await this.settled();
     undos.push(...this.timings);
   }
-  this.syncDraw = false;
+  this.syncDraw = this.holdIdle = false;
   this.constraints.points.visible = shown;
   return { add: breakdown(adds), undo: breakdown(undos), triangles: this.slots.triangles };
 };
@@ -103,6 +103,7 @@ Studio.prototype.benchDrag = async function ({ moves = 60, radius = 12, live = f
   const start = this.draggable();
   if (!start) throw new Error('no constraint to drag in view');
   this.syncDraw = !live;
+  this.holdIdle = true;
   this.timings = [];
   this.pointer('pointerdown', start.x, start.y);
   if (!this.drag) throw new Error('the pointer did not pick a constraint');
@@ -117,7 +118,7 @@ Studio.prototype.benchDrag = async function ({ moves = 60, radius = 12, live = f
   this.pointer('pointerup', start.x, start.y);
   await this.settled();
   const timings = this.timings.filter((t) => !live || t.drawn <= end);  // live: those drawn while moving
-  this.syncDraw = false;
+  this.syncDraw = this.holdIdle = false;
   await this.command('/api/undo');
   await this.settled();
   return Object.assign(breakdown(timings), { index: start.index, moves, updates: timings.length,

@@ -112,7 +112,9 @@ std::string constraint_delta_json(const ConstraintDelta& d) {
                     ",\"full\":" + (d.full ? "true" : "false") + ",\"changes\":[";
   for (std::size_t k = 0; k < d.changes.size(); ++k) {
     const ConstraintChange& c = d.changes[k];
-    const char* op = c.op == ConstraintChange::Op::Add ? "add" : c.op == ConstraintChange::Op::Remove ? "remove" : "update";
+    const char* op = c.op == ConstraintChange::Op::Add      ? "add"
+                     : c.op == ConstraintChange::Op::Remove ? "remove"
+                                                            : "update";
     if (k) out.push_back(',');
     out += "{\"op\":\"" + std::string(op) + "\"," + constraint_json(c.constraint).substr(1);
   }
@@ -216,7 +218,8 @@ ApiResponse Api::handle(const ApiRequest& request) {
 ApiResponse Api::route(const ApiRequest& r) {
   const std::string& p = r.path;
   const char* method =
-      p == "/api/stats" || p == "/api/state" || p == "/api/constraints" || p == "/api/mesh" || p == "/api/export"
+      p == "/api/stats" || p == "/api/state" || p == "/api/constraints" || p == "/api/mesh" ||
+              p == "/api/export"
           ? "GET"
       : p == "/api/edit" || p == "/api/undo" || p == "/api/redo" || p == "/api/refine" || p == "/api/load"
           ? "POST"
@@ -226,7 +229,8 @@ ApiResponse Api::route(const ApiRequest& r) {
   if (p == "/api/stats") return stats();
   if (p == "/api/state") return state();
   if (p == "/api/constraints")
-    return json_response(constraint_delta_json(session_.constraint_delta(version_param(r, std::numeric_limits<std::uint64_t>::max()))));
+    return json_response(constraint_delta_json(
+        session_.constraint_delta(version_param(r, std::numeric_limits<std::uint64_t>::max()))));
   if (p == "/api/mesh") return mesh(r);
   if (p == "/api/export") return export_file(r);
   if (p == "/api/edit") return edit(r);
@@ -235,7 +239,8 @@ ApiResponse Api::route(const ApiRequest& r) {
   check_keys(parse_body(r.body), {});
   const std::uint64_t base = session_.constraint_version();
   const bool done = p == "/api/undo" ? session_.undo() : session_.redo();
-  return json_response(stats_json(std::string("\"done\":") + (done ? "true" : "false") + changes_since(base)));
+  return json_response(
+      stats_json(std::string("\"done\":") + (done ? "true" : "false") + changes_since(base)));
 }
 
 std::string Api::stats_json(const std::string& extra) {

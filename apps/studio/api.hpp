@@ -23,7 +23,7 @@ struct ApiResponse {
   int status = 200;
   std::string content_type = "application/json";
   std::string body;
-  std::string download;  ///< non-empty: offer the body as a file of this name (Content-Disposition)
+  std::string download;   ///< non-empty: offer the body as a file of this name (Content-Disposition)
   double server_ms = -1;  ///< time the session spent on it (after waiting for earlier requests); < 0: none
 };
 

@@ -35,8 +35,9 @@ void Session::load(Constraints constraints, std::string name) {
                       constraints.size() > options_.mesher.auto_local_above);
   const std::size_t limit = local ? options_.max_local_constraints : options_.max_constraints;
   if (constraints.size() > limit)
-    throw LimitError(name + ": " + std::to_string(constraints.size()) + " constraints, the studio holds at most " +
-                     std::to_string(limit) + (local ? "" : " with the global function (try --function local)"));
+    throw LimitError(name + ": " + std::to_string(constraints.size()) +
+                     " constraints, the studio holds at most " + std::to_string(limit) +
+                     (local ? "" : " with the global function (try --function local)"));
   auto mesher = std::make_unique<Mesher>(constraints, options_.mesher);  // throws before anything changes
   mesher_ = std::move(mesher);
   name_ = std::move(name);
@@ -89,8 +90,10 @@ Edit Session::apply(const Edit& e) {
   Edit inverse = e;
   switch (e.op) {
     case Edit::Op::Add:
-      if (ids_.size() >= (mesher_->local_function() ? options_.max_local_constraints : options_.max_constraints))
-        throw LimitError("the studio holds at most " + std::to_string(ids_.size()) + " constraints with this function");
+      if (ids_.size() >=
+          (mesher_->local_function() ? options_.max_local_constraints : options_.max_constraints))
+        throw LimitError("the studio holds at most " + std::to_string(ids_.size()) +
+                         " constraints with this function");
       check_position(e.position);
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
       timed_edit([&] { mesher_->add_constraint(e.position, e.value); });

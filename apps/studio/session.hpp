@@ -161,7 +161,7 @@ class Session {
   std::uint64_t revision_ = 0;
   std::uint64_t constraint_version_ = 0;
   std::deque<ConstraintChange> log_;  // the last changes; log_.back() made constraint_version_
-  bool mesh_timed_ = false;  // extraction time of the current mesh recorded
+  bool mesh_timed_ = false;           // extraction time of the current mesh recorded
 };
 
 }  // namespace vitri::studio

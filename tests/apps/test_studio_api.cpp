@@ -92,8 +92,8 @@ struct Running {
   std::string fingerprint() {
     const Json s = get("/api/state");
     std::string out = Json(s.find("constraint_list")->as_array("")).dump();
-    for (const char* k :
-         {"constraints", "vertices", "triangles", "undo", "redo", "revision", "precision", "constraint_version"})
+    for (const char* k : {"constraints", "vertices", "triangles", "undo", "redo", "revision", "precision",
+                          "constraint_version"})
       out += std::string(" ") + k + "=" + s.find(k)->dump();
     return out;
   }
@@ -351,8 +351,10 @@ struct HeldConstraints {
         list.push_back(key(c));
       } else {
         REQUIRE(i < list.size());
-        if (op == "remove") list.erase(list.begin() + static_cast<std::ptrdiff_t>(i));
-        else list[i] = key(c);
+        if (op == "remove")
+          list.erase(list.begin() + static_cast<std::ptrdiff_t>(i));
+        else
+          list[i] = key(c);
       }
     }
     version = number(d, "version");
@@ -384,18 +386,20 @@ TEST_CASE("studio api: constraint deltas keep a client's list equal to the serve
     std::string path = "/api/edit", body;
     switch (rng() % 6) {
       case 0:
-        body = "{\"op\":\"add\",\"position\":[" + std::to_string(0.8 * u(rng)) + "," + std::to_string(0.6 * u(rng)) +
-               "," + std::to_string(0.4 * u(rng)) + "],\"value\":0}";
+        body = "{\"op\":\"add\",\"position\":[" + std::to_string(0.8 * u(rng)) + "," +
+               std::to_string(0.6 * u(rng)) + "," + std::to_string(0.4 * u(rng)) + "],\"value\":0}";
         break;
       case 1:
-        body = "{\"op\":\"move\",\"index\":" + std::to_string(i) + ",\"position\":[" + std::to_string(0.7 * u(rng)) +
-               "," + std::to_string(0.5 * u(rng)) + ",0.3],\"merge\":" + (rng() % 2 ? "true" : "false") + "}";
+        body = "{\"op\":\"move\",\"index\":" + std::to_string(i) + ",\"position\":[" +
+               std::to_string(0.7 * u(rng)) + "," + std::to_string(0.5 * u(rng)) +
+               ",0.3],\"merge\":" + (rng() % 2 ? "true" : "false") + "}";
         break;
       case 2:
         body = "{\"op\":\"remove\",\"index\":" + std::to_string(i) + "}";
         break;
       case 3:
-        body = "{\"op\":\"value\",\"index\":" + std::to_string(i) + ",\"value\":" + std::to_string(0.02 * u(rng)) + "}";
+        body = "{\"op\":\"value\",\"index\":" + std::to_string(i) +
+               ",\"value\":" + std::to_string(0.02 * u(rng)) + "}";
         break;
       default:
         path = rng() % 3 ? "/api/undo" : "/api/redo";
@@ -417,7 +421,8 @@ TEST_CASE("studio api: constraint deltas keep a client's list equal to the serve
     CHECK(page.version == number(s, "constraint_version"));
     CHECK(page.list == HeldConstraints::of(r));
     if (step % 7 == 3) {  // several versions behind: the changes since then, not the whole list
-      const Json catch_up = r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(late.version)));
+      const Json catch_up =
+          r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(late.version)));
       CHECK_FALSE(catch_up.find("full")->as_bool(""));
       REQUIRE(late.apply(catch_up));
       CHECK(late.list == page.list);
@@ -430,17 +435,20 @@ TEST_CASE("studio api: constraint deltas keep a client's list equal to the serve
   CHECK_FALSE(none.find("full")->as_bool(""));
   // A version from the future, and a load: the whole list.
   CHECK(r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(page.version) + 5))
-            .find("full")->as_bool(""));
+            .find("full")
+            ->as_bool(""));
   const auto x = r.client.Get("/api/export?format=xyzv");
   REQUIRE(x);
   r.check(r.client.Post("/api/load?name=again.xyzv", x->body, "application/octet-stream"), 200);
-  const Json after_load = r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(page.version)));
+  const Json after_load =
+      r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(page.version)));
   CHECK(after_load.find("full")->as_bool(""));
   REQUIRE(page.apply(after_load));
   CHECK(page.list == HeldConstraints::of(r));
 }
 
-TEST_CASE("studio session: the constraint log is bounded; older versions get the whole list", "[studio][session]") {
+TEST_CASE("studio session: the constraint log is bounded; older versions get the whole list",
+          "[studio][session]") {
   SessionOptions o = fast_options();
   o.constraint_log = 3;
   Session session(small_model(), "small", o);

@@ -451,7 +451,8 @@ class Studio {
   // and draws. `event`: the time of the pointer or key event that caused it (the latency's start). The
   // mesh delta is approximate (vertices that moved less than the drag tolerance are not resent: with the
   // global function an edit moves every root a little); the exact mesh follows when the user is idle.
-  update(path, body, { event, approximate = true } = {}) {
+  // `select(answer)`: the constraint to select after it (-1: none).
+  update(path, body, { event, approximate = true, select } = {}) {
     return this.queue(async () => {
       const timing = { event: event === undefined ? performance.now() : event, sent: performance.now(), server: 0 };
       const r = await api.request('POST', path, body === undefined ? undefined : JSON.stringify(body));
@@ -459,6 +460,7 @@ class Studio {
       const s = await r.json();
       await this.pull(timing, approximate);
       await this.syncConstraints(s.constraint_delta);
+      if (select !== undefined) this.select(select(s), false);  // in the same frame
       this.present(timing);
       this.showStats(s);
       this.scheduleRefine();
@@ -466,14 +468,13 @@ class Studio {
     });
   }
 
-  // One edit (docs/studio.md).
+  // One edit (docs/studio.md); an added constraint is selected.
   edit(body, event) {
-    return this.update('/api/edit', body, { event });
+    return this.update('/api/edit', body, { event, select: body.op === 'add' ? (s) => s.index : undefined });
   }
 
   command(path, event) {
-    this.select(-1);
-    return this.update(path, undefined, { event });
+    return this.update(path, undefined, { event, select: () => -1 });
   }
 
   // While the user is idle: the exact mesh after approximate updates, then progressive refinement (the
@@ -543,10 +544,10 @@ class Studio {
     this.render();
   }
 
-  select(index) {
+  select(index, draw = true) {
     this.constraints.select(index);
     this.updateSelection();
-    this.present();
+    if (draw) this.present();
   }
 
   updateSelection() {
@@ -677,7 +678,7 @@ Studio.prototype.onPointerUp = function (event) {
   let p = hit.point, value = 0;
   if (event.shiftKey) { p = p.clone().addScaledVector(n, depth); value = depth; }
   else if (event.altKey || event.ctrlKey) { p = p.clone().addScaledVector(n, -depth); value = -depth; }
-  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }, event.timeStamp).then((s) => s && this.select(s.index));
+  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }, event.timeStamp);
 };
 
 // ------------------------------------------------------------------------------------------ wiring

@@ -44,6 +44,7 @@ std::vector<StaticFile> static_files(const ServerOptions& o) {
   return {{"/", o.web_dir + "/index.html", "text/html; charset=utf-8"},
           {"/index.html", o.web_dir + "/index.html", "text/html; charset=utf-8"},
           {"/studio.js", o.web_dir + "/studio.js", js},
+          {"/studio_buffers.js", o.web_dir + "/studio_buffers.js", js},
           {"/studio_bench.js", o.web_dir + "/studio_bench.js", js},
           {"/studio.css", o.web_dir + "/studio.css", "text/css; charset=utf-8"},
           {"/three/three.min.js", o.three_dir + "/build/three.min.js", js},

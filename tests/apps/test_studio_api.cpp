@@ -476,7 +476,7 @@ TEST_CASE("studio api: the page's files are served, three.js missing is a clear 
   REQUIRE(page);
   CHECK(page->status == 200);
   CHECK_THAT(page->body, Catch::Contains("studio.js"));
-  for (const char* file : {"/studio.js", "/studio_bench.js"}) {
+  for (const char* file : {"/studio.js", "/studio_buffers.js", "/studio_bench.js"}) {
     const auto js = r.client.Get(file);
     REQUIRE(js);
     CHECK(js->status == 200);

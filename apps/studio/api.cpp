@@ -9,10 +9,13 @@
 
 #include <unistd.h>
 #include <cctype>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace vitri::studio {
@@ -86,13 +89,36 @@ std::string param(const ApiRequest& r, const std::string& key, const std::string
   return it == r.params.end() ? fallback : it->second;
 }
 
-std::uint32_t version_param(const ApiRequest& r) {
+/// The version a client holds (query parameter "since", default 0 = none), at most `max`.
+std::uint64_t version_param(const ApiRequest& r, std::uint64_t max) {
   const std::string s = param(r, "since", "0");
   char* end = nullptr;
+  errno = 0;
   const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
-  if (s.empty() || *end != '\0' || s[0] == '-' || v > 0xffffffffull)
-    throw BadRequest("\"since\" must be a mesh version (a non-negative integer), got '" + s + "'");
-  return static_cast<std::uint32_t>(v);
+  if (s.empty() || *end != '\0' || s[0] == '-' || errno == ERANGE || v > max)
+    throw BadRequest("\"since\" must be a version (a non-negative integer), got '" + s + "'");
+  return v;
+}
+
+std::string constraint_json(const ConstraintInfo& c) {
+  return "{\"index\":" + std::to_string(c.index) + ",\"id\":" + std::to_string(c.id) + ",\"position\":[" +
+         json_number(c.position.x) + "," + json_number(c.position.y) + "," + json_number(c.position.z) +
+         "],\"value\":" + json_number(c.value) + "}";
+}
+
+/// {"base","version","full","changes":[{"op":"add"|"remove"|"update", <constraint>}..]} (docs/studio.md).
+std::string constraint_delta_json(const ConstraintDelta& d) {
+  std::string out = "{\"base\":" + std::to_string(d.base) + ",\"version\":" + std::to_string(d.version) +
+                    ",\"full\":" + (d.full ? "true" : "false") + ",\"changes\":[";
+  for (std::size_t k = 0; k < d.changes.size(); ++k) {
+    const ConstraintChange& c = d.changes[k];
+    const char* op = c.op == ConstraintChange::Op::Add      ? "add"
+                     : c.op == ConstraintChange::Op::Remove ? "remove"
+                                                            : "update";
+    if (k) out.push_back(',');
+    out += "{\"op\":\"" + std::string(op) + "\"," + constraint_json(c.constraint).substr(1);
+  }
+  return out + "]}";
 }
 
 std::string points_json(const std::vector<Point3>& pts) {
@@ -164,14 +190,18 @@ bool Api::is_api_path(const std::string& path) {
 
 ApiResponse Api::handle(const ApiRequest& request) {
   try {
+    std::unique_lock<std::mutex> lock(mutex_, std::defer_lock);
     if (request.path == "/api/refine") {  // yields to waiting requests, so it does not count as one
-      std::lock_guard<std::mutex> lock(mutex_);
-      return route(request);
+      lock.lock();
+    } else {
+      ++waiting_;
+      lock.lock();
+      --waiting_;
     }
-    ++waiting_;
-    std::unique_lock<std::mutex> lock(mutex_);
-    --waiting_;
-    return route(request);
+    const auto t0 = std::chrono::steady_clock::now();
+    ApiResponse out = route(request);
+    out.server_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    return out;
   } catch (const BadRequest& e) {
     return error_response(400, e.what());
   } catch (const JsonError& e) {
@@ -188,7 +218,9 @@ ApiResponse Api::handle(const ApiRequest& request) {
 ApiResponse Api::route(const ApiRequest& r) {
   const std::string& p = r.path;
   const char* method =
-      p == "/api/stats" || p == "/api/state" || p == "/api/mesh" || p == "/api/export" ? "GET"
+      p == "/api/stats" || p == "/api/state" || p == "/api/constraints" || p == "/api/mesh" ||
+              p == "/api/export"
+          ? "GET"
       : p == "/api/edit" || p == "/api/undo" || p == "/api/redo" || p == "/api/refine" || p == "/api/load"
           ? "POST"
           : nullptr;
@@ -196,14 +228,19 @@ ApiResponse Api::route(const ApiRequest& r) {
   if (r.method != method) return error_response(405, p + " takes " + method + ", not " + r.method);
   if (p == "/api/stats") return stats();
   if (p == "/api/state") return state();
+  if (p == "/api/constraints")
+    return json_response(constraint_delta_json(
+        session_.constraint_delta(version_param(r, std::numeric_limits<std::uint64_t>::max()))));
   if (p == "/api/mesh") return mesh(r);
   if (p == "/api/export") return export_file(r);
   if (p == "/api/edit") return edit(r);
   if (p == "/api/refine") return refine(r);
   if (p == "/api/load") return load(r);
   check_keys(parse_body(r.body), {});
+  const std::uint64_t base = session_.constraint_version();
   const bool done = p == "/api/undo" ? session_.undo() : session_.redo();
-  return json_response(stats_json(std::string("\"done\":") + (done ? "true" : "false")));
+  return json_response(
+      stats_json(std::string("\"done\":") + (done ? "true" : "false") + changes_since(base)));
 }
 
 std::string Api::stats_json(const std::string& extra) {
@@ -227,8 +264,13 @@ std::string Api::stats_json(const std::string& extra) {
          ",\"rebuilds\":" + std::to_string(s.rebuilds) +
          ",\"undo\":" + std::to_string(session_.undo_depth()) +
          ",\"redo\":" + std::to_string(session_.redo_depth()) +
-         ",\"revision\":" + std::to_string(session_.revision()) + "}";
+         ",\"revision\":" + std::to_string(session_.revision()) +
+         ",\"constraint_version\":" + std::to_string(session_.constraint_version()) + "}";
   return out;
+}
+
+std::string Api::changes_since(std::uint64_t base) const {
+  return ",\"constraint_delta\":" + constraint_delta_json(session_.constraint_delta(base));
 }
 
 ApiResponse Api::stats() {
@@ -239,9 +281,7 @@ ApiResponse Api::state() {
   std::string list = "[";
   for (const ConstraintInfo& c : session_.constraints()) {
     if (list.size() > 1) list.push_back(',');
-    list += "{\"index\":" + std::to_string(c.index) + ",\"id\":" + std::to_string(c.id) + ",\"position\":[" +
-            json_number(c.position.x) + "," + json_number(c.position.y) + "," + json_number(c.position.z) +
-            "],\"value\":" + json_number(c.value) + "}";
+    list += constraint_json(c);
   }
   return json_response(stats_json("\"constraint_list\":" + list + "]"));
 }
@@ -253,7 +293,8 @@ ApiResponse Api::mesh(const ApiRequest& r) {
     throw BadRequest("\"format\" must be binary, json or indexed, got '" + format + "'");
   const std::string exact = param(r, "exact", "1");
   if (exact != "0" && exact != "1") throw BadRequest("\"exact\" must be 0 or 1, got '" + exact + "'");
-  const ClientDelta d = session_.delta(version_param(r), exact == "1");
+  const auto since = static_cast<std::uint32_t>(version_param(r, 0xffffffffull));
+  const ClientDelta d = session_.delta(since, exact == "1");
   if (format == "json") return json_response(encode_json(d));
   ApiResponse out;
   out.content_type = "application/octet-stream";
@@ -264,6 +305,7 @@ ApiResponse Api::mesh(const ApiRequest& r) {
 ApiResponse Api::edit(const ApiRequest& r) {
   const Json body = parse_body(r.body);
   const std::string op = member(body, "op").as_string("\"op\"");
+  const std::uint64_t base = session_.constraint_version();
   std::string extra = "\"op\":" + json_quote(op);
   if (op == "add") {
     check_keys(body, {"op", "position", "value"});
@@ -282,7 +324,7 @@ ApiResponse Api::edit(const ApiRequest& r) {
   } else {
     throw BadRequest("unknown edit \"" + op + "\" (add, move, remove, value)");
   }
-  return json_response(stats_json(extra));
+  return json_response(stats_json(extra + changes_since(base)));
 }
 
 ApiResponse Api::refine(const ApiRequest& r) {

@@ -23,7 +23,8 @@ struct ApiResponse {
   int status = 200;
   std::string content_type = "application/json";
   std::string body;
-  std::string download;  ///< non-empty: offer the body as a file of this name (Content-Disposition)
+  std::string download;   ///< non-empty: offer the body as a file of this name (Content-Disposition)
+  double server_ms = -1;  ///< time the session spent on it (after waiting for earlier requests); < 0: none
 };
 
 /// A response {"error": what} with the given status.
@@ -54,6 +55,7 @@ class Api {
   ApiResponse load(const ApiRequest& request);
   ApiResponse export_file(const ApiRequest& request);
   std::string stats_json(const std::string& extra = {});
+  std::string changes_since(std::uint64_t base) const;
   std::string temp_path(const std::string& ext) const;
 
   Session& session_;

@@ -8,6 +8,7 @@
 
 #include <sys/socket.h>
 
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 
@@ -19,6 +20,11 @@ void answer(httplib::Response& res, const ApiResponse& r) {
   res.set_header("Cache-Control", "no-store");
   if (!r.download.empty())
     res.set_header("Content-Disposition", "attachment; filename=\"" + r.download + "\"");
+  if (r.server_ms >= 0) {  // the page separates server time from transfer (docs/studio.md)
+    char timing[64];
+    std::snprintf(timing, sizeof timing, "app;dur=%.3f", r.server_ms);
+    res.set_header("Server-Timing", timing);
+  }
   res.set_content(r.body, r.content_type.c_str());
 }
 
@@ -38,6 +44,8 @@ std::vector<StaticFile> static_files(const ServerOptions& o) {
   return {{"/", o.web_dir + "/index.html", "text/html; charset=utf-8"},
           {"/index.html", o.web_dir + "/index.html", "text/html; charset=utf-8"},
           {"/studio.js", o.web_dir + "/studio.js", js},
+          {"/studio_buffers.js", o.web_dir + "/studio_buffers.js", js},
+          {"/studio_bench.js", o.web_dir + "/studio_bench.js", js},
           {"/studio.css", o.web_dir + "/studio.css", "text/css; charset=utf-8"},
           {"/three/three.min.js", o.three_dir + "/build/three.min.js", js},
           {"/three/OrbitControls.js", o.three_dir + "/examples/js/controls/OrbitControls.js", js}};

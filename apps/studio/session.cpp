@@ -35,8 +35,9 @@ void Session::load(Constraints constraints, std::string name) {
                       constraints.size() > options_.mesher.auto_local_above);
   const std::size_t limit = local ? options_.max_local_constraints : options_.max_constraints;
   if (constraints.size() > limit)
-    throw LimitError(name + ": " + std::to_string(constraints.size()) + " constraints, the studio holds at most " +
-                     std::to_string(limit) + (local ? "" : " with the global function (try --function local)"));
+    throw LimitError(name + ": " + std::to_string(constraints.size()) +
+                     " constraints, the studio holds at most " + std::to_string(limit) +
+                     (local ? "" : " with the global function (try --function local)"));
   auto mesher = std::make_unique<Mesher>(constraints, options_.mesher);  // throws before anything changes
   mesher_ = std::move(mesher);
   name_ = std::move(name);
@@ -44,6 +45,8 @@ void Session::load(Constraints constraints, std::string name) {
   for (auto& id : ids_) id = next_id_++;
   undo_.clear();
   redo_.clear();
+  log_.clear();
+  ++constraint_version_;  // a page holding an older list gets the whole new one
   unit_ = mesher_->diagonal();
   Box3 box;
   for (const Point3& p : mesher_->constraints().points) box.extend(p);
@@ -87,12 +90,15 @@ Edit Session::apply(const Edit& e) {
   Edit inverse = e;
   switch (e.op) {
     case Edit::Op::Add:
-      if (ids_.size() >= (mesher_->local_function() ? options_.max_local_constraints : options_.max_constraints))
-        throw LimitError("the studio holds at most " + std::to_string(ids_.size()) + " constraints with this function");
+      if (ids_.size() >=
+          (mesher_->local_function() ? options_.max_local_constraints : options_.max_constraints))
+        throw LimitError("the studio holds at most " + std::to_string(ids_.size()) +
+                         " constraints with this function");
       check_position(e.position);
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
       timed_edit([&] { mesher_->add_constraint(e.position, e.value); });
       ids_.push_back(e.id);
+      log_change(ConstraintChange::Op::Add, info(ids_.size() - 1));
       inverse.op = Edit::Op::Remove;
       break;
     case Edit::Op::Remove: {
@@ -101,8 +107,10 @@ Edit Session::apply(const Edit& e) {
       inverse.op = Edit::Op::Add;
       inverse.position = mesher_->constraints().points[i];
       inverse.value = mesher_->constraints().values[i];
+      const ConstraintInfo gone = info(i);
       timed_edit([&] { mesher_->remove_constraint(i); });
       ids_.erase(ids_.begin() + static_cast<std::ptrdiff_t>(i));
+      log_change(ConstraintChange::Op::Remove, gone);
       break;
     }
     case Edit::Op::Move: {
@@ -110,6 +118,7 @@ Edit Session::apply(const Edit& e) {
       const std::size_t i = index_of(e.id);
       inverse.position = mesher_->constraints().points[i];
       timed_edit([&] { mesher_->move_constraint(i, e.position); });
+      log_change(ConstraintChange::Op::Update, info(i));
       break;
     }
     case Edit::Op::SetValue: {
@@ -117,10 +126,22 @@ Edit Session::apply(const Edit& e) {
       const std::size_t i = index_of(e.id);
       inverse.value = mesher_->constraints().values[i];
       timed_edit([&] { mesher_->set_value(i, e.value); });
+      log_change(ConstraintChange::Op::Update, info(i));
       break;
     }
   }
   return inverse;
+}
+
+ConstraintInfo Session::info(std::size_t index) const {
+  const Constraints& c = mesher_->constraints();
+  return {index, ids_[index], c.points[index], c.values[index]};
+}
+
+void Session::log_change(ConstraintChange::Op op, const ConstraintInfo& c) {
+  log_.push_back({op, c});
+  while (log_.size() > std::max<std::size_t>(options_.constraint_log, 1)) log_.pop_front();
+  ++constraint_version_;
 }
 
 void Session::record(Edit inverse) {
@@ -239,8 +260,21 @@ std::vector<ConstraintInfo> Session::constraints() const {
   const Constraints& c = mesher_->constraints();
   std::vector<ConstraintInfo> out;
   out.reserve(c.size());
-  for (std::size_t i = 0; i < c.size(); ++i) out.push_back({i, ids_[i], c.points[i], c.values[i]});
+  for (std::size_t i = 0; i < c.size(); ++i) out.push_back(info(i));
   return out;
+}
+
+ConstraintDelta Session::constraint_delta(std::uint64_t since) const {
+  ConstraintDelta d;
+  d.base = since;
+  d.version = constraint_version_;
+  if (since <= constraint_version_ && constraint_version_ - since <= log_.size()) {
+    d.changes.assign(log_.end() - static_cast<std::ptrdiff_t>(constraint_version_ - since), log_.end());
+    return d;
+  }
+  d.full = true;
+  for (const ConstraintInfo& c : constraints()) d.changes.push_back({ConstraintChange::Op::Add, c});
+  return d;
 }
 
 }  // namespace vitri::studio

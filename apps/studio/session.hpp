@@ -7,6 +7,7 @@
 #include "vitri/mesher.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -30,6 +31,9 @@ struct SessionOptions {
   double max_reach = 4.0;
   /// Grid cell of approximate mesh deltas (during drags), relative to the load diagonal (delta.hpp).
   double drag_tolerance = 1e-4;
+  /// Constraint changes remembered for incremental updates of a page's constraint list; a page further
+  /// behind gets the whole list.
+  std::size_t constraint_log = 4096;
   /// Mesher options (RBF, polygonizer, garbage collection); the implicit function choice goes here.
   MesherOptions mesher;
 };
@@ -40,6 +44,24 @@ struct ConstraintInfo {
   std::uint64_t id;
   Point3 position;
   double value;
+};
+
+/// One change of the constraint list, in index space, as the page applies it (docs/studio.md): Add appends
+/// `constraint` (its index is the new last one), Remove erases index `constraint.index` (later indices
+/// shift down), Update sets the position and value of `constraint.index`.
+struct ConstraintChange {
+  enum class Op { Add, Remove, Update };
+  Op op = Op::Add;
+  ConstraintInfo constraint{};
+};
+
+/// What a client holding the constraint list of version `base` applies to reach `version`. `full`: the
+/// log does not reach `base` (or a load happened); `changes` then adds the whole list to an empty one.
+struct ConstraintDelta {
+  std::uint64_t base = 0;
+  std::uint64_t version = 0;
+  bool full = false;
+  std::vector<ConstraintChange> changes;
 };
 
 /// One undoable edit, on a constraint named by its stable id.
@@ -101,6 +123,11 @@ class Session {
   /// triangles the Mesher changed travel (Mesher::update_surface()).
   ClientDelta delta(std::uint32_t since, bool exact);
   std::vector<ConstraintInfo> constraints() const;
+  /// Version of the constraint list: bumped by every change of a constraint (edit, undo, redo) and by a
+  /// load; never reused within a session (a page's version from before a load gets the full list).
+  std::uint64_t constraint_version() const { return constraint_version_; }
+  /// The constraint changes from version `since` to now (incremental when the log reaches back to it).
+  ConstraintDelta constraint_delta(std::uint64_t since) const;
   std::size_t size() const { return ids_.size(); }
   const std::string& name() const { return name_; }
   Mesher& mesher() { return *mesher_; }
@@ -118,6 +145,8 @@ class Session {
   void check_position(const Point3& p) const;
   void start(Constraints constraints);
   void timed_edit(const std::function<void()>& op);
+  ConstraintInfo info(std::size_t index) const;
+  void log_change(ConstraintChange::Op op, const ConstraintInfo& c);
 
   SessionOptions options_;
   std::string name_;
@@ -130,7 +159,9 @@ class Session {
   DeltaTracker tracker_;
   UpdateTimes times_;
   std::uint64_t revision_ = 0;
-  bool mesh_timed_ = false;  // extraction time of the current mesh recorded
+  std::uint64_t constraint_version_ = 0;
+  std::deque<ConstraintChange> log_;  // the last changes; log_.back() made constraint_version_
+  bool mesh_timed_ = false;           // extraction time of the current mesh recorded
 };
 
 }  // namespace vitri::studio

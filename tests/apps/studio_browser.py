@@ -5,7 +5,8 @@ Starts `vitri studio` on a free port, opens the page, adds a constraint by click
 it, undoes both edits, and checks through the HTTP API that the mesh changed, stayed closed (every edge
 shared by exactly two triangles) and came back. Screenshots go to --out (kept as test artifacts).
 
-Usage: studio_browser.py --vitri PATH/TO/vitri --out DIR [--model FILE] [--bench]
+Usage: studio_browser.py --vitri PATH/TO/vitri --out DIR [--model FILE] [--bench | --api-bench]
+                         [--precision P] [--studio-args "..."] [--window W,H] [--query "aa=1&lowres=0"]
 Exit status: 0 pass, 1 fail, 77 skipped (no browser, driver or selenium installed).
 --bench measures the edit-to-screen latency and drag rate in the page and prints them (docs/benchmarks.md).
 """
@@ -263,6 +264,9 @@ def click_drag_undo(driver, server, shot, s0, m0):
           % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
     check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
           "the page draws the server's mesh after the deltas")
+    check(page_constraints_match(driver, server), "the page's constraint list is the server's after the edits")
+    check(full_constraint_fetches(driver) == 1,
+          "the page took the constraint list once (at load), then only the changes of each edit")
 
 
 def open_file(driver, server, shot, out_dir):
@@ -280,13 +284,18 @@ def open_file(driver, server, shot, out_dir):
     wait_for("the page to be idle", lambda: page_idle(driver))
     s4 = server.get("/api/stats")
     check(s4["constraints"] == 15 and s4["undo"] == 0, "the uploaded file replaced the model")
+    check(page_constraints_match(driver, server), "the page holds the uploaded model's constraints")
     check(edges_closed(server.get("/api/mesh?format=indexed")), "the uploaded model's mesh is closed")
-    check(driver.execute_script("return studio.slots.triangles") == s4["triangles"],
+    # Refinement goes on while the page is idle: compare the page's mesh with the server's once it ended.
+    wait_for("refinement of the uploaded model", lambda: server.get("/api/stats")["refined"], 300)
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    time.sleep(0.5)
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    check(driver.execute_script("return studio.slots.triangles") == server.get("/api/stats")["triangles"],
           "the page draws the uploaded model")
     shot("studio-4-opened.png")
     # Shift+click: an outside constraint (value +depth); alt+click: an inside one (value -depth).
     canvas = driver.find_element("css selector", "#view canvas")
-    wait_for("refinement of the uploaded model", lambda: server.get("/api/stats")["refined"], 300)
     for key, sign, what, dx, dy in ((Keys.SHIFT, 1, "outside", -70, 50), (Keys.ALT, -1, "inside", 60, -40)):
         n = server.get("/api/stats")["constraints"]
         ActionChains(driver).move_to_element_with_offset(canvas, dx, dy).key_down(key).click().key_up(key).perform()
@@ -294,6 +303,7 @@ def open_file(driver, server, shot, out_dir):
         wait_for("the page to be idle", lambda: page_idle(driver))
         value = server.get("/api/state")["constraint_list"][-1]["value"]
         check(value * sign > 0, "modifier click added an %s constraint (value %g)" % (what, value))
+        check(page_constraints_match(driver, server), "the page's constraint list is the server's")
     check(edges_closed(server.get("/api/mesh?format=indexed")), "the mesh is closed after them")
     shot("studio-5-modifiers.png")
 
@@ -307,7 +317,8 @@ def run(args):
         if args.api_bench:
             return api_bench(server)
         driver, profile = launch_browser(args.out, args.window)
-        driver.get(server.url + "/" + ("?aa=0" if args.no_antialias else ""))
+        query = "&".join(q for q in (["aa=0"] if args.no_antialias else []) + ([args.query] if args.query else []))
+        driver.get(server.url + "/" + ("?" + query if query else ""))
         wait_for("the page to start", lambda: driver.execute_script("return !!(window.studio && studio.ready)"))
         webgl = driver.execute_script("return !!studio.renderer.getContext()")
         check(webgl, "the page has a WebGL context")
@@ -341,18 +352,49 @@ def run(args):
 
 
 def bench(driver, server, out_dir):
-    run_js = lambda code: driver.execute_async_script(
-        "const done = arguments[arguments.length - 1];" + code + ".then(done, (e) => done({error: String(e)}));")
+    """In-page latencies (apps/studio/web/studio_bench.js): clicks that add a constraint (each undone),
+    a drag waiting for each frame, and a live drag (one pointer move per animation frame)."""
+    def run_js(code):
+        r = driver.execute_async_script(
+            "const done = arguments[arguments.length - 1];" + code + ".then(done, (e) => done({error: String(e)}));")
+        if "error" in r:
+            raise Failure(code + ": " + r["error"])
+        return r
     stats = server.get("/api/stats")
+    load = [os.getloadavg()[0]]
     adds = run_js("studio.benchAdd({count: 12})")
     drag = run_js("studio.benchDrag({moves: 60})")
-    drag_async = run_js("studio.benchDrag({moves: 60, sync: false})")
+    live = run_js("studio.benchDrag({moves: 120, live: true})")
+    load.append(os.getloadavg()[0])
     driver.save_screenshot(os.path.join(out_dir, "studio-bench.png"))
-    print("BENCH " + json.dumps({"model": stats["name"], "load_average": os.getloadavg()[0], "constraints": stats["constraints"],
+    print("BENCH " + json.dumps({"model": stats["name"], "load_average": load, "constraints": stats["constraints"],
                                  "triangles": stats["triangles"], "vertices": stats["vertices"],
-                                 "add": adds, "drag": drag,
-                                 "drag_async_updates_per_second": drag_async["updates_per_second"]}))
+                                 "browser": driver.capabilities.get("browserVersion"),
+                                 "webgl": driver.execute_script(WEBGL_RENDERER),
+                                 "antialias": driver.execute_script("return studio.renderer.getContextAttributes().antialias"),
+                                 "low_res_interaction": driver.execute_script("return studio.lowResInteraction"),
+                                 "add": adds["add"], "undo": adds["undo"], "drag": drag, "live_drag": live}, indent=1))
     return 0
+
+
+WEBGL_RENDERER = """const gl = studio.renderer.getContext(), e = gl.getExtension('WEBGL_debug_renderer_info');
+return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);"""
+
+
+def page_constraints_match(driver, server):
+    """The page's constraint list (kept from deltas) equals the server's, value for value."""
+    page = driver.execute_script(
+        "const c = studio.constraints, out = [];"
+        "for (let i = 0; i < c.count; ++i) out.push(c.position(i).concat([c.value(i)]));"
+        "return out;")
+    server_list = [c["position"] + [c["value"]] for c in server.get("/api/state")["constraint_list"]]
+    return page == server_list
+
+
+def full_constraint_fetches(driver):
+    """How many times the page asked for the constraint list with /api/constraints (a load, or out of step)."""
+    return driver.execute_script(
+        "return performance.getEntriesByType('resource').filter((e) => e.name.includes('/api/constraints')).length")
 
 
 def main():
@@ -365,6 +407,7 @@ def main():
     ap.add_argument("--api-bench", action="store_true", help="measure edit + delta round trips without a browser")
     ap.add_argument("--window", default="1280,800", help="browser window size W,H")
     ap.add_argument("--no-antialias", action="store_true", help="WebGL without antialiasing (page ?aa=0)")
+    ap.add_argument("--query", default="", help="more page options, e.g. aa=1&lowres=0 (docs/studio.md)")
     ap.add_argument("--studio-args", default="", help="more vitri studio arguments (space-separated)")
     args = ap.parse_args()
     os.makedirs(args.out, exist_ok=True)

@@ -92,7 +92,8 @@ struct Running {
   std::string fingerprint() {
     const Json s = get("/api/state");
     std::string out = Json(s.find("constraint_list")->as_array("")).dump();
-    for (const char* k : {"constraints", "vertices", "triangles", "undo", "redo", "revision", "precision"})
+    for (const char* k : {"constraints", "vertices", "triangles", "undo", "redo", "revision", "precision",
+                          "constraint_version"})
       out += std::string(" ") + k + "=" + s.find(k)->dump();
     return out;
   }
@@ -305,6 +306,9 @@ TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[
   get_error("/api/mesh?since=-1", 400, "since");
   get_error("/api/mesh?since=abc", 400, "since");
   get_error("/api/mesh?since=99999999999", 400, "since");
+  get_error("/api/constraints?since=-1", 400, "since");
+  get_error("/api/constraints?since=x1", 400, "since");
+  get_error("/api/constraints?since=99999999999999999999999", 400, "since");
   get_error("/api/mesh?format=svg", 400, "format");
   get_error("/api/mesh?exact=2", 400, "exact");
   get_error("/api/export?format=stl", 400, "format");
@@ -324,16 +328,160 @@ TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[
   CHECK(number(r.post("/api/undo", "{}"), "undo") == 0);
 }
 
+namespace {
+
+/// A client's copy of the constraint list, kept up to date from constraint deltas only (as the page).
+struct HeldConstraints {
+  std::vector<std::string> list;  // per index: id, position and value as JSON
+  double version = 0;
+
+  static std::string key(const Json& c) {
+    return c.find("id")->dump() + " " + c.find("position")->dump() + " " + c.find("value")->dump();
+  }
+  /// Applies a delta; false when it does not follow the version held (the page then asks for another).
+  bool apply(const Json& d) {
+    const bool full = d.find("full")->as_bool("");
+    if (!full && number(d, "base") != version) return false;
+    if (full) list.clear();
+    for (const Json& c : d.find("changes")->as_array("")) {
+      const std::string op = c.find("op")->as_string("");
+      const auto i = static_cast<std::size_t>(number(c, "index"));
+      if (op == "add") {
+        REQUIRE(i == list.size());
+        list.push_back(key(c));
+      } else {
+        REQUIRE(i < list.size());
+        if (op == "remove")
+          list.erase(list.begin() + static_cast<std::ptrdiff_t>(i));
+        else
+          list[i] = key(c);
+      }
+    }
+    version = number(d, "version");
+    return true;
+  }
+  /// The server's list, in the same form.
+  static std::vector<std::string> of(Running& r) {
+    std::vector<std::string> out;
+    const Json state = r.get("/api/state");
+    for (const Json& c : state.find("constraint_list")->as_array("")) out.push_back(key(c));
+    return out;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("studio api: constraint deltas keep a client's list equal to the server's", "[studio][api]") {
+  Running r;
+  HeldConstraints page, late;  // `page` applies every answer's delta; `late` catches up now and then
+  REQUIRE(page.apply(r.get("/api/constraints?since=0")));
+  CHECK(page.list == HeldConstraints::of(r));
+  CHECK(page.version == number(r.get("/api/stats"), "constraint_version"));
+  late = page;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  int applied = 0;
+  for (int step = 0; step < 30; ++step) {
+    const std::size_t n = page.list.size(), i = 1 + rng() % (n - 7);  // not the center, not the outside six
+    std::string path = "/api/edit", body;
+    switch (rng() % 6) {
+      case 0:
+        body = "{\"op\":\"add\",\"position\":[" + std::to_string(0.8 * u(rng)) + "," +
+               std::to_string(0.6 * u(rng)) + "," + std::to_string(0.4 * u(rng)) + "],\"value\":0}";
+        break;
+      case 1:
+        body = "{\"op\":\"move\",\"index\":" + std::to_string(i) + ",\"position\":[" +
+               std::to_string(0.7 * u(rng)) + "," + std::to_string(0.5 * u(rng)) +
+               ",0.3],\"merge\":" + (rng() % 2 ? "true" : "false") + "}";
+        break;
+      case 2:
+        body = "{\"op\":\"remove\",\"index\":" + std::to_string(i) + "}";
+        break;
+      case 3:
+        body = "{\"op\":\"value\",\"index\":" + std::to_string(i) +
+               ",\"value\":" + std::to_string(0.02 * u(rng)) + "}";
+        break;
+      default:
+        path = rng() % 3 ? "/api/undo" : "/api/redo";
+        body = "{}";
+    }
+    INFO("step " << step << ": " << path << " " << body);
+    const auto res = r.client.Post(path.c_str(), body, "application/json");
+    REQUIRE(res);
+    if (res->status != 200) {  // a rejected edit (e.g. a degenerate fit) changes nothing
+      CHECK(number(r.get("/api/stats"), "constraint_version") == page.version);
+      continue;
+    }
+    CHECK_THAT(res->get_header_value("Server-Timing"), Catch::StartsWith("app;dur="));
+    const Json s = Json::parse(res->body);
+    const Json& d = *s.find("constraint_delta");
+    CHECK_FALSE(d.find("full")->as_bool(""));
+    REQUIRE(page.apply(d));  // the answer's delta follows the page's version: no second request
+    applied += !d.find("changes")->as_array("").empty();
+    CHECK(page.version == number(s, "constraint_version"));
+    CHECK(page.list == HeldConstraints::of(r));
+    if (step % 7 == 3) {  // several versions behind: the changes since then, not the whole list
+      const Json catch_up =
+          r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(late.version)));
+      CHECK_FALSE(catch_up.find("full")->as_bool(""));
+      REQUIRE(late.apply(catch_up));
+      CHECK(late.list == page.list);
+    }
+  }
+  CHECK(applied > 10);
+  // Nothing changed since the version held: an empty delta.
+  const Json none = r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(page.version)));
+  CHECK(none.find("changes")->as_array("").empty());
+  CHECK_FALSE(none.find("full")->as_bool(""));
+  // A version from the future, and a load: the whole list.
+  CHECK(r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(page.version) + 5))
+            .find("full")
+            ->as_bool(""));
+  const auto x = r.client.Get("/api/export?format=xyzv");
+  REQUIRE(x);
+  r.check(r.client.Post("/api/load?name=again.xyzv", x->body, "application/octet-stream"), 200);
+  const Json after_load =
+      r.get("/api/constraints?since=" + std::to_string(static_cast<long long>(page.version)));
+  CHECK(after_load.find("full")->as_bool(""));
+  REQUIRE(page.apply(after_load));
+  CHECK(page.list == HeldConstraints::of(r));
+}
+
+TEST_CASE("studio session: the constraint log is bounded; older versions get the whole list",
+          "[studio][session]") {
+  SessionOptions o = fast_options();
+  o.constraint_log = 3;
+  Session session(small_model(), "small", o);
+  const std::uint64_t v0 = session.constraint_version();
+  for (int k = 0; k < 5; ++k) session.move(2, {0.1 * k, 0.5, 0.3}, false);
+  CHECK(session.constraint_version() == v0 + 5);
+  const ConstraintDelta recent = session.constraint_delta(v0 + 2);
+  CHECK_FALSE(recent.full);
+  REQUIRE(recent.changes.size() == 3);
+  CHECK(recent.changes.back().op == ConstraintChange::Op::Update);
+  CHECK(recent.changes.back().constraint.position.x == 0.4);
+  const ConstraintDelta old = session.constraint_delta(v0 + 1);
+  CHECK(old.full);
+  CHECK(old.changes.size() == session.size());
+  session.remove(4);
+  const ConstraintDelta removal = session.constraint_delta(v0 + 5);
+  REQUIRE(removal.changes.size() == 1);
+  CHECK(removal.changes[0].op == ConstraintChange::Op::Remove);
+  CHECK(removal.changes[0].constraint.index == 4);
+}
+
 TEST_CASE("studio api: the page's files are served, three.js missing is a clear error", "[studio][api]") {
   Running r;
   const auto page = r.client.Get("/");
   REQUIRE(page);
   CHECK(page->status == 200);
   CHECK_THAT(page->body, Catch::Contains("studio.js"));
-  const auto js = r.client.Get("/studio.js");
-  REQUIRE(js);
-  CHECK(js->status == 200);
-  CHECK(js->get_header_value("Content-Type").rfind("application/javascript", 0) == 0);
+  for (const char* file : {"/studio.js", "/studio_buffers.js", "/studio_bench.js"}) {
+    const auto js = r.client.Get(file);
+    REQUIRE(js);
+    CHECK(js->status == 200);
+    CHECK(js->get_header_value("Content-Type").rfind("application/javascript", 0) == 0);
+  }
   const Json e = r.get("/three/three.min.js", 500);
   CHECK_THAT(e.find("error")->as_string(""), Catch::Contains("/nonexistent-three/build/three.min.js"));
 }

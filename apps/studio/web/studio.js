@@ -1,6 +1,7 @@
 // vitri studio: the page. Draws the mesh and the constraints with three.js, sends edits to the server's
 // HTTP/JSON API and applies the mesh deltas it answers with (docs/studio.md). No build step, no modules:
-// three.min.js and OrbitControls.js (Debian libjs-three) are loaded before this file.
+// three.min.js and OrbitControls.js (Debian libjs-three), then studio_buffers.js (the mesh and the
+// constraints held in WebGL buffers) are loaded before this file.
 'use strict';
 
 // ------------------------------------------------------------------------------------------- server
@@ -24,153 +25,33 @@ const api = {
   },
 };
 
-// ------------------------------------------------------------------------------ mesh held as slots
-// Each triangle the server sent has an id; it lives in a slot (9 floats of positions and normals) of
-// one growing, non-indexed BufferGeometry. A removed triangle's slot is zeroed (degenerate, invisible)
-// and reused by the next added one; only the range of slots that changed is uploaded.
-class MeshSlots {
-  constructor(scene) {
-    this.geometry = new THREE.BufferGeometry();
-    this.capacity = 0;
-    this.used = 0;          // slots ever used (draw range)
-    this.slotOf = new Map(); // triangle id -> slot
-    this.free = [];
-    this.version = 0;
-    this.triangles = 0;
-    this.grow(1024);
-    const shaded = new THREE.MeshPhongMaterial({ color: 0xb9c4d6, specular: 0x222222, shininess: 30,
-                                                 side: THREE.DoubleSide, polygonOffset: true,
-                                                 polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
-    this.mesh = new THREE.Mesh(this.geometry, shaded);
-    this.wire = new THREE.Mesh(this.geometry, new THREE.MeshBasicMaterial({ color: 0x20242c, wireframe: true }));
-    this.wire.visible = false;
-    scene.add(this.mesh, this.wire);
-  }
-
-  grow(capacity) {
-    const positions = new Float32Array(capacity * 9), normals = new Float32Array(capacity * 9);
-    if (this.capacity) {
-      positions.set(this.geometry.attributes.position.array);
-      normals.set(this.geometry.attributes.normal.array);
-    }
-    for (const [name, array] of [['position', positions], ['normal', normals]]) {
-      const attribute = new THREE.BufferAttribute(array, 3);
-      attribute.setUsage(THREE.DynamicDrawUsage);
-      this.geometry.setAttribute(name, attribute);
-    }
-    this.capacity = capacity;
-  }
-
-  // Applies one binary delta (format in docs/studio.md). Returns the number of triangles changed.
-  apply(buffer) {
-    const words = new Uint32Array(buffer, 0, 6);
-    if (words[0] !== 0x44525456) throw new Error('not a vitri mesh delta');
-    const full = words[1] & 1, version = words[2], nRemoved = words[4], nAdded = words[5];
-    const removed = new Uint32Array(buffer, 24, nRemoved);
-    const added = new Uint32Array(buffer, 24 + 4 * nRemoved, nAdded);
-    const floats = 24 + 4 * (nRemoved + nAdded);
-    const pos = new Float32Array(buffer, floats, 9 * nAdded);
-    const nrm = new Float32Array(buffer, floats + 36 * nAdded, 9 * nAdded);
-    if (full) this.clear();
-    let lo = Infinity, hi = -1;
-    const P = () => this.geometry.attributes.position.array;
-    for (const id of removed) {
-      const slot = this.slotOf.get(id);
-      if (slot === undefined) continue;
-      this.slotOf.delete(id);
-      P().fill(0, 9 * slot, 9 * slot + 9);
-      this.free.push(slot);
-      lo = Math.min(lo, slot); hi = Math.max(hi, slot);
-    }
-    if (this.used + nAdded > this.capacity && this.free.length < nAdded) {
-      this.grow(Math.max(2 * this.capacity, this.used + nAdded));
-      lo = 0; hi = Math.max(hi, this.used - 1);
-    }
-    const positions = P(), normals = this.geometry.attributes.normal.array;
-    for (let k = 0; k < nAdded; ++k) {
-      const slot = this.free.length ? this.free.pop() : this.used++;
-      this.slotOf.set(added[k], slot);
-      positions.set(pos.subarray(9 * k, 9 * k + 9), 9 * slot);
-      normals.set(nrm.subarray(9 * k, 9 * k + 9), 9 * slot);
-      lo = Math.min(lo, slot); hi = Math.max(hi, slot);
-    }
-    if (hi >= lo) {
-      for (const name of ['position', 'normal']) {
-        const a = this.geometry.attributes[name];
-        a.updateRange.offset = 9 * lo;
-        a.updateRange.count = 9 * (hi - lo + 1);
-        a.needsUpdate = true;
-      }
-    }
-    this.geometry.setDrawRange(0, 3 * this.used);
-    this.geometry.computeBoundingSphere();
-    this.version = version;
-    this.triangles = this.slotOf.size;
-    return nRemoved + nAdded;
-  }
-
-  clear() {
-    this.geometry.attributes.position.array.fill(0);
-    this.slotOf.clear();
-    this.free = [];
-    this.used = 0;
-  }
-}
-
-// ------------------------------------------------------------------------------------- constraints
-const KIND_COLORS = { on: new THREE.Color(0xf2c94c), in: new THREE.Color(0x4c9bf2), out: new THREE.Color(0xf2584c) };
-const kindOf = (value) => (value === 0 ? 'on' : value < 0 ? 'in' : 'out');
-
-function discTexture() {
-  const c = document.createElement('canvas');
-  c.width = c.height = 64;
-  const g = c.getContext('2d');
-  g.beginPath(); g.arc(32, 32, 28, 0, 2 * Math.PI);
-  g.fillStyle = '#fff'; g.fill();
-  g.lineWidth = 5; g.strokeStyle = '#000'; g.stroke();
-  return new THREE.CanvasTexture(c);
-}
-
-class ConstraintPoints {
-  constructor(scene) {
-    this.list = [];
-    this.selected = -1;
-    this.material = new THREE.PointsMaterial({ size: 11 * window.devicePixelRatio, vertexColors: THREE.VertexColors,
-                                               map: discTexture(), alphaTest: 0.5, sizeAttenuation: false });
-    this.points = new THREE.Points(new THREE.BufferGeometry(), this.material);
-    this.points.renderOrder = 1;
-    scene.add(this.points);
-  }
-
-  set(list) {
-    this.list = list;
-    const n = list.length, pos = new Float32Array(3 * n), col = new Float32Array(3 * n);
-    list.forEach((c, i) => {
-      pos.set(c.position, 3 * i);
-      const color = i === this.selected ? new THREE.Color(0xffffff) : KIND_COLORS[kindOf(c.value)];
-      col.set([color.r, color.g, color.b], 3 * i);
-    });
-    const g = this.points.geometry;
-    g.setAttribute('position', new THREE.BufferAttribute(pos, 3));
-    g.setAttribute('color', new THREE.BufferAttribute(col, 3));
-    g.computeBoundingSphere();
-    // Discs of 11 pixels for a few constraints, down to 5 for thousands (so that the surface shows).
-    this.material.size = Math.max(5, Math.min(11, 60 / Math.sqrt(Math.max(n, 1)))) * window.devicePixelRatio;
-  }
-
-  moveLocally(index, p) {
-    const a = this.points.geometry.attributes.position;
-    a.setXYZ(index, p.x, p.y, p.z);
-    a.needsUpdate = true;
-    this.list[index].position = [p.x, p.y, p.z];
-  }
-}
-
 // ------------------------------------------------------------------------------------------ studio
+// Milliseconds the server spent on a response (its Server-Timing header; 0 when absent).
+function serverMs(response) {
+  const m = /dur=([0-9.]+)/.exec(response.headers.get('Server-Timing') || '');
+  return m ? parseFloat(m[1]) : 0;
+}
+
+// True when WebGL is drawn by a software rasterizer (SwiftShader, llvmpipe): a probe context's renderer.
+function softwareWebGL() {
+  const gl = document.createElement('canvas').getContext('webgl');
+  if (!gl) return false;
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  const lose = gl.getExtension('WEBGL_lose_context');
+  if (lose) lose.loseContext();
+  return /swiftshader|llvmpipe|softpipe|software/i.test(name);
+}
+
 class Studio {
   constructor() {
     this.view = document.getElementById('view');
-    this.renderer = new THREE.WebGLRenderer({ antialias: !/[?&]aa=0/.test(location.search) });
+    // A software rasterizer (no GPU) pays for every pixel on the CPU; multisampling doubles the cost of a
+    // frame there (docs/benchmarks.md), so it is off unless asked for (?aa=1); ?aa=0 turns it off anywhere.
+    this.software = softwareWebGL();
+    const aa = /[?&]aa=([01])/.exec(location.search);
+    this.renderer = new THREE.WebGLRenderer({ antialias: aa ? aa[1] === '1' : !this.software });
+    this.lowResInteraction = this.software && !/[?&]lowres=0/.test(location.search);
     this.renderer.setPixelRatio(window.devicePixelRatio);
     this.renderer.setClearColor(0x2b2f37);
     this.view.appendChild(this.renderer.domElement);
@@ -182,21 +63,24 @@ class Studio {
     this.camera.add(light);
     this.scene.add(this.camera);
     this.controls = new THREE.OrbitControls(this.camera, this.renderer.domElement);
-    this.controls.addEventListener('change', () => this.render());
+    this.controls.addEventListener('change', () => this.present());
     this.slots = new MeshSlots(this.scene);
     this.constraints = new ConstraintPoints(this.scene);
     this.raycaster = new THREE.Raycaster();
     this.stats = null;
-    this.latency = null;     // ms from sending the last edit to its picture on screen
-    this.latencies = [];
-    this.drawTimes = [];
+    this.latency = null;  // ms from the last edit's pointer event to its frame
+    // Timing of every edit (see present()); benchmarks read and clear it.
+    this.timings = [];
+    this.waiting = [];    // timings of updates applied, waiting for their frame
+    this.frame = null;    // promise of the next frame, while one is requested
     this.busy = Promise.resolve();  // edits run one after the other
     this.drag = null;
     this.pixel = new Uint8Array(4);
-    // Benchmarks wait for each frame to be drawn, so that a latency includes the drawing; otherwise the
-    // next request goes out while the GPU draws.
+    // Benchmarks wait for each frame to be drawn (a pixel read back), so that the draw time is the GPU's
+    // (here the software rasterizer's), not only the submission of the commands.
     this.syncDraw = false;
     this.idleTimer = 0;
+    this.holdIdle = false;  // benchmarks: no idle work between the updates they time
     this.ready = false;
     window.addEventListener('resize', () => this.resize());
     this.resize();
@@ -210,7 +94,43 @@ class Studio {
     this.render();
   }
 
-  render() { this.renderer.render(this.scene, this.camera); }
+  // Draws the scene. `interactive`: a frame for an edit or a drag; a software rasterizer draws those at
+  // half resolution (a quarter of the pixels; ?lowres=0 turns it off), the next other frame (the exact
+  // mesh when idle, orbiting, selecting) at full resolution again.
+  render(interactive = false) {
+    const ratio = window.devicePixelRatio * (interactive && this.lowResInteraction ? 0.5 : 1);
+    if (this.renderer.getPixelRatio() !== ratio) this.renderer.setPixelRatio(ratio);
+    this.constraints.material.size = this.constraints.size * ratio;
+    this.renderer.render(this.scene, this.camera);
+  }
+
+  // Draws in the next animation frame (several updates within one frame are drawn once). `timing`: an
+  // edit's record, completed when its frame is drawn: {event, sent, server, received, applied, frame,
+  // drawn} (performance.now() ms; server: ms the server spent on the edit and its delta). Returns a
+  // promise resolved after the frame.
+  present(timing) {
+    if (timing) {
+      timing.applied = performance.now();
+      this.waiting.push(timing);
+    }
+    if (!this.frame) {
+      this.frame = new Promise((resolve) => requestAnimationFrame(() => {
+        const t = performance.now();
+        this.render(this.waiting.length > 0 || this.drag !== null);
+        if (this.syncDraw) this.waitForDraw();
+        const drawn = performance.now();
+        for (const w of this.waiting) {
+          Object.assign(w, { frame: t, drawn });
+          this.latency = drawn - w.event;
+          this.timings.push(w);
+        }
+        this.waiting = [];
+        this.frame = null;
+        resolve();
+      }));
+    }
+    return this.frame;
+  }
 
   // Blocks until the last frame is drawn: reading a pixel back waits for the GPU (gl.finish() may not).
   waitForDraw() {
@@ -233,27 +153,27 @@ class Studio {
     this.errorTimer = setTimeout(() => { box.hidden = true; }, 6000);
   }
 
-  // Fetches the mesh delta since the version held, applies it and draws. `t0`: when the edit was sent.
+  // Fetches the mesh delta since the version held and applies it (not drawn yet: present()).
   // `approximate`: during a drag, triangles that moved less than the drag tolerance are not resent.
-  async pull(t0, approximate) {
+  async pull(timing, approximate) {
     const r = await api.request('GET', '/api/mesh?since=' + this.slots.version + (approximate ? '&exact=0' : ''));
-    const buffer = await r.arrayBuffer(), t1 = performance.now();
-    this.slots.apply(buffer);
-    this.render();
-    if (this.syncDraw) this.waitForDraw();
-    if (t0 !== undefined) {
-      const t2 = performance.now();
-      this.latency = t2 - t0;
-      this.latencies.push(this.latency);
-      this.drawTimes.push(t2 - t1);  // of which: applying the delta and drawing (when syncDraw)
+    const buffer = await r.arrayBuffer();
+    if (timing) {
+      timing.server += serverMs(r);
+      timing.received = performance.now();
+      timing.bytes = buffer.byteLength;
     }
+    const changed = this.slots.apply(buffer);
+    this.slots.approximate = !!approximate;
+    if (timing) timing.changed = changed;
   }
 
-  async refreshState() {
-    const s = await api.json('GET', '/api/state');
-    this.constraints.set(s.constraint_list);
-    delete s.constraint_list;
-    this.showStats(s);
+  // Brings the constraint list up to date: `delta` (from an edit's answer) when it follows the version
+  // held, else the changes since that version (the whole list after a load or when too far behind).
+  async syncConstraints(delta) {
+    if (delta && this.constraints.apply(delta)) return;
+    const r = await api.request('GET', '/api/constraints?since=' + this.constraints.version);
+    if (!this.constraints.apply(await r.json())) throw new Error('constraint list out of step with the server');
   }
 
   showStats(s) {
@@ -275,40 +195,54 @@ class Studio {
     this.updateSelection();
   }
 
-  // One edit: POST it, then bring the mesh up to date (approximately while `dragging`), and the
-  // constraint list unless `dragging` (the page moved the dragged point itself).
-  edit(body, dragging) {
+  // Sends a POST (an edit, undo or redo), applies the mesh delta and the constraint changes it brought,
+  // and draws. `event`: the time of the pointer or key event that caused it (the latency's start). The
+  // mesh delta is approximate (vertices that moved less than the drag tolerance are not resent: with the
+  // global function an edit moves every root a little); the exact mesh follows when the user is idle.
+  // `select(answer)`: the constraint to select after it (-1: none).
+  update(path, body, { event, approximate = true, select } = {}) {
     return this.queue(async () => {
-      const t0 = performance.now();
-      const s = await api.json('POST', '/api/edit', body);
-      await this.pull(t0, dragging);
-      if (dragging) this.showStats(s); else await this.refreshState();
+      const timing = { event: event === undefined ? performance.now() : event, sent: performance.now(), server: 0 };
+      const r = await api.request('POST', path, body === undefined ? undefined : JSON.stringify(body));
+      timing.server += serverMs(r);
+      const s = await r.json();
+      await this.pull(timing, approximate);
+      await this.syncConstraints(s.constraint_delta);
+      if (select !== undefined) this.select(select(s), false);  // in the same frame
+      this.present(timing);
+      this.showStats(s);
       this.scheduleRefine();
       return s;
     });
   }
 
-  command(path) {
-    return this.queue(async () => {
-      const t0 = performance.now();
-      await api.json('POST', path);
-      this.select(-1);
-      await this.pull(t0);
-      await this.refreshState();
-      this.scheduleRefine();
-    });
+  // One edit (docs/studio.md); an added constraint is selected.
+  edit(body, event) {
+    return this.update('/api/edit', body, { event, select: body.op === 'add' ? (s) => s.index : undefined });
   }
 
-  // Progressive refinement: while the user is idle, ask the server for the next level.
+  command(path, event) {
+    return this.update(path, undefined, { event, select: () => -1 });
+  }
+
+  // While the user is idle: the exact mesh after approximate updates, then progressive refinement (the
+  // server's next level, one request at a time).
   scheduleRefine(delay = 300) {
     clearTimeout(this.idleTimer);
-    if (this.stats && this.stats.refined) return;
+    if (this.stats && this.stats.refined && !this.slots.approximate) return;
     this.idleTimer = setTimeout(() => {
-      if (this.drag) return this.scheduleRefine();
+      if (this.drag || this.holdIdle) return this.scheduleRefine();
       this.queue(async () => {
-        const s = await api.json('POST', '/api/refine');
-        await this.pull();
-        this.showStats(s);
+        if (this.slots.approximate) {
+          await this.pull();
+          this.present();
+        }
+        if (!this.stats.refined) {
+          const s = await api.json('POST', '/api/refine');
+          await this.pull();
+          this.present();
+          this.showStats(s);
+        }
         this.scheduleRefine(50);
       });
     }, delay);
@@ -319,24 +253,32 @@ class Studio {
     return this.queue(async () => {
       const s = await api.json('POST', '/api/refine', { precision: p });
       await this.pull();
+      this.present();
       this.showStats(s);
       this.scheduleRefine(50);
     });
+  }
+
+  // The whole state after a start or a load: the mesh from nothing, the whole constraint list.
+  async reload() {
+    this.select(-1);
+    await this.pull();
+    await this.syncConstraints();
+    this.showStats(await api.json('GET', '/api/stats'));
   }
 
   async load(file) {
     const bytes = await file.arrayBuffer();
     await this.queue(async () => {
       await api.request('POST', '/api/load?name=' + encodeURIComponent(file.name), bytes);
-      this.select(-1);
-      await this.pull();
-      await this.refreshState();
-      this.frame();
+      await this.reload();
+      this.frameModel();
       this.scheduleRefine();
     });
   }
 
-  frame() {
+  frameModel() {
+    this.slots.geometry.computeBoundingSphere();
     const sphere = this.slots.geometry.boundingSphere;
     const r = sphere && sphere.radius > 0 ? sphere.radius : 1;
     const c = sphere ? sphere.center : new THREE.Vector3();
@@ -350,22 +292,22 @@ class Studio {
     this.render();
   }
 
-  select(index) {
-    this.constraints.selected = index;
-    this.constraints.set(this.constraints.list);
+  select(index, draw = true) {
+    this.constraints.select(index);
     this.updateSelection();
-    this.render();
+    if (draw) this.present();
   }
 
   updateSelection() {
-    const i = this.constraints.selected, c = this.constraints.list[i];
-    document.getElementById('selection').hidden = !c;
-    document.getElementById('delete').disabled = !c;
-    if (!c) return;
+    const i = this.constraints.selected, has = i >= 0 && i < this.constraints.count;
+    document.getElementById('selection').hidden = !has;
+    document.getElementById('delete').disabled = !has;
+    if (!has) return;
+    const value = this.constraints.value(i);
     document.getElementById('sel-index').textContent = i;
-    document.getElementById('sel-kind').textContent = { on: 'on-surface', in: 'inside', out: 'outside' }[kindOf(c.value)];
+    document.getElementById('sel-kind').textContent = { on: 'on-surface', in: 'inside', out: 'outside' }[kindOf(value)];
     const input = document.getElementById('sel-value');
-    if (document.activeElement !== input) input.value = c.value;
+    if (document.activeElement !== input) input.value = value;
   }
 
   depth() {
@@ -385,19 +327,33 @@ Studio.prototype.ray = function (event) {
   return this.raycaster;
 };
 
-// The constraint drawn nearest to the pointer (within 8 pixels), the front-most when several are.
+// Window coordinates and depth (NDC z) of constraint i.
+Studio.prototype.screenOf = function (i, rect = this.renderer.domElement.getBoundingClientRect()) {
+  const p = new THREE.Vector3().fromArray(this.constraints.position(i)).project(this.camera);
+  return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height, z: p.z };
+};
+
+// The constraint drawn nearest to the pointer (within 8 pixels), the front-most when several are. One
+// projection per constraint (a few ms for 10^5), with the camera's matrix applied by hand.
 Studio.prototype.pickConstraint = function (event) {
   if (!this.constraints.points.visible) return -1;
-  const r = this.renderer.domElement.getBoundingClientRect(), v = new THREE.Vector3();
+  const r = this.renderer.domElement.getBoundingClientRect();
+  const m = new THREE.Matrix4().multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).elements;
+  const xyz = this.constraints.xyz, px = event.clientX, py = event.clientY;
   let best = -1, bestDepth = Infinity;
-  this.constraints.list.forEach((c, i) => {
-    v.fromArray(c.position).project(this.camera);
-    const x = r.left + ((v.x + 1) / 2) * r.width, y = r.top + ((1 - v.y) / 2) * r.height;
-    if (v.z < 1 && Math.hypot(x - event.clientX, y - event.clientY) <= 8 && v.z < bestDepth) {
+  for (let i = 0; i < this.constraints.count; ++i) {
+    const x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
+    const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+    if (!(w > 0)) continue;
+    const nz = (m[2] * x + m[6] * y + m[10] * z + m[14]) / w;
+    if (nz >= 1 || nz >= bestDepth) continue;
+    const sx = r.left + (((m[0] * x + m[4] * y + m[8] * z + m[12]) / w + 1) / 2) * r.width;
+    const sy = r.top + ((1 - (m[1] * x + m[5] * y + m[9] * z + m[13]) / w) / 2) * r.height;
+    if (Math.hypot(sx - px, sy - py) <= 8) {
       best = i;
-      bestDepth = v.z;
+      bestDepth = nz;
     }
-  });
+  }
   return best;
 };
 
@@ -413,10 +369,10 @@ Studio.prototype.onPointerDown = function (event) {
   if (index < 0) return;
   this.controls.enabled = false;  // this drag moves a constraint, not the camera
   this.select(index);
-  const p = new THREE.Vector3().fromArray(this.constraints.list[index].position);
+  const p = new THREE.Vector3().fromArray(this.constraints.position(index));
   const normal = this.camera.getWorldDirection(new THREE.Vector3());
   this.drag = { index, plane: new THREE.Plane().setFromNormalAndCoplanarPoint(normal, p), pending: null,
-                inFlight: false, first: true, ended: false };
+                event: 0, inFlight: false, first: true, ended: false };
 };
 
 Studio.prototype.onPointerMove = function (event) {
@@ -425,6 +381,7 @@ Studio.prototype.onPointerMove = function (event) {
   const p = this.ray(event).ray.intersectPlane(d.plane, new THREE.Vector3());
   if (!p) return;
   this.constraints.moveLocally(d.index, p);
+  if (!d.pending) d.event = event.timeStamp;  // the oldest move not sent yet: the latency's start
   d.pending = p;
   this.pumpDrag();
 };
@@ -440,7 +397,7 @@ Studio.prototype.pumpDrag = function () {
   const p = d.pending;
   d.pending = null;
   d.inFlight = true;
-  this.edit({ op: 'move', index: d.index, position: [p.x, p.y, p.z], merge: !d.first }, true).finally(() => {
+  this.edit({ op: 'move', index: d.index, position: [p.x, p.y, p.z], merge: !d.first }, d.event).finally(() => {
     d.first = false;
     d.inFlight = false;
     this.pumpDrag();
@@ -449,10 +406,7 @@ Studio.prototype.pumpDrag = function () {
 
 Studio.prototype.endDrag = function () {
   this.drag = null;
-  this.queue(async () => {
-    await this.pull();  // exact again
-    await this.refreshState();
-  });
+  this.scheduleRefine(0);  // the exact mesh again
 };
 
 Studio.prototype.onPointerUp = function (event) {
@@ -472,65 +426,7 @@ Studio.prototype.onPointerUp = function (event) {
   let p = hit.point, value = 0;
   if (event.shiftKey) { p = p.clone().addScaledVector(n, depth); value = depth; }
   else if (event.altKey || event.ctrlKey) { p = p.clone().addScaledVector(n, -depth); value = -depth; }
-  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }).then((s) => s && this.select(s.index));
-};
-
-// ------------------------------------------------------------------------------- measurements
-function summary(values) {
-  const v = values.slice().sort((a, b) => a - b);
-  const at = (q) => v[Math.min(v.length - 1, Math.floor(q * v.length))];
-  return { count: v.length, median: at(0.5), p90: at(0.9), max: v[v.length - 1] };
-}
-
-// Drags constraint `index` (default: the first on-surface one) along a small circle: `moves` updates one
-// after the other, as a user's drag when the server keeps up; then undoes the drag. Latency = edit sent
-// -> picture drawn when `sync` (each frame waited for), else -> frame submitted (the page's normal mode,
-// which gives the drag rate a user sees).
-Studio.prototype.benchDrag = async function ({ index = -1, moves = 40, radius = 0.01, sync = true } = {}) {
-  if (index < 0) index = this.constraints.list.findIndex((c) => c.value === 0);  // an on-surface one
-  const c = this.constraints.list[index].position.slice(), r = radius * this.stats.unit;
-  this.latencies = [];
-  this.drawTimes = [];
-  this.syncDraw = sync;
-  const t0 = performance.now();
-  for (let k = 1; k <= moves; ++k) {
-    const a = (2 * Math.PI * k) / moves;
-    await this.edit({ op: 'move', index, position: [c[0] + r * Math.sin(a), c[1] + r * (1 - Math.cos(a)), c[2]],
-                      merge: k > 1 }, true);
-  }
-  const seconds = (performance.now() - t0) / 1000;
-  this.syncDraw = false;
-  await this.queue(() => this.pull());
-  const result = Object.assign(summary(this.latencies), { updates_per_second: moves / seconds,
-                                                          draw_median: summary(this.drawTimes).median,
-                                                          triangles: this.stats.triangles });
-  await this.command('/api/undo');
-  return result;
-};
-
-// Adds `count` on-surface constraints at mesh triangle centers (each undone after); edit-to-screen latency.
-Studio.prototype.benchAdd = async function ({ count = 10 } = {}) {
-  const lat = [];
-  this.drawTimes = [];
-  this.syncDraw = true;
-  for (let k = 0; k < count; ++k) {
-    const P = this.slots.geometry.attributes.position.array, slots = Array.from(this.slots.slotOf.values());
-    const s = slots[Math.floor(((k + 0.5) / count) * slots.length)];
-    const p = [0, 1, 2].map((j) => (P[9 * s + j] + P[9 * s + 3 + j] + P[9 * s + 6 + j]) / 3);
-    await this.edit({ op: 'add', position: p, value: 0 });
-    lat.push(this.latency);
-    await this.command('/api/undo');
-  }
-  this.syncDraw = false;
-  return Object.assign(summary(lat), { draw_median: summary(this.drawTimes.filter((_, k) => k % 2 === 0)).median,
-                                       triangles: this.stats.triangles });
-};
-
-// Window coordinates of constraint i (for the browser test).
-Studio.prototype.screenOf = function (i) {
-  const p = new THREE.Vector3().fromArray(this.constraints.list[i].position).project(this.camera);
-  const r = this.renderer.domElement.getBoundingClientRect();
-  return { x: r.left + ((p.x + 1) / 2) * r.width, y: r.top + ((1 - p.y) / 2) * r.height };
+  this.edit({ op: 'add', position: [p.x, p.y, p.z], value }, event.timeStamp);
 };
 
 // ------------------------------------------------------------------------------------------ wiring
@@ -551,17 +447,17 @@ async function main() {
   window.addEventListener('pointermove', (e) => studio.onPointerMove(e));
   window.addEventListener('pointerup', (e) => studio.onPointerUp(e));
   const byId = (id) => document.getElementById(id);
-  const deleteSelected = () => {
+  const deleteSelected = (e) => {
     const i = studio.constraints.selected;
     if (i < 0) return;
     studio.select(-1);
-    studio.edit({ op: 'remove', index: i });
+    studio.edit({ op: 'remove', index: i }, e ? e.timeStamp : undefined);
   };
-  byId('undo').onclick = () => studio.command('/api/undo');
-  byId('redo').onclick = () => studio.command('/api/redo');
+  byId('undo').onclick = (e) => studio.command('/api/undo', e.timeStamp);
+  byId('redo').onclick = (e) => studio.command('/api/redo', e.timeStamp);
   byId('delete').onclick = deleteSelected;
-  byId('wireframe').onchange = (e) => { studio.slots.wire.visible = e.target.checked; studio.render(); };
-  byId('show-constraints').onchange = (e) => { studio.constraints.points.visible = e.target.checked; studio.render(); };
+  byId('wireframe').onchange = (e) => { studio.slots.wire.visible = e.target.checked; studio.present(); };
+  byId('show-constraints').onchange = (e) => { studio.constraints.points.visible = e.target.checked; studio.present(); };
   byId('precision').oninput = (e) => { byId('precision-value').textContent = sliderToPrecision(+e.target.value).toPrecision(3); };
   byId('precision').onchange = (e) => studio.setPrecision(sliderToPrecision(+e.target.value));
   const showDepth = () => { byId('depth-value').textContent = (byId('depth').value / 100 * 0.05).toPrecision(2) + ' x diagonal'; };
@@ -579,18 +475,15 @@ async function main() {
   window.addEventListener('keydown', (e) => {
     if (e.target.tagName === 'INPUT' && e.target.type !== 'checkbox' && e.target.type !== 'range') return;
     const key = e.key.toLowerCase(), mod = e.ctrlKey || e.metaKey;
-    if (mod && key === 'z' && !e.shiftKey) studio.command('/api/undo');
-    else if (mod && (key === 'y' || (key === 'z' && e.shiftKey))) studio.command('/api/redo');
-    else if (key === 'delete' || key === 'backspace') deleteSelected();
+    if (mod && key === 'z' && !e.shiftKey) studio.command('/api/undo', e.timeStamp);
+    else if (mod && (key === 'y' || (key === 'z' && e.shiftKey))) studio.command('/api/redo', e.timeStamp);
+    else if (key === 'delete' || key === 'backspace') deleteSelected(e);
     else if (key === 'w' && !mod) { byId('wireframe').click(); }
     else return;
     e.preventDefault();
   });
-  await studio.queue(async () => {
-    await studio.pull();
-    await studio.refreshState();
-  });
-  studio.frame();
+  await studio.queue(() => studio.reload());
+  studio.frameModel();
   studio.ready = true;
   studio.scheduleRefine();
 }

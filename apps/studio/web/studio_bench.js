@@ -1,0 +1,127 @@
+// vitri studio: measurements in the page (docs/benchmarks.md, tests/apps/studio_browser.py --bench).
+// Pointer events are synthesized on the canvas, so that a latency runs from the event through the
+// page's own handlers (picking, raycast, request, delta, constraint changes) to the frame drawn after
+// the update (Studio.present(): the animation frame after applying, with a pixel read back so that the
+// drawing is finished). Loaded after studio.js; nothing here runs unless a script calls it.
+'use strict';
+
+function summary(values) {
+  const v = values.filter((x) => Number.isFinite(x)).sort((a, b) => a - b);
+  if (!v.length) return { count: 0 };
+  const at = (q) => v[Math.min(v.length - 1, Math.floor(q * v.length))];
+  const r = (x) => Math.round(x * 100) / 100;
+  return { count: v.length, p50: r(at(0.5)), p90: r(at(0.9)), max: r(v[v.length - 1]) };
+}
+
+// Where the time of updates went: input (event to request sent: handlers, raycast, queue), server (its
+// Server-Timing: edit + delta), transfer (request to delta received, less the server: HTTP, JSON parse),
+// apply (mesh delta and constraint changes into the buffers), wait (to the animation frame), draw
+// (render + read back), total (event to drawn).
+function breakdown(timings) {
+  const of = (f) => summary(timings.map(f));
+  return {
+    total: of((t) => t.drawn - t.event), input: of((t) => t.sent - t.event), server: of((t) => t.server),
+    transfer: of((t) => t.received - t.sent - t.server), apply: of((t) => t.applied - t.received),
+    wait: of((t) => t.frame - t.applied), draw: of((t) => t.drawn - t.frame),
+    delta_kb: of((t) => t.bytes / 1024), triangles_changed: of((t) => t.changed),
+  };
+}
+
+Studio.prototype.pointer = function (type, x, y) {
+  const target = type === 'pointerdown' ? this.renderer.domElement : window;
+  target.dispatchEvent(new PointerEvent(type, { clientX: x, clientY: y, button: 0, buttons: type === 'pointerup' ? 0 : 1,
+                                                bubbles: true, pointerType: 'mouse', isPrimary: true }));
+};
+
+// Resolves when every queued request is done and its frame drawn.
+Studio.prototype.settled = async function () {
+  for (;;) {
+    const busy = this.busy;
+    await busy;
+    if (this.frame) await this.frame;
+    if (busy === this.busy && !this.frame) return;
+  }
+};
+
+// Window points where a click hits the surface: a grid over the middle of the view.
+Studio.prototype.surfacePixels = function (count) {
+  const r = this.renderer.domElement.getBoundingClientRect(), found = [];
+  for (let k = 0; k < 400 && found.length < count; ++k) {
+    const x = r.left + r.width * (0.3 + 0.4 * (((k * 0.618034) % 1))), y = r.top + r.height * (0.3 + 0.4 * ((k * 0.41421) % 1));
+    if (this.pickSurface({ clientX: x, clientY: y })) found.push({ x, y });
+  }
+  return found;
+};
+
+// Clicks the surface `count` times (on-surface constraints; the constraint discs are hidden, as with the
+// "constraints" box, so that the click adds instead of selecting), each followed by an undo (Ctrl+Z path).
+Studio.prototype.benchAdd = async function ({ count = 12 } = {}) {
+  await this.settled();
+  const shown = this.constraints.points.visible;
+  this.constraints.points.visible = false;
+  this.syncDraw = this.holdIdle = true;
+  const adds = [], undos = [];
+  for (const p of this.surfacePixels(count)) {
+    this.timings = [];
+    const before = this.constraints.count;
+    this.pointer('pointerdown', p.x, p.y);
+    this.pointer('pointerup', p.x, p.y);
+    await this.settled();
+    if (this.constraints.count !== before + 1) throw new Error('the click did not add a constraint');
+    adds.push(...this.timings);
+    this.timings = [];
+    await this.command('/api/undo', performance.now());
+    await this.settled();
+    undos.push(...this.timings);
+  }
+  this.syncDraw = this.holdIdle = false;
+  this.constraints.points.visible = shown;
+  return { add: breakdown(adds), undo: breakdown(undos), triangles: this.slots.triangles };
+};
+
+// The on-surface constraint drawn nearest to the middle of the view, and where it is on screen.
+Studio.prototype.draggable = function () {
+  const r = this.renderer.domElement.getBoundingClientRect(), cx = r.left + r.width / 2, cy = r.top + r.height / 2;
+  let best = null;
+  for (let i = 0; i < this.constraints.count; ++i) {
+    if (this.constraints.value(i) !== 0) continue;
+    const s = this.screenOf(i, r), d = Math.hypot(s.x - cx, s.y - cy);
+    if (s.z < 1 && (!best || d < best.d)) best = { i, x: s.x, y: s.y, d };
+  }
+  // The front-most constraint under that point is the one the pointer picks.
+  const picked = best ? this.pickConstraint({ clientX: best.x, clientY: best.y }) : -1;
+  return picked < 0 ? null : Object.assign(this.screenOf(picked, r), { index: picked });
+};
+
+// Drags a constraint along a circle of `radius` pixels with synthesized pointer events, then releases
+// it and undoes the drag. `live` false: each move waits until the previous one is drawn (latency of one
+// update, frames read back). `live` true: one move per animation frame for `moves` frames whatever the
+// server's pace, as a user's hand (the page sends the latest position when the previous update is done);
+// drag updates per second = updates drawn / time.
+Studio.prototype.benchDrag = async function ({ moves = 60, radius = 12, live = false } = {}) {
+  await this.settled();
+  const start = this.draggable();
+  if (!start) throw new Error('no constraint to drag in view');
+  this.syncDraw = !live;
+  this.holdIdle = true;
+  this.timings = [];
+  this.pointer('pointerdown', start.x, start.y);
+  if (!this.drag) throw new Error('the pointer did not pick a constraint');
+  const t0 = performance.now();
+  for (let k = 1; k <= moves; ++k) {
+    const a = (2 * Math.PI * k) / moves;
+    this.pointer('pointermove', start.x + radius * Math.sin(a), start.y - radius * (1 - Math.cos(a)));
+    if (live) await new Promise((resolve) => requestAnimationFrame(resolve));
+    else await this.settled();
+  }
+  const end = performance.now(), seconds = (end - t0) / 1000;
+  this.pointer('pointerup', start.x, start.y);
+  await this.settled();
+  const timings = this.timings.filter((t) => !live || t.drawn <= end);  // live: those drawn while moving
+  this.syncDraw = this.holdIdle = false;
+  await this.command('/api/undo');
+  await this.settled();
+  return Object.assign(breakdown(timings), { index: start.index, moves, updates: timings.length,
+                                             updates_per_second: timings.length / seconds,
+                                             triangles: this.slots.triangles });
+};

@@ -2,6 +2,7 @@
 // optionally replay an edit script (the paper's Tables 1, 2 and 3).
 #include "commands.hpp"
 #include "input.hpp"
+#include "phases.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
@@ -89,13 +90,15 @@ const char* const kUsage =
     "                       default; 1e-3..1e-1 smooths a noisy scan)\n"
     "  -q, --quiet          no table, no progress\n"
     "\n"
-    "Progress goes to stderr: a line before and after the fit of 1000 or more constraints (the fit is\n"
-    "O(N^3): seconds for a few thousand constraints) and the Delaunay vertex count during a refinement\n"
-    "that takes more than a second.\n"
+    "Progress goes to stderr: a line as each phase starts (read, constraints, precision, fit,\n"
+    "tetrahedralization, refinement, extraction, writing) with the elapsed time, the constraint count\n"
+    "and fit time of a fit of 1000 or more constraints, the count of merged near-duplicate points, and\n"
+    "the Delaunay vertex count during a refinement that takes more than a second.\n"
     "\n"
     "Prints, per level: vertices, triangles, refinement and extraction times, and the running total\n"
-    "(the paper's Table 1). A bad edit line is reported with its line number; index I out of range is\n"
-    "bad input.\n"
+    "(the paper's Table 1); then the seconds of every phase, the total wall time and the peak memory.\n"
+    "Without --edits the Delaunay history is not kept (a batch run: same mesh, about a quarter of the\n"
+    "memory). A bad edit line is reported with its line number; index I out of range is bad input.\n"
     "Exit status: 0 ok, 1 bad input (unreadable or malformed file, bad edit line, singular fit),\n"
     "2 usage error (unknown option, missing or bad argument, e.g. a precision <= 0 or NaN, or\n"
     "precisions not strictly decreasing),\n"
@@ -141,8 +144,8 @@ void write_current(Mesher& mesher, const std::string& path) {
   write_mesh(path, tm);
 }
 
-/// From this many constraints on, the fit (O(N^3)) is announced on stderr before it starts and after it
-/// ends: it is the one long phase without a progress callback.
+/// From this many constraints on, the fit is announced with its constraint count and its time (every
+/// phase is announced on stderr as it starts, see PhaseTimes).
 constexpr std::size_t kFitProgressConstraints = 1000;
 /// Default precision = this x the median spacing of the surface points: marching tetrahedra puts a mesh
 /// vertex on every crossed Delaunay edge, so a circumradius bound of one spacing gives about 6x as many
@@ -251,28 +254,45 @@ int run_mesh(const Args& args) {
     for (std::string line; std::getline(in, line);) script.push_back(line);
   }
 
-  const auto t_start = Clock::now();
-  const Constraints constraints = constraints_of(read_input(input), input, options.constraint_build);
+  PhaseTimes phases(quiet);
+  // A batch run (no edit script) drops the Delaunay history: the same mesh in about a quarter of the
+  // memory (docs/mesher.md "Batch runs").
+  options.polygonizer.keep_history = !script.empty();
+  phases.start("read", "reading " + input);
+  Input data = read_input(input);
+  phases.start("constraints");
+  ConstraintBuildReport merged;
+  const Constraints constraints = constraints_of(std::move(data), input, options.constraint_build, &merged);
+  if (!quiet && merged.merged_points + merged.merged_off_surface > 0)
+    std::fprintf(stderr, "merged %zu near-duplicate points and dropped %zu off-surface constraints on another "
+                 "constraint (closer than %g x the diagonal)\n", merged.merged_points, merged.merged_off_surface,
+                 options.constraint_build.merge_tolerance);
   if (default_precision) {
     // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
+    phases.start("precision", "median spacing");
     Box3 box;
     for (const Point3& p : constraints.points) box.extend(p);
     precisions.push_back(kSpacingFactor * median_spacing(constraints) / box.diagonal());
     if (!quiet) std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", precisions[0]);
   }
   const std::size_t levels = std::max(precisions.size(), distances.size());
-  const bool announce_fit = !quiet && constraints.size() >= kFitProgressConstraints;
-  if (announce_fit)
-    std::fprintf(stderr, "fitting the implicit function to %zu constraints...\n", constraints.size());
+  const bool announce_fit = constraints.size() >= kFitProgressConstraints;
+  options.on_phase = [&](const char* phase) {
+    const std::string name = phase;
+    if (name != "fit") return phases.start(name);
+    phases.start(name, announce_fit ? "fitting the implicit function to " + std::to_string(constraints.size()) +
+                                          " constraints"
+                                    : name);
+  };
   Mesher mesher(constraints, options);
-  if (announce_fit) std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
+  phases.stop();
+  if (announce_fit && !quiet) std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
   const double diag = mesher.diagonal();
-  const double build_ms = ms_since(t_start);
+  const double build_ms = 1e3 * phases.elapsed();
   if (!quiet) {
     std::printf("%s: %zu constraints, diagonal %.6g; %s fit %.0f ms, initial tetrahedralization %.0f ms\n",
                 input.c_str(), mesher.size(), diag, mesher.local_function() ? "local" : "global",
-                mesher.stats().fit_seconds * 1e3,
-                build_ms - mesher.stats().fit_seconds * 1e3);
+                1e3 * phases.seconds("fit"), 1e3 * phases.seconds("tetrahedralization"));
     std::printf("%5s %10s %9s %10s %11s %11s %10s\n", "level", "precision", "vertices", "triangles", "refine ms",
                 "extract ms", "total ms");
   }
@@ -285,6 +305,7 @@ int run_mesh(const Args& args) {
       if (!distances.empty()) q.max_distance = distances[std::min(k, distances.size() - 1)] * diag;
       mesher.set_quality_options(q);
     }
+    phases.start("refinement", "refining level " + std::to_string(k));
     const auto t0 = Clock::now();
     auto last_report = Clock::now();
     bool reported = false;
@@ -299,15 +320,22 @@ int run_mesh(const Args& args) {
     });
     if (reported) std::fprintf(stderr, "\n");
     const double refine_ms = ms_since(t0);
+    phases.start("extraction");
     const auto t1 = Clock::now();
     const SurfaceMesh& m = mesher.surface();
     const double extract_ms = ms_since(t1);
     total_ms += refine_ms + extract_ms;
     const std::string path = levels == 1 ? output : level_path(output, k);
+    phases.start("writing", "writing " + path);
     write_current(mesher, path);
+    phases.stop();
     if (!quiet)
       std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
                   m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());
+  }
+  if (!quiet) {
+    std::printf("\n");
+    phases.print(stdout);
   }
 
   if (!script.empty() && !quiet)

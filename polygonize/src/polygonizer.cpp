@@ -38,6 +38,13 @@ namespace vitri {
 
 namespace {
 
+/// The Delaunay tree's options as the polygonizer's options ask (history kept or not).
+TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
+  TriangulationOptions t;
+  t.keep_history = options.keep_history;
+  return t;
+}
+
 constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
 // Thin features: an edge with ends of one sign that is probably crossed twice is refined only when the
@@ -110,7 +117,7 @@ Box3 Polygonizer::domain_for(const std::vector<Point3>& points, double factor) {
 
 Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                          const std::vector<double>& seed_values, const PolygonizerOptions& options)
-    : f_(f), options_(options), tri_(domain), precision_(std::numeric_limits<double>::infinity()) {
+    : f_(f), options_(options), tri_(domain, triangulation_options(options)), precision_(std::numeric_limits<double>::infinity()) {
   const auto t0 = Clock::now();
   if (!(options_.sampling_fraction >= 0.0) || !std::isfinite(options_.sampling_fraction))
     throw InvalidArgument("PolygonizerOptions::sampling_fraction must be >= 0");

@@ -3,6 +3,7 @@
 
 #include "local_patch.hpp"
 #include "local_tree.hpp"
+#include "parallel.hpp"
 #include "slot_ranks.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/point_index.hpp"
@@ -30,35 +31,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Runs body(begin, end) over [0, n) in chunks of `grain` on up to `threads` threads; rethrows the first
-/// exception of any chunk.
-void parallel_chunks(std::size_t n, unsigned threads, std::size_t grain,
-                     const std::function<void(std::size_t, std::size_t)>& body) {
-  const std::size_t chunks = (n + grain - 1) / grain;
-  const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads, chunks));
-  if (workers <= 1) {
-    if (n) body(0, n);
-    return;
-  }
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (std::size_t k; (k = next.fetch_add(1)) < chunks;) {
-      try {
-        body(k * grain, std::min(n, (k + 1) * grain));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < workers; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-}
+using rbf_detail::parallel_chunks;
 
 std::string format_point(const Point3& p) {
   std::ostringstream s;

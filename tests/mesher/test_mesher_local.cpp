@@ -5,13 +5,17 @@
 #include <catch2/catch.hpp>
 
 #include "support/surface_metrics.hpp"
+#include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
 #include "vitri/polygonize/mesh_metrics.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
 using namespace vitri;
 
@@ -107,4 +111,65 @@ TEST_CASE("unsupported components are dropped unless the whole zero set is asked
     if (!keep)
       for (const Point3& v : mesher.surface().vertices) REQUIRE(std::abs(norm(v) - 1.0) < 0.1);
   }
+}
+
+// A batch run (PolygonizerOptions::keep_history = false, what the CLI does without --edits) keeps no
+// Delaunay history: it must give the same mesh as the default, and the Delaunay tree must really run
+// without history. Then edits still work on it and agree with the default's edits.
+TEST_CASE("batch option: no Delaunay history, the same mesh as the default", "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  MesherOptions batch = o;
+  batch.polygonizer.keep_history = false;
+  Mesher a = Mesher::from_mesh(in.V, in.F, o), b = Mesher::from_mesh(in.V, in.F, batch);
+  REQUIRE(a.polygonizer().triangulation().keeps_history());
+  REQUIRE_FALSE(b.polygonizer().triangulation().keeps_history());
+  for (double p : {0.03, 0.015}) {
+    a.refine(p * a.diagonal());
+    b.refine(p * b.diagonal());
+    const SurfaceMesh& ma = a.surface();
+    const SurfaceMesh& mb = b.surface();
+    REQUIRE(mb.vertices.size() == ma.vertices.size());
+    REQUIRE(mb.triangles.size() == ma.triangles.size());
+    // Same mesh up to the numbering: the same vertex positions, the same triangles over them.
+    std::vector<std::array<double, 3>> va, vb;
+    for (const Point3& q : ma.vertices) va.push_back({q.x, q.y, q.z});
+    for (const Point3& q : mb.vertices) vb.push_back({q.x, q.y, q.z});
+    std::sort(va.begin(), va.end());
+    std::sort(vb.begin(), vb.end());
+    REQUIRE(va == vb);
+    require_closed(mb, 0);
+  }
+  // An edit on the batch structure: still closed, same mesh size as the same edit with history.
+  const Point3 p = a.constraints().points[5];
+  const Point3 moved = p + 0.01 * a.diagonal() * Point3{1, 0, 0};
+  a.move_constraint(5, moved);
+  b.move_constraint(5, moved);
+  require_closed(b.surface(), 0);
+  CHECK(b.surface().vertices.size() == a.surface().vertices.size());
+}
+
+TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the count", "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  const std::size_t start = mesher.stats().polygonizer.vertices;
+  Mesher unlimited = Mesher::from_mesh(in.V, in.F, o);
+  unlimited.refine(0.01 * unlimited.diagonal());
+  const std::size_t needed = unlimited.stats().polygonizer.vertices;
+  REQUIRE(needed > start + 10000);
+  o.max_vertices = start + 1000;
+  Mesher limited = Mesher::from_mesh(in.V, in.F, o);
+  try {
+    limited.refine(0.01 * limited.diagonal());
+    FAIL("no exception");
+  } catch (const LimitError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("max_vertices = " + std::to_string(start + 1000)) != std::string::npos);
+    CHECK(what.find("refinement stopped at ") != std::string::npos);
+  }
+  // The structure stays valid: a coarse level within the limit still meshes.
+  CHECK(limited.stats().polygonizer.vertices < needed);
 }

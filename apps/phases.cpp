@@ -1,0 +1,47 @@
+// PhaseTimes (phases.hpp).
+#include "phases.hpp"
+
+#include <sys/resource.h>
+
+namespace vitri::cli {
+
+void PhaseTimes::start(const std::string& name, const std::string& text) {
+  stop();
+  std::size_t k = 0;
+  while (k < phases_.size() && phases_[k].name != name) ++k;
+  if (k == phases_.size()) phases_.push_back({name, 0.0});
+  running_ = k;
+  phase_start_ = Clock::now();
+  if (!quiet_) std::fprintf(stderr, "[%7.1f s] %s...\n", elapsed(), (text.empty() ? name : text).c_str());
+}
+
+void PhaseTimes::stop() {
+  if (running_ >= phases_.size()) return;
+  phases_[running_].seconds += std::chrono::duration<double>(Clock::now() - phase_start_).count();
+  running_ = static_cast<std::size_t>(-1);
+}
+
+double PhaseTimes::seconds(const std::string& name) const {
+  for (const Phase& p : phases_)
+    if (p.name == name) return p.seconds;
+  return 0.0;
+}
+
+double PhaseTimes::elapsed() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+
+void PhaseTimes::print(std::FILE* out) const {
+  const double total = elapsed();
+  std::fprintf(out, "%-20s %10s %7s\n", "phase", "seconds", "share");
+  for (const Phase& p : phases_)
+    std::fprintf(out, "%-20s %10.2f %6.1f%%\n", p.name.c_str(), p.seconds, total > 0 ? 100.0 * p.seconds / total : 0.0);
+  std::fprintf(out, "%-20s %10.2f %6.1f%%\n", "total (wall)", total, 100.0);
+  std::fprintf(out, "peak memory (RSS)    %10.2f GB\n", static_cast<double>(peak_rss_bytes()) / 1e9);
+}
+
+std::size_t peak_rss_bytes() {
+  rusage u{};
+  if (getrusage(RUSAGE_SELF, &u) != 0) return 0;
+  return static_cast<std::size_t>(u.ru_maxrss) * 1024;  // Linux: kilobytes
+}
+
+}  // namespace vitri::cli

@@ -20,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace vitri::cli {
 namespace {
 
@@ -97,8 +99,8 @@ const char* const kUsage =
     "\n"
     "Prints, per level: vertices, triangles, refinement and extraction times, and the running total\n"
     "(the paper's Table 1); then the seconds of every phase, the total wall time and the peak memory.\n"
-    "Without --edits the Delaunay history is not kept (a batch run: same mesh, about a quarter of the\n"
-    "memory). A bad edit line is reported with its line number; index I out of range is bad input.\n"
+    "Without --edits the Delaunay history is not kept (a batch run: an equivalent mesh in well under\n"
+    "half the memory). A bad edit line is reported with its line number; index I out of range is bad input.\n"
     "Exit status: 0 ok, 1 bad input (unreadable or malformed file, bad edit line, singular fit),\n"
     "2 usage error (unknown option, missing or bad argument, e.g. a precision <= 0 or NaN, or\n"
     "precisions not strictly decreasing),\n"
@@ -152,6 +154,35 @@ constexpr std::size_t kFitProgressConstraints = 1000;
 /// mesh vertices as points (hand.off: 7231 for 1197); 2.5 spacings give 1-1.5x as many (hand 1855,
 /// sphere926 990, 33k samples of man.off 49.6k).
 constexpr double kSpacingFactor = 2.5;
+/// Memory per Delaunay vertex of the whole meshing structure (Delaunay tree, polygonizer arrays, vector
+/// growth slack), measured on 10^6 oriented points (docs/benchmarks.md "10^6 points end to end"): about
+/// 1 KB in a batch run, about 2.5 KB with the history kept (a run with --edits).
+constexpr double kBytesPerVertexBatch = 1100.0;
+constexpr double kBytesPerVertexHistory = 2500.0;
+
+/// The Delaunay vertex budget of this machine: 80% of the physical memory over the bytes per vertex
+/// (0: unknown, no limit).
+std::size_t vertex_budget(bool keep_history) {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return 0;
+  const double bytes = 0.8 * static_cast<double>(pages) * static_cast<double>(page);
+  return static_cast<std::size_t>(bytes / (keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch));
+}
+
+/// mesher.refine(), its LimitError (MesherOptions::max_vertices, set from the machine's memory) said in
+/// the CLI's terms.
+void refine_within_memory(Mesher& mesher, double precision, const ProgressCallback& progress) {
+  try {
+    mesher.refine(precision, progress);
+  } catch (const LimitError& e) {
+    std::ostringstream what;
+    what << "this machine's memory holds about " << mesher.options().max_vertices
+         << " Delaunay vertices (80% of the physical memory at "
+         << (mesher.options().polygonizer.keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch)
+         << " bytes each) and the refinement needs more: give a coarser --precision (" << e.what() << ")";
+    throw LimitError(what.str());
+  }
+}
 
 }  // namespace
 
@@ -255,9 +286,12 @@ int run_mesh(const Args& args) {
   }
 
   PhaseTimes phases(quiet);
-  // A batch run (no edit script) drops the Delaunay history: the same mesh in about a quarter of the
-  // memory (docs/mesher.md "Batch runs").
+  // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
+  // memory (docs/mesher.md "Batch runs and memory").
   options.polygonizer.keep_history = !script.empty();
+  // A precision far below the data's spacing would need more memory than the machine has: a LimitError
+  // naming the count instead of an out-of-memory end.
+  options.max_vertices = vertex_budget(options.polygonizer.keep_history);
   phases.start("read", "reading " + input);
   Input data = read_input(input);
   phases.start("constraints");
@@ -309,7 +343,7 @@ int run_mesh(const Args& args) {
     const auto t0 = Clock::now();
     auto last_report = Clock::now();
     bool reported = false;
-    mesher.refine(precision * diag, [&](const RefineProgress& p) {
+    refine_within_memory(mesher, precision * diag, [&](const RefineProgress& p) {
       if (!quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
         std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
                      p.queued);

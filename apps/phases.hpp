@@ -8,10 +8,15 @@
 
 namespace vitri::cli {
 
+/// Peak resident memory of this process so far, in bytes (getrusage; 0 where unknown).
+std::size_t peak_rss_bytes();
+/// CPU seconds (user + system, all threads) of this process so far (getrusage; 0 where unknown).
+double cpu_seconds();
+
 class PhaseTimes {
  public:
   /// quiet: nothing is announced (the times are still kept).
-  explicit PhaseTimes(bool quiet) : quiet_(quiet), start_(Clock::now()) {}
+  explicit PhaseTimes(bool quiet) : quiet_(quiet), start_(Clock::now()), cpu_start_(cpu_seconds()) {}
   /// Ends the running phase and starts `name`, announced on stderr as "[elapsed] text..." (text defaults
   /// to the name). Phases of the same name add up in the table.
   void start(const std::string& name, const std::string& text = "");
@@ -21,24 +26,25 @@ class PhaseTimes {
   double seconds(const std::string& name) const;
   /// Seconds since construction.
   double elapsed() const;
-  /// The table: one row per phase (seconds, share of the total), the total wall time and the peak
-  /// resident memory (getrusage).
+  /// The table: one row per phase (wall seconds, share of the total wall time, CPU seconds of all
+  /// threads: on a loaded machine the CPU time says what the phase costs, the wall time what it took),
+  /// the totals and the peak resident memory (getrusage).
   void print(std::FILE* out) const;
 
  private:
   using Clock = std::chrono::steady_clock;
   struct Phase {
     std::string name;
-    double seconds = 0;
+    double seconds = 0;      // wall
+    double cpu_seconds = 0;  // CPU time of the process (all threads)
   };
   bool quiet_;
   Clock::time_point start_;
+  double cpu_start_;
   Clock::time_point phase_start_{};
+  double phase_cpu_start_ = 0;
   std::size_t running_ = static_cast<std::size_t>(-1);  // index into phases_, or none
   std::vector<Phase> phases_;
 };
-
-/// Peak resident memory of this process so far, in bytes (getrusage; 0 where unknown).
-std::size_t peak_rss_bytes();
 
 }  // namespace vitri::cli

@@ -105,10 +105,10 @@ struct PolygonizerOptions {
   /// Keep the Delaunay tree's history DAG (TriangulationOptions::keep_history): point location by
   /// descent, O(log n) for single insertions and edits, at about 1250 bytes per Delaunay vertex instead
   /// of about 250 for the live mesh alone. false suits a batch run that refines and extracts without
-  /// editing (the CLI without --edits): the same mesh (bit for bit: the tetrahedralization and every
-  /// decision are the same, only location walks from the last tetrahedron) in about a quarter of the
-  /// memory. Edits still work without it, with walking location (slower on large models). See
-  /// docs/mesher.md "Batch runs".
+  /// editing (the CLI without --edits): an equivalent mesh (same precision guarantee; not bit for bit
+  /// the same, since the refinement order follows tetrahedron ids, which are recycled without the
+  /// history) in well under half the memory. Edits still work without it, with walking location
+  /// (slower on large models). See docs/mesher.md "Batch runs and memory".
   bool keep_history = true;
 };
 

@@ -207,14 +207,15 @@ ApiResponse Api::route(const ApiRequest& r) {
 }
 
 std::string Api::stats_json(const std::string& extra) {
-  const SurfaceMesh& m = session_.surface();
+  session_.mesher().sync_surface();  // counts from the live mesh: no copy of the mesh per request
+  const LiveMesh& m = session_.mesher().live_surface();
   const MesherStats s = session_.mesher().stats();
   const double current = session_.current_precision();
   std::string out = "{";
   if (!extra.empty()) out += extra + ",";
   out += "\"name\":" + json_quote(session_.name()) + ",\"constraints\":" + std::to_string(session_.size()) +
-         ",\"vertices\":" + std::to_string(m.vertices.size()) +
-         ",\"triangles\":" + std::to_string(m.triangles.size()) +
+         ",\"vertices\":" + std::to_string(m.num_vertices()) +
+         ",\"triangles\":" + std::to_string(m.num_triangles()) +
          ",\"precision\":" + (std::isfinite(current) ? json_number(current) : std::string("null")) +
          ",\"target_precision\":" + json_number(session_.target_precision()) +
          ",\"refined\":" + (session_.refined() ? "true" : "false") +
@@ -252,7 +253,7 @@ ApiResponse Api::mesh(const ApiRequest& r) {
     throw BadRequest("\"format\" must be binary, json or indexed, got '" + format + "'");
   const std::string exact = param(r, "exact", "1");
   if (exact != "0" && exact != "1") throw BadRequest("\"exact\" must be 0 or 1, got '" + exact + "'");
-  const MeshDelta d = session_.delta(version_param(r), exact == "1");
+  const ClientDelta d = session_.delta(version_param(r), exact == "1");
   if (format == "json") return json_response(encode_json(d));
   ApiResponse out;
   out.content_type = "application/octet-stream";

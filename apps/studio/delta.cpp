@@ -15,12 +15,6 @@ std::int64_t cell_code(double x, double cell) {
   return static_cast<std::int64_t>(std::clamp(q, -kLimit, kLimit));
 }
 
-std::uint32_t float_bits(float f) {
-  std::uint32_t b;
-  std::memcpy(&b, &f, sizeof b);
-  return b;
-}
-
 void append_point(std::vector<float>& out, const Point3& p) {
   out.push_back(static_cast<float>(p.x));
   out.push_back(static_cast<float>(p.y));
@@ -50,90 +44,113 @@ void append_json_array(std::string& out, const char* name, const std::vector<T>&
 
 }  // namespace
 
-std::size_t DeltaTracker::CodesHash::operator()(const Codes& k) const {
-  std::uint64_t h = 0x9e3779b97f4a7c15ull;
-  for (const std::int64_t w : k) h = (h ^ static_cast<std::uint64_t>(w)) * 0x100000001b3ull + (h >> 29);
-  return static_cast<std::size_t>(h);
-}
-
 void DeltaTracker::set_cell(double cell) {
   cell_ = cell;
   reset();
 }
 
-std::size_t DeltaTracker::triangle_key(const SurfaceMesh& mesh, std::size_t t, Codes& codes,
-                                       Corners& corners) const {
-  const auto& tri = mesh.triangles[t];
-  std::array<std::int64_t, 9> c;  // per corner: codes, in triangle order
-  std::array<float, 9> f;
-  for (std::size_t k = 0; k < 3; ++k)
-    for (std::size_t j = 0; j < 3; ++j) {
-      c[3 * k + j] = cell_code(mesh.vertices[tri[k]][j], cell_);
-      f[3 * k + j] = static_cast<float>(mesh.vertices[tri[k]][j]);
-    }
-  // Canonical rotation: the corner with the smallest (codes, float bits) first; cyclic order kept.
-  const auto corner_less = [&](std::size_t a, std::size_t b) {
-    for (std::size_t j = 0; j < 3; ++j)
-      if (c[3 * a + j] != c[3 * b + j]) return c[3 * a + j] < c[3 * b + j];
-    for (std::size_t j = 0; j < 3; ++j)
-      if (float_bits(f[3 * a + j]) != float_bits(f[3 * b + j]))
-        return float_bits(f[3 * a + j]) < float_bits(f[3 * b + j]);
-    return false;
-  };
-  std::size_t first = 0;
-  for (std::size_t k = 1; k < 3; ++k)
-    if (corner_less(k, first)) first = k;
-  for (std::size_t k = 0; k < 3; ++k)
-    for (std::size_t j = 0; j < 3; ++j) {
-      codes[3 * k + j] = c[3 * ((first + k) % 3) + j];
-      corners[3 * k + j] = f[3 * ((first + k) % 3) + j];
-    }
-  return first;
+void DeltaTracker::reset() {
+  sent_any_ = false;
+  ++version_;  // a client's version no longer matches: its next request gets the full mesh
 }
 
-MeshDelta DeltaTracker::update(const SurfaceMesh& mesh, std::uint32_t since, bool exact) {
-  MeshDelta d;
-  d.full = since == 0 || since != version_;
+bool DeltaTracker::moved_beyond_cell(const Held& held, const Point3& p) const {
+  for (std::size_t k = 0; k < 3; ++k)
+    if (cell_code(held[k], cell_) != cell_code(p[k], cell_)) return true;
+  return false;
+}
+
+// Mirrors the live mesh's connectivity; lists the triangles removed and those around moved vertices.
+void DeltaTracker::track(const LiveMesh& mesh, const MeshDelta& change, std::vector<std::uint32_t>& resend,
+                         std::vector<std::uint32_t>& removed) {
+  if (change.full) {
+    corners_.clear();
+    incident_.clear();
+    held_.clear();
+    stale_.clear();
+    sent_any_ = false;
+  }
+  if (corners_.size() < mesh.triangle_capacity()) corners_.resize(mesh.triangle_capacity());
+  if (incident_.size() < mesh.vertex_capacity()) {
+    incident_.resize(mesh.vertex_capacity());
+    held_.resize(mesh.vertex_capacity());
+  }
+  for (const std::uint32_t t : change.removed_triangles) {
+    for (const std::uint32_t v : corners_[t]) {
+      auto& inc = incident_[v];
+      inc.erase(std::find(inc.begin(), inc.end(), t));
+    }
+    removed.push_back(t);
+  }
+  for (const std::uint32_t v : change.added_vertices) {
+    const Point3& p = mesh.position(v);
+    held_[v] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+  }
+  for (const std::uint32_t t : change.added_triangles) {
+    corners_[t] = mesh.triangle(t);
+    for (const std::uint32_t v : corners_[t]) incident_[v].push_back(t);
+    resend.push_back(t);
+  }
+  stale_.insert(stale_.end(), change.moved_vertices.begin(), change.moved_vertices.end());
+}
+
+void DeltaTracker::append_triangle(const LiveMesh& mesh, std::uint32_t t, ClientDelta& d) {
+  d.added.push_back(t);
+  for (const std::uint32_t v : mesh.triangle(t)) {
+    append_point(d.positions, mesh.position(v));
+    append_point(d.normals, mesh.normal(v));
+  }
+}
+
+ClientDelta DeltaTracker::update(const LiveMesh& mesh, const MeshDelta& change, std::uint32_t since, bool exact) {
+  std::vector<std::uint32_t> resend, removed;
+  track(mesh, change, resend, removed);
+  ClientDelta d;
+  d.full = !sent_any_ || since == 0 || since != version_;
   d.base = d.full ? 0 : since;
-  if (d.full) sent_.clear();
-  const bool has_normals = mesh.normals.size() == mesh.vertices.size();
-  SentMap next;
-  next.reserve(mesh.triangles.size());
-  Codes codes;
-  Corners corners;
-  for (std::size_t t = 0; t < mesh.triangles.size(); ++t) {
-    const std::size_t first = triangle_key(mesh, t, codes, corners);
-    // A sent triangle in the same cells (and, when exact, with the same corners) is kept. Several can
-    // share cells (triangles smaller than a cell): any one of them serves in the approximate mode.
-    auto [lo, hi] = sent_.equal_range(codes);
-    while (lo != hi && exact && lo->second.corners != corners) ++lo;
-    if (lo != hi) {
-      next.emplace(codes, lo->second);
-      sent_.erase(lo);
+  // Moved vertices: resent (their triangles) when exact, or when they left the cell the page holds.
+  std::vector<std::uint32_t> still_stale;
+  std::sort(stale_.begin(), stale_.end());
+  stale_.erase(std::unique(stale_.begin(), stale_.end()), stale_.end());
+  for (const std::uint32_t v : stale_) {
+    if (!mesh.is_vertex(v)) continue;
+    const Point3& p = mesh.position(v);
+    if (!d.full && !exact && !moved_beyond_cell(held_[v], p)) {
+      still_stale.push_back(v);
       continue;
     }
-    const Sent s{next_id_++, corners};
-    next.emplace(codes, s);
-    d.added.push_back(s.id);
-    d.positions.insert(d.positions.end(), corners.begin(), corners.end());
-    for (std::size_t k = 0; k < 3; ++k) {  // normals in the rotated order of the corners
-      const std::uint32_t v = mesh.triangles[t][(first + k) % 3];
-      append_point(d.normals, has_normals ? mesh.normals[v] : Point3{0, 0, 0});
+    held_[v] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+    resend.insert(resend.end(), incident_[v].begin(), incident_[v].end());
+  }
+  stale_ = std::move(still_stale);
+  if (d.full) {
+    for (std::uint32_t v = 0; v < mesh.vertex_capacity(); ++v)
+      if (mesh.is_vertex(v)) {
+        const Point3& p = mesh.position(v);
+        held_[v] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
+      }
+    stale_.clear();
+    for (std::uint32_t t = 0; t < mesh.triangle_capacity(); ++t)
+      if (mesh.is_triangle(t)) append_triangle(mesh, t, d);
+    sent_any_ = true;
+  } else {
+    std::sort(resend.begin(), resend.end());
+    resend.erase(std::unique(resend.begin(), resend.end()), resend.end());
+    std::sort(removed.begin(), removed.end());
+    d.removed = removed;
+    for (const std::uint32_t t : resend) {
+      if (!mesh.is_triangle(t)) continue;
+      const bool fresh = std::binary_search(change.added_triangles.begin(), change.added_triangles.end(), t);
+      if (!fresh) d.removed.push_back(t);  // resent around a moved vertex: the page drops its copy first
+      append_triangle(mesh, t, d);
     }
   }
-  for (const auto& [key, s] : sent_) d.removed.push_back(s.id);  // what the new mesh did not claim
-  sent_ = std::move(next);
   if (d.full || !d.added.empty() || !d.removed.empty()) ++version_;
   d.version = version_;
   return d;
 }
 
-void DeltaTracker::reset() {
-  sent_.clear();
-  ++version_;  // a client's version no longer matches: its next request gets the full mesh
-}
-
-std::string encode_binary(const MeshDelta& d) {
+std::string encode_binary(const ClientDelta& d) {
   const std::uint32_t header[6] = {0x44525456u /* "VTRD" */,
                                    d.full ? 1u : 0u,
                                    d.version,
@@ -151,7 +168,7 @@ std::string encode_binary(const MeshDelta& d) {
   return out;
 }
 
-std::string encode_json(const MeshDelta& d) {
+std::string encode_json(const ClientDelta& d) {
   std::string out = "{\"version\":" + std::to_string(d.version) + ",\"base\":" + std::to_string(d.base) +
                     ",\"full\":" + (d.full ? "true" : "false");
   append_json_array(out, "removed", d.removed);

@@ -225,6 +225,16 @@ const SurfaceMesh& Session::surface() {
   return m;
 }
 
+ClientDelta Session::delta(std::uint32_t since, bool exact) {
+  const double t0 = now_ms();
+  const MeshDelta change = mesher_->update_surface();
+  if (!mesh_timed_) {
+    times_.extract_ms = now_ms() - t0;
+    mesh_timed_ = true;
+  }
+  return tracker_.update(mesher_->live_surface(), change, since, exact);
+}
+
 std::vector<ConstraintInfo> Session::constraints() const {
   const Constraints& c = mesher_->constraints();
   std::vector<ConstraintInfo> out;

@@ -97,8 +97,9 @@ class Session {
 
   // ---- Queries
   const SurfaceMesh& surface();
-  /// The mesh delta from the client's version `since` (delta.hpp); `exact` false during drags.
-  MeshDelta delta(std::uint32_t since, bool exact) { return tracker_.update(surface(), since, exact); }
+  /// The mesh delta from the client's version `since` (delta.hpp); `exact` false during drags. Only the
+  /// triangles the Mesher changed travel (Mesher::update_surface()).
+  ClientDelta delta(std::uint32_t since, bool exact);
   std::vector<ConstraintInfo> constraints() const;
   std::size_t size() const { return ids_.size(); }
   const std::string& name() const { return name_; }

@@ -7,6 +7,7 @@
 // - bulk/N: bulk build of N uniform points (vitri: insert_points with the history; CGAL: range insert,
 //   which sorts spatially too). bulk_nohist/N: vitri without history.
 // - grid/n: the n^3 integer grid (cospherical everywhere).
+// - bulk_threads/N/T: the build without history on T threads (parallel bulk insertion), real time.
 // - insert1M: 10^4 single insertions at random locations into a 10^6-point triangulation (vitri:
 //   insert(), history location; CGAL: Fast_location, i.e. the Delaunay hierarchy, no hint).
 // - tetgen_bulk/N, tetgen_grid/n: TetGen (`tetgen` command) on the same points, its own Delaunay time.
@@ -104,6 +105,30 @@ void vitri_bulk(benchmark::State& state) { vitri_bulk_impl(state, true); }
 void vitri_bulk_nohist(benchmark::State& state) { vitri_bulk_impl(state, false); }
 BENCHMARK(vitri_bulk)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
 BENCHMARK(vitri_bulk_nohist)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true);
+
+// bulk_threads/N/T: the same build without history on T threads (TriangulationOptions::threads; T = 1
+// is the serial build). Real time: the point is the wall clock. Counters: points deferred by the
+// parallel passes and inserted serially (percent of N), and the CPU time of the parallel passes in
+// total and along the slowest thread of each pass (what the passes take with one free core per thread).
+void vitri_bulk_threads(benchmark::State& state) {
+  const auto pts = uniform(std::size_t(state.range(0)), 1);
+  vitri::TriangulationOptions options;
+  options.keep_history = false;
+  options.threads = unsigned(state.range(1));
+  vitri::BulkStats stats;
+  for (auto _ : state) {
+    vitri::Triangulation tr(kBox, options);
+    tr.insert_points(pts);
+    stats = tr.last_bulk_stats();
+    benchmark::DoNotOptimize(tr.num_tetrahedra());
+  }
+  const double n = double(pts.size());
+  state.counters["deferred_pct"] = 100.0 * double(stats.deferred) / n;
+  state.counters["serial_pct"] = 100.0 * double(stats.serial) / n;
+  state.counters["pass_cpu_s"] = stats.thread_cpu_seconds;
+  state.counters["pass_slowest_s"] = stats.slowest_thread_cpu_seconds;
+}
+BENCHMARK(vitri_bulk_threads)->Args({100000, 1})->Args({100000, 2})->Args({1000000, 1})->Args({1000000, 2})->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
 
 #ifdef VITRI_HAVE_CGAL
 void cgal_bulk(benchmark::State& state) {

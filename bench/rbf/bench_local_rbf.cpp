@@ -6,6 +6,7 @@
 // The surface samples are drawn on the mesh's triangles (area-weighted, fixed seed) with the triangle
 // normals, then turned into normal constraints (constraints_from_oriented_points). Peak memory is the
 // process's maximum resident set (run one size per process). Results: docs/benchmarks.md.
+#include "support/sample_mesh.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/local_rbf.hpp"
@@ -27,29 +28,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-void sample_mesh(const vitri::TriangleMesh& m, std::size_t n, std::vector<vitri::Point3>& p,
-                 std::vector<vitri::Point3>& nrm) {
-  std::vector<double> cumulative;
-  double total = 0;
-  auto vertex = [&](int i) { return vitri::Point3{m.V(i, 0), m.V(i, 1), m.V(i, 2)}; };
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
-    const auto a = vertex(m.F(f, 0)), b = vertex(m.F(f, 1)), c = vertex(m.F(f, 2));
-    total += 0.5 * vitri::norm(vitri::cross(b - a, c - a));
-    cumulative.push_back(total);
-  }
-  std::mt19937_64 rng(12345);
-  std::uniform_real_distribution<double> u(0, 1);
-  for (std::size_t i = 0; i < n; ++i) {
-    const auto f = static_cast<Eigen::Index>(std::lower_bound(cumulative.begin(), cumulative.end(), u(rng) * total) -
-                                             cumulative.begin());
-    const auto a = vertex(m.F(f, 0)), b = vertex(m.F(f, 1)), c = vertex(m.F(f, 2));
-    double s = u(rng), t = u(rng);
-    if (s + t > 1) s = 1 - s, t = 1 - t;
-    p.push_back(a + s * (b - a) + t * (c - a));
-    nrm.push_back(vitri::cross(b - a, c - a));
-  }
-}
-
 double peak_mb() {
   rusage r{};
   getrusage(RUSAGE_SELF, &r);
@@ -67,7 +45,7 @@ int main(int argc, char** argv) {
   const auto points = static_cast<std::size_t>(std::atoll(argv[2]));
   const bool global = argc > 3 && std::strcmp(argv[3], "--global") == 0;
   std::vector<vitri::Point3> p, nrm;
-  sample_mesh(mesh, points, p, nrm);
+  vitri::bench::sample_mesh(mesh, points, p, nrm);
   if (const char* out = std::getenv("VITRI_WRITE_PWN")) {  // the samples, for other tools (vitri studio)
     vitri::OrientedPoints op{p, nrm};
     vitri::write_points(out, op);

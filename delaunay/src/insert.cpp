@@ -16,10 +16,12 @@ namespace vitri {
 
 // start_contains: p lies in the closed tetrahedron `start` and is none of its vertices (checked by the
 // caller), hence p is no vertex of the triangulation (closed tetrahedra meet only in common faces) and
-// the duplicate test per tested tetrahedron is skipped. Returns false (marks cleared) when p duplicates
-// the vertex `duplicate`; otherwise the cavity stays marked for the caller.
-bool Triangulation::grow_cavity(const Point3& p, TetId start, bool start_contains, Cavity& cav,
-                                PointId& duplicate) {
+// the duplicate test per tested tetrahedron is skipped. Returns Duplicate (marks cleared) when p
+// duplicates the vertex `duplicate`; otherwise Ok with the cavity marked for the caller. With an owner
+// (parallel insertion, parallel_insert.cpp) the cavity may only contain tetrahedra that the owner owns:
+// Blocked (marks cleared) as soon as one in conflict is not.
+Triangulation::Grow Triangulation::grow_cavity(const Point3& p, TetId start, bool start_contains, Cavity& cav,
+                                               PointId& duplicate, const detail::Partition* owner) {
   cav.tets.clear();
   cav.boundary.clear();
   cav.tested.clear();
@@ -46,9 +48,13 @@ bool Triangulation::grow_cavity(const Point3& p, TetId start, bool start_contain
       if (!start_contains && (p == a0 || p == a1 || p == a2 || p == a3)) {
         duplicate = tets_.vertex(n, p == a0 ? 0 : p == a1 ? 1 : p == a2 ? 2 : 3);
         clear_cavity_marks(cav);
-        return false;
+        return Grow::Duplicate;
       }
       if (insphere_sos(a0, a1, a2, a3, p) == Sign::Positive) {
+        if (owner && !owner->owns(tets_, n)) {
+          clear_cavity_marks(cav);
+          return Grow::Blocked;
+        }
         tets_.mark(n, Store::kMark);
         cav.tets.push_back(n);
       } else {
@@ -58,7 +64,7 @@ bool Triangulation::grow_cavity(const Point3& p, TetId start, bool start_contain
       }
     }
   }
-  return true;
+  return Grow::Ok;
 }
 
 void Triangulation::clear_cavity_marks(const Cavity& cav) {
@@ -93,7 +99,8 @@ InsertResult Triangulation::check_cavity(const Point3& p, TetId start, bool star
     if (pos_[w] == p) return {InsertStatus::TooClose, kNoVertex, vid(w)};
   }
   PointId dup = kNoVertex;
-  if (!grow_cavity(p, start, start_contains, cav, dup)) return {InsertStatus::TooClose, kNoVertex, vid(dup)};
+  if (grow_cavity(p, start, start_contains, cav, dup) != Grow::Ok)
+    return {InsertStatus::TooClose, kNoVertex, vid(dup)};
   if (min_distance > 0.0) {
     double best2 = min_distance * min_distance;
     const PointId nearest = nearest_vertex(cav.tets, p, kNoVertex, best2);
@@ -105,12 +112,12 @@ InsertResult Triangulation::check_cavity(const Point3& p, TetId start, bool star
   return {};
 }
 
-// One new tetrahedron per boundary face: q replaces the killed tetrahedron's vertex opposite the face,
-// and takes its place for the outer neighbour. The killed tetrahedron's slot for that face then names
-// the new one (the hint of its history record).
+// One new tetrahedron per boundary face (cav.created[k] on cav.boundary[k], allocated by the caller): q
+// replaces the killed tetrahedron's vertex opposite the face, and takes its place for the outer
+// neighbour. The killed tetrahedron's slot for that face then names the new one (the hint of its
+// history record).
 void Triangulation::build_cavity_tets(PointId q, Cavity& cav) {
   const std::size_t nb = cav.boundary.size();
-  alloc_tets(nb, cav.created);
   for (std::size_t k = 0; k < nb; ++k) {
     const Cavity::Face& bf = cav.boundary[k];
     const TetId s = cav.created[k];
@@ -158,10 +165,16 @@ InsertResult Triangulation::insert_at(const Point3& p, TetId start, bool start_c
     clear_cavity_marks(cav);
     throw;
   }
+  commit_insertion(q, cav, changes);
+  return {InsertStatus::Inserted, vid(q), kNoVertex};
+}
+
+// The cavity of the new vertex q (marked, checked) becomes the star of q.
+void Triangulation::commit_insertion(PointId q, Cavity& cav, ChangeSet* changes) {
+  alloc_tets(cav.boundary.size(), cav.created);
   build_cavity_tets(q, cav);
   link_around_apex(q, cav, scratch_->links);
   commit_cavity(q, cav, changes);
-  return {InsertStatus::Inserted, vid(q), kNoVertex};
 }
 
 InsertResult Triangulation::insert(const Point3& p, double min_distance, ChangeSet* changes) {
@@ -208,7 +221,13 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
   detail::check_min_distance(min_distance);
   if (changes) changes->clear();
   std::vector<InsertResult> results(points.size());
+  bulk_stats_ = BulkStats{};
+  bulk_stats_.serial = points.size();
   if (points.empty()) return results;
+  if (bulk_threads(points.size(), min_distance, changes) > 1) {
+    insert_parallel(points, results);
+    return results;
+  }
   const std::vector<std::uint32_t> order = detail::brio_order(points, box_);
   reserve_bulk(points.size());
   ChangeSet one;

@@ -60,6 +60,21 @@ TetId Triangulation::walk_limited(const Point3& p, TetId t, std::size_t max_step
   return kNoTet;
 }
 
+// The walk of a parallel bulk insertion (parallel_insert.cpp): from a tetrahedron that `owner` owns, it
+// steps only into tetrahedra that `owner` owns, and gives up (kNoTet) where the walk would leave them.
+// Reading a neighbour's vertices is safe: it shares a face, hence three vertices, with an owned one.
+TetId Triangulation::walk_owned(const Point3& p, TetId t, const detail::Partition& owner) const {
+  TetId prev = kNoTet;
+  std::uint32_t rng = 0x9e3779b9u ^ t;
+  for (;;) {
+    const TetId next = walk_step(points_of(t), p, rng, prev, [&](int i) { return tets_.neighbor(t, i); });
+    if (next == kNoTet) return t;
+    if (!owner.owns(tets_, next)) return kNoTet;
+    prev = t;
+    t = next;
+  }
+}
+
 // p lies in the closed tetrahedron s of record op (for an insertion record, the face opposite the apex
 // needs no test).
 bool Triangulation::in_op_tet(const Op& op, TetId s, const Point3& p) const {

@@ -187,7 +187,7 @@ TetId Triangulation::locate_move_target(PointId pv, const Point3& p) {
 bool Triangulation::move_too_close(PointId pv, const Point3& p, TetId start, double min_distance,
                                    MoveState& m, InsertResult& result) {
   PointId dup = kNoVertex;
-  if (!grow_cavity(p, start, true, m.probe, dup)) {
+  if (grow_cavity(p, start, true, m.probe, dup) != Grow::Ok) {
     result = {InsertStatus::TooClose, kNoVertex, vid(dup)};
     return true;
   }

@@ -12,6 +12,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -59,6 +60,36 @@ void net_changes(ChangeEvents& events, ChangeSet& out);
 std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z);
 /// BRIO insertion order of `pts` (spatial_sort.cpp).
 std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3& box);
+
+/// Key of a point of the box on the 2^21 grid: its Hilbert index (spatial_sort.cpp).
+std::uint64_t point_key(const Point3& p, const Box3& box);
+
+/// BRIO order with what the parallel bulk insertion needs besides: the Hilbert key of every input point
+/// and where each round starts in the order (spatial_sort.cpp).
+struct BrioOrder {
+  std::vector<std::uint32_t> order;  // input indices in insertion order
+  std::vector<std::uint64_t> key;    // by input index
+  std::vector<std::size_t> rounds;   // round r is order[rounds[r], rounds[r + 1]); last = size
+};
+BrioOrder brio_rounds(const std::vector<Point3>& pts, const Box3& box, unsigned threads = 1);
+
+/// Calls fn(lo, hi) on `threads` consecutive slices of [0, n), each on its own thread (the caller's thread
+/// takes the first); rethrows the first exception after all have finished.
+void parallel_slices(std::size_t n, unsigned threads,
+                     const std::function<void(std::size_t, std::size_t)>& fn);
+
+/// Parallel bulk insertion: each point id belongs to one partition (`part`, by point id) and thread k
+/// owns exactly the tetrahedra whose four vertices are in partition k. Two threads never touch the same
+/// record: a thread writes only tetrahedra it owns and the neighbours across their faces (three of the
+/// four vertices in its partition), and reads only those (see parallel_insert.cpp).
+struct Partition {
+  const std::uint8_t* part = nullptr;
+  std::uint8_t k = 0;
+  bool owns(const TetStore& s, TetStore::Id t) const {
+    return ((part[s.vertex(t, 0)] ^ k) | (part[s.vertex(t, 1)] ^ k) | (part[s.vertex(t, 2)] ^ k) |
+            (part[s.vertex(t, 3)] ^ k)) == 0;
+  }
+};
 
 /// Gift wrapping (hole_wrap.cpp): marks an adjacency entry that names a link face, not a new tetrahedron.
 inline constexpr std::uint32_t kLinkBit = 0x80000000u;

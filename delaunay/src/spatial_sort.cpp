@@ -2,8 +2,10 @@
 #include "scratch.hpp"
 
 #include <algorithm>
+#include <exception>
 #include <numeric>
 #include <random>
+#include <thread>
 
 namespace vitri {
 namespace detail {
@@ -34,16 +36,7 @@ std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   return key;
 }
 
-// BRIO: a fixed-seed shuffle cut into rounds of growing size (each 8x the previous), each round sorted
-// along a Hilbert curve. Rounds keep the randomness that bounds the cavity sizes; the sort keeps walks
-// short.
-std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3& box) {
-  const std::size_t n = pts.size();
-  std::vector<std::uint32_t> idx(n);
-  std::iota(idx.begin(), idx.end(), 0u);
-  std::mt19937_64 rng(0x5eedf00dULL);
-  for (std::size_t i = n; i > 1; --i) std::swap(idx[i - 1], idx[rng() % i]);
-  std::vector<std::uint64_t> key(n);
+std::uint64_t point_key(const Point3& p, const Box3& box) {
   const Point3 lo = box.lo;
   const Point3 ext = box.extent();
   const double scale = double((1u << 21) - 1);
@@ -52,17 +45,78 @@ std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3
     f = std::min(std::max(f, 0.0), scale);
     return static_cast<std::uint32_t>(f);
   };
-  for (std::size_t i = 0; i < n; ++i)
-    key[i] =
-        hilbert_key(grid(pts[i].x, lo.x, ext.x), grid(pts[i].y, lo.y, ext.y), grid(pts[i].z, lo.z, ext.z));
-  std::size_t e = n;
-  while (e > 0) {
-    const std::size_t b = e > 64 ? e / 8 : 0;
-    std::sort(idx.begin() + std::ptrdiff_t(b), idx.begin() + std::ptrdiff_t(e),
-              [&](std::uint32_t a, std::uint32_t c) { return key[a] < key[c]; });
-    e = b;
+  return hilbert_key(grid(p.x, lo.x, ext.x), grid(p.y, lo.y, ext.y), grid(p.z, lo.z, ext.z));
+}
+
+// BRIO: a fixed-seed shuffle cut into rounds of growing size (each 8x the previous), each round sorted
+// along a Hilbert curve. Rounds keep the randomness that bounds the cavity sizes; the sort keeps walks
+// short.
+void parallel_slices(std::size_t n, unsigned threads,
+                     const std::function<void(std::size_t, std::size_t)>& fn) {
+  const std::size_t T = std::max<std::size_t>(1, std::min<std::size_t>(threads, n));
+  std::vector<std::exception_ptr> errors(T);
+  auto run = [&](std::size_t k) {
+    try {
+      fn(k * n / T, (k + 1) * n / T);
+    } catch (...) {
+      errors[k] = std::current_exception();
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t k = 1; k < T; ++k) pool.emplace_back(run, k);
+  run(0);
+  for (std::thread& t : pool) t.join();
+  for (const std::exception_ptr& e : errors)
+    if (e) std::rethrow_exception(e);
+}
+
+namespace {
+// Sorts [first, last) by key, then index: a total order, so that the result does not depend on the sort
+// (the parallel bulk insertion must give the points the ids that the serial one gives them). Large
+// ranges are cut into `threads` slices sorted concurrently, then merged.
+void sort_by_key(std::uint32_t* first, std::uint32_t* last, const std::vector<std::uint64_t>& key,
+                 unsigned threads) {
+  auto less = [&](std::uint32_t a, std::uint32_t c) {
+    return key[a] < key[c] || (key[a] == key[c] && a < c);
+  };
+  const std::size_t n = std::size_t(last - first);
+  if (threads <= 1 || n < 16384) {
+    std::sort(first, last, less);
+    return;
   }
-  return idx;
+  parallel_slices(n, threads,
+                  [&](std::size_t lo, std::size_t hi) { std::sort(first + lo, first + hi, less); });
+  const std::size_t T = std::min<std::size_t>(threads, n);
+  for (std::size_t k = 1; k < T; ++k)
+    std::inplace_merge(first, first + k * n / T, first + (k + 1) * n / T, less);
+}
+}  // namespace
+
+BrioOrder brio_rounds(const std::vector<Point3>& pts, const Box3& box, unsigned threads) {
+  const std::size_t n = pts.size();
+  BrioOrder b;
+  b.order.resize(n);
+  std::iota(b.order.begin(), b.order.end(), 0u);
+  std::mt19937_64 rng(0x5eedf00dULL);
+  for (std::size_t i = n; i > 1; --i) std::swap(b.order[i - 1], b.order[rng() % i]);
+  b.key.resize(n);
+  parallel_slices(n, n < 16384 ? 1 : threads, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t i = lo; i < hi; ++i) b.key[i] = point_key(pts[i], box);
+  });
+  std::size_t e = n;
+  b.rounds.push_back(n);
+  while (e > 0) {
+    const std::size_t s = e > 64 ? e / 8 : 0;
+    sort_by_key(b.order.data() + s, b.order.data() + e, b.key, threads);
+    b.rounds.push_back(s);
+    e = s;
+  }
+  std::reverse(b.rounds.begin(), b.rounds.end());
+  return b;
+}
+
+std::vector<std::uint32_t> brio_order(const std::vector<Point3>& pts, const Box3& box) {
+  return brio_rounds(pts, box).order;
 }
 
 }  // namespace detail

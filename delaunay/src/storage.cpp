@@ -9,11 +9,20 @@
 #include <cmath>
 #include <numeric>
 #include <string>
+#include <thread>
 #include <unordered_set>
 
 namespace vitri {
 
 // ---- Construction ----------------------------------------------------------------------------------
+
+namespace {
+// TriangulationOptions::threads: 0 = the hardware's concurrency; at most 64 (one partition byte each).
+unsigned resolve_threads(unsigned threads) {
+  if (threads == 0) threads = std::thread::hardware_concurrency();
+  return std::min(std::max(threads, 1u), 64u);
+}
+}  // namespace
 
 Triangulation::Triangulation(const Box3& box) : Triangulation(box, TriangulationOptions{}) {}
 
@@ -23,6 +32,7 @@ Triangulation::Triangulation(const Box3& box, const TriangulationOptions& option
       tets_(options.keep_history),
       rebuild_factor_(options.history_rebuild_factor),
       max_wrap_link_(options.max_wrap_link),
+      threads_(resolve_threads(options.threads)),
       root_(options.keep_history),
       scratch_(std::make_unique<Scratch>()) {
   if (!(rebuild_factor_ >= 0.0))
@@ -57,6 +67,8 @@ Triangulation::Triangulation(const Triangulation& o)
       edit_tets_(o.edit_tets_),
       excess_levels_(o.excess_levels_),
       rebuilds_(o.rebuilds_),
+      threads_(o.threads_),
+      bulk_stats_(o.bulk_stats_),
       grid_(o.grid_),
       root_(o.root_),
       scratch_(std::make_unique<Scratch>()) {}

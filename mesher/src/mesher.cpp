@@ -17,6 +17,7 @@
 // The mesh is extracted on demand afterwards.
 #include "vitri/mesher.hpp"
 
+#include "support_filter.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/point_index.hpp"
 
@@ -96,6 +97,8 @@ void Mesher::build() {
   const Constraints& c = constraints();
   const Box3 domain = Polygonizer::domain_for(c.points, options_.box_factor);
   poly_ = std::make_unique<Polygonizer>(function(), domain, c.points, c.values, options_.polygonizer);
+  filter_ = std::make_unique<SupportFilter>();  // a new polygonizer: the next delta is full
+  filter_precision_ = 0;
   vertex_of_ = poly_->seed_vertices();
   zero_index_ = PointIndex();
   for (std::size_t i = 0; i < c.size(); ++i) track_zero(vertex_of_[i], c.points[i], c.values[i]);
@@ -162,22 +165,44 @@ void Mesher::track_zero(VertexId v, const Point3& p, double value) {
   if (v != kNoVertex && value == 0) zero_index_.insert(v, p);
 }
 
+void Mesher::sync_surface() {
+  const bool filter = !options_.keep_unsupported_components && !zero_index_.empty() && std::isfinite(precision_);
+  const double reach2 = std::pow(2.5 * precision_, 2);
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  const SupportFilter::Supported supported = [&](const Point3& p) {
+    zero_index_.nearest(p, 1, ids, &d2);
+    return !d2.empty() && d2[0] <= reach2;
+  };
+  if (quality_) {
+    std::size_t dropped = 0;
+    SurfaceMesh m = quality_->extract();
+    if (filter) m = keep_supported_components(m, supported, &dropped);
+    filter_->replace(m);
+    stats_.dropped_components = dropped;
+  } else {
+    const MeshDelta delta = poly_->update_surface();
+    const bool recheck = filter && filter_precision_ != precision_;
+    filter_->update(poly_->live_surface(), delta, filter ? supported : SupportFilter::Supported{}, recheck);
+    filter_precision_ = precision_;
+    stats_.dropped_components = filter_->hidden_components();
+  }
+}
+
+MeshDelta Mesher::update_surface() {
+  deltas_wanted_ = true;
+  sync_surface();
+  mesh_valid_ = false;  // surface() copies the view again
+  return filter_->view().take_delta();
+}
+
+const LiveMesh& Mesher::live_surface() const { return filter_->view(); }
+
 const SurfaceMesh& Mesher::surface() {
   if (!mesh_valid_) {
-    mesh_ = quality_ ? quality_->extract() : poly_->extract();
-    stats_.dropped_components = 0;
-    if (!options_.keep_unsupported_components && !zero_index_.empty() && std::isfinite(precision_)) {
-      const double reach2 = std::pow(2.5 * precision_, 2);
-      std::vector<PointIndex::Id> ids;
-      std::vector<double> d2;
-      mesh_ = keep_supported_components(
-          mesh_,
-          [&](const Point3& p) {
-            zero_index_.nearest(p, 1, ids, &d2);
-            return !d2.empty() && d2[0] <= reach2;
-          },
-          &stats_.dropped_components);
-    }
+    sync_surface();
+    if (!deltas_wanted_) filter_->view().take_delta();  // nobody reads the record: free the ids
+    mesh_ = filter_->view().to_surface_mesh();
     mesh_valid_ = true;
   }
   return mesh_;
@@ -188,13 +213,12 @@ void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { 
 void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion* region) {
   const double t1 = now_seconds();
   if (region && !region->everywhere) {
-    const Box3 bounds = region->bounds();
-    poly_->function_changed([&](const Point3& p) { return bounds.contains(p) && region->contains(p); });
+    poly_->function_changed(region->balls);  // the vertices near the balls only (no scan)
   } else {
     poly_->function_changed();
   }
   if (std::isfinite(precision_)) poly_->refine(precision_);
-  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction);
+  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction, options_.garbage_per_edit);
   if (quality_) {
     quality_->function_changed();
     quality_->refine();

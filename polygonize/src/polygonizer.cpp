@@ -23,6 +23,8 @@
 // causes an insertion, and entries are created only by insertions: the loop ends.
 #include "vitri/polygonize/polygonizer.hpp"
 
+#include "polygonizer_internal.hpp"
+#include "surface_tracker.hpp"
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
@@ -38,6 +40,8 @@ namespace vitri {
 
 namespace {
 
+using namespace polygonizer_detail;
+
 /// The Delaunay tree's options as the polygonizer's options ask (history kept or not).
 TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
   TriangulationOptions t;
@@ -45,7 +49,6 @@ TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
   return t;
 }
 
-constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
 // Thin features: an edge with ends of one sign that is probably crossed twice is refined only when the
 // gradients at its ends point into opposite half-spaces (cosine below this): the crossings then belong to
@@ -55,19 +58,6 @@ constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of e
 constexpr double kThinCosine = 0.0;
 // Proximity distance of thin-feature points, as a fraction of the refinement's (1: the same rule).
 constexpr double kThinDistance = 1.0;
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-/// The sign rule of the whole module: exactly 0 counts as positive.
-inline bool is_negative(double v) { return v < 0.0; }
-
-/// The Delaunay tree accepts points strictly inside its box only (the corners alone are on the hull).
-bool strictly_inside(const Box3& b, const Point3& p) {
-  return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
-}
 
 /// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
 /// removal swaps the last element in. @pre x is not listed (on) or listed (off).
@@ -117,7 +107,11 @@ Box3 Polygonizer::domain_for(const std::vector<Point3>& points, double factor) {
 
 Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                          const std::vector<double>& seed_values, const PolygonizerOptions& options)
-    : f_(f), options_(options), tri_(domain, triangulation_options(options)), precision_(std::numeric_limits<double>::infinity()) {
+    : f_(f),
+      options_(options),
+      tri_(domain, triangulation_options(options)),
+      precision_(std::numeric_limits<double>::infinity()),
+      surface_(std::make_unique<SurfaceTracker>()) {
   const auto t0 = Clock::now();
   if (!(options_.sampling_fraction >= 0.0) || !std::isfinite(options_.sampling_fraction))
     throw InvalidArgument("PolygonizerOptions::sampling_fraction must be >= 0");
@@ -127,6 +121,8 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
     throw InvalidArgument("PolygonizerOptions::root_tolerance must be in (0, 1)");
   if (!(options_.zero_offset > 0.0 && options_.zero_offset < 0.5))
     throw InvalidArgument("PolygonizerOptions::zero_offset must be in (0, 0.5)");
+  if (!(options_.snap_fraction > 0.0 && options_.snap_fraction < 0.5))
+    throw InvalidArgument("PolygonizerOptions::snap_fraction must be in (0, 0.5)");
   if (options_.max_root_iterations < 1) throw InvalidArgument("PolygonizerOptions::max_root_iterations must be >= 1");
   if (!seed_values.empty() && seed_values.size() != seeds.size())
     throw InvalidArgument("Polygonizer: seed_values must be empty or have one value per seed");
@@ -175,7 +171,6 @@ void Polygonizer::grow_vertex_arrays() {
   kind_.resize(cap, static_cast<std::uint8_t>(VertexKind::Refinement));
   fixed_.resize(cap, 0);
   tcount_.resize(cap, 0);
-  moved_.resize(cap, 0);
   lpos_.resize(cap, kNotListed);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   grad_.resize(cap, Point3{nan, nan, nan});
@@ -244,8 +239,12 @@ void Polygonizer::set_transverse(TetId t, bool on) {
     for (const VertexId u : v)
       if (tcount_[u]++ == 0 && lpos_[u] != kNotListed) set_lonely(u, false);  // no longer a lone zero
   } else {
-    for (const VertexId u : v)  // the vertex may have become a lone zero (decided after the batch)
-      if (--tcount_[u] == 0 && values_[u] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(u);
+    for (const VertexId u : v) {
+      if (--tcount_[u] != 0) continue;
+      // The vertex may have become a lone zero (decided after the batch), or garbage.
+      if (values_[u] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(u);
+      if (kind_[u] == static_cast<std::uint8_t>(VertexKind::Refinement)) idle_.push_back(u);
+    }
   }
 }
 
@@ -262,6 +261,8 @@ void Polygonizer::set_transverse(TetId t, bool on) {
 
 void Polygonizer::set_value(VertexId v, double value) {
   values_[v] = value;
+  surface_->note_value(v);
+  note_thin_vertex(v);
   if ((value == 0.0 && options_.refine_lone_zeros) || lpos_[v] != kNotListed) zcheck_.push_back(v);
 }
 
@@ -305,14 +306,21 @@ void Polygonizer::on_killed(const ChangeSet& cs) {
     // The Delaunay tree rebuilt its history and renumbered every tetrahedron (rare: after Omega(n)
     // edited tetrahedra): drop the per-tetrahedron state; cs.created lists every live tetrahedron and
     // the caller classifies them (O(n), amortized O(1) per edit). Vertex state is kept.
+    surface_->note_renumbered();
     tlist_.clear();
     std::fill(tpos_.begin(), tpos_.end(), kNotListed);
     std::fill(tcount_.begin(), tcount_.end(), 0u);
     clear_queue();
+    thin_all_ = true;
+    idle_.clear();  // every refinement vertex is a candidate again until classified
+    for (VertexId v = 8; v < tri_.vertex_capacity(); ++v)
+      if (tri_.is_vertex(v) && kind_[v] == static_cast<std::uint8_t>(VertexKind::Refinement)) idle_.push_back(v);
     return;
   }
-  for (const TetId t : cs.killed)
+  for (const TetId t : cs.killed) {
+    surface_->note_killed(t);
     if (t < tpos_.size() && tpos_[t] != kNotListed) set_transverse(t, false);
+  }
 }
 
 // After a rejected move: the tree may still have renumbered its tetrahedra before rejecting it.
@@ -334,7 +342,11 @@ void Polygonizer::classify(TetId t, bool requeue) {
 
 void Polygonizer::classify_created(std::vector<TetId>& created) {
   grow_tet_arrays();
-  for (const TetId t : created) classify(t, false);
+  for (const TetId t : created) {
+    surface_->note_created(t);
+    classify(t, false);
+  }
+  note_thin_tets(created);
   settle_zeros(created);
   created.clear();
 }
@@ -392,6 +404,7 @@ bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, Ve
   grow_vertex_arrays();
   grow_tet_arrays();
   kind_[r.vertex] = static_cast<std::uint8_t>(kind);
+  if (kind == VertexKind::Refinement) idle_.push_back(r.vertex);  // until a transverse tetrahedron holds it
   fixed_[r.vertex] = 0;
   tcount_[r.vertex] = 0;
   pending_.push_back(r.vertex);
@@ -483,21 +496,30 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   if (!(precision > 0.0) || !std::isfinite(precision))
     throw InvalidArgument("refine: precision must be positive and finite");
   const auto t0 = Clock::now();
+  // After edits at the same precision (the Mesher's updates), the queue already holds every active
+  // tetrahedron above the precision (classify() and settle_zeros() queue them as they appear), and only
+  // the tetrahedra created or around changed vertices need the thin-feature test: no pass over the mesh.
+  const bool resume = queue_valid_ && precision == precision_ && !thin_all_;
   precision_ = precision;
   const double dmin = options_.min_distance_fraction * precision;
-  clear_queue();
-  for (const TetId t : tlist_)
-    if (radius_[t] > precision) push(t);
-  for (const VertexId z : lonely_)
-    for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
+  if (!resume) {
+    clear_queue();
+    for (const TetId t : tlist_)
+      if (radius_[t] > precision) push(t);
+    for (const VertexId z : lonely_)
+      for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
+  }
   // Thin features: edges shorter than 2 dmin are not checked (every point of them is within dmin of an
-  // end, so its point would be rejected anyway). All live tetrahedra are checked once per call (values
-  // and gradients may have changed since the last call, and the length floor moved with the precision);
-  // from then on only the created ones.
+  // end, so its point would be rejected anyway). A new precision checks every live tetrahedron (the
+  // length floor moved); a resumed one those changed since; from then on only the created ones.
   const bool thin = options_.refine_thin_features;
   const double thin_dmin = kThinDistance * dmin, thin_min = 2.0 * thin_dmin;
   thin_.clear();
-  if (thin) check_thin(tri_.live_tetrahedra(), thin_min);
+  if (thin) check_thin(resume ? thin_recheck_set() : tri_.live_tetrahedra(), thin_min);
+  thin_tets_.clear();
+  thin_vertices_.clear();
+  thin_all_ = false;
+  in_refine_ = true;
   std::vector<TetId> created, retry, fresh;
   RefineProgress info;
   bool completed = true;
@@ -532,6 +554,7 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
       info.queued = queued() + thin_.size();
       if (!progress(info)) {
         completed = false;
+        thin_all_ = true;
         clear_queue();
         thin_.clear();
         break;
@@ -549,6 +572,8 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   stats_.boundary_coarse = 0;
   for (const TetId t : hull)
     if (is_active(t) && tri_.circumradius(t) > precision) ++stats_.boundary_coarse;
+  in_refine_ = false;
+  queue_valid_ = completed;
   stats_.refine_seconds = seconds_since(t0);
   return completed;
 }
@@ -614,6 +639,34 @@ void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) 
               thin_.end());
 }
 
+// Between refine() calls: remember what the next one must test (bounded: past the live tetrahedra
+// count, test everything instead).
+void Polygonizer::note_thin_vertex(VertexId v) {
+  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
+  thin_vertices_.push_back(v);
+  if (thin_vertices_.size() > tri_.num_vertices()) thin_all_ = true;
+}
+
+void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
+  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
+  thin_tets_.insert(thin_tets_.end(), tets.begin(), tets.end());
+  if (thin_tets_.size() > tri_.num_tetrahedra()) thin_all_ = true;
+}
+
+std::vector<TetId> Polygonizer::thin_recheck_set() {
+  std::vector<TetId> tets = thin_tets_;
+  std::sort(thin_vertices_.begin(), thin_vertices_.end());
+  thin_vertices_.erase(std::unique(thin_vertices_.begin(), thin_vertices_.end()), thin_vertices_.end());
+  for (const VertexId v : thin_vertices_) {
+    if (!tri_.is_vertex(v)) continue;
+    const auto star = tri_.incident_tetrahedra(v);
+    tets.insert(tets.end(), star.begin(), star.end());
+  }
+  std::sort(tets.begin(), tets.end());
+  tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+  return tets;
+}
+
 bool Polygonizer::insert_thin_point(double min_distance, std::vector<TetId>& created) {
   const ThinEdge e = thin_.back();
   thin_.pop_back();
@@ -662,6 +715,7 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
   const VertexId v = r.vertex;
   kind_[v] = static_cast<std::uint8_t>(kind);
   tcount_[v] = 0;
+  if (kind == VertexKind::Refinement) idle_.push_back(v);
   if (value) {
     set_value(v, *value);
     fixed_[v] = 1;
@@ -707,7 +761,8 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
     }
   }
   grow_tet_arrays();
-  moved_[v] = 1;
+  surface_->note_moved(v);
+  note_thin_vertex(v);  // its star changed shape
   if (value) {
     set_value(v, *value);
     fixed_[v] = 1;
@@ -736,59 +791,6 @@ void Polygonizer::set_vertex_value(VertexId v, double value) {
   fixed_[v] = 1;
   for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, false);
   settle_zeros({});
-}
-
-void Polygonizer::function_changed() { function_changed([](const Point3&) { return true; }); }
-
-void Polygonizer::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
-  const auto t0 = Clock::now();
-  std::vector<VertexId> ids;
-  const std::size_t cap = tri_.vertex_capacity();
-  for (VertexId v = 0; v < cap; ++v)
-    if (needs_evaluation(v) && may_have_changed(tri_.point(v))) ids.push_back(v);
-  std::vector<double> out;
-  evaluate_at(ids, out);
-  std::vector<TetId> touched;
-  for (std::size_t i = 0; i < ids.size(); ++i) {
-    if (fixed_[ids[i]]) continue;
-    const VertexId v = ids[i];
-    const bool flip = is_negative(out[i]) != is_negative(values_[v]);
-    set_value(v, out[i]);
-    if (flip) {
-      const auto inc = tri_.incident_tetrahedra(v);
-      touched.insert(touched.end(), inc.begin(), inc.end());
-    }
-  }
-  std::sort(touched.begin(), touched.end());
-  touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-  for (const TetId t : touched) classify(t, false);
-  settle_zeros({});
-  stats_.update_seconds = seconds_since(t0);
-}
-
-std::size_t Polygonizer::collect_garbage(double min_fraction) {
-  std::size_t removed = 0;
-  const std::size_t cap = tri_.vertex_capacity();
-  if (min_fraction > 0.0) {
-    std::size_t candidates = 0;
-    for (VertexId v = 8; v < cap; ++v)
-      candidates += kind_[v] == static_cast<std::uint8_t>(VertexKind::Refinement) && tcount_[v] == 0 &&
-                    tri_.is_vertex(v);
-    if (static_cast<double>(candidates) <= min_fraction * static_cast<double>(tri_.num_vertices())) return 0;
-  }
-  for (VertexId v = 8; v < cap; ++v) {
-    if (kind_[v] != static_cast<std::uint8_t>(VertexKind::Refinement) || tcount_[v] != 0 || !tri_.is_vertex(v))
-      continue;
-    // Keep the refinement of the stars of lone zeros (they are active; removing would redo it).
-    if (lpos_[v] != kNotListed) continue;
-    bool serves = false;
-    for (const TetId t : tri_.incident_tetrahedra(v)) serves = serves || touches_lonely(t);
-    if (serves) continue;
-    remove_vertex(v);
-    ++removed;
-  }
-  stats_.removed_steiner += removed;
-  return removed;
 }
 
 PolygonizerStats Polygonizer::stats() const {

@@ -107,7 +107,7 @@ struct Client {
   std::map<std::uint32_t, Corners> triangles;
   std::uint32_t version = 0;
 
-  void apply(const MeshDelta& d) {
+  void apply(const ClientDelta& d) {
     if (d.full)
       triangles.clear();
     else
@@ -157,14 +157,21 @@ std::vector<Corners> triangles_of(const Client& c) {
   return out;
 }
 
-/// A closed octahedron whose vertex v is displaced by `by` along z.
-SurfaceMesh octahedron(std::size_t v = 0, double by = 0) {
-  SurfaceMesh m;
-  m.vertices = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
-  m.vertices[v].z += by;
-  m.triangles = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
-  m.normals = m.vertices;
+/// A closed octahedron as a live mesh; vertex v is displaced by `by` along z.
+LiveMesh octahedron_live() {
+  LiveMesh m;
+  const std::vector<Point3> p = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  for (const Point3& q : p) m.add_vertex(q, q);
+  for (const auto& t : std::vector<std::array<std::uint32_t, 3>>{
+           {0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4}, {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}})
+    m.add_triangle(t);
   return m;
+}
+
+void displace(LiveMesh& m, std::uint32_t v, double z) {
+  Point3 p = m.position(v);
+  p.z = z;
+  m.move_vertex(v, p, m.normal(v));
 }
 
 }  // namespace
@@ -173,81 +180,105 @@ TEST_CASE("delta: a client applying every delta holds the server's mesh", "[stud
   DeltaTracker tracker;
   tracker.set_cell(1e-6);
   Client client;
-  const MeshDelta first = tracker.update(octahedron(), 0);
+  LiveMesh live = octahedron_live();
+  const ClientDelta first = tracker.update(live, live.take_delta(), 0);
   CHECK(first.full);
   CHECK(first.added.size() == 8);
   client.apply(first);
-  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(octahedron())));
+  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
 
   // Nothing changed: an empty delta, same version.
-  const MeshDelta same = tracker.update(octahedron(), client.version);
+  const ClientDelta same = tracker.update(live, live.take_delta(), client.version);
   CHECK_FALSE(same.full);
   CHECK(same.added.empty());
   CHECK(same.removed.empty());
   CHECK(same.version == client.version);
 
-  // Vertex 4 (the apex, in 4 triangles) moves: exactly those 4 are resent.
-  const MeshDelta moved = tracker.update(octahedron(4, 0.5), client.version);
+  // Vertex 4 (the apex, in 4 triangles) moves: exactly those 4 are resent, under their ids.
+  displace(live, 4, 1.5);
+  const ClientDelta moved = tracker.update(live, live.take_delta(), client.version);
   CHECK(moved.removed.size() == 4);
   CHECK(moved.added.size() == 4);
+  CHECK(moved.removed == moved.added);
   client.apply(moved);
-  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(octahedron(4, 0.5))));
+  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
 
   // A client with another version (a second tab, a reload) gets the full mesh.
-  const MeshDelta other = tracker.update(octahedron(4, 0.5), client.version + 7);
+  const ClientDelta other = tracker.update(live, live.take_delta(), client.version + 7);
   CHECK(other.full);
   CHECK(other.added.size() == 8);
+  client = Client{};
+  client.apply(other);
 
-  // A rotated triangle (same cyclic order) is the same triangle; a reversed one is not.
-  SurfaceMesh rotated = octahedron(4, 0.5);
-  for (auto& t : rotated.triangles) t = {t[1], t[2], t[0]};
-  CHECK(tracker.update(rotated, other.version).added.empty());
-  SurfaceMesh flipped = rotated;
-  std::swap(flipped.triangles[0][0], flipped.triangles[0][1]);
-  const MeshDelta flip = tracker.update(flipped, other.version);
-  CHECK(flip.added.size() == 1);
+  // A triangle replaced (flipped): one removed, one added.
+  live.remove_triangle(0);
+  live.add_triangle({2, 0, 4});
+  live.add_triangle({0, 2, 4});  // (keeps vertex 0 in use after the removal, then the flip goes)
+  const MeshDelta change = live.take_delta();
+  const ClientDelta flip = tracker.update(live, change, client.version);
   CHECK(flip.removed.size() == 1);
+  CHECK(flip.added.size() == 2);
+  client.apply(flip);
+  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
 }
 
-TEST_CASE("delta: approximate mode keeps triangles that moved less than a cell", "[studio][delta]") {
+TEST_CASE("delta: approximate mode keeps vertices that moved less than a cell", "[studio][delta]") {
   DeltaTracker tracker;
   tracker.set_cell(0.25);
   Client client;
-  client.apply(tracker.update(octahedron(4, 0.01), 0));  // apex at z = 1.01, inside cell [1, 1.25)
-  // The apex moves within its cell: nothing resent in approximate mode, everything around it when exact.
-  const MeshDelta approx = tracker.update(octahedron(4, 0.02), client.version, false);
+  LiveMesh live = octahedron_live();
+  displace(live, 4, 1.01);  // inside cell [1, 1.25)
+  client.apply(tracker.update(live, live.take_delta(), 0));
+  // The apex moves within its cell: nothing resent in approximate mode; the exact request resends it.
+  displace(live, 4, 1.02);
+  const ClientDelta approx = tracker.update(live, live.take_delta(), client.version, false);
   CHECK(approx.added.empty());
-  const MeshDelta exact = tracker.update(octahedron(4, 0.02), client.version, true);
+  client.apply(approx);
+  const ClientDelta exact = tracker.update(live, live.take_delta(), client.version, true);
   CHECK(exact.added.size() == 4);
   client.apply(exact);
-  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(octahedron(4, 0.02))));
+  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
   // Leaving the cell resends in both modes.
-  const MeshDelta far = tracker.update(octahedron(4, 0.4), client.version, false);
+  displace(live, 4, 1.4);
+  const ClientDelta far = tracker.update(live, live.take_delta(), client.version, false);
   CHECK(far.added.size() == 4);
 }
 
-TEST_CASE("delta: random meshes, random edits, exact deltas reproduce each mesh", "[studio][delta]") {
+TEST_CASE("delta: random edits of a live mesh, exact deltas reproduce it", "[studio][delta]") {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1, 1);
-  SurfaceMesh m;
-  for (int i = 0; i < 60; ++i) m.vertices.push_back({u(rng), u(rng), u(rng)});
-  for (int t = 0; t < 200; ++t)
-    m.triangles.push_back({static_cast<std::uint32_t>(rng() % 60), static_cast<std::uint32_t>(rng() % 60),
-                           static_cast<std::uint32_t>(rng() % 60)});
+  LiveMesh live;
+  for (int i = 0; i < 60; ++i) live.add_vertex({u(rng), u(rng), u(rng)}, {0, 0, 1});
+  const auto random_triangle = [&] {
+    std::array<std::uint32_t, 3> t{};
+    do {
+      for (auto& c : t) c = static_cast<std::uint32_t>(rng() % 60);
+    } while (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || !live.is_vertex(t[0]) || !live.is_vertex(t[1]) ||
+             !live.is_vertex(t[2]));
+    return t;
+  };
+  for (int t = 0; t < 200; ++t) live.add_triangle(random_triangle());
   DeltaTracker tracker;
   tracker.set_cell(1e-3);
   Client client;
   for (int step = 0; step < 30; ++step) {
-    client.apply(tracker.update(m, client.version));
-    REQUIRE(canonical(triangles_of(client)) == canonical(triangles_of(m)));  // repeated triangles too
-    m.vertices[rng() % 60] = {u(rng), u(rng), u(rng)};  // moves every triangle of one vertex
-    m.triangles[rng() % m.triangles.size()][0] = static_cast<std::uint32_t>(rng() % 60);
+    client.apply(tracker.update(live, live.take_delta(), client.version));
+    REQUIRE(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
+    const auto v = static_cast<std::uint32_t>(rng() % 60);
+    if (live.is_vertex(v)) live.move_vertex(v, {u(rng), u(rng), u(rng)}, {0, 0, 1});
+    std::uint32_t t = static_cast<std::uint32_t>(rng() % live.triangle_capacity());
+    while (!live.is_triangle(t)) t = static_cast<std::uint32_t>(rng() % live.triangle_capacity());
+    const auto keep = live.triangle(t);
+    live.add_triangle(random_triangle());
+    live.add_triangle(keep);  // the corners stay in use
+    live.remove_triangle(t);
   }
 }
 
 TEST_CASE("delta: binary encoding layout", "[studio][delta]") {
   DeltaTracker tracker;
-  const MeshDelta d = tracker.update(octahedron(), 0);
+  LiveMesh live = octahedron_live();
+  const ClientDelta d = tracker.update(live, live.take_delta(), 0);
   const std::string bin = encode_binary(d);
   REQUIRE(bin.size() == 24 + 4 * (d.added.size() + 18 * d.added.size()));
   std::uint32_t header[6];

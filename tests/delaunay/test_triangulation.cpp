@@ -5,6 +5,8 @@
 #include "vitri/core/predicates.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 
+#include "test_points.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -16,6 +18,8 @@
 #include <vector>
 
 using namespace vitri;
+using test::grid_points;
+using test::uniform_points;
 
 namespace {
 
@@ -91,14 +95,6 @@ void check_brute_force_empty(const Triangulation& tr) {
   });
 }
 
-std::vector<Point3> uniform_points(std::size_t n, unsigned seed, double lo = 0.05, double hi = 0.95) {
-  std::mt19937_64 rng(seed);
-  std::uniform_real_distribution<double> u(lo, hi);
-  std::vector<Point3> p(n);
-  for (auto& q : p) q = {u(rng), u(rng), u(rng)};
-  return p;
-}
-
 std::vector<Point3> clustered_points(std::size_t n, unsigned seed) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> u(0.2, 0.8);
@@ -118,14 +114,6 @@ std::vector<Point3> integer_sphere_points() {
       for (int z = -8; z <= 8; ++z)
         if (x * x + y * y + z * z == 50) p.push_back({double(x), double(y), double(z)});
   p.push_back({0, 0, 0});
-  return p;
-}
-
-std::vector<Point3> grid_points(int n) {
-  std::vector<Point3> p;
-  for (int x = 0; x < n; ++x)
-    for (int y = 0; y < n; ++y)
-      for (int z = 0; z < n; ++z) p.push_back({double(x), double(y), double(z)});
   return p;
 }
 

@@ -12,7 +12,9 @@
 #include "vitri/rbf/point_index.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <map>
 #include <random>
 #include <string>
 #include <vector>
@@ -176,4 +178,79 @@ TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the 
   }
   // The structure stays valid: a coarse level within the limit still meshes.
   CHECK(limited.stats().polygonizer.vertices < needed);
+}
+
+namespace {
+
+using Corner = std::array<double, 3>;
+using Tri = std::array<Corner, 3>;
+
+std::vector<Tri> canonical(const SurfaceMesh& m) {
+  std::vector<Tri> out;
+  for (const auto& t : m.triangles) {
+    Tri tri;
+    for (int i = 0; i < 3; ++i) tri[i] = {m.vertices[t[i]].x, m.vertices[t[i]].y, m.vertices[t[i]].z};
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    out.push_back(tri);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("local function: edits send small deltas that keep a client's copy exact", "[mesher][local]") {
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  const double precision = 0.015 * mesher.diagonal();
+  mesher.refine(precision);
+  std::map<std::uint32_t, std::array<std::uint32_t, 3>> tris;  // the client's copy: ids and corners
+  std::map<std::uint32_t, Point3> verts;
+  const auto apply = [&](const MeshDelta& d) {
+    const LiveMesh& m = mesher.live_surface();
+    if (d.full) tris.clear(), verts.clear();
+    for (const auto t : d.removed_triangles) REQUIRE(tris.erase(t) == 1);
+    for (const auto v : d.removed_vertices) REQUIRE(verts.erase(v) == 1);
+    for (const auto v : d.added_vertices) verts[v] = m.position(v);
+    for (const auto v : d.moved_vertices) verts.at(v) = m.position(v);
+    for (const auto t : d.added_triangles) tris[t] = m.triangle(t);
+  };
+  apply(mesher.update_surface());
+  const std::size_t total = tris.size();
+  REQUIRE(total > 5000);
+  // The filter's rule, applied from scratch to the unfiltered mesh.
+  std::vector<Point3> zeros;
+  for (std::size_t i = 0; i < mesher.size(); ++i)
+    if (mesher.constraints().values[i] == 0) zeros.push_back(mesher.constraints().points[i]);
+  const PointIndex index(zeros);
+  const auto supported = [&](const Point3& p) {
+    std::vector<PointIndex::Id> ids;
+    std::vector<double> d2;
+    index.nearest(p, 1, ids, &d2);
+    return !d2.empty() && d2[0] <= std::pow(2.5 * precision, 2);
+  };
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<std::size_t> pick(0, zeros.size() - 1);
+  std::uniform_real_distribution<double> u(-1, 1);
+  for (int step = 0; step < 6; ++step) {
+    const std::size_t i = pick(rng);
+    mesher.move_constraint(i, mesher.constraints().points[i] + (0.004 * mesher.diagonal()) * Point3{u(rng), u(rng), u(rng)});
+    const MeshDelta d = mesher.update_surface();
+    apply(d);
+    // Only the triangles near the edit travel.
+    INFO("added " << d.added_triangles.size() << " removed " << d.removed_triangles.size() << " of " << total);
+    REQUIRE(d.added_triangles.size() < total / 10);
+    // The copy is the live mesh, which is closed and equals the filter applied from scratch.
+    const LiveMesh& m = mesher.live_surface();
+    REQUIRE(tris.size() == m.num_triangles());
+    REQUIRE(verts.size() == m.num_vertices());
+    for (const auto& [t, c] : tris) REQUIRE(m.triangle(t) == c);
+    for (const auto& [v, p] : verts) REQUIRE(m.position(v) == p);
+    const SurfaceMesh s = mesher.surface();
+    require_closed(s, 0);
+    const SurfaceMesh all = mesher.polygonizer().live_surface().to_surface_mesh();
+    REQUIRE(canonical(s) == canonical(keep_supported_components(all, supported)));
+  }
 }

@@ -284,6 +284,36 @@ TEST_CASE("dynamic function: re-evaluation, local reclassification, garbage coll
     REQUIRE(poly.stats().vertices == before - garbage);
     require_closed(poly.extract(), 2, 1);
   }
+
+  SECTION("collect_garbage(min_fraction, max_removals) drains a batch over several calls") {
+    f.c = {-0.4, 0.3, 0.2};
+    f.r = 0.5;
+    poly.function_changed();
+    const std::size_t insertions_before = poly.stats().insertions;
+    REQUIRE(poly.refine(precision));
+    const std::size_t before = poly.stats().vertices;
+    const std::size_t bound = 5;
+    std::size_t total = 0, calls = 0;
+    // The first call decides (fraction reached) and may also remove as many as refine() inserted; later
+    // calls go on even below the fraction, each removing at most `bound` (nothing was inserted in
+    // between), until no candidate is left.
+    const std::size_t inserted = poly.stats().insertions - insertions_before;
+    REQUIRE(inserted > 0);
+    std::size_t removed = poly.collect_garbage(0.01, bound);
+    REQUIRE(removed > 0);
+    REQUIRE(removed <= bound + inserted);
+    for (; removed > 0; removed = poly.collect_garbage(0.99, bound)) {
+      if (calls > 0) REQUIRE(removed <= bound);
+      total += removed;
+      ++calls;
+    }
+    REQUIRE(calls > 1);
+    REQUIRE(poly.stats().vertices == before - total);
+    REQUIRE(poly.collect_garbage() == 0);  // the drain left no idle refinement vertex
+    require_closed(poly.extract(), 2, 1);
+    for (const TetId t : poly.transverse_tetrahedra())
+      REQUIRE(poly.triangulation().circumradius(t) <= precision);
+  }
 }
 
 TEST_CASE("bad input is rejected with a clear error", "[polygonizer]") {

@@ -5,9 +5,28 @@
 
 #include <catch2/catch.hpp>
 
+#include "vitri/core/box.hpp"
+
+#include <algorithm>
 #include <cstddef>
 
 namespace vitri::test {
+
+/// Smallest triangle area over the square of the diagonal of the mesh's bounding box (1 when empty).
+inline double min_relative_area(const SurfaceMesh& m) {
+  Box3 box;
+  for (const Point3& p : m.vertices) box.extend(p);
+  const double d2 = box.diagonal() * box.diagonal();
+  double smallest = 1.0;
+  for (const auto& t : m.triangles) {
+    const Point3 n = cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]);
+    smallest = std::min(smallest, 0.5 * norm(n) / d2);
+  }
+  return smallest;
+}
+
+/// No triangle with an area below 1e-14 x diagonal^2 (issue 12's bound).
+inline void require_no_tiny_triangle(const SurfaceMesh& m) { REQUIRE(min_relative_area(m) >= 1e-14); }
 
 /// Closed, consistently oriented, manifold, no degenerate or duplicate element, no isolated vertex, the
 /// given Euler characteristic and component count, outward (positive volume), one normal per vertex.
@@ -24,6 +43,7 @@ inline void require_closed(const SurfaceMesh& m, long long euler, std::size_t co
   REQUIRE(mm.components == components);
   REQUIRE(mm.signed_volume > 0.0);
   REQUIRE(m.normals.size() == m.vertices.size());
+  require_no_tiny_triangle(m);
 }
 
 }  // namespace vitri::test

@@ -35,6 +35,8 @@
 
 namespace vitri {
 
+class SupportFilter;
+
 /// Which variational function the Mesher fits (docs/local_rbf.md).
 enum class FunctionKind {
   Global,  ///< vitri::Rbf: one dense cubic RBF over all constraints (O(N^2) memory, O(N^3) fit, global edits)
@@ -91,6 +93,9 @@ struct MesherOptions {
   /// 0: after every edit. The Delaunay vertex count then stays within about (1 + this) of a session
   /// that collects after every edit.
   double garbage_fraction = 0.1;
+  /// Once collecting, at most this many removals per edit plus as many as the edit inserted, the rest at
+  /// the next edits: no edit pays for a whole batch (Polygonizer::collect_garbage).
+  std::size_t garbage_per_edit = 64;
   /// refine() stops and throws LimitError (naming the count) once the Delaunay tree holds more than
   /// this many vertices; 0: no limit. A precision far below the data's spacing asks for a number of
   /// vertices that grows as 1 / precision^2 (precision^-3 for a zero set that fills space): the limit
@@ -154,8 +159,18 @@ class Mesher {
   ///         LimitError past options().max_vertices.
   bool refine(double precision, const ProgressCallback& progress = {});
 
-  /// The current mesh (extracted on demand, cached until the next refine or edit).
+  /// The current mesh (extracted on demand, cached until the next refine or edit), compact.
   const SurfaceMesh& surface();
+  /// Brings the live mesh (live_surface()) up to date and returns what changed in it since the previous
+  /// call: only the changed triangles (polygonizer's incremental extraction, then the support filter kept
+  /// incrementally, docs/mesher.md). The first call returns a full delta, so does every call in the
+  /// quality mode (its mesh is rebuilt). Until this is first called, surface() drops the records.
+  MeshDelta update_surface();
+  /// The current mesh with stable ids, as of the last update_surface(), sync_surface() or surface().
+  const LiveMesh& live_surface() const;
+  /// Brings live_surface() up to date without taking its delta (the next update_surface() returns the
+  /// changes since the previous one, these included). Cost as update_surface().
+  void sync_surface();
   /// The current mesh as Eigen arrays: V #V x 3, F #F x 3 (CCW seen from outside), N #V x 3 unit
   /// outward normals (gradient of f).
   void mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N);
@@ -217,6 +232,9 @@ class Mesher {
   double precision_;
   SurfaceMesh mesh_;
   bool mesh_valid_ = false;
+  std::unique_ptr<SupportFilter> filter_;  // the live mesh without unsupported components
+  double filter_precision_ = 0;             // precision of its last support check
+  bool deltas_wanted_ = false;              // update_surface() was called: keep the records
   MesherStats stats_;
 };
 

@@ -11,6 +11,12 @@
 namespace vitri {
 
 /// A closed axis-aligned box [lo, hi]. A default-constructed box is empty (lo > hi) and grows with extend().
+/// A closed ball (used to describe where something changed, e.g. a local function's edit).
+struct Ball {
+  Point3 center;
+  double radius = 0;
+};
+
 struct Box3 {
   Point3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
             std::numeric_limits<double>::infinity()};

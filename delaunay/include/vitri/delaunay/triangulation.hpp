@@ -33,6 +33,10 @@
 
 namespace vitri {
 
+namespace detail {
+struct Partition;  // parallel bulk insertion: which thread owns a tetrahedron (delaunay/src/scratch.hpp)
+}  // namespace detail
+
 using VertexId = std::uint32_t;  ///< Stable id of a vertex; never reused after removal.
 using TetId = std::uint32_t;     ///< Id of a tetrahedron (live or in the history).
 inline constexpr VertexId kNoVertex = std::numeric_limits<VertexId>::max();
@@ -89,6 +93,26 @@ struct TriangulationOptions {
   /// otherwise through a scratch triangulation of the link (both give the same tetrahedra; a tuning
   /// knob, exposed so that tests can force either method).
   std::size_t max_wrap_link = 64;
+  /// Threads of a bulk insertion (insert_points); 0 = std::thread::hardware_concurrency(). With more
+  /// than one, insert_points inserts in parallel when the triangulation keeps no history, no ChangeSet
+  /// is requested, min_distance is 0 and no vertex has moved (otherwise serially). The parallel build
+  /// gives the same tetrahedra over the same vertex ids and the same results as the serial one (the
+  /// perturbed Delaunay tetrahedralization is unique); tetrahedron ids, the vertex order inside a
+  /// tetrahedron and the free slots may differ and may vary from run to run.
+  unsigned threads = 1;
+};
+
+/// What the last insert_points did (diagnostics, e.g. for benchmarks and tests).
+struct BulkStats {
+  std::size_t serial = 0;    ///< points inserted (or rejected) by one thread
+  std::size_t parallel = 0;  ///< points inserted (or rejected) by the parallel passes
+  std::size_t deferred = 0;  ///< deferrals: a point whose cavity crossed a partition (counted per pass)
+  std::size_t passes = 0;    ///< parallel passes
+  unsigned threads = 1;      ///< threads used
+  /// CPU time of the threads in the parallel passes, in total and summed over the passes for the
+  /// slowest thread of each: on a machine with a free core per thread the passes take about the latter.
+  double thread_cpu_seconds = 0;
+  double slowest_thread_cpu_seconds = 0;
 };
 
 /// Exact, dynamic Delaunay tetrahedralization of points inside a box. Not thread-safe for writes;
@@ -155,6 +179,8 @@ class Triangulation {
   void rebuild_history(ChangeSet* changes = nullptr);
   /// Number of history rebuilds so far (automatic or explicit).
   std::size_t history_rebuilds() const { return rebuilds_; }
+  /// How the last insert_points split its work between serial and parallel insertion.
+  const BulkStats& last_bulk_stats() const { return bulk_stats_; }
 
   // ---- Queries --------------------------------------------------------------------------------------
   /// A live tetrahedron containing p (closed); p must lie in the box. Uses the history DAG.
@@ -245,6 +271,11 @@ class Triangulation {
   struct SubFill;    // removal of a huge star: the scratch triangulation of its link
   struct MoveState;  // move: the star rebuilt in place
   struct Scratch;    // one of each, reused between operations (never shared between copies)
+  struct Worker;     // parallel bulk insertion: the state of one thread (parallel_insert.cpp)
+  struct Bulk;       // parallel bulk insertion: the batch and its partitions (parallel_insert.cpp)
+  // Outcome of growing a cavity: complete, p duplicates a vertex, or (parallel insertion) the cavity
+  // reaches a tetrahedron that the growing thread does not own.
+  enum class Grow : std::uint8_t { Ok, Duplicate, Blocked };
   using Points4 = std::array<const Point3*, 4>;
 
   PointId pid(VertexId v) const { return pid_of_vid_.empty() ? v : pid_of_vid_[v]; }
@@ -279,7 +310,8 @@ class Triangulation {
   TetId descend(TetId dead, const Point3& p, std::size_t* visited) const;
   TetId descend_around_apex(TetId dead, const Point3& p, std::size_t* visited) const;
   // insert.cpp
-  bool grow_cavity(const Point3& p, TetId start, bool start_contains, Cavity& cavity, PointId& duplicate);
+  Grow grow_cavity(const Point3& p, TetId start, bool start_contains, Cavity& cavity, PointId& duplicate,
+                   const detail::Partition* owner = nullptr);
   void clear_cavity_marks(const Cavity& cavity);
   PointId nearest_vertex(const std::vector<TetId>& tets, const Point3& p, PointId skip, double& best2) const;
   InsertResult insert_at(const Point3& p, TetId start, bool start_contains, double min_distance,
@@ -288,7 +320,25 @@ class Triangulation {
                             Cavity& cavity);
   void build_cavity_tets(PointId q, Cavity& cavity);
   void commit_cavity(PointId q, Cavity& cavity, ChangeSet* changes);
+  void commit_insertion(PointId q, Cavity& cavity, ChangeSet* changes);
   void reserve_bulk(std::size_t n);
+  // parallel_insert.cpp
+  unsigned bulk_threads(std::size_t n, double min_distance, const ChangeSet* changes) const;
+  void insert_parallel(const std::vector<Point3>& points, std::vector<InsertResult>& results);
+  std::size_t bulk_prefix(const Bulk& b) const;
+  void bulk_assign_points(const std::vector<Point3>& points, Bulk& b);
+  void bulk_round(Bulk& b, std::size_t lo, std::size_t hi);
+  void bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pending, std::size_t pass);
+  void bulk_give_room(Bulk& b, Worker& w, std::size_t points);
+  void bulk_work(const Bulk& b, Worker& w);
+  bool bulk_insert_one(const Bulk& b, Worker& w, std::uint32_t rank);
+  TetId bulk_start(const Bulk& b, const Worker& w, const Point3& p, int attempt) const;
+  void bulk_note_pass(const Bulk& b, const std::vector<std::uint32_t>& ranks);
+  TetId walk_owned(const Point3& p, TetId t, const detail::Partition& owner) const;
+  void bulk_insert_serial(Bulk& b, const std::vector<std::uint32_t>& ranks);
+  void bulk_finish(Bulk& b, std::vector<InsertResult>& results);
+  std::vector<PointId> bulk_relabel(Bulk& b);
+  InsertResult bulk_result(const Bulk& b, const std::vector<PointId>& final_id, PointId q) const;
   // link_apex.cpp
   void link_around_apex(PointId q, const Cavity& cavity, ApexLinks& links);
   bool link_by_table(PointId q, const Cavity& cavity, ApexLinks& links);
@@ -351,6 +401,8 @@ class Triangulation {
   std::size_t edit_tets_ = 0;       // tetrahedra created by removals and moves since the last rebuild
   std::size_t excess_levels_ = 0;   // levels descended beyond 6 log2 n + 64 by insert() and move()
   std::size_t rebuilds_ = 0;
+  unsigned threads_ = 1;  // TriangulationOptions::threads (resolved: >= 1)
+  BulkStats bulk_stats_;
   detail::VertexGrid grid_;           // location hints: the last vertex inserted in each cell
   Store root_;                        // the 8-corner triangulation, for reset_to_corners()
   std::unique_ptr<Scratch> scratch_;  // work buffers, never shared between copies

@@ -25,12 +25,15 @@
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/delaunay/triangulation.hpp"
+#include "vitri/polygonize/live_mesh.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include <cstddef>
 #include <cstdint>
 #include <deque>
 #include <functional>
+#include <limits>
+#include <memory>
 #include <optional>
 #include <queue>
 #include <unordered_map>
@@ -38,6 +41,8 @@
 #include <vector>
 
 namespace vitri {
+
+class SurfaceTracker;
 
 /// Order in which transverse tetrahedra are refined.
 enum class QueueOrder {
@@ -80,12 +85,23 @@ struct PolygonizerOptions {
   double root_tolerance = 1e-4;
   /// Root finder iteration cap per edge (each iteration is one function evaluation, batched).
   int max_root_iterations = 16;
+  /// After an edit, an edge whose ends did not move starts the root finder from its previous root (one
+  /// evaluation usually accepts it). false: every placement starts cold, so the mesh depends only on the
+  /// current state, not on the edit history (the tests compare incremental and fresh extractions so).
+  bool warm_start_roots = true;
   /// Zero-valued vertices: collapse the mesh vertices of their crossed edges into the zero vertex
   /// itself when the result stays a manifold (see docs/polygonize.md). When false, or when the collapse
   /// would pinch or fold the mesh, those mesh vertices stay at `zero_offset` along their edges.
   bool snap_zero_vertices = true;
   /// Fraction of the edge length, from the zero vertex, at which a non-snapped crossing is placed.
   double zero_offset = 0.05;
+  /// Near-vertex crossings: a root closer than this fraction of its edge to an end is *anchored* there,
+  /// and the crossings anchored at a Delaunay vertex z merge into one mesh vertex, at z moved onto the
+  /// surface by one Newton step, when the result stays a manifold without folds (the rule of zero-valued
+  /// vertices, which merge at z itself; both off with snap_zero_vertices). Without it, a surface passing
+  /// within rounding of a Delaunay vertex leaves a fan of triangles with edges ~1e-6 of the Delaunay edge
+  /// (areas ~1e-12 of its square). In (0, 0.5).
+  double snap_fraction = 0.01;
   /// Lone zeros: refine the star of every zero-valued vertex that no transverse tetrahedron touches
   /// (circumradius > precision), so that the surface through it is found even when no vertex is on its
   /// negative side yet (a zero constraint added away from the surface; a thin part with only outside
@@ -133,8 +149,8 @@ struct PolygonizerStats {
   std::size_t thin_insertions = 0;      ///< refine(): points inserted on edges probably crossed twice
   std::size_t rejected = 0;             ///< refine(): points rejected by proximity (tetrahedron dropped)
   std::size_t removed_steiner = 0;      ///< refinement vertices removed by collect_garbage()
-  std::size_t zero_snapped = 0;         ///< last extract(): zero vertices used as mesh vertices
-  std::size_t zero_offset = 0;          ///< last extract(): zero vertices whose crossings stayed offset
+  std::size_t zero_snapped = 0;         ///< last extract(): Delaunay vertices with crossings collapsed onto them (mesh vertices)
+  std::size_t zero_offset = 0;          ///< last extract(): vertices with anchored crossings left at their offset
   std::size_t lone_zeros = 0;           ///< current zero-valued vertices touched by no transverse tetrahedron
   std::size_t lone_zero_insertions = 0; ///< refinement points inserted for the stars of lone zeros
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
@@ -169,6 +185,9 @@ class Polygonizer {
   ///         InvalidPoint(i) when seed i is not finite or not strictly inside the domain.
   Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds = {},
               const std::vector<double>& seed_values = {}, const PolygonizerOptions& options = {});
+  ~Polygonizer();
+  Polygonizer(const Polygonizer&) = delete;
+  Polygonizer& operator=(const Polygonizer&) = delete;
 
   /// The bounding box of `points` scaled by `factor` about its center (paper 3.2.2: factor 2). A flat or
   /// single-point set is padded to a cube of side 1e-3 of its diagonal (or 1 when everything is one point).
@@ -185,7 +204,23 @@ class Polygonizer {
   /// Marching tetrahedra over the transverse tetrahedra: one mesh vertex per crossed Delaunay edge
   /// (shared, so the mesh is indexed and watertight), triangles counter-clockwise seen from f > 0,
   /// unit normals from the gradient of f. Evaluates f (root finder, gradients), hence non-const.
+  /// Incremental: only what changed since the previous extraction is recomputed (update_surface()),
+  /// then the live mesh is copied out compactly (O(mesh) for the copy only).
   SurfaceMesh extract();
+
+  /// Brings the incremental mesh (live_surface()) up to date and returns what changed in it since the
+  /// previous call: the crossings on Delaunay edges with a changed end are placed again, the polygons of
+  /// changed tetrahedra rebuilt, snapping re-decided around them; O(size of the change). The first call,
+  /// and the first after the Delaunay tree renumbered its tetrahedra (a history rebuild), return a full
+  /// delta. extract() calls it too (and drops the delta): a caller that keeps a copy by applying deltas
+  /// must take every update through this function. Design: docs/polygonize.md "Incremental extraction".
+  MeshDelta update_surface();
+  /// The incremental mesh as of the last update_surface() or extract(): stable ids (live_mesh.hpp).
+  const LiveMesh& live_surface() const;
+  /// The mesh a fresh extraction of the current state gives (a new tracker over every transverse
+  /// tetrahedron; O(mesh), leaves the incremental mesh alone). For checks: with warm_start_roots false
+  /// it equals extract() exactly (same triangles on the same positions, up to the order).
+  SurfaceMesh extract_fresh();
 
   // ---- Dynamic editing (used by vitri::Mesher) -----------------------------------------------------
   /// Inserts p as a vertex of kind `kind` with a fixed value (kept by function_changed()) or, when
@@ -205,17 +240,32 @@ class Polygonizer {
   /// The function changed: re-evaluates f at every vertex without a fixed value (one batch), and
   /// reclassifies only the tetrahedra around vertices whose sign changed. Call refine() afterwards.
   void function_changed();
-  /// The function changed only where `may_have_changed(p)` is true (e.g. the region a local function's
-  /// edit reports): re-evaluates f at those vertices only, then as function_changed(). The scan over the
-  /// vertices is O(n) but cheap; the evaluations are confined to the region.
+  /// The function changed only where `may_have_changed(p)` is true: re-evaluates f at those vertices
+  /// only, then as function_changed(). Scans every vertex (O(n)); prefer the ball form below.
+  /// @note The caller's predicate must also hold at the ends of every crossed edge that passes through
+  /// the changed region (dilate the region by the longest crossed edge, crossing_reach()), else
+  /// extraction keeps the old crossing on such an edge.
   void function_changed(const std::function<bool(const Point3&)>& may_have_changed);
+  /// The function changed only inside these balls (e.g. the region a local function's edit reports):
+  /// re-evaluates f at the vertices within crossing_reach() of a ball, found by walking the
+  /// tetrahedra from the ball's center (O(tetrahedra near the balls), no scan of the mesh), then as
+  /// function_changed(). An empty list changes nothing.
+  void function_changed(const std::vector<Ball>& changed);
+  /// Length by which a changed region must be dilated so that it holds an end of every crossed edge
+  /// that meets it: the longest crossed edge placed since the last full extraction (0 before the first).
+  double crossing_reach() const;
   /// Removes Refinement vertices that no transverse tetrahedron touches (they no longer serve the
   /// surface; those in the star of a lone zero are kept). Removing such a vertex never creates a
-  /// transverse tetrahedron. Returns how many.
+  /// transverse tetrahedron. Returns how many. Candidates come from events (no scan of the vertices).
   /// @param min_fraction  do nothing (return 0) unless such vertices are more than this fraction of the
   ///        live vertices: removals are expensive, and vertices left by one edit often serve the next
   ///        one (a constraint moved back and forth), so a session can collect in batches. 0: always.
-  std::size_t collect_garbage(double min_fraction = 0.0);
+  /// @param max_removals  once collecting, remove at most max_removals + the points inserted since the
+  ///        previous call, and go on at the next calls (whatever min_fraction) until no candidate is
+  ///        left: an interactive session never pays for a whole batch in one edit, and removals outpace
+  ///        what edits add. Default: no bound (all at once).
+  std::size_t collect_garbage(double min_fraction = 0.0,
+                              std::size_t max_removals = std::numeric_limits<std::size_t>::max());
 
   // ---- Queries ---------------------------------------------------------------------------------------
   const Triangulation& triangulation() const { return tri_; }
@@ -269,6 +319,11 @@ class Polygonizer {
   bool crossed_twice(VertexId a, VertexId b, double min_length, double& s) const;
   void check_thin(const std::vector<TetId>& tets, double min_length);
   bool insert_thin_point(double min_distance, std::vector<TetId>& created);
+  void reevaluate(const std::vector<VertexId>& ids);
+  std::vector<VertexId> vertices_near(const std::vector<Ball>& balls, double pad);
+  void note_thin_vertex(VertexId v);
+  void note_thin_tets(const std::vector<TetId>& tets);
+  std::vector<TetId> thin_recheck_set();
 
   const ImplicitFunction& f_;
   PolygonizerOptions options_;
@@ -290,14 +345,8 @@ class Polygonizer {
   std::priority_queue<std::pair<double, TetId>> heap_;
   ChangeSet changes_;
   PolygonizerStats stats_;
-  // Roots found by the last extract(), per crossed edge (key: ordered vertex pair), to warm-start the
-  // next one; moved_ marks vertices moved since (their edges start cold).
-  struct RootCacheEntry {
-    double t;      // parameter from the positive end
-    VertexId pos;  // the positive end when it was found
-  };
-  std::unordered_map<std::uint64_t, RootCacheEntry> root_cache_;
-  std::vector<std::uint8_t> moved_;
+  // The marching-tetrahedra mesh, kept up to date from the changes reported to it (surface_tracker.hpp).
+  std::unique_ptr<SurfaceTracker> surface_;
   // Thin features: gradient of f per vertex (NaN when unknown) and the edges waiting for a point.
   std::vector<Point3> grad_;
   struct ThinEdge {
@@ -306,6 +355,21 @@ class Polygonizer {
     double s;  // parameter of the point from a
   };
   std::vector<ThinEdge> thin_;  // flagged edges waiting for their point (one entry per edge)
+  // Between refine() calls (edits): what the next refine() must check for thin features instead of every
+  // tetrahedron, and whether the queue still holds every active tetrahedron above the precision.
+  std::vector<TetId> thin_tets_;        // created since the last refine()
+  std::vector<VertexId> thin_vertices_; // value or gradient changed since (their stars)
+  bool thin_all_ = true;                // the lists overflowed (or no refine yet): check everything
+  bool queue_valid_ = false;            // the last refine() completed and the queue was kept since
+  bool in_refine_ = false;
+  // Garbage candidates: refinement vertices whose transverse count dropped to 0 (may hold stale or
+  // repeated ids; checked when collected).
+  std::vector<VertexId> idle_;
+  std::size_t idle_compacted_ = 0;
+  bool draining_ = false;                // collect_garbage() is removing a batch over several calls
+  std::size_t insertions_at_collect_ = 0;
+  std::vector<std::uint32_t> walk_stamp_;  // vertices_near(): per tetrahedron, the walk that visited it
+  std::uint32_t walk_epoch_ = 0;
 };
 
 }  // namespace vitri

@@ -59,12 +59,6 @@ struct LocalRbfOptions {
   unsigned threads = 0;
 };
 
-/// A ball of R^3.
-struct Ball {
-  Point3 center;
-  double radius = 0;
-};
-
 /// Where an edit changed f: f(x) is bitwise unchanged at every x outside every ball (and outside the
 /// domain cube's exterior when `everywhere`). `everywhere` is set when the edit refitted the whole
 /// function (e.g. a constraint moved outside the domain cube).

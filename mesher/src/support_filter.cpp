@@ -1,0 +1,162 @@
+// SupportFilter (support_filter.hpp): the live mesh without unsupported components, kept from deltas.
+#include "support_filter.hpp"
+
+#include <algorithm>
+
+namespace vitri {
+
+namespace {
+
+template <typename T>
+void grow(std::vector<T>& v, std::size_t n, const T& fill) {
+  if (v.size() < n) v.resize(std::max(n, 2 * v.size()), fill);
+}
+
+}  // namespace
+
+void SupportFilter::clear() {
+  view_.clear();
+  corners_.clear();
+  view_tri_.clear();
+  incident_.clear();
+  view_vertex_.clear();
+  source_of_.clear();
+  hidden_.clear();
+  hidden_components_ = 0;
+}
+
+void SupportFilter::replace(const SurfaceMesh& mesh) {
+  clear();
+  std::vector<std::uint32_t> ids(mesh.vertices.size());
+  for (std::size_t i = 0; i < mesh.vertices.size(); ++i)
+    ids[i] = view_.add_vertex(mesh.vertices[i], i < mesh.normals.size() ? mesh.normals[i] : Point3{0, 0, 0});
+  for (const auto& t : mesh.triangles) view_.add_triangle({ids[t[0]], ids[t[1]], ids[t[2]]});
+}
+
+std::uint32_t SupportFilter::view_vertex(const LiveMesh& source, std::uint32_t v) {
+  if (view_vertex_[v] != kNone) return view_vertex_[v];
+  const std::uint32_t w = view_.add_vertex(source.position(v), source.normal(v));
+  grow(source_of_, static_cast<std::size_t>(w) + 1, kNone);
+  source_of_[w] = v;
+  return view_vertex_[v] = w;
+}
+
+void SupportFilter::show(const LiveMesh& source, std::uint32_t t) {
+  if (view_tri_[t] != kNone) return;
+  const auto& c = corners_[t];
+  view_tri_[t] = view_.add_triangle({view_vertex(source, c[0]), view_vertex(source, c[1]), view_vertex(source, c[2])});
+}
+
+void SupportFilter::hide(std::uint32_t t) {
+  if (view_tri_[t] == kNone) return;
+  const auto corners = view_.triangle(view_tri_[t]);
+  view_.remove_triangle(view_tri_[t]);
+  view_tri_[t] = kNone;
+  for (const std::uint32_t w : corners)
+    if (!view_.is_vertex(w)) {
+      view_vertex_[source_of_[w]] = kNone;
+      source_of_[w] = kNone;
+    }
+}
+
+// Mirrors the source's connectivity (corners of each triangle, triangles of each vertex) and lists the
+// triangles from which the search starts.
+void SupportFilter::track_source(const LiveMesh& source, const MeshDelta& delta, std::vector<std::uint32_t>& seeds) {
+  grow(corners_, source.triangle_capacity(), std::array<std::uint32_t, 3>{kNone, kNone, kNone});
+  grow(view_tri_, source.triangle_capacity(), kNone);
+  grow(incident_, source.vertex_capacity(), std::vector<std::uint32_t>{});
+  grow(view_vertex_, source.vertex_capacity(), kNone);
+  std::vector<std::uint32_t> split_at;  // surviving corners of removed triangles
+  for (const std::uint32_t t : delta.removed_triangles) {
+    for (const std::uint32_t v : corners_[t]) {
+      auto& inc = incident_[v];
+      inc.erase(std::find(inc.begin(), inc.end(), t));
+      split_at.push_back(v);
+    }
+    corners_[t] = {kNone, kNone, kNone};
+  }
+  for (const std::uint32_t t : delta.added_triangles) {
+    corners_[t] = source.triangle(t);
+    for (const std::uint32_t v : corners_[t]) incident_[v].push_back(t);
+    seeds.push_back(t);
+  }
+  split_at.insert(split_at.end(), delta.moved_vertices.begin(), delta.moved_vertices.end());
+  for (const std::uint32_t v : split_at)
+    if (source.is_vertex(v)) seeds.insert(seeds.end(), incident_[v].begin(), incident_[v].end());
+  for (const std::uint32_t t : hidden_)
+    if (source.is_triangle(t)) seeds.push_back(t);
+}
+
+// From each seed: stop at the first supported vertex (keep the triangles reached) or at the end of the
+// component (hide it). A triangle reached by an earlier search of this update belongs to a kept
+// component (a hidden one would have been exhausted, seed included).
+void SupportFilter::search(const LiveMesh& source, const std::vector<std::uint32_t>& seeds, const Supported& supported) {
+  grow(tri_stamp_, source.triangle_capacity(), 0u);
+  grow(vertex_stamp_, source.vertex_capacity(), 0u);
+  grow(vertex_support_, source.vertex_capacity(), std::uint8_t{0});
+  update_start_ = search_;
+  hidden_.clear();
+  hidden_components_ = 0;
+  std::vector<std::uint32_t> reached;
+  for (const std::uint32_t s : seeds) {
+    if (!source.is_triangle(s) || tri_stamp_[s] > update_start_) continue;
+    const std::uint32_t id = ++search_;
+    reached.assign(1, s);
+    tri_stamp_[s] = id;
+    bool kept = false;
+    for (std::size_t next = 0; next < reached.size() && !kept; ++next) {
+      for (const std::uint32_t v : corners_[reached[next]]) {
+        if (vertex_stamp_[v] <= update_start_) {
+          vertex_stamp_[v] = id;
+          vertex_support_[v] = supported(source.position(v)) ? 1 : 0;
+        }
+        if (vertex_support_[v]) kept = true;
+        for (const std::uint32_t u : incident_[v]) {
+          if (tri_stamp_[u] > update_start_ && tri_stamp_[u] != id) kept = true;  // an earlier kept one
+          if (tri_stamp_[u] <= update_start_) {
+            tri_stamp_[u] = id;
+            reached.push_back(u);
+          }
+        }
+        if (kept) break;
+      }
+    }
+    if (kept) {
+      for (const std::uint32_t t : reached) show(source, t);
+    } else {
+      ++hidden_components_;
+      for (const std::uint32_t t : reached) {
+        hide(t);
+        hidden_.push_back(t);
+      }
+    }
+  }
+}
+
+void SupportFilter::update(const LiveMesh& source, const MeshDelta& delta, const Supported& supported,
+                           bool recheck_all) {
+  if (delta.full) clear();
+  // Removed source triangles leave the view first; corners_ still names their vertices.
+  grow(view_tri_, source.triangle_capacity(), kNone);
+  for (const std::uint32_t t : delta.removed_triangles) hide(t);
+  std::vector<std::uint32_t> seeds;
+  track_source(source, delta, seeds);
+  if (recheck_all)
+    for (std::uint32_t t = 0; t < source.triangle_capacity(); ++t)
+      if (source.is_triangle(t)) seeds.push_back(t);
+  if (supported) {
+    search(source, seeds, supported);
+  } else {
+    hidden_components_ = 0;
+    for (const std::uint32_t t : hidden_)
+      if (source.is_triangle(t)) show(source, t);
+    hidden_.clear();
+    for (const std::uint32_t t : delta.added_triangles) show(source, t);
+    if (recheck_all)
+      for (const std::uint32_t t : seeds) show(source, t);
+  }
+  for (const std::uint32_t v : delta.moved_vertices)
+    if (view_vertex_[v] != kNone) view_.move_vertex(view_vertex_[v], source.position(v), source.normal(v));
+}
+
+}  // namespace vitri

@@ -1,0 +1,27 @@
+#pragma once
+// Definitions shared by the Polygonizer's source files (polygonizer.cpp, function_changes.cpp).
+#include "vitri/core/box.hpp"
+#include "vitri/core/point.hpp"
+
+#include <chrono>
+#include <cstdint>
+#include <limits>
+
+namespace vitri::polygonizer_detail {
+
+inline constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
+
+using Clock = std::chrono::steady_clock;
+inline double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+/// The sign rule of the whole module: exactly 0 counts as positive.
+inline bool is_negative(double v) { return v < 0.0; }
+
+/// The Delaunay tree accepts points strictly inside its box only (the corners alone are on the hull).
+inline bool strictly_inside(const Box3& b, const Point3& p) {
+  return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+}
+
+}  // namespace vitri::polygonizer_detail

@@ -1,0 +1,525 @@
+// Incremental marching tetrahedra (surface_tracker.hpp; docs/polygonize.md, "Incremental extraction").
+//
+// Snapping, as one pass in increasing vertex id would do it: the crossings anchored at z (the set S_z)
+// collapse onto z when the triangles around S_z that keep exactly one S_z corner have links forming a
+// single cycle of length >= 3 (a disk around the new vertex, one fan per neighbour) and each keeps a
+// positive area and its orientation; triangles with two S_z corners vanish. The test sees the collapses
+// of lower ids already applied (their corners at their vertex, their vanished triangles gone) and the
+// higher ones not yet. An update re-decides the vertices of the tetrahedra it rebuilt in increasing id;
+// when a decision flips, the higher anchored vertices of the flipped vertex's star are re-decided too
+// (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
+// result equals the one-pass result, which the tests check against a fresh tracker.
+#include "surface_tracker.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <queue>
+
+namespace vitri {
+
+namespace {
+
+inline std::uint64_t edge_key(VertexId a, VertexId b) {
+  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+}
+
+Point3 unit_or_zero(const Point3& g) {
+  const double l = norm(g);
+  return (l > 0.0 && std::isfinite(l)) ? g / l : Point3{0.0, 0.0, 0.0};
+}
+
+void sort_unique(std::vector<std::uint32_t>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+}  // namespace
+
+void SurfaceTracker::note_tet(std::vector<TetId>& list, TetId t) {
+  if (rebuild_ || sweep_) return;
+  list.push_back(t);
+  if (killed_.size() + created_.size() > 2 * (polygons_.size() + free_polygons_.size()) + 4096) {
+    sweep_ = true;
+    killed_.clear();
+    created_.clear();
+  }
+}
+
+// Stamps carry the number of the coming update (epoch_ + 1).
+void SurfaceTracker::note_value(VertexId v) {
+  grow_vertex_arrays(static_cast<std::size_t>(v) + 1);
+  if (stamp_[v] == epoch_ + 1) return;
+  stamp_[v] = epoch_ + 1;
+  touched_.push_back(v);
+}
+
+void SurfaceTracker::note_moved(VertexId v) {
+  note_value(v);
+  if (moved_stamp_[v] != epoch_ + 1) moved_.push_back(v);
+  moved_stamp_[v] = epoch_ + 1;
+}
+
+std::uint32_t& SurfaceTracker::polygon_of(TetId t) {
+  if (t >= polygon_of_.size()) polygon_of_.resize(std::max<std::size_t>(t + 1, 2 * polygon_of_.size()), kNone);
+  return polygon_of_[t];
+}
+
+void SurfaceTracker::grow_vertex_arrays(std::size_t n) {
+  if (collapsed_.size() >= n) return;
+  const std::size_t cap = std::max(n, 2 * collapsed_.size());
+  collapsed_.resize(cap, 0);
+  zero_out_.resize(cap, kNone);
+  anchored_.resize(cap, 0);
+  stamp_.resize(cap, 0);
+  moved_stamp_.resize(cap, 0);
+  decide_stamp_.resize(cap, 0);
+}
+
+std::uint32_t SurfaceTracker::corner_identity(std::uint32_t e) const {
+  const VertexId a = edges_[e].anchor;
+  return a != kNoVertex && collapsed_[a] ? (kZeroTag | a) : e;
+}
+
+void SurfaceTracker::update(const TrackerInput& in) {
+  report_ = {};
+  ++epoch_;
+  grow_vertex_arrays(in.tri.vertex_capacity());
+  for (const VertexId v : touched_) snap_target_.erase(v);
+  if (rebuild_) snap_target_.clear();
+  Work w;
+  if (rebuild_)
+    reset_all(in, w);
+  else
+    collect_tets(in, w);
+  rebuild_polygons(in, w);
+  place_edges(in, w);
+  split_polygons(w);
+  decide_snapping(in, w);
+  remesh_polygons(in, w);
+  retire_triangles(w);
+  refresh_vertices(in, w);
+  killed_.clear();
+  created_.clear();
+  touched_.clear();
+  moved_.clear();
+  sweep_ = false;
+  report_.snapped = num_collapsed_;
+  report_.offset = num_anchored_ - num_collapsed_;
+}
+
+// Forgets everything (first update, or the tetrahedra were renumbered): every transverse tetrahedron is
+// rebuilt and the mesh delta is full.
+void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
+  mesh_.clear();
+  edge_index_.clear();
+  edges_.clear();
+  free_edges_.clear();
+  polygons_.clear();
+  free_polygons_.clear();
+  std::fill(polygon_of_.begin(), polygon_of_.end(), kNone);
+  std::fill(collapsed_.begin(), collapsed_.end(), 0);
+  std::fill(zero_out_.begin(), zero_out_.end(), kNone);
+  std::fill(anchored_.begin(), anchored_.end(), 0);
+  owner_.clear();
+  num_collapsed_ = num_anchored_ = 0;
+  max_edge_ = 0.0;
+  w.tets = in.transverse;
+  std::sort(w.tets.begin(), w.tets.end());
+  rebuild_ = false;
+}
+
+// The tetrahedra to rebuild: killed, created, and the stars of vertices whose value or position changed
+// (every crossing on their edges must be placed again). When most vertices changed (a global function
+// was edited), every polygon and every transverse tetrahedron instead.
+void SurfaceTracker::collect_tets(const TrackerInput& in, Work& w) {
+  std::sort(touched_.begin(), touched_.end());
+  w.tets = killed_;
+  w.tets.insert(w.tets.end(), created_.begin(), created_.end());
+  if (sweep_ || touched_.size() * 8 > in.tri.num_vertices()) {
+    for (const Polygon& p : polygons_)
+      if (p.corners) w.tets.push_back(p.tet);
+    w.tets.insert(w.tets.end(), in.transverse.begin(), in.transverse.end());
+  } else {
+    for (const VertexId v : touched_) {
+      if (!in.tri.is_vertex(v)) continue;
+      const auto star = in.tri.incident_tetrahedra(v);
+      w.tets.insert(w.tets.end(), star.begin(), star.end());
+    }
+  }
+  sort_unique(w.tets);
+}
+
+// New polygons for the tetrahedra of the work list (a polygon with the same crossed edges is kept, and
+// placed again when an end of one of its edges changed).
+void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
+  for (const TetId t : w.tets) {
+    const std::uint32_t old = polygon_of(t);
+    marching::CellPolygon cell;
+    std::array<VertexId, 4> v{};
+    if (in.tri.is_live(t)) {
+      v = in.tri.tet_vertices(t);
+      cell = marching::march_tetrahedron(
+          {in.values[v[0]] < 0.0, in.values[v[1]] < 0.0, in.values[v[2]] < 0.0, in.values[v[3]] < 0.0});
+    }
+    if (old != kNone && cell.corners == polygons_[old].corners) {
+      bool same = true;
+      for (int i = 0; i < cell.corners && same; ++i) {
+        const Edge& e = edges_[polygons_[old].e[i]];
+        same = e.neg == v[cell.edges[i][0]] && e.pos == v[cell.edges[i][1]];
+      }
+      if (same) {
+        bool placed = false;
+        for (int i = 0; i < cell.corners; ++i) placed = mark_if_touched(polygons_[old].e[i], w) || placed;
+        if (placed) w.remesh.push_back(old);
+        continue;
+      }
+    }
+    if (old != kNone) w.old_polygons.push_back(old);
+    polygon_of_[t] = kNone;
+    if (cell.corners == 0) continue;
+    std::uint32_t p;
+    if (!free_polygons_.empty()) {
+      p = free_polygons_.back();
+      free_polygons_.pop_back();
+    } else {
+      p = static_cast<std::uint32_t>(polygons_.size());
+      polygons_.emplace_back();
+    }
+    Polygon poly;
+    poly.corners = static_cast<std::uint8_t>(cell.corners);
+    poly.tet = t;
+    for (int i = 0; i < cell.corners; ++i) poly.e[i] = edge_slot(v[cell.edges[i][0]], v[cell.edges[i][1]], w);
+    polygons_[p] = poly;
+    polygon_of_[t] = p;
+    w.remesh.push_back(p);
+  }
+}
+
+// Marks edge e for placement when an end changed in this update; true when it is (or already was).
+bool SurfaceTracker::mark_if_touched(std::uint32_t e, Work& w) {
+  Edge& edge = edges_[e];
+  if (!edge.dirty && (stamp_[edge.pos] == epoch_ || stamp_[edge.neg] == epoch_)) {
+    edge.dirty = true;
+    w.placed.push_back(e);
+  }
+  return edge.dirty;
+}
+
+// The edge (neg, pos), created when new; one more polygon uses it.
+std::uint32_t SurfaceTracker::edge_slot(VertexId neg, VertexId pos, Work& w) {
+  const auto it = edge_index_.try_emplace(edge_key(neg, pos), kNone).first;
+  if (it->second == kNone) {
+    std::uint32_t e;
+    if (!free_edges_.empty()) {
+      e = free_edges_.back();
+      free_edges_.pop_back();
+    } else {
+      e = static_cast<std::uint32_t>(edges_.size());
+      edges_.emplace_back();
+    }
+    edges_[e] = Edge{};
+    edges_[e].pos = pos;
+    edges_[e].neg = neg;
+    edges_[e].dirty = true;
+    w.placed.push_back(e);
+    it->second = e;
+  }
+  const std::uint32_t e = it->second;
+  Edge& edge = edges_[e];
+  if (edge.pos != pos) {  // both ends changed sign: same edge, crossed the other way
+    edge.pos = pos;
+    edge.neg = neg;
+    edge.t = 0.0;  // no warm start
+  }
+  mark_if_touched(e, w);
+  ++edge.refs;
+  return e;
+}
+
+void SurfaceTracker::set_anchor(std::uint32_t e, VertexId anchor) {
+  Edge& edge = edges_[e];
+  if (edge.anchor == anchor) return;
+  if (edge.anchor != kNoVertex && --anchored_[edge.anchor] == 0) --num_anchored_;
+  if (anchor != kNoVertex && anchored_[anchor]++ == 0) ++num_anchored_;
+  edge.anchor = anchor;
+}
+
+// Places a vertex on every edge marked in this update (warm start from its previous root when neither
+// end moved), and anchors it: at the positive end when f is exactly 0 there, at an end the root lies
+// within snap_fraction of (the root is kept at least that far from the ends).
+void SurfaceTracker::place_edges(const TrackerInput& in, Work& w) {
+  std::vector<marching::Crossing> crossings(w.placed.size());
+  for (std::size_t i = 0; i < w.placed.size(); ++i) {
+    const Edge& e = edges_[w.placed[i]];
+    marching::Crossing& c = crossings[i];
+    c.pos_point = in.tri.point(e.pos);
+    c.neg_point = in.tri.point(e.neg);
+    c.pos_value = in.values[e.pos];
+    c.neg_value = in.values[e.neg];
+    const bool moved = moved_stamp_[e.pos] == epoch_ || moved_stamp_[e.neg] == epoch_;
+    if (in.warm_start && !moved && e.t > 0.0 && e.t < 1.0) c.guess = e.t;
+    max_edge_ = std::max(max_edge_, norm(c.neg_point - c.pos_point));
+  }
+  const marching::RootSettings& settings = in.roots;
+  std::vector<marching::Placement> placed;
+  const std::size_t evaluations = marching::place_crossings(in.f, settings, crossings, placed);
+  report_.evaluations += evaluations;
+  report_.root_evaluations += evaluations;
+  report_.placed_edges = w.placed.size();
+  const double lo = in.snap_fraction, hi = 1.0 - in.snap_fraction;
+  for (std::size_t i = 0; i < w.placed.size(); ++i) {
+    Edge& e = edges_[w.placed[i]];
+    e.x = placed[i].x;
+    e.gradient = placed[i].gradient;
+    e.has_gradient = placed[i].has_gradient;
+    e.t = placed[i].t;
+    e.dirty = false;
+    VertexId anchor = kNoVertex;
+    if (in.values[e.pos] == 0.0 || e.t <= lo) anchor = e.pos;
+    else if (e.t >= hi) anchor = e.neg;
+    set_anchor(w.placed[i], anchor);
+  }
+}
+
+void SurfaceTracker::split_polygons(Work& w) {
+  sort_unique(w.remesh);
+  for (const std::uint32_t p : w.remesh) {
+    Polygon& poly = polygons_[p];
+    if (poly.corners == 4)
+      poly.split = static_cast<std::uint8_t>(marching::quad_split(edges_[poly.e[0]].x, edges_[poly.e[1]].x,
+                                                                  edges_[poly.e[2]].x, edges_[poly.e[3]].x));
+  }
+}
+
+// Re-decides, in increasing id, the anchored (or collapsed) vertices of the rebuilt tetrahedra and of
+// the stars of vertices whose decision flipped.
+void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
+  std::priority_queue<VertexId, std::vector<VertexId>, std::greater<VertexId>> heap;
+  const std::uint32_t mark = epoch_;
+  auto offer = [&](VertexId u) {
+    if (u >= anchored_.size() || (anchored_[u] == 0 && !collapsed_[u]) || decide_stamp_[u] == mark) return;
+    decide_stamp_[u] = mark;
+    heap.push(u);
+  };
+  for (const TetId t : w.tets)
+    if (in.tri.is_live(t))
+      for (const VertexId u : in.tri.tet_vertices(t)) offer(u);
+  for (const VertexId u : touched_) offer(u);  // removed vertices among them drop their collapse
+  while (!heap.empty()) {
+    const VertexId z = heap.top();
+    heap.pop();
+    const bool now = can_collapse(in, z);
+    if (now == static_cast<bool>(collapsed_[z])) continue;
+    collapsed_[z] = now ? 1 : 0;
+    num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
+    if (!in.tri.is_vertex(z)) continue;  // its polygons died with it
+    for (const TetId t : in.tri.incident_tetrahedra(z)) {
+      if (polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
+      for (const VertexId u : in.tri.tet_vertices(t))
+        if (u > z) offer(u);  // not decided yet (the heap pops in increasing id)
+    }
+  }
+}
+
+// The collapse test of z (see the top of the file), with the lower collapses applied.
+Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
+  const Point3& p = in.tri.point(z);
+  const double value = in.values[z];
+  if (value == 0.0) return p;
+  const auto it = snap_target_.find(z);
+  if (it != snap_target_.end()) return it->second;
+  Point3 g;
+  const double fz = in.f.value_gradient(p, g);
+  ++report_.evaluations;
+  const double g2 = dot(g, g);
+  Point3 q = p;
+  if (g2 > 0.0 && std::isfinite(g2) && std::isfinite(fz)) q = p - (fz / g2) * g;
+  snap_target_.emplace(z, q);
+  return q;
+}
+
+bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
+  if (!in.snap || anchored_[z] == 0 || !in.tri.is_vertex(z)) return false;
+  const Point3 zp = snap_target(in, z);
+  // Identity and position of a corner as the one-pass order sees it when z's turn comes.
+  const auto before = [&](std::uint32_t e, Point3& p) {
+    const VertexId a = edges_[e].anchor;
+    if (a != kNoVertex && a < z && collapsed_[a]) {
+      p = snap_target(in, a);
+      return kZeroTag | a;
+    }
+    p = edges_[e].x;
+    return e;
+  };
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> link;  // directed (w1 -> w2)
+  for (const TetId t : in.tri.incident_tetrahedra(z)) {
+    const std::uint32_t pi = polygon_of(t);
+    if (pi == kNone) continue;
+    const Polygon& poly = polygons_[pi];
+    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
+      const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
+      std::array<std::uint32_t, 3> c{}, id{};
+      std::array<Point3, 3> p;
+      int inside = 0, first = -1;
+      for (int i = 0; i < 3; ++i) {
+        c[i] = poly.e[idx[i]];
+        id[i] = before(c[i], p[i]);
+        if (edges_[c[i]].anchor == z) {
+          ++inside;
+          if (first < 0) first = i;
+        }
+      }
+      if (inside == 0) continue;
+      if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) continue;  // gone with a lower collapse
+      if (inside >= 2) continue;                                         // vanishes with this one
+      const int i1 = (first + 1) % 3, i2 = (first + 2) % 3;
+      const Point3 old_n = cross(p[i1] - p[first], p[i2] - p[first]);
+      const Point3 new_n = cross(p[i1] - zp, p[i2] - zp);
+      if (!(dot(old_n, new_n) > 0.0) || !(squared_norm(new_n) > 0.0)) return false;
+      link.emplace_back(id[i1], id[i2]);
+    }
+  }
+  // One cycle through all link vertices, each once as a source and once as a target.
+  std::sort(link.begin(), link.end());
+  const std::size_t n = link.size();
+  if (n < 3) return false;
+  for (std::size_t i = 1; i < n; ++i)
+    if (link[i].first == link[i - 1].first) return false;
+  std::uint32_t cur = link[0].second;
+  std::size_t steps = 1;
+  while (cur != link[0].first && steps <= n) {
+    const auto it = std::lower_bound(link.begin(), link.end(), std::make_pair(cur, std::uint32_t{0}));
+    if (it == link.end() || it->first != cur) return false;
+    cur = it->second;
+    ++steps;
+  }
+  return cur == link[0].first && steps == n;
+}
+
+// The LiveMesh vertex of a corner: the collapsed vertex's, or the edge's own (created on first use).
+std::uint32_t SurfaceTracker::out_vertex(const TrackerInput& in, std::uint32_t e, Work& w) {
+  const VertexId a = edges_[e].anchor;
+  std::uint32_t* slot;
+  Point3 p;
+  std::uint32_t owner;
+  if (a != kNoVertex && collapsed_[a]) {
+    slot = &zero_out_[a];
+    p = snap_target(in, a);
+    owner = kZeroTag | a;
+  } else {
+    slot = &edges_[e].out;
+    p = edges_[e].x;
+    owner = e;
+  }
+  if (*slot != kNone) return *slot;
+  const bool has_normal = owner == e && edges_[e].has_gradient;
+  *slot = mesh_.add_vertex(p, has_normal ? unit_or_zero(edges_[e].gradient) : Point3{0.0, 0.0, 0.0});
+  if (!has_normal) w.normals.push_back(*slot);
+  if (*slot >= owner_.size()) owner_.resize(std::max<std::size_t>(*slot + 1, 2 * owner_.size()), kNone);
+  owner_[*slot] = owner;
+  return *slot;
+}
+
+// The output triangles of the polygons to remesh: corners merged by the collapses; a triangle with two
+// corners merged into one vanishes. A triangle with the same corners as before keeps its id.
+void SurfaceTracker::remesh_polygons(const TrackerInput& in, Work& w) {
+  sort_unique(w.remesh);
+  for (const std::uint32_t p : w.remesh) {
+    Polygon& poly = polygons_[p];
+    if (poly.corners == 0) continue;
+    for (int k = 0; k < 2; ++k) {
+      std::uint32_t& out = poly.out[k];
+      bool keep = k == 0 || poly.corners == 4;
+      std::array<std::uint32_t, 3> c{};
+      if (keep) {
+        const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
+        std::array<std::uint32_t, 3> id{};
+        for (int i = 0; i < 3; ++i) id[i] = corner_identity(c[i] = poly.e[idx[i]]);
+        keep = id[0] != id[1] && id[1] != id[2] && id[0] != id[2];
+      }
+      std::array<std::uint32_t, 3> corners{};
+      if (keep)
+        for (int i = 0; i < 3; ++i) corners[i] = out_vertex(in, c[i], w);
+      if (out != kNone && keep && mesh_.triangle(out) == corners) continue;
+      if (out != kNone) w.retire.push_back(out);
+      out = keep ? mesh_.add_triangle(corners) : kNone;
+    }
+  }
+}
+
+// Removes a LiveMesh triangle; a corner that goes with it is forgotten by its owner.
+void SurfaceTracker::drop_triangle(std::uint32_t t) {
+  const auto corners = mesh_.triangle(t);
+  mesh_.remove_triangle(t);
+  for (const std::uint32_t v : corners) {
+    if (mesh_.is_vertex(v)) continue;
+    const std::uint32_t o = owner_[v];
+    if (o & kZeroTag)
+      zero_out_[o & ~kZeroTag] = kNone;
+    else
+      edges_[o].out = kNone;
+    owner_[v] = kNone;
+  }
+}
+
+void SurfaceTracker::release_edge(std::uint32_t e) {
+  Edge& edge = edges_[e];
+  if (--edge.refs > 0) return;
+  set_anchor(e, kNoVertex);
+  edge_index_.erase(edge_key(edge.pos, edge.neg));
+  edge.pos = edge.neg = kNoVertex;
+  free_edges_.push_back(e);
+}
+
+// Replaced triangles and polygons go (after the new ones were added, so shared vertices keep their ids).
+void SurfaceTracker::retire_triangles(Work& w) {
+  for (const std::uint32_t t : w.retire) drop_triangle(t);
+  for (const std::uint32_t p : w.old_polygons) {
+    Polygon& poly = polygons_[p];
+    for (const std::uint32_t t : poly.out)
+      if (t != kNone) drop_triangle(t);
+    for (int i = 0; i < poly.corners; ++i) release_edge(poly.e[i]);
+    poly = Polygon{};
+    free_polygons_.push_back(p);
+  }
+}
+
+// Vertices of placed edges move to their new roots; vertices at a moved (or re-valued) Delaunay vertex
+// follow it; normals that the root finder did not give are evaluated in one batch.
+void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
+  for (const std::uint32_t e : w.placed) {
+    const Edge& edge = edges_[e];
+    if (edge.pos == kNoVertex || edge.out == kNone) continue;
+    const std::uint32_t v = edge.out;
+    const Point3 n = edge.has_gradient ? unit_or_zero(edge.gradient) : Point3{0.0, 0.0, 0.0};
+    if (mesh_.position(v) == edge.x && mesh_.normal(v) == n) continue;
+    mesh_.move_vertex(v, edge.x, n);
+    if (!edge.has_gradient) w.normals.push_back(v);
+  }
+  for (const VertexId z : touched_) {
+    if (z >= zero_out_.size() || zero_out_[z] == kNone) continue;
+    const std::uint32_t v = zero_out_[z];
+    const Point3 q = snap_target(in, z);
+    if (!(mesh_.position(v) == q)) mesh_.move_vertex(v, q, mesh_.normal(v));
+    w.normals.push_back(v);
+  }
+  sort_unique(w.normals);
+  std::vector<std::uint32_t> ids;
+  for (const std::uint32_t v : w.normals)
+    if (mesh_.is_vertex(v)) ids.push_back(v);
+  std::vector<Point3> at(ids.size()), g(ids.size());
+  std::vector<double> unused(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) at[k] = mesh_.position(ids[k]);
+  in.f.values_gradients(at.data(), at.size(), unused.data(), g.data());
+  report_.evaluations += ids.size();
+  report_.gradient_evaluations += ids.size();
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const Point3 n = unit_or_zero(g[k]);
+    if (!(mesh_.normal(ids[k]) == n)) mesh_.set_normal(ids[k], n);
+  }
+}
+
+}  // namespace vitri

@@ -1,0 +1,165 @@
+#pragma once
+// The marching-tetrahedra mesh of a Polygonizer, kept up to date incrementally (docs/polygonize.md,
+// "Incremental extraction").
+//
+// Three layers, each derived from the one below and updated only where it changed:
+//   1. crossed edges: one record per Delaunay edge whose ends have different signs, keyed by the vertex
+//      pair, holding its placed mesh vertex (root) and a count of the polygons using it;
+//   2. polygons: per transverse tetrahedron its triangle or quad (crossed edges as corners) and the quad's
+//      split;
+//   3. snapping: a crossed edge is *anchored* at an end when its vertex belongs there: the positive end
+//      has f = 0 exactly (a constraint point), or the root lies within `snap_fraction` of the edge from
+//      an end. The edges anchored at a vertex z collapse onto z when the result stays a manifold without
+//      folds (the test of docs/polygonize.md), deciding the vertices in increasing id with the earlier
+//      collapses applied, exactly as one pass over all of them would;
+// and the output: a LiveMesh whose triangles are the polygons' triangles with collapsed corners merged.
+// The Polygonizer reports what it changed (tetrahedra killed and created, vertices whose value or
+// position changed, a renumbering of the tetrahedra); update() then re-places the crossings on edges with
+// a changed end only, rebuilds the polygons of the tetrahedra involved, re-decides the snapping of the
+// vertices of those tetrahedra (and of the later vertices a changed decision reaches), and edits the
+// LiveMesh where a triangle's corners changed. Far from a change nothing is visited: an update costs
+// O(size of the change), not O(mesh).
+#include "marching.hpp"
+
+#include "vitri/core/implicit.hpp"
+#include "vitri/delaunay/triangulation.hpp"
+#include "vitri/polygonize/live_mesh.hpp"
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+namespace vitri {
+
+/// What the tracker reads from its Polygonizer during update().
+struct TrackerInput {
+  const Triangulation& tri;
+  const std::vector<double>& values;       ///< per Delaunay vertex
+  const std::vector<TetId>& transverse;    ///< live transverse tetrahedra
+  const ImplicitFunction& f;
+  marching::RootSettings roots;
+  bool snap = true;                        ///< collapse anchored crossings onto their vertex
+  double snap_fraction = 0.01;             ///< anchored when the root is this close to an end (fraction)
+  bool warm_start = true;                  ///< start a re-placed edge from its previous root
+};
+
+/// Counters of the last update().
+struct TrackerReport {
+  std::size_t evaluations = 0;          ///< calls of f (roots and normals)
+  std::size_t root_evaluations = 0;
+  std::size_t gradient_evaluations = 0;
+  std::size_t snapped = 0;              ///< vertices whose anchored crossings are collapsed (all of them)
+  std::size_t offset = 0;               ///< vertices with anchored crossings left in place (all of them)
+  std::size_t placed_edges = 0;         ///< crossings placed by this update
+};
+
+class SurfaceTracker {
+ public:
+  static constexpr std::uint32_t kNone = 0xffffffffu;
+
+  // ---- What changed (called by the Polygonizer as it edits) -----------------------------------------
+  // Tetrahedra are listed until the lists outgrow the mesh (a refinement), then the next update sweeps
+  // every polygon and transverse tetrahedron instead; vertices are stamped (each listed once).
+  void note_killed(TetId t) { note_tet(killed_, t); }
+  void note_created(TetId t) { note_tet(created_, t); }
+  /// v's value changed (or may have).
+  void note_value(VertexId v);
+  /// v moved (its crossings start cold).
+  void note_moved(VertexId v);
+  /// Every tetrahedron id changed: the next update rebuilds everything (the mesh delta is `full`).
+  void note_renumbered() { rebuild_ = true; }
+
+  /// Brings the mesh up to date. @throws NumericalError as the function does.
+  void update(const TrackerInput& in);
+  const LiveMesh& mesh() const { return mesh_; }
+  LiveMesh& mesh() { return mesh_; }
+  const TrackerReport& report() const { return report_; }
+  /// The longest crossed edge placed since the last full rebuild (0 before the first update).
+  double max_edge_length() const { return max_edge_; }
+
+ private:
+  struct Edge {
+    VertexId pos = kNoVertex, neg = kNoVertex;  // f(pos) >= 0 > f(neg)
+    Point3 x, gradient;                          // placed vertex; gradient of f there (when has_gradient)
+    double t = 0;                                // parameter of x from pos
+    std::uint32_t refs = 0;                      // polygons using the edge
+    std::uint32_t out = kNone;                   // its LiveMesh vertex while not collapsed
+    VertexId anchor = kNoVertex;                 // the end it is anchored at, or kNoVertex
+    bool has_gradient = false;
+    bool dirty = false;                          // to be placed by this update
+  };
+  struct Polygon {
+    std::array<std::uint32_t, 4> e{kNone, kNone, kNone, kNone};  // edge slots, CCW from outside
+    std::uint8_t corners = 0;                                    // 3 or 4; 0 for a free slot
+    std::uint8_t split = 0;
+    std::array<std::uint32_t, 2> out{kNone, kNone};              // LiveMesh triangles
+    TetId tet = kNoTet;                                          // its tetrahedron
+  };
+  // What one update works on (named so the phases pass it explicitly).
+  struct Work {
+    std::vector<TetId> tets;                 // tetrahedra whose polygon is rebuilt
+    std::vector<std::uint32_t> old_polygons; // replaced polygons, released at the end
+    std::vector<std::uint32_t> placed;       // edges to place (dirty)
+    std::vector<std::uint32_t> remesh;       // polygons whose output triangles are recomputed
+    std::vector<std::uint32_t> retire;       // LiveMesh triangles replaced
+    std::vector<std::uint32_t> normals;      // LiveMesh vertices whose normal is evaluated
+  };
+
+  void note_tet(std::vector<TetId>& list, TetId t);
+  void reset_all(const TrackerInput& in, Work& w);
+  void collect_tets(const TrackerInput& in, Work& w);
+  void rebuild_polygons(const TrackerInput& in, Work& w);
+  std::uint32_t edge_slot(VertexId neg, VertexId pos, Work& w);
+  bool mark_if_touched(std::uint32_t e, Work& w);
+  void release_edge(std::uint32_t e);
+  void place_edges(const TrackerInput& in, Work& w);
+  void set_anchor(std::uint32_t e, VertexId anchor);
+  void split_polygons(Work& w);
+  void decide_snapping(const TrackerInput& in, Work& w);
+  bool can_collapse(const TrackerInput& in, VertexId z);
+  void remesh_polygons(const TrackerInput& in, Work& w);
+  std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);
+  void drop_triangle(std::uint32_t t);
+  void retire_triangles(Work& w);
+  void refresh_vertices(const TrackerInput& in, Work& w);
+  void grow_vertex_arrays(std::size_t n);
+  std::uint32_t& polygon_of(TetId t);
+  // Identity of a corner for merging: the edge slot, or kZeroTag | z when collapsed onto z.
+  std::uint32_t corner_identity(std::uint32_t e) const;
+  /// Where the crossings anchored at z collapse to: z itself when f(z) = 0, else z moved onto the surface
+  /// by one Newton step (cached until z's value changes).
+  Point3 snap_target(const TrackerInput& in, VertexId z);
+
+  static constexpr std::uint32_t kZeroTag = 0x80000000u;
+
+  LiveMesh mesh_;
+  TrackerReport report_;
+  bool rebuild_ = true;
+  bool sweep_ = false;
+  double max_edge_ = 0.0;
+  std::unordered_map<std::uint64_t, std::uint32_t> edge_index_;  // vertex pair -> edge slot
+  std::vector<Edge> edges_;
+  std::vector<std::uint32_t> free_edges_;
+  std::vector<Polygon> polygons_;
+  std::vector<std::uint32_t> free_polygons_;
+  std::vector<std::uint32_t> polygon_of_;  // per TetId: polygon slot or kNone
+  // Per Delaunay vertex: snapping state.
+  std::vector<std::uint8_t> collapsed_;    // its anchored crossings are merged into zero_out_
+  std::vector<std::uint32_t> zero_out_;    // LiveMesh vertex at the Delaunay vertex, or kNone
+  std::vector<std::uint32_t> anchored_;    // number of edges anchored at it
+  std::vector<std::uint32_t> stamp_;       // update number when last touched / moved
+  std::vector<std::uint32_t> moved_stamp_;
+  std::vector<std::uint32_t> decide_stamp_;  // update number when offered for a decision
+  std::uint32_t epoch_ = 1;
+  std::size_t num_collapsed_ = 0, num_anchored_ = 0;  // vertices collapsed / with anchored edges
+  // Owner of each LiveMesh vertex: an edge slot, or kZeroTag | Delaunay vertex.
+  std::vector<std::uint32_t> owner_;
+  std::unordered_map<VertexId, Point3> snap_target_;  // cache of snap_target() for f(z) != 0
+  // Reported changes since the last update.
+  std::vector<TetId> killed_, created_;
+  std::vector<VertexId> touched_, moved_;
+};
+
+}  // namespace vitri

@@ -1,0 +1,272 @@
+// Tests of the incremental extraction (surface_tracker.hpp): the pure marching pieces on hand-made
+// input, the live mesh kept by deltas, equality with a fresh extraction of the same state after every
+// kind of change, locality of a change confined to a ball, and no tiny triangle.
+#include <catch2/catch.hpp>
+
+#include "marching.hpp"
+#include "support/mesh_checks.hpp"
+#include "vitri/delaunay/triangulation.hpp"
+#include "vitri/polygonize/analytic.hpp"
+#include "vitri/polygonize/live_mesh.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <random>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
+
+/// A sphere with a bump of compact support: f(x) = |x - c| - r - a phi(|x - b| / R), phi the Wendland C2
+/// function (0 beyond 1). Outside the ball (b, R) f is bitwise the sphere's, whatever a is.
+class BumpedSphere final : public ImplicitFunction {
+ public:
+  Point3 c{0.1, -0.05, 0.02};
+  double r = 1.0;
+  Point3 b{1.0, 0.0, 0.0};
+  double R = 0.4, a = 0.0;
+  double value(const Point3& p) const override {
+    Point3 g;
+    return value_gradient(p, g);
+  }
+  double value_gradient(const Point3& p, Point3& g) const override {
+    const Point3 d = p - c;
+    const double n = norm(d);
+    g = n > 0.0 ? d / n : Point3{0.0, 0.0, 1.0};
+    double v = n - r;
+    const Point3 e = p - b;
+    const double s = norm(e) / R;
+    if (s < 1.0 && a != 0.0) {
+      const double phi = std::pow(1.0 - s, 4) * (4.0 * s + 1.0);
+      const double dphi = -20.0 * s * std::pow(1.0 - s, 3);  // d phi / d s
+      v -= a * phi;
+      if (s > 0.0) g = g - (a * dphi / (R * R * s)) * e;
+    }
+    return v;
+  }
+};
+
+using Corner = std::array<double, 3>;
+using Tri = std::array<Corner, 3>;
+
+/// The triangles of a mesh as position triples, each rotated to start at its smallest corner, sorted:
+/// equal for two meshes with the same triangles on the same positions, whatever the numbering.
+std::vector<Tri> canonical(const SurfaceMesh& m) {
+  std::vector<Tri> out;
+  for (const auto& t : m.triangles) {
+    Tri tri;
+    for (int i = 0; i < 3; ++i) tri[i] = {m.vertices[t[i]].x, m.vertices[t[i]].y, m.vertices[t[i]].z};
+    const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
+    std::rotate(tri.begin(), tri.begin() + first, tri.end());
+    out.push_back(tri);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+/// A client's copy of a LiveMesh, kept by applying deltas only.
+struct Client {
+  std::map<std::uint32_t, Point3> vertices;
+  std::map<std::uint32_t, std::array<std::uint32_t, 3>> triangles;
+
+  void apply(const MeshDelta& d, const LiveMesh& m) {
+    if (d.full) {
+      vertices.clear();
+      triangles.clear();
+    }
+    for (const std::uint32_t t : d.removed_triangles) REQUIRE(triangles.erase(t) == 1);
+    for (const std::uint32_t v : d.removed_vertices) REQUIRE(vertices.erase(v) == 1);
+    for (const std::uint32_t v : d.added_vertices) REQUIRE(vertices.emplace(v, m.position(v)).second);
+    for (const std::uint32_t v : d.moved_vertices) {
+      REQUIRE(vertices.count(v) == 1);
+      vertices[v] = m.position(v);
+    }
+    for (const std::uint32_t t : d.added_triangles) REQUIRE(triangles.emplace(t, m.triangle(t)).second);
+  }
+
+  /// The copy equals the live mesh exactly (ids, corners, positions).
+  void require_equal(const LiveMesh& m) const {
+    REQUIRE(vertices.size() == m.num_vertices());
+    REQUIRE(triangles.size() == m.num_triangles());
+    for (const auto& [v, p] : vertices) {
+      REQUIRE(m.is_vertex(v));
+      REQUIRE(m.position(v) == p);
+    }
+    for (const auto& [t, c] : triangles) {
+      REQUIRE(m.is_triangle(t));
+      REQUIRE(m.triangle(t) == c);
+    }
+  }
+};
+
+/// The incremental mesh equals a fresh extraction of the same state, is closed with the given Euler
+/// characteristic, and the client's copy follows it through the delta.
+void check_state(Polygonizer& poly, Client& client, long long euler) {
+  client.apply(poly.update_surface(), poly.live_surface());
+  client.require_equal(poly.live_surface());
+  const SurfaceMesh live = poly.live_surface().to_surface_mesh();
+  test::require_closed(live, euler, 1);
+  REQUIRE(canonical(live) == canonical(poly.extract_fresh()));
+}
+
+}  // namespace
+
+TEST_CASE("march_tetrahedron: every sign pattern gives a polygon facing the positive side", "[incremental]") {
+  const Triangulation tri(kCube);
+  const TetId t = tri.live_tetrahedra().front();  // live, hence positively oriented
+  const auto v = tri.tet_vertices(t);
+  for (int mask = 1; mask < 15; ++mask) {
+    const std::array<bool, 4> neg{(mask & 1) != 0, (mask & 2) != 0, (mask & 4) != 0, (mask & 8) != 0};
+    const marching::CellPolygon poly = marching::march_tetrahedron(neg);
+    const int count = (mask & 1) + ((mask >> 1) & 1) + ((mask >> 2) & 1) + ((mask >> 3) & 1);
+    REQUIRE(poly.corners == (count == 2 ? 4 : 3));
+    // Corners at edge midpoints; the centroid of the negative vertices minus that of the positive ones
+    // points to the inside, so every triangle's normal must point the other way.
+    Point3 in{0, 0, 0}, out{0, 0, 0};
+    for (int i = 0; i < 4; ++i) (neg[i] ? in : out) = (neg[i] ? in : out) + tri.point(v[i]);
+    const Point3 inward = in / count - out / (4 - count);
+    std::vector<Point3> q;
+    for (int i = 0; i < poly.corners; ++i) {
+      REQUIRE(neg[poly.edges[i][0]]);
+      REQUIRE_FALSE(neg[poly.edges[i][1]]);
+      q.push_back(0.5 * (tri.point(v[poly.edges[i][0]]) + tri.point(v[poly.edges[i][1]])));
+    }
+    for (int split = 0; split < 2; ++split)
+      for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
+        const auto c = marching::polygon_triangle(poly.corners, split, k);
+        REQUIRE(dot(cross(q[c[1]] - q[c[0]], q[c[2]] - q[c[0]]), inward) < 0.0);
+      }
+  }
+  // The shorter diagonal splits a quad.
+  REQUIRE(marching::quad_split({0, 0, 0}, {1, 0, 0}, {1, 0.5, 0}, {0, 1, 0}) == 0);
+  REQUIRE(marching::quad_split({0, 0, 0}, {1, 0, 0}, {1, 2, 0}, {0, 1, 0}) == 1);
+}
+
+TEST_CASE("place_crossings: roots of a linear function, zero ends offset, warm starts", "[incremental]") {
+  const SphereFunction f({0.0, 0.0, 0.0}, 1.0);
+  marching::RootSettings s;
+  std::vector<marching::Crossing> c(3);
+  c[0] = {{2.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 1.0, -1.0, -1.0};  // root at t = 0.5
+  c[1] = {{1.0, 0.0, 0.0}, {0.0, 0.0, 0.0}, 0.0, -1.0, -1.0};  // positive end on the surface
+  c[2] = {{0.0, 3.0, 0.0}, {0.0, 0.0, 0.0}, 2.0, -1.0, 2.0 / 3.0};  // exact warm start
+  std::vector<marching::Placement> out;
+  const std::size_t evaluations = marching::place_crossings(f, s, c, out);
+  REQUIRE(std::abs(out[0].t - 0.5) <= 1e-4);
+  REQUIRE(out[0].has_gradient);
+  REQUIRE(out[1].t == s.zero_offset);
+  REQUIRE_FALSE(out[1].has_gradient);
+  REQUIRE(std::abs(norm(out[2].x) - 1.0) <= 1e-12);
+  REQUIRE(evaluations <= 4);  // the warm start is accepted at once; the linear root in one or two
+}
+
+TEST_CASE("incremental extraction equals a fresh one after every kind of change", "[incremental]") {
+  BumpedSphere f;
+  PolygonizerOptions options;
+  options.warm_start_roots = false;  // the placement then depends on the state only
+  const double precision = 0.12;
+  Polygonizer poly(f, kCube, {}, {}, options);
+  REQUIRE(poly.refine(precision));
+  Client client;
+  const MeshDelta first = poly.update_surface();
+  REQUIRE(first.full);
+  client.apply(first, poly.live_surface());
+  client.require_equal(poly.live_surface());
+  REQUIRE(canonical(poly.live_surface().to_surface_mesh()) == canonical(poly.extract_fresh()));
+  REQUIRE(poly.update_surface().empty());  // nothing changed
+
+  SECTION("a change of f inside a ball") {
+    std::map<std::uint32_t, Point3> before;
+    const LiveMesh& live = poly.live_surface();
+    for (std::uint32_t v = 0; v < live.vertex_capacity(); ++v)
+      if (live.is_vertex(v)) before.emplace(v, live.position(v));
+    f.a = 0.25;
+    poly.function_changed({Ball{f.b, f.R}});
+    REQUIRE(poly.refine(precision));
+    const MeshDelta d = poly.update_surface();
+    client.apply(d, poly.live_surface());
+    client.require_equal(poly.live_surface());
+    REQUIRE_FALSE(d.empty());
+    test::require_closed(poly.live_surface().to_surface_mesh(), 2, 1);
+    REQUIRE(canonical(poly.live_surface().to_surface_mesh()) == canonical(poly.extract_fresh()));
+    // Far from the ball every vertex kept its id and its position bit for bit.
+    const double far = f.R + 2.0 * poly.crossing_reach() + 2.0 * precision;
+    std::size_t kept = 0;
+    for (const auto& [v, p] : before) {
+      if (norm(p - f.b) <= far) continue;
+      REQUIRE(poly.live_surface().is_vertex(v));
+      REQUIRE(poly.live_surface().position(v) == p);
+      ++kept;
+    }
+    REQUIRE(kept > before.size() / 2);
+    for (const std::uint32_t v : d.moved_vertices) REQUIRE(norm(poly.live_surface().position(v) - f.b) <= far);
+    // Back to the sphere: the mesh is again the fresh one.
+    f.a = 0.0;
+    poly.function_changed({Ball{f.b, f.R}});
+    REQUIRE(poly.refine(precision));
+    check_state(poly, client, 2);
+  }
+
+  SECTION("vertices inserted, moved and removed, with fixed values, and a global change") {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-1.3, 1.3);
+    std::vector<VertexId> added;
+    for (int k = 0; k < 12; ++k) {
+      const Point3 p{u(rng), u(rng), u(rng)};
+      const VertexId v = poly.insert_vertex(p, f.value(p));
+      if (v != kNoVertex) added.push_back(v);
+      REQUIRE(poly.refine(precision));
+      check_state(poly, client, 2);
+    }
+    for (std::size_t k = 0; k < added.size(); k += 2) {
+      const Point3 p{u(rng), u(rng), u(rng)};
+      if (poly.move_vertex(added[k], p, f.value(p))) {
+        REQUIRE(poly.refine(precision));
+        check_state(poly, client, 2);
+      }
+    }
+    for (std::size_t k = 1; k < added.size(); k += 2) {
+      poly.remove_vertex(added[k]);
+      REQUIRE(poly.refine(precision));
+      check_state(poly, client, 2);
+    }
+    f.c = {0.15, -0.02, 0.05};  // everything moves
+    poly.function_changed();
+    REQUIRE(poly.refine(precision));
+    poly.collect_garbage();
+    check_state(poly, client, 2);
+    REQUIRE(poly.refine(0.5 * precision));  // a finer level continues the same mesh
+    check_state(poly, client, 2);
+  }
+}
+
+TEST_CASE("zero-valued and near-zero vertices: snapped, no tiny triangle", "[incremental]") {
+  // The quadric sphere of radius 5 passes exactly through integer points such as (3, 4, 0): seeds there
+  // carry f = 0; seeds a rounding away from it give roots within ~1e-15 of the edge from a vertex.
+  const QuadricSphereFunction f({0.0, 0.0, 0.0}, 5.0);
+  std::vector<Point3> seeds;
+  for (int i = -5; i <= 5; ++i)
+    for (int j = -5; j <= 5; ++j)
+      for (int k = -5; k <= 5; ++k)
+        if (i * i + j * j + k * k == 25) seeds.push_back({double(i), double(j), double(k)});
+  for (int k = 0; k < 60; ++k) {  // on the sphere up to rounding: |f| ~ 1e-14, of either sign
+    const double theta = 0.37 + 0.91 * k, phi = 0.13 + 2.39 * k;
+    seeds.push_back({5.0 * std::cos(theta), 5.0 * std::sin(theta) * std::cos(phi), 5.0 * std::sin(theta) * std::sin(phi)});
+  }
+  const Box3 box{{-8.0, -8.0, -8.0}, {8.0, 8.0, 8.0}};
+  for (const double precision : {1.5, 0.6, 0.25}) {
+    Polygonizer poly(f, box, seeds);
+    REQUIRE(poly.refine(precision));
+    const SurfaceMesh m = poly.extract();
+    test::require_closed(m, 2, 1);
+    REQUIRE(poly.stats().zero_snapped > 0);
+    // Collapsed vertices are on the surface (f = 0 exactly, or one Newton step from a vertex within 1% of
+    // an edge of it).
+    for (const Point3& p : m.vertices) REQUIRE(std::abs(norm(p) - 5.0) <= 1e-3 * precision);
+  }
+}

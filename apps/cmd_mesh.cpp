@@ -29,7 +29,8 @@ const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj [--precision P [--precision P2 ...]] [--edits SCRIPT]\n"
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--neighbours K]\n"
-    "                  [--function global|local|auto] [--smoothing S] [-q]\n"    "\n"
+    "                  [--function global|local|auto] [--smoothing S] [-q]\n"
+    "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
     "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
@@ -289,6 +290,8 @@ int run_mesh(const Args& args) {
   // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
   // memory (docs/mesher.md "Batch runs and memory").
   options.polygonizer.keep_history = !script.empty();
+  // Then the seeds go into the tree on all hardware threads (same tetrahedra as a serial build).
+  options.polygonizer.threads = 0;
   // A precision far below the data's spacing would need more memory than the machine has: a LimitError
   // naming the count instead of an out-of-memory end.
   options.max_vertices = vertex_budget(options.polygonizer.keep_history);

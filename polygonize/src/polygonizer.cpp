@@ -42,10 +42,11 @@ namespace {
 
 using namespace polygonizer_detail;
 
-/// The Delaunay tree's options as the polygonizer's options ask (history kept or not).
+/// The Delaunay tree's options as the polygonizer's options ask (history kept or not, bulk threads).
 TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
   TriangulationOptions t;
   t.keep_history = options.keep_history;
+  t.threads = options.keep_history ? 1 : options.threads;
   return t;
 }
 

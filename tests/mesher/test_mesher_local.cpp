@@ -115,6 +115,26 @@ TEST_CASE("unsupported components are dropped unless the whole zero set is asked
   }
 }
 
+namespace {
+
+// Two meshes of the same surface at one precision: about as many vertices (2%), every vertex of mb within
+// the precision of a vertex of ma.
+void require_close(const SurfaceMesh& ma, const SurfaceMesh& mb, double precision) {
+  const double na = static_cast<double>(ma.vertices.size()), nb = static_cast<double>(mb.vertices.size());
+  CHECK(std::abs(na - nb) <= 0.02 * na);
+  const PointIndex index(ma.vertices);
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  double worst = 0;
+  for (const Point3& q : mb.vertices) {
+    index.nearest(q, 1, ids, &d2);
+    worst = std::max(worst, std::sqrt(d2[0]));
+  }
+  CHECK(worst <= precision);
+}
+
+}  // namespace
+
 // A batch run (PolygonizerOptions::keep_history = false, what the CLI does without --edits) keeps no
 // Delaunay history. The refinement visits tetrahedra in an order that follows their ids, which the tree
 // recycles without history, so the mesh is not bit for bit the default's: it must be an equally good mesh
@@ -129,19 +149,6 @@ TEST_CASE("batch option: no Delaunay history, an equivalent mesh", "[mesher][loc
   Mesher a = Mesher::from_mesh(in.V, in.F, o), b = Mesher::from_mesh(in.V, in.F, batch);
   REQUIRE(a.polygonizer().triangulation().keeps_history());
   REQUIRE_FALSE(b.polygonizer().triangulation().keeps_history());
-  auto require_close = [](const SurfaceMesh& ma, const SurfaceMesh& mb, double precision) {
-    const double na = static_cast<double>(ma.vertices.size()), nb = static_cast<double>(mb.vertices.size());
-    CHECK(std::abs(na - nb) <= 0.02 * na);
-    const PointIndex index(ma.vertices);
-    std::vector<PointIndex::Id> ids;
-    std::vector<double> d2;
-    double worst = 0;
-    for (const Point3& q : mb.vertices) {
-      index.nearest(q, 1, ids, &d2);
-      worst = std::max(worst, std::sqrt(d2[0]));
-    }
-    CHECK(worst <= precision);
-  };
   for (double p : {0.03, 0.015}) {
     a.refine(p * a.diagonal());
     b.refine(p * b.diagonal());
@@ -154,6 +161,32 @@ TEST_CASE("batch option: no Delaunay history, an equivalent mesh", "[mesher][loc
   b.move_constraint(5, moved);
   require_closed(b.surface(), 0);
   require_close(a.surface(), b.surface(), 0.015 * a.diagonal());
+}
+
+// A batch run with threads for the seeds' bulk insertion (what the CLI does without --edits): the
+// insertion really runs in parallel, gives the serial tetrahedralization (same vertex and tetrahedron
+// counts, same transverse tetrahedra), and the refined mesh is closed and equivalent to the serial one
+// (tetrahedron ids, hence the refinement order, may differ).
+TEST_CASE("batch option with bulk threads: the serial tetrahedralization, an equivalent mesh", "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions serial;
+  serial.function = FunctionKind::Local;
+  serial.polygonizer.keep_history = false;
+  serial.polygonizer.sampling_fraction = 0;  // the seeds' insertion is then the tree's last bulk insertion
+  MesherOptions threaded = serial;
+  threaded.polygonizer.threads = 2;
+  Mesher a = Mesher::from_mesh(in.V, in.F, serial), b = Mesher::from_mesh(in.V, in.F, threaded);
+  REQUIRE(a.polygonizer().triangulation().last_bulk_stats().parallel == 0);
+  REQUIRE(b.polygonizer().triangulation().last_bulk_stats().parallel > 0);
+  const PolygonizerStats sa = a.polygonizer().stats(), sb = b.polygonizer().stats();
+  CHECK(sb.vertices == sa.vertices);
+  CHECK(sb.tetrahedra == sa.tetrahedra);
+  CHECK(sb.transverse == sa.transverse);
+  const double p = 0.015 * a.diagonal();
+  a.refine(p);
+  b.refine(p);
+  require_closed(b.surface(), 0);
+  require_close(a.surface(), b.surface(), p);
 }
 
 TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the count", "[mesher][local]") {

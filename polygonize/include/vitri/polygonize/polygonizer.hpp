@@ -126,6 +126,12 @@ struct PolygonizerOptions {
   /// history) in well under half the memory. Edits still work without it, with walking location
   /// (slower on large models). See docs/mesher.md "Batch runs and memory".
   bool keep_history = true;
+  /// Threads of the bulk insertion of the seeds at construction (TriangulationOptions::threads; 0 = all
+  /// hardware threads). Used only without the history (keep_history = false): the parallel build gives the
+  /// same tetrahedra as the serial one, but its tetrahedron ids may differ from run to run, and the
+  /// refinement order follows them, so a run with more than one thread is equivalent to (not bit for bit)
+  /// a serial one, and may differ from run to run within the precision. 1: serial, deterministic.
+  unsigned threads = 1;
 };
 
 /// Counters and timings. Times in seconds; counters cumulative since construction unless stated.

@@ -155,11 +155,12 @@ constexpr std::size_t kFitProgressConstraints = 1000;
 /// mesh vertices as points (hand.off: 7231 for 1197); 2.5 spacings give 1-1.5x as many (hand 1855,
 /// sphere926 990, 33k samples of man.off 49.6k).
 constexpr double kSpacingFactor = 2.5;
-/// Memory per Delaunay vertex of the whole meshing structure (Delaunay tree, polygonizer arrays, vector
-/// growth slack), measured on 10^6 oriented points (docs/benchmarks.md "10^6 points end to end"): about
-/// 1 KB in a batch run, about 2.5 KB with the history kept (a run with --edits).
-constexpr double kBytesPerVertexBatch = 1100.0;
-constexpr double kBytesPerVertexHistory = 2500.0;
+/// Memory per Delaunay vertex of the whole meshing structure (Delaunay tree, polygonizer arrays, live
+/// mesh, vector growth slack), measured on 10^6 oriented points (docs/benchmarks.md "10^6 points end to
+/// end"): about 1.5 KB in a batch run; with the history kept (a run with --edits) 2.5 KB measured before
+/// the incremental extraction, which adds about 0.4 KB.
+constexpr double kBytesPerVertexBatch = 1600.0;
+constexpr double kBytesPerVertexHistory = 2900.0;
 
 /// The Delaunay vertex budget of this machine: 80% of the physical memory over the bytes per vertex
 /// (0: unknown, no limit).
@@ -290,8 +291,6 @@ int run_mesh(const Args& args) {
   // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
   // memory (docs/mesher.md "Batch runs and memory").
   options.polygonizer.keep_history = !script.empty();
-  // Then the seeds go into the tree on all hardware threads (same tetrahedra as a serial build).
-  options.polygonizer.threads = 0;
   // A precision far below the data's spacing would need more memory than the machine has: a LimitError
   // naming the count instead of an out-of-memory end.
   options.max_vertices = vertex_budget(options.polygonizer.keep_history);

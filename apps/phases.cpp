@@ -20,6 +20,7 @@ void PhaseTimes::stop() {
   if (running_ >= phases_.size()) return;
   phases_[running_].seconds += std::chrono::duration<double>(Clock::now() - phase_start_).count();
   phases_[running_].cpu_seconds += cpu_seconds() - phase_cpu_start_;
+  phases_[running_].peak_rss = peak_rss_bytes();
   running_ = static_cast<std::size_t>(-1);
 }
 
@@ -33,10 +34,10 @@ double PhaseTimes::elapsed() const { return std::chrono::duration<double>(Clock:
 
 void PhaseTimes::print(std::FILE* out) const {
   const double total = elapsed();
-  std::fprintf(out, "%-20s %10s %7s %10s\n", "phase", "wall s", "share", "CPU s");
+  std::fprintf(out, "%-20s %10s %7s %10s %10s\n", "phase", "wall s", "share", "CPU s", "peak GB");
   for (const Phase& p : phases_)
-    std::fprintf(out, "%-20s %10.2f %6.1f%% %10.2f\n", p.name.c_str(), p.seconds,
-                 total > 0 ? 100.0 * p.seconds / total : 0.0, p.cpu_seconds);
+    std::fprintf(out, "%-20s %10.2f %6.1f%% %10.2f %10.2f\n", p.name.c_str(), p.seconds,
+                 total > 0 ? 100.0 * p.seconds / total : 0.0, p.cpu_seconds, static_cast<double>(p.peak_rss) / 1e9);
   std::fprintf(out, "%-20s %10.2f %6.1f%% %10.2f\n", "total", total, 100.0, cpu_seconds() - cpu_start_);
   std::fprintf(out, "peak memory (RSS)    %10.2f GB\n", static_cast<double>(peak_rss_bytes()) / 1e9);
 }

@@ -27,8 +27,9 @@ class PhaseTimes {
   /// Seconds since construction.
   double elapsed() const;
   /// The table: one row per phase (wall seconds, share of the total wall time, CPU seconds of all
-  /// threads: on a loaded machine the CPU time says what the phase costs, the wall time what it took),
-  /// the totals and the peak resident memory (getrusage).
+  /// threads: on a loaded machine the CPU time says what the phase costs, the wall time what it took;
+  /// the process's peak resident memory when the phase ended: the first phase whose value jumps is the
+  /// one that needed the memory), the totals and the peak resident memory (getrusage).
   void print(std::FILE* out) const;
 
  private:
@@ -37,6 +38,7 @@ class PhaseTimes {
     std::string name;
     double seconds = 0;      // wall
     double cpu_seconds = 0;  // CPU time of the process (all threads)
+    std::size_t peak_rss = 0;  // peak resident memory of the process when the phase last ended
   };
   bool quiet_;
   Clock::time_point start_;

@@ -5,6 +5,7 @@
 #include "local_tree.hpp"
 #include "parallel.hpp"
 #include "slot_ranks.hpp"
+#include "spatial_order.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/point_index.hpp"
 
@@ -613,17 +614,6 @@ double LocalRbf::value_gradient(const Point3& p, Point3& gradient) const { retur
 
 namespace {
 
-/// Spreads the low 21 bits of v to every third bit (Morton interleaving).
-std::uint64_t spread_bits(std::uint64_t v) {
-  v &= 0x1fffff;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
 /// Order in which a large batch is evaluated: along a Morton curve of the root cube, so that consecutive
 /// points visit the same patches (their coefficients stay in cache). Results do not depend on the order.
 std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, const Box3& root) {
@@ -633,7 +623,7 @@ std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, cons
     std::uint64_t code = 0;
     for (int a = 0; a < 3; ++a) {
       const double t = std::min(std::max((points[i][a] - root.lo[a]) * scale, 0.0), double((1 << 21) - 1));
-      code |= spread_bits(static_cast<std::uint64_t>(t)) << a;
+      code |= rbf_detail::spread_bits3(static_cast<std::uint64_t>(t)) << a;
     }
     keyed[i] = {code, static_cast<std::uint32_t>(i)};
   }

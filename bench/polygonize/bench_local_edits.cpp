@@ -70,6 +70,11 @@ int main(int argc, char** argv) {
               s.fit_seconds, build - s.fit_seconds, refine, extract, s.polygonizer.vertices,
               mesher.live_surface().num_vertices(), mesher.live_surface().num_triangles(), peak_mb());
   (void)first;
+  std::printf("first extraction: polygons %.2f s, placement %.2f s, collapses %.2f s, live mesh %.2f s; "
+              "polygonizer %.2f s, support filter and delta %.2f s\n",
+              s.polygonizer.extract_polygons_seconds, s.polygonizer.extract_placement_seconds,
+              s.polygonizer.extract_snapping_seconds, s.polygonizer.extract_mesh_seconds,
+              s.polygonizer.extract_seconds, extract - s.polygonizer.extract_seconds);
   std::mt19937_64 rng(99);
   const std::size_t surface = mesher.size() / 3;  // the first third are the surface points (f = 0)
   std::uniform_int_distribution<std::size_t> pick(0, surface - 1);
@@ -94,6 +99,12 @@ int main(int argc, char** argv) {
     update_ms.push_back(1e3 * up);
     total_ms.push_back(1e3 * (e + up));
     changed.push_back(static_cast<double>(d.added_triangles.size() + d.removed_triangles.size() + d.moved_vertices.size()));
+    if (total_ms.back() > 100.0)  // an outlier: say where its time went
+      std::printf("  edit %d: %.1f ms (function edit %.1f, re-evaluation %.1f, refinement %.1f, update_surface %.1f; "
+                  "%s delta, %zu history rebuilds so far, %zu Steiner vertices removed so far)\n",
+                  k, total_ms.back(), rbf_ms.back(), reeval_ms.back(), refine_ms.back(), update_ms.back(),
+                  d.full ? "full" : "partial", mesher.polygonizer().triangulation().history_rebuilds(),
+                  st.polygonizer.removed_steiner);
   }
   std::printf("%d edits: total median %.2f ms, p90 %.2f, max %.2f | move_constraint median %.2f ms | update_surface "
               "median %.2f ms | delta median %.0f elements (of %zu triangles); peak %.0f MB\n",

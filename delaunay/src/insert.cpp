@@ -29,6 +29,8 @@ Triangulation::Grow Triangulation::grow_cavity(const Point3& p, TetId start, boo
   cav.tets.push_back(start);
   for (std::size_t k = 0; k < cav.tets.size(); ++k) {
     const TetId t = cav.tets[k];
+    for (int i = 0; i < 4; ++i)
+      if (tets_.neighbor(t, i) != kNoTet) tets_.prefetch(tets_.neighbor(t, i));
     for (int i = 0; i < 4; ++i) {
       const TetId n = tets_.neighbor(t, i);
       if (n == kNoTet) {

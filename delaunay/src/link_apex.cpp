@@ -36,6 +36,17 @@ constexpr std::uint8_t kEdge[4][4][2] = {{{0, 0}, {2, 3}, {1, 3}, {1, 2}},
                                          {{2, 3}, {0, 0}, {0, 3}, {0, 2}},
                                          {{1, 3}, {0, 3}, {0, 0}, {0, 1}},
                                          {{1, 2}, {0, 2}, {0, 1}, {0, 0}}};
+constexpr std::uint32_t kNarrow = 64;  // row length of the edge table of ordinary cavities
+
+// The directed edges (a, b) of the faces through the apex (index f) of new tetrahedron k, in local
+// numbers L: M[a * row + b] = 4k + j for its face j.
+inline void write_edges(int f, std::size_t k, const std::uint32_t* L, std::uint32_t* M, std::uint32_t row) {
+  for (int j = 0; j < 4; ++j) {
+    if (j == f) continue;
+    const std::uint32_t a = L[4 * k + kDir[f][j][0]], b = L[4 * k + kDir[f][j][1]];
+    M[a * row + b] = std::uint32_t(4 * k + std::size_t(j));
+  }
+}
 }  // namespace
 
 void Triangulation::link_around_apex(PointId q, const Cavity& cav, ApexLinks& links) {
@@ -44,14 +55,18 @@ void Triangulation::link_around_apex(PointId q, const Cavity& cav, ApexLinks& li
 
 // Small cavities: number the boundary vertices 0..nv-1, tagging each one's vtet_ slot with lim + its
 // number (lim = tets_.size() is above every tetrahedron id; commit_cavity overwrites these slots with
-// real tetrahedra right after), then glue through an nv x nv table of directed edges: the face (q, a, b)
-// of one tetrahedron is (q, b, a) seen from its neighbour. False (nothing glued) beyond kMaxLocal.
+// real tetrahedra right after), then glue through a table of directed edges: the face (q, a, b) of one
+// tetrahedron is (q, b, a) seen from its neighbour. While nv <= kNarrow (ordinary cavities: nv is about
+// 15 for uniform points) the table has the fixed row length kNarrow and is written in the same pass as
+// the numbering; beyond, it is rewritten with rows of nv. False (nothing glued) beyond kMaxLocal.
 bool Triangulation::link_by_table(PointId q, const Cavity& cav, ApexLinks& links) {
   const std::size_t nb = cav.created.size();
   const TetId lim = TetId(tets_.size());
   links.local.resize(4 * nb);
+  if (links.dir_edge.size() < std::size_t(kNarrow) * kNarrow) links.dir_edge.resize(kNarrow * kNarrow);
+  std::uint32_t* const L = links.local.data();
   std::uint32_t nv = 0;
-  for (std::size_t k = 0; k < nb; ++k)
+  for (std::size_t k = 0; k < nb; ++k) {
     for (int i = 0; i < 4; ++i) {
       const PointId w = tets_.vertex(cav.created[k], i);
       if (w == q) continue;
@@ -60,20 +75,17 @@ bool Triangulation::link_by_table(PointId q, const Cavity& cav, ApexLinks& links
       const std::uint32_t loc = fresh ? nv : t - lim;
       vtet_[w] = lim + loc;
       nv += fresh;
-      links.local[4 * k + std::size_t(i)] = loc;
+      L[4 * k + std::size_t(i)] = loc;
     }
-  if (nv > kMaxLocal) return false;
-  links.dir_edge.resize(std::size_t(nv) * nv);
-  std::uint32_t* const M = links.dir_edge.data();
-  const std::uint32_t* const L = links.local.data();
-  for (std::size_t k = 0; k < nb; ++k) {
-    const int f = cav.boundary[k].face;
-    for (int j = 0; j < 4; ++j) {
-      if (j == f) continue;
-      const std::uint32_t a = L[4 * k + kDir[f][j][0]], b = L[4 * k + kDir[f][j][1]];
-      M[a * nv + b] = std::uint32_t(4 * k + std::size_t(j));
-    }
+    if (nv <= kNarrow) write_edges(cav.boundary[k].face, k, L, links.dir_edge.data(), kNarrow);
   }
+  if (nv > kMaxLocal) return false;
+  const std::uint32_t row = nv <= kNarrow ? kNarrow : nv;
+  if (row > kNarrow) {
+    if (links.dir_edge.size() < std::size_t(nv) * nv) links.dir_edge.resize(std::size_t(nv) * nv);
+    for (std::size_t k = 0; k < nb; ++k) write_edges(cav.boundary[k].face, k, L, links.dir_edge.data(), row);
+  }
+  const std::uint32_t* const M = links.dir_edge.data();
   const bool offsets = keep_history_ && nb < Store::kNoOffset;
   for (std::size_t k = 0; k < nb; ++k) {
     const int f = cav.boundary[k].face;
@@ -81,7 +93,7 @@ bool Triangulation::link_by_table(PointId q, const Cavity& cav, ApexLinks& links
     for (int j = 0; j < 4; ++j) {
       if (j == f) continue;
       const std::uint32_t a = L[4 * k + kDir[f][j][0]], b = L[4 * k + kDir[f][j][1]];
-      const std::uint32_t o = M[b * nv + a] >> 2;
+      const std::uint32_t o = M[b * row + a] >> 2;
       tets_.set_neighbor(s, j, cav.created[o]);
       if (offsets) tets_.offsets(s)[std::size_t(j)] = std::uint16_t(o);
     }

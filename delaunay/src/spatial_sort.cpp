@@ -71,24 +71,34 @@ void parallel_slices(std::size_t n, unsigned threads,
 }
 
 namespace {
+// A point's sort record: its key beside its index, so that the sort compares contiguous records instead
+// of looking keys up by index (the lookups were most of the sort's time).
+struct Keyed {
+  std::uint64_t key;
+  std::uint32_t index;
+  bool operator<(const Keyed& o) const { return key < o.key || (key == o.key && index < o.index); }
+};
+
 // Sorts [first, last) by key, then index: a total order, so that the result does not depend on the sort
 // (the parallel bulk insertion must give the points the ids that the serial one gives them). Large
 // ranges are cut into `threads` slices sorted concurrently, then merged.
 void sort_by_key(std::uint32_t* first, std::uint32_t* last, const std::vector<std::uint64_t>& key,
                  unsigned threads) {
-  auto less = [&](std::uint32_t a, std::uint32_t c) {
-    return key[a] < key[c] || (key[a] == key[c] && a < c);
-  };
   const std::size_t n = std::size_t(last - first);
+  std::vector<Keyed> rec(n);
+  for (std::size_t i = 0; i < n; ++i) rec[i] = {key[first[i]], first[i]};
   if (threads <= 1 || n < 16384) {
-    std::sort(first, last, less);
-    return;
+    std::sort(rec.begin(), rec.end());
+  } else {
+    parallel_slices(n, threads, [&](std::size_t lo, std::size_t hi) {
+      std::sort(rec.begin() + std::ptrdiff_t(lo), rec.begin() + std::ptrdiff_t(hi));
+    });
+    const std::size_t T = std::min<std::size_t>(threads, n);
+    for (std::size_t k = 1; k < T; ++k)
+      std::inplace_merge(rec.begin(), rec.begin() + std::ptrdiff_t(k * n / T),
+                         rec.begin() + std::ptrdiff_t((k + 1) * n / T));
   }
-  parallel_slices(n, threads,
-                  [&](std::size_t lo, std::size_t hi) { std::sort(first + lo, first + hi, less); });
-  const std::size_t T = std::min<std::size_t>(threads, n);
-  for (std::size_t k = 1; k < T; ++k)
-    std::inplace_merge(first, first + k * n / T, first + (k + 1) * n / T, less);
+  for (std::size_t i = 0; i < n; ++i) first[i] = rec[i].index;
 }
 }  // namespace
 

@@ -6,6 +6,7 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -220,20 +221,33 @@ std::vector<TetId> Triangulation::incident_tetrahedra(VertexId v) const {
   std::vector<TetId> out;
   if (!is_vertex(v)) return out;
   const PointId pv = pid(v);
-  std::unordered_set<TetId> seen;
-  auto visited = [&](TetId t) {
-    if (out.size() < 64) return std::find(out.begin(), out.end(), t) != out.end();
-    if (seen.empty()) seen.insert(out.begin(), out.end());
-    return seen.count(t) > 0;
+  // Visited tetrahedra: an open-addressing set on the stack (a star has ~27 tetrahedra, rarely over 100),
+  // a hash set beyond half its size. O(1) per test, no allocation for usual stars.
+  constexpr std::size_t kSlots = 256;  // a power of two
+  std::array<TetId, kSlots> slots;
+  slots.fill(kNoTet);
+  std::unordered_set<TetId> big;
+  const auto first_visit = [&](TetId t) {
+    if (out.size() >= kSlots / 2) {
+      if (big.empty()) big.insert(out.begin(), out.end());
+      return big.insert(t).second;
+    }
+    std::size_t h = (static_cast<std::size_t>(t) * 0x9E3779B1u) & (kSlots - 1);
+    while (slots[h] != kNoTet) {
+      if (slots[h] == t) return false;
+      h = (h + 1) & (kSlots - 1);
+    }
+    slots[h] = t;
+    return true;
   };
+  out.reserve(32);
   out.push_back(vtet_[pv]);
+  first_visit(vtet_[pv]);
   for (std::size_t k = 0; k < out.size(); ++k) {
     for (int i = 0; i < 4; ++i) {
       if (tets_.vertex(out[k], i) == pv) continue;
       const TetId n = tets_.neighbor(out[k], i);
-      if (n == kNoTet || visited(n)) continue;
-      out.push_back(n);
-      if (!seen.empty()) seen.insert(n);
+      if (n != kNoTet && first_visit(n)) out.push_back(n);
     }
   }
   return out;

@@ -99,7 +99,7 @@ void Mesher::build() {
   poly_ = std::make_unique<Polygonizer>(function(), domain, c.points, c.values, options_.polygonizer);
   filter_ = std::make_unique<SupportFilter>();  // a new polygonizer: the next delta is full
   filter_precision_ = 0;
-  vertex_of_ = poly_->seed_vertices();
+  vertex_of_.assign(poly_->seed_vertices());
   zero_index_ = PointIndex();
   for (std::size_t i = 0; i < c.size(); ++i) track_zero(vertex_of_[i], c.points[i], c.values[i]);
   quality_.reset();
@@ -212,13 +212,19 @@ void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { 
 
 void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion* region) {
   const double t1 = now_seconds();
+  const std::size_t insertions = poly_->stats().insertions;
   if (region && !region->everywhere) {
     poly_->function_changed(region->balls);  // the vertices near the balls only (no scan)
   } else {
     poly_->function_changed();
   }
   if (std::isfinite(precision_)) poly_->refine(precision_);
-  if (options_.collect_garbage) poly_->collect_garbage(options_.garbage_fraction, options_.garbage_per_edit);
+  if (options_.collect_garbage) {
+    // At most garbage_per_edit removals plus as many as this edit inserted: removals outpace insertions,
+    // and no edit pays for a whole batch.
+    const std::size_t inserted = poly_->stats().insertions - insertions;
+    poly_->collect_garbage(options_.garbage_fraction, options_.garbage_per_edit + inserted);
+  }
   if (quality_) {
     quality_->function_changed();
     quality_->refine();
@@ -276,6 +282,16 @@ void Mesher::move_constraint(std::size_t i, const Point3& p) {
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
 }
 
+void Mesher::ConstraintVertices::erase(std::size_t i) {
+  ranks_.set_dead(ranks_.select(i));
+  --live_;
+  if (slots_.size() - live_ <= live_ + 1024) return;
+  std::vector<VertexId> live;  // compact: keep the live slots in order
+  live.reserve(live_);
+  for (std::size_t k = 0; k < live_; ++k) live.push_back(slots_[ranks_.select(k)]);
+  assign(std::move(live));
+}
+
 void Mesher::remove_constraint(std::size_t i) {
   const double t0 = now_seconds();
   ChangedRegion region;  // throws on a bad index or an impossible removal
@@ -283,7 +299,7 @@ void Mesher::remove_constraint(std::size_t i) {
   else region = local_->remove_constraint(i);
   const double t_rbf = now_seconds() - t0;
   const VertexId v = vertex_of_[i];
-  vertex_of_.erase(vertex_of_.begin() + static_cast<std::ptrdiff_t>(i));
+  vertex_of_.erase(i);
   forget_zero(v);
   if (v != kNoVertex) poly_->remove_vertex(v);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);

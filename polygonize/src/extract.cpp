@@ -44,6 +44,10 @@ MeshDelta Polygonizer::update_surface() {
   stats_.gradient_evaluations += r.gradient_evaluations;
   stats_.zero_snapped = r.snapped;
   stats_.zero_offset = r.offset;
+  stats_.extract_polygons_seconds = r.polygons_seconds;
+  stats_.extract_placement_seconds = r.placement_seconds;
+  stats_.extract_snapping_seconds = r.snapping_seconds;
+  stats_.extract_mesh_seconds = r.mesh_seconds;
   MeshDelta delta = surface_->mesh().take_delta();
   stats_.extract_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return delta;

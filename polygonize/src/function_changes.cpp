@@ -17,7 +17,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 
 namespace vitri {
@@ -71,13 +70,9 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
   }
   std::vector<VertexId> out;
   if (grown.empty()) return out;
-  if (walk_stamp_.size() < tri_.tet_capacity()) walk_stamp_.resize(2 * tri_.tet_capacity(), 0);
-  const std::uint32_t mark = ++walk_epoch_;
-  const auto first_visit = [&](TetId t) {
-    if (walk_stamp_[t] == mark) return false;
-    walk_stamp_[t] = mark;
-    return true;
-  };
+  tet_marks_.begin(tri_.tet_capacity());
+  vertex_marks_.begin(tri_.vertex_capacity());
+  const auto first_visit = [&](TetId t) { return tet_marks_.first_visit(t); };
   std::vector<TetId> stack;
   for (const Ball& b : grown) {
     Point3 start;  // the point of the domain nearest the center, nudged strictly inside
@@ -88,9 +83,27 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
     const TetId t = tri_.locate(start);
     if (first_visit(t)) stack.push_back(t);
   }
+  // Does the box [lo, hi] meet a grown ball? The balls (the patches refitted by an edit, ~10-20) overlap
+  // and the walk is spatially coherent: reject outside the balls' bounding box first, then try the ball
+  // that answered last before the others.
+  Box3 reach;
+  for (const Ball& b : grown) {
+    reach.extend(b.center - Point3{b.radius, b.radius, b.radius});
+    reach.extend(b.center + Point3{b.radius, b.radius, b.radius});
+  }
+  std::size_t last = 0;
   const auto meets = [&](const Point3& lo, const Point3& hi) {
-    for (const Ball& b : grown)
-      if (squared_distance_to_box(b.center, lo, hi) <= b.radius * b.radius) return true;
+    for (std::size_t k = 0; k < 3; ++k)
+      if (hi[k] < reach.lo[k] || lo[k] > reach.hi[k]) return false;
+    const auto hit = [&](std::size_t i) {
+      return squared_distance_to_box(grown[i].center, lo, hi) <= grown[i].radius * grown[i].radius;
+    };
+    if (hit(last)) return true;
+    for (std::size_t i = 0; i < grown.size(); ++i)
+      if (i != last && hit(i)) {
+        last = i;
+        return true;
+      }
     return false;
   };
   while (!stack.empty()) {
@@ -101,15 +114,22 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
     for (const VertexId u : v) tb.extend(tri_.point(u));
     if (!meets(tb.lo, tb.hi)) continue;
     for (const VertexId u : v)
-      if (meets(tri_.point(u), tri_.point(u))) out.push_back(u);
+      if (vertex_marks_.first_visit(u) && meets(tri_.point(u), tri_.point(u))) out.push_back(u);
     for (int i = 0; i < 4; ++i) {
       const TetId n = tri_.tet_neighbor(t, i);
       if (n != kNoTet && first_visit(n)) stack.push_back(n);
     }
   }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
+  std::sort(out.begin(), out.end());  // each vertex is listed once (marks)
   return out;
+}
+
+void Polygonizer::VisitMarks::begin(std::size_t capacity) {
+  if (stamp.size() < capacity) stamp.resize(capacity + capacity / 2, 0);
+  if (++epoch == 0) {  // wrapped: old stamps could match again
+    std::fill(stamp.begin(), stamp.end(), 0);
+    epoch = 1;
+  }
 }
 
 // New values at `ids` (one batch), then the tetrahedra around vertices whose sign flipped are
@@ -139,14 +159,21 @@ std::size_t Polygonizer::collect_garbage(double min_fraction, std::size_t max_re
   const auto is_idle = [&](VertexId v) {
     return tri_.is_vertex(v) && kind_[v] == static_cast<std::uint8_t>(VertexKind::Refinement) && tcount_[v] == 0;
   };
-  const auto compact = [&] {
+  // Keep the refinement of the stars of lone zeros (they are active; removing would redo it). Such a
+  // vertex leaves the list; set_lonely() puts it back when the zero stops being lone.
+  const auto serves = [&](VertexId v) {
+    if (lpos_[v] != kNotListed) return true;
+    for (const TetId t : tri_.incident_tetrahedra(v))
+      if (touches_lonely(t)) return true;
+    return false;
+  };
+  const auto compact = [&] {  // exactly the garbage, once each
     std::sort(idle_.begin(), idle_.end());
     idle_.erase(std::unique(idle_.begin(), idle_.end()), idle_.end());
-    idle_.erase(std::remove_if(idle_.begin(), idle_.end(), [&](VertexId v) { return !is_idle(v); }), idle_.end());
+    idle_.erase(std::remove_if(idle_.begin(), idle_.end(), [&](VertexId v) { return !is_idle(v) || serves(v); }),
+                idle_.end());
     idle_compacted_ = idle_.size();
   };
-  const std::size_t inserted = stats_.insertions - insertions_at_collect_;
-  insertions_at_collect_ = stats_.insertions;
   if (!draining_) {
     if (min_fraction > 0.0) {
       // idle_ bounds the candidates from above. It is compacted (O(its size)) when nothing was added
@@ -163,31 +190,19 @@ std::size_t Polygonizer::collect_garbage(double min_fraction, std::size_t max_re
     }
     draining_ = true;
   }
-  // Removals outpace what the edits add: the bound plus the points inserted since the last call.
-  const std::size_t budget =
-      max_removals > std::numeric_limits<std::size_t>::max() - inserted ? max_removals : max_removals + inserted;
   std::size_t removed = 0;
   // A removal may renumber the tetrahedra, which refills idle_: take the list, keep what comes.
-  std::vector<VertexId> candidates, kept;
+  std::vector<VertexId> candidates;
   candidates.swap(idle_);
   std::size_t next = 0;
-  for (; next < candidates.size() && removed < budget; ++next) {
+  for (; next < candidates.size() && removed < max_removals; ++next) {
     const VertexId v = candidates[next];
-    if (!is_idle(v)) continue;
-    // Keep the refinement of the stars of lone zeros (they are active; removing would redo it).
-    bool serves = lpos_[v] != kNotListed;
-    if (!serves)
-      for (const TetId t : tri_.incident_tetrahedra(v)) serves = serves || touches_lonely(t);
-    if (serves) {
-      kept.push_back(v);
-      continue;
-    }
+    if (!is_idle(v) || serves(v)) continue;  // (serves: changed since the compaction)
     remove_vertex(v);
     ++removed;
   }
   draining_ = next < candidates.size();  // candidates left for the next calls
   idle_.insert(idle_.end(), candidates.begin() + static_cast<std::ptrdiff_t>(next), candidates.end());
-  idle_.insert(idle_.end(), kept.begin(), kept.end());
   idle_compacted_ = idle_.size();
   stats_.removed_steiner += removed;
   return removed;

@@ -268,7 +268,14 @@ void Polygonizer::set_value(VertexId v, double value) {
 }
 
 void Polygonizer::set_lonely(VertexId v, bool on) {
-  if (on != (lpos_[v] != kNotListed)) set_listed(lonely_, lpos_, v, on);
+  if (on == (lpos_[v] != kNotListed)) return;
+  set_listed(lonely_, lpos_, v, on);
+  if (on || !tri_.is_vertex(v)) return;
+  // The refinement vertices around v may have served only its star: garbage candidates again
+  // (collect_garbage() dropped them while they served).
+  for (const TetId t : tri_.incident_tetrahedra(v))
+    for (const VertexId u : tri_.tet_vertices(t))
+      if (kind_[u] == static_cast<std::uint8_t>(VertexKind::Refinement) && tcount_[u] == 0) idle_.push_back(u);
 }
 
 bool Polygonizer::touches_lonely(TetId t) const {
@@ -655,16 +662,19 @@ void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
 }
 
 std::vector<TetId> Polygonizer::thin_recheck_set() {
-  std::vector<TetId> tets = thin_tets_;
-  std::sort(thin_vertices_.begin(), thin_vertices_.end());
-  thin_vertices_.erase(std::unique(thin_vertices_.begin(), thin_vertices_.end()), thin_vertices_.end());
+  std::vector<TetId> tets;
+  tet_marks_.begin(tri_.tet_capacity());
+  vertex_marks_.begin(tri_.vertex_capacity());
+  const auto add = [&](TetId t) {
+    if (tet_marks_.first_visit(t)) tets.push_back(t);
+  };
+  for (const TetId t : thin_tets_)
+    if (t < tri_.tet_capacity()) add(t);
   for (const VertexId v : thin_vertices_) {
-    if (!tri_.is_vertex(v)) continue;
-    const auto star = tri_.incident_tetrahedra(v);
-    tets.insert(tets.end(), star.begin(), star.end());
+    if (!tri_.is_vertex(v) || !vertex_marks_.first_visit(v)) continue;
+    for (const TetId t : tri_.incident_tetrahedra(v)) add(t);
   }
-  std::sort(tets.begin(), tets.end());
-  tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+  std::sort(tets.begin(), tets.end());  // the order of the full check (ascending ids)
   return tets;
 }
 

@@ -14,6 +14,7 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <functional>
 #include <queue>
@@ -90,17 +91,28 @@ void SurfaceTracker::update(const TrackerInput& in) {
   for (const VertexId v : touched_) snap_target_.erase(v);
   if (rebuild_) snap_target_.clear();
   Work w;
+  using Clock = std::chrono::steady_clock;
+  auto lap = [t = Clock::now()]() mutable {
+    const auto now = Clock::now();
+    const double s = std::chrono::duration<double>(now - t).count();
+    t = now;
+    return s;
+  };
   if (rebuild_)
     reset_all(in, w);
   else
     collect_tets(in, w);
   rebuild_polygons(in, w);
+  report_.polygons_seconds = lap();
   place_edges(in, w);
+  report_.placement_seconds = lap();
   split_polygons(w);
   decide_snapping(in, w);
+  report_.snapping_seconds = lap();
   remesh_polygons(in, w);
   retire_triangles(w);
   refresh_vertices(in, w);
+  report_.mesh_seconds = lap();
   killed_.clear();
   created_.clear();
   touched_.clear();
@@ -128,6 +140,7 @@ void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
   max_edge_ = 0.0;
   w.tets = in.transverse;
   std::sort(w.tets.begin(), w.tets.end());
+  edge_index_.reserve(2 * w.tets.size());  // about 1.6 crossed edges per transverse tetrahedron
   rebuild_ = false;
 }
 
@@ -210,8 +223,8 @@ bool SurfaceTracker::mark_if_touched(std::uint32_t e, Work& w) {
 
 // The edge (neg, pos), created when new; one more polygon uses it.
 std::uint32_t SurfaceTracker::edge_slot(VertexId neg, VertexId pos, Work& w) {
-  const auto it = edge_index_.try_emplace(edge_key(neg, pos), kNone).first;
-  if (it->second == kNone) {
+  std::uint32_t* const slot = edge_index_.try_emplace(edge_key(neg, pos), kNone).first;
+  if (*slot == kNone) {
     std::uint32_t e;
     if (!free_edges_.empty()) {
       e = free_edges_.back();
@@ -225,9 +238,9 @@ std::uint32_t SurfaceTracker::edge_slot(VertexId neg, VertexId pos, Work& w) {
     edges_[e].neg = neg;
     edges_[e].dirty = true;
     w.placed.push_back(e);
-    it->second = e;
+    *slot = e;
   }
-  const std::uint32_t e = it->second;
+  const std::uint32_t e = *slot;
   Edge& edge = edges_[e];
   if (edge.pos != pos) {  // both ends changed sign: same edge, crossed the other way
     edge.pos = pos;
@@ -311,12 +324,12 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
   while (!heap.empty()) {
     const VertexId z = heap.top();
     heap.pop();
-    const bool now = can_collapse(in, z);
+    const bool now = can_collapse(in, z);  // leaves the star of a live z in star_
     if (now == static_cast<bool>(collapsed_[z])) continue;
     collapsed_[z] = now ? 1 : 0;
     num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
     if (!in.tri.is_vertex(z)) continue;  // its polygons died with it
-    for (const TetId t : in.tri.incident_tetrahedra(z)) {
+    for (const TetId t : star_) {
       if (polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
       for (const VertexId u : in.tri.tet_vertices(t))
         if (u > z) offer(u);  // not decided yet (the heap pops in increasing id)
@@ -342,7 +355,10 @@ Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
 }
 
 bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
-  if (!in.snap || anchored_[z] == 0 || !in.tri.is_vertex(z)) return false;
+  star_.clear();
+  if (!in.tri.is_vertex(z)) return false;
+  star_ = in.tri.incident_tetrahedra(z);
+  if (!in.snap || anchored_[z] == 0) return false;
   const Point3 zp = snap_target(in, z);
   // Identity and position of a corner as the one-pass order sees it when z's turn comes.
   const auto before = [&](std::uint32_t e, Point3& p) {
@@ -354,8 +370,9 @@ bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
     p = edges_[e].x;
     return e;
   };
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> link;  // directed (w1 -> w2)
-  for (const TetId t : in.tri.incident_tetrahedra(z)) {
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>& link = link_;  // directed (w1 -> w2)
+  link.clear();
+  for (const TetId t : star_) {
     const std::uint32_t pi = polygon_of(t);
     if (pi == kNone) continue;
     const Polygon& poly = polygons_[pi];

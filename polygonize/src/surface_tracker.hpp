@@ -19,6 +19,7 @@
 // vertices of those tetrahedra (and of the later vertices a changed decision reaches), and edits the
 // LiveMesh where a triangle's corners changed. Far from a change nothing is visited: an update costs
 // O(size of the change), not O(mesh).
+#include "edge_map.hpp"
 #include "marching.hpp"
 
 #include "vitri/core/implicit.hpp"
@@ -53,6 +54,9 @@ struct TrackerReport {
   std::size_t snapped = 0;              ///< vertices whose anchored crossings are collapsed (all of them)
   std::size_t offset = 0;               ///< vertices with anchored crossings left in place (all of them)
   std::size_t placed_edges = 0;         ///< crossings placed by this update
+  // Seconds of the update's steps: which tetrahedra and polygons changed, root placement (function
+  // evaluations), collapse decisions, the live mesh's edits (triangles and vertices).
+  double polygons_seconds = 0, placement_seconds = 0, snapping_seconds = 0, mesh_seconds = 0;
 };
 
 class SurfaceTracker {
@@ -139,7 +143,7 @@ class SurfaceTracker {
   bool rebuild_ = true;
   bool sweep_ = false;
   double max_edge_ = 0.0;
-  std::unordered_map<std::uint64_t, std::uint32_t> edge_index_;  // vertex pair -> edge slot
+  EdgeMap edge_index_;  // vertex pair -> edge slot
   std::vector<Edge> edges_;
   std::vector<std::uint32_t> free_edges_;
   std::vector<Polygon> polygons_;
@@ -157,6 +161,10 @@ class SurfaceTracker {
   // Owner of each LiveMesh vertex: an edge slot, or kZeroTag | Delaunay vertex.
   std::vector<std::uint32_t> owner_;
   std::unordered_map<VertexId, Point3> snap_target_;  // cache of snap_target() for f(z) != 0
+  // can_collapse(z) scratch: the star of z (read again by decide_snapping when z's decision changes)
+  // and the directed link edges.
+  std::vector<TetId> star_;
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> link_;
   // Reported changes since the last update.
   std::vector<TetId> killed_, created_;
   std::vector<VertexId> touched_, moved_;

@@ -1,10 +1,10 @@
 // vitri::LocalRbf: the partition-of-unity variational function (see local_rbf.hpp, docs/local_rbf.md).
 #include "vitri/rbf/local_rbf.hpp"
+#include "vitri/core/slot_ranks.hpp"
 
 #include "local_patch.hpp"
 #include "local_tree.hpp"
 #include "parallel.hpp"
-#include "slot_ranks.hpp"
 #include "spatial_order.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/point_index.hpp"

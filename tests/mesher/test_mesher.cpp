@@ -231,6 +231,36 @@ TEST_CASE("100 random edits: vertex count stays within 1.5x of a fresh mesh", "[
   mesher.polygonizer().triangulation().verify_topology();
 }
 
+// Constraint indices shift down on removal; the Mesher keeps the Delaunay vertex of each constraint in
+// stable slots with ranks (O(log n) per removal) and compacts them when dead slots dominate. After more
+// add/remove cycles than a compaction needs, every constraint still owns the Delaunay vertex at its point,
+// and moving constraint i moves that vertex.
+TEST_CASE("constraint indices stay tied to their Delaunay vertices over many removals", "[mesher]") {
+  Mesher mesher(small_model());  // no refine(): edits skip refinement, so 2500 of them are cheap
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.4, 0.4);
+  for (int e = 0; e < 1300; ++e) {
+    mesher.add_constraint({u(rng), u(rng), u(rng)}, -0.2);
+    mesher.remove_constraint(1 + rng() % (mesher.size() - 1));  // anywhere but the center
+  }
+  const Triangulation& tri = mesher.polygonizer().triangulation();
+  const auto seed_at = [&](const Point3& p) {
+    std::size_t count = 0;
+    for (VertexId v = 8; v < tri.vertex_capacity(); ++v)
+      count += tri.is_vertex(v) && tri.point(v) == p && mesher.polygonizer().vertex_kind(v) == VertexKind::Seed;
+    return count;
+  };
+  REQUIRE(mesher.size() == small_model().size());
+  for (std::size_t i = 0; i < mesher.size(); ++i) REQUIRE(seed_at(mesher.constraints().points[i]) == 1);
+  for (std::size_t i = 0; i < mesher.size(); i += 5) {
+    const Point3 old = mesher.constraints().points[i], q = old + Point3{0.01, -0.02, 0.015};
+    mesher.move_constraint(i, q);
+    REQUIRE(seed_at(q) == 1);
+    REQUIRE(seed_at(old) == 0);
+  }
+  tri.verify_topology();
+}
+
 TEST_CASE("mesher errors", "[mesher]") {
   Mesher mesher(small_model());
   REQUIRE_THROWS_AS(mesher.refine(0.0), InvalidArgument);

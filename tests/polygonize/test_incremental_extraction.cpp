@@ -3,6 +3,7 @@
 // kind of change, locality of a change confined to a ball, and no tiny triangle.
 #include <catch2/catch.hpp>
 
+#include "edge_map.hpp"
 #include "marching.hpp"
 #include "support/mesh_checks.hpp"
 #include "vitri/delaunay/triangulation.hpp"
@@ -15,6 +16,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <unordered_map>
 #include <vector>
 
 using namespace vitri;
@@ -116,6 +118,31 @@ void check_state(Polygonizer& poly, Client& client, long long euler) {
 }
 
 }  // namespace
+
+TEST_CASE("EdgeMap: the same answers as std::unordered_map under random inserts and erases", "[incremental]") {
+  EdgeMap map;
+  std::unordered_map<std::uint64_t, std::uint32_t> ref;
+  std::mt19937_64 rng(3);
+  // Few distinct keys with clustered bits, so probe runs are long and erase shifts them often.
+  const auto key = [&] { return (rng() % 64) << 32 | (rng() % 512); };
+  for (int step = 0; step < 200000; ++step) {
+    const std::uint64_t k = key();
+    if (rng() % 3 == 0) {
+      REQUIRE(map.erase(k) == (ref.erase(k) == 1));
+    } else {
+      const auto [value, inserted] = map.try_emplace(k, static_cast<std::uint32_t>(step));
+      const auto [it, ref_inserted] = ref.try_emplace(k, static_cast<std::uint32_t>(step));
+      REQUIRE(inserted == ref_inserted);
+      REQUIRE(*value == it->second);
+    }
+    REQUIRE(map.size() == ref.size());
+  }
+  for (const auto& [k, v] : ref) REQUIRE(*map.try_emplace(k, 0).first == v);  // every key still found
+  REQUIRE(map.size() == ref.size());
+  map.clear();
+  REQUIRE(map.size() == 0);
+  REQUIRE_FALSE(map.erase(ref.begin()->first));
+}
 
 TEST_CASE("march_tetrahedron: every sign pattern gives a polygon facing the positive side", "[incremental]") {
   const Triangulation tri(kCube);

@@ -18,6 +18,7 @@
 
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
+#include "vitri/core/slot_ranks.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/quality_mesher.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
@@ -227,7 +228,31 @@ class Mesher {
   std::unique_ptr<LocalRbf> local_;  // keeps a reference. Exactly one of the two is set.
   std::unique_ptr<Polygonizer> poly_;
   std::unique_ptr<QualityMesher> quality_;  // quality mode, built by the first refine()
-  std::vector<VertexId> vertex_of_;  // Delaunay vertex of each constraint (kNoVertex: duplicate position)
+  /// The Delaunay vertex of each constraint (kNoVertex: its position duplicates another's), by constraint
+  /// index: stable slots and their ranks, so that removing constraint i (later indices shift down) costs
+  /// O(log n), not a shift of the array; compacted when dead slots outnumber live ones (amortized O(1)).
+  class ConstraintVertices {
+   public:
+    void assign(std::vector<VertexId> vertices) {
+      slots_ = std::move(vertices);
+      ranks_.reset(slots_.size());
+      live_ = slots_.size();
+    }
+    VertexId& operator[](std::size_t i) { return slots_[ranks_.select(i)]; }
+    VertexId back() const { return slots_.back(); }  // of the last push_back
+    void push_back(VertexId v) {
+      slots_.push_back(v);
+      ranks_.push_back_alive();
+      ++live_;
+    }
+    void erase(std::size_t i);
+
+   private:
+    std::vector<VertexId> slots_;
+    SlotRanks ranks_;
+    std::size_t live_ = 0;
+  };
+  ConstraintVertices vertex_of_;
   PointIndex zero_index_;            // on-surface constraints, keyed by their Delaunay vertex (support test)
   double precision_;
   SurfaceMesh mesh_;

@@ -162,6 +162,10 @@ struct PolygonizerStats {
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
   double refine_seconds = 0;            ///< last refine() call
   double extract_seconds = 0;           ///< last extract() call
+  /// Of the last extraction: finding the changed polygons, placing crossings (evaluations of f),
+  /// deciding collapses, editing the live mesh (they add up to about extract_seconds).
+  double extract_polygons_seconds = 0, extract_placement_seconds = 0, extract_snapping_seconds = 0,
+         extract_mesh_seconds = 0;
   double update_seconds = 0;            ///< last function_changed() call
 };
 
@@ -266,10 +270,13 @@ class Polygonizer {
   /// @param min_fraction  do nothing (return 0) unless such vertices are more than this fraction of the
   ///        live vertices: removals are expensive, and vertices left by one edit often serve the next
   ///        one (a constraint moved back and forth), so a session can collect in batches. 0: always.
-  /// @param max_removals  once collecting, remove at most max_removals + the points inserted since the
-  ///        previous call, and go on at the next calls (whatever min_fraction) until no candidate is
-  ///        left: an interactive session never pays for a whole batch in one edit, and removals outpace
-  ///        what edits add. Default: no bound (all at once).
+  /// @param max_removals  once collecting, remove at most this many per call and go on at the next calls
+  ///        (whatever min_fraction) until no candidate is left: an interactive session never pays for a
+  ///        whole batch in one edit (the Mesher passes MesherOptions::garbage_per_edit plus the points the
+  ///        edit inserted, so that removals outpace insertions). Default: no bound (all at once).
+  /// Candidates are kept from events (a refinement vertex losing its last transverse tetrahedron, a lone
+  /// zero ceasing to be one: its neighbours); one found serving a lone zero's star leaves the list until
+  /// that zero stops being lone, so the count compared with min_fraction is that of real garbage.
   std::size_t collect_garbage(double min_fraction = 0.0,
                               std::size_t max_removals = std::numeric_limits<std::size_t>::max());
 
@@ -373,9 +380,20 @@ class Polygonizer {
   std::vector<VertexId> idle_;
   std::size_t idle_compacted_ = 0;
   bool draining_ = false;                // collect_garbage() is removing a batch over several calls
-  std::size_t insertions_at_collect_ = 0;
-  std::vector<std::uint32_t> walk_stamp_;  // vertices_near(): per tetrahedron, the walk that visited it
-  std::uint32_t walk_epoch_ = 0;
+  /// Marks of one traversal over ids (tetrahedra or vertices) without clearing between traversals:
+  /// after begin(capacity), first_visit(i) is true for the first call with i only. O(1) per call; the
+  /// array is zeroed only when the epoch wraps.
+  struct VisitMarks {
+    std::vector<std::uint32_t> stamp;
+    std::uint32_t epoch = 0;
+    void begin(std::size_t capacity);
+    bool first_visit(std::size_t i) {
+      if (stamp[i] == epoch) return false;
+      stamp[i] = epoch;
+      return true;
+    }
+  };
+  VisitMarks tet_marks_, vertex_marks_;  // vertices_near(), thin_recheck_set() (one traversal at a time)
 };
 
 }  // namespace vitri

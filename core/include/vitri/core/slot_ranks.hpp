@@ -1,14 +1,16 @@
 #pragma once
-// SlotRanks (internal): the public constraint numbering of the local RBF over its stable storage slots.
-// Slots are never reordered; a removed constraint's slot is marked dead, so constraint i is the i-th live
-// slot. A Fenwick tree over the live flags answers both directions in O(log n).
+/// @file slot_ranks.hpp
+/// SlotRanks: a public numbering (0..n-1, later indices shift down on removal) over stable storage slots.
+/// Slots are never reordered; a removed element's slot is marked dead, so element i is the i-th live
+/// slot. A Fenwick tree over the live flags answers both directions in O(log n). Used by the local RBF
+/// (constraint slots) and the Mesher (the Delaunay vertex of each constraint).
 
 #include <cassert>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
-namespace vitri::local_detail {
+namespace vitri {
 
 class SlotRanks {
  public:
@@ -61,4 +63,4 @@ class SlotRanks {
   std::vector<std::int64_t> tree_;  // 1-based Fenwick tree of the live flags
 };
 
-}  // namespace vitri::local_detail
+}  // namespace vitri

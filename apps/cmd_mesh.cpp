@@ -2,6 +2,7 @@
 // optionally replay an edit script (the paper's Tables 1, 2 and 3).
 #include "commands.hpp"
 #include "input.hpp"
+#include "phases.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
@@ -19,6 +20,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 namespace vitri::cli {
 namespace {
 
@@ -26,7 +29,8 @@ const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj [--precision P [--precision P2 ...]] [--edits SCRIPT]\n"
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--neighbours K]\n"
-    "                  [--function global|local|auto] [--smoothing S] [-q]\n"    "\n"
+    "                  [--function global|local|auto] [--smoothing S] [-q]\n"
+    "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
     "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
@@ -89,13 +93,15 @@ const char* const kUsage =
     "                       default; 1e-3..1e-1 smooths a noisy scan)\n"
     "  -q, --quiet          no table, no progress\n"
     "\n"
-    "Progress goes to stderr: a line before and after the fit of 1000 or more constraints (the fit is\n"
-    "O(N^3): seconds for a few thousand constraints) and the Delaunay vertex count during a refinement\n"
-    "that takes more than a second.\n"
+    "Progress goes to stderr: a line as each phase starts (read, constraints, precision, fit,\n"
+    "tetrahedralization, refinement, extraction, writing) with the elapsed time, the constraint count\n"
+    "and fit time of a fit of 1000 or more constraints, the count of merged near-duplicate points, and\n"
+    "the Delaunay vertex count during a refinement that takes more than a second.\n"
     "\n"
     "Prints, per level: vertices, triangles, refinement and extraction times, and the running total\n"
-    "(the paper's Table 1). A bad edit line is reported with its line number; index I out of range is\n"
-    "bad input.\n"
+    "(the paper's Table 1); then the seconds of every phase, the total wall time and the peak memory.\n"
+    "Without --edits the Delaunay history is not kept (a batch run: an equivalent mesh in well under\n"
+    "half the memory). A bad edit line is reported with its line number; index I out of range is bad input.\n"
     "Exit status: 0 ok, 1 bad input (unreadable or malformed file, bad edit line, singular fit),\n"
     "2 usage error (unknown option, missing or bad argument, e.g. a precision <= 0 or NaN, or\n"
     "precisions not strictly decreasing),\n"
@@ -141,14 +147,44 @@ void write_current(Mesher& mesher, const std::string& path) {
   write_mesh(path, tm);
 }
 
-/// From this many constraints on, the fit (O(N^3)) is announced on stderr before it starts and after it
-/// ends: it is the one long phase without a progress callback.
+/// From this many constraints on, the fit is announced with its constraint count and its time (every
+/// phase is announced on stderr as it starts, see PhaseTimes).
 constexpr std::size_t kFitProgressConstraints = 1000;
 /// Default precision = this x the median spacing of the surface points: marching tetrahedra puts a mesh
 /// vertex on every crossed Delaunay edge, so a circumradius bound of one spacing gives about 6x as many
 /// mesh vertices as points (hand.off: 7231 for 1197); 2.5 spacings give 1-1.5x as many (hand 1855,
 /// sphere926 990, 33k samples of man.off 49.6k).
 constexpr double kSpacingFactor = 2.5;
+/// Memory per Delaunay vertex of the whole meshing structure (Delaunay tree, polygonizer arrays, live
+/// mesh, vector growth slack), measured on 10^6 oriented points (docs/benchmarks.md "10^6 points end to
+/// end"): about 1.5 KB in a batch run; with the history kept (a run with --edits) 2.5 KB measured before
+/// the incremental extraction, which adds about 0.4 KB.
+constexpr double kBytesPerVertexBatch = 1600.0;
+constexpr double kBytesPerVertexHistory = 2900.0;
+
+/// The Delaunay vertex budget of this machine: 80% of the physical memory over the bytes per vertex
+/// (0: unknown, no limit).
+std::size_t vertex_budget(bool keep_history) {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return 0;
+  const double bytes = 0.8 * static_cast<double>(pages) * static_cast<double>(page);
+  return static_cast<std::size_t>(bytes / (keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch));
+}
+
+/// mesher.refine(), its LimitError (MesherOptions::max_vertices, set from the machine's memory) said in
+/// the CLI's terms.
+void refine_within_memory(Mesher& mesher, double precision, const ProgressCallback& progress) {
+  try {
+    mesher.refine(precision, progress);
+  } catch (const LimitError& e) {
+    std::ostringstream what;
+    what << "this machine's memory holds about " << mesher.options().max_vertices
+         << " Delaunay vertices (80% of the physical memory at "
+         << (mesher.options().polygonizer.keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch)
+         << " bytes each) and the refinement needs more: give a coarser --precision (" << e.what() << ")";
+    throw LimitError(what.str());
+  }
+}
 
 }  // namespace
 
@@ -251,28 +287,48 @@ int run_mesh(const Args& args) {
     for (std::string line; std::getline(in, line);) script.push_back(line);
   }
 
-  const auto t_start = Clock::now();
-  const Constraints constraints = constraints_of(read_input(input), input, options.constraint_build);
+  PhaseTimes phases(quiet);
+  // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
+  // memory (docs/mesher.md "Batch runs and memory").
+  options.polygonizer.keep_history = !script.empty();
+  // A precision far below the data's spacing would need more memory than the machine has: a LimitError
+  // naming the count instead of an out-of-memory end.
+  options.max_vertices = vertex_budget(options.polygonizer.keep_history);
+  phases.start("read", "reading " + input);
+  Input data = read_input(input);
+  phases.start("constraints");
+  ConstraintBuildReport merged;
+  const Constraints constraints = constraints_of(std::move(data), input, options.constraint_build, &merged);
+  if (!quiet && merged.merged_points + merged.merged_off_surface > 0)
+    std::fprintf(stderr, "merged %zu near-duplicate points and dropped %zu off-surface constraints on another "
+                 "constraint (closer than %g x the diagonal)\n", merged.merged_points, merged.merged_off_surface,
+                 options.constraint_build.merge_tolerance);
   if (default_precision) {
     // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
+    phases.start("precision", "median spacing");
     Box3 box;
     for (const Point3& p : constraints.points) box.extend(p);
     precisions.push_back(kSpacingFactor * median_spacing(constraints) / box.diagonal());
     if (!quiet) std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", precisions[0]);
   }
   const std::size_t levels = std::max(precisions.size(), distances.size());
-  const bool announce_fit = !quiet && constraints.size() >= kFitProgressConstraints;
-  if (announce_fit)
-    std::fprintf(stderr, "fitting the implicit function to %zu constraints...\n", constraints.size());
+  const bool announce_fit = constraints.size() >= kFitProgressConstraints;
+  options.on_phase = [&](const char* phase) {
+    const std::string name = phase;
+    if (name != "fit") return phases.start(name);
+    phases.start(name, announce_fit ? "fitting the implicit function to " + std::to_string(constraints.size()) +
+                                          " constraints"
+                                    : name);
+  };
   Mesher mesher(constraints, options);
-  if (announce_fit) std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
+  phases.stop();
+  if (announce_fit && !quiet) std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
   const double diag = mesher.diagonal();
-  const double build_ms = ms_since(t_start);
+  const double build_ms = 1e3 * phases.elapsed();
   if (!quiet) {
     std::printf("%s: %zu constraints, diagonal %.6g; %s fit %.0f ms, initial tetrahedralization %.0f ms\n",
                 input.c_str(), mesher.size(), diag, mesher.local_function() ? "local" : "global",
-                mesher.stats().fit_seconds * 1e3,
-                build_ms - mesher.stats().fit_seconds * 1e3);
+                1e3 * phases.seconds("fit"), 1e3 * phases.seconds("tetrahedralization"));
     std::printf("%5s %10s %9s %10s %11s %11s %10s\n", "level", "precision", "vertices", "triangles", "refine ms",
                 "extract ms", "total ms");
   }
@@ -285,10 +341,11 @@ int run_mesh(const Args& args) {
       if (!distances.empty()) q.max_distance = distances[std::min(k, distances.size() - 1)] * diag;
       mesher.set_quality_options(q);
     }
+    phases.start("refinement", "refining level " + std::to_string(k));
     const auto t0 = Clock::now();
     auto last_report = Clock::now();
     bool reported = false;
-    mesher.refine(precision * diag, [&](const RefineProgress& p) {
+    refine_within_memory(mesher, precision * diag, [&](const RefineProgress& p) {
       if (!quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
         std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
                      p.queued);
@@ -299,15 +356,22 @@ int run_mesh(const Args& args) {
     });
     if (reported) std::fprintf(stderr, "\n");
     const double refine_ms = ms_since(t0);
+    phases.start("extraction");
     const auto t1 = Clock::now();
     const SurfaceMesh& m = mesher.surface();
     const double extract_ms = ms_since(t1);
     total_ms += refine_ms + extract_ms;
     const std::string path = levels == 1 ? output : level_path(output, k);
+    phases.start("writing", "writing " + path);
     write_current(mesher, path);
+    phases.stop();
     if (!quiet)
       std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
                   m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());
+  }
+  if (!quiet) {
+    std::printf("\n");
+    phases.print(stdout);
   }
 
   if (!script.empty() && !quiet)

@@ -14,6 +14,8 @@ namespace vitri::cli {
 /// constraints_from_oriented_points). `name` is used in messages.
 /// @throws InvalidArgument where the normals of unoriented points cannot be oriented (names the file and
 /// the point); as constraints_from_mesh / _oriented_points.
-Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build);
+/// `report`, when given, receives what the builder merged (left zero for .xyzv constraints).
+Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
+                           ConstraintBuildReport* report = nullptr);
 
 }  // namespace vitri::cli

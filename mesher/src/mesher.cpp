@@ -26,6 +26,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <string>
 #include <utility>
 
 namespace vitri {
@@ -44,6 +45,7 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
   if (!(options_.garbage_fraction >= 0.0) || !std::isfinite(options_.garbage_fraction))
     throw InvalidArgument("MesherOptions::garbage_fraction must be >= 0");
   QualityMesher::validate(options_.quality);
+  if (options_.on_phase) options_.on_phase("fit");
   const double t0 = now_seconds();
   const bool local = options_.function == FunctionKind::Local ||
                      (options_.function == FunctionKind::Auto && constraints.size() > options_.auto_local_above);
@@ -55,6 +57,7 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
     rbf_->fit(constraints, options_.rbf);
   }
   stats_.fit_seconds = now_seconds() - t0;
+  if (options_.on_phase) options_.on_phase("tetrahedralization");
   build();
 }
 
@@ -121,7 +124,19 @@ bool Mesher::inside_domain(const Point3& p) const {
 
 bool Mesher::refine(double precision, const ProgressCallback& progress) {
   mesh_valid_ = false;
-  const bool done = poly_->refine(precision, progress);
+  std::size_t over_limit = 0;  // the vertex count that passed options_.max_vertices, 0 while within it
+  const bool done = poly_->refine(precision, [&](const RefineProgress& p) {
+    if (options_.max_vertices && p.vertices > options_.max_vertices) {
+      over_limit = p.vertices;
+      return false;
+    }
+    return !progress || progress(p);
+  });
+  if (over_limit)
+    throw LimitError("refinement stopped at " + std::to_string(over_limit) +
+                     " Delaunay vertices, past MesherOptions::max_vertices = " +
+                     std::to_string(options_.max_vertices) + " (precision " + std::to_string(precision) +
+                     "; a coarser precision needs fewer)");
   precision_ = precision;
   if (done) refine_quality();
   return done;

@@ -89,8 +89,12 @@ void SupportFilter::track_source(const LiveMesh& source, const MeshDelta& delta,
 
 // From each seed: stop at the first supported vertex (keep the triangles reached) or at the end of the
 // component (hide it). A triangle reached by an earlier search of this update belongs to a kept
-// component (a hidden one would have been exhausted, seed included).
-void SupportFilter::search(const LiveMesh& source, const std::vector<std::uint32_t>& seeds, const Supported& supported) {
+// component (a hidden one would have been exhausted, seed included). `flood` (every triangle is a seed:
+// a full delta or a recheck): a kept component is then reached to its end without asking `supported`
+// again, so that the later seeds in it are skipped: one support query per component instead of one per
+// vertex (the decision is the same: a component is kept iff one of its vertices is supported).
+void SupportFilter::search(const LiveMesh& source, const std::vector<std::uint32_t>& seeds, const Supported& supported,
+                           bool flood) {
   grow(tri_stamp_, source.triangle_capacity(), 0u);
   grow(vertex_stamp_, source.vertex_capacity(), 0u);
   grow(vertex_support_, source.vertex_capacity(), std::uint8_t{0});
@@ -104,13 +108,13 @@ void SupportFilter::search(const LiveMesh& source, const std::vector<std::uint32
     reached.assign(1, s);
     tri_stamp_[s] = id;
     bool kept = false;
-    for (std::size_t next = 0; next < reached.size() && !kept; ++next) {
+    for (std::size_t next = 0; next < reached.size() && (flood || !kept); ++next) {
       for (const std::uint32_t v : corners_[reached[next]]) {
-        if (vertex_stamp_[v] <= update_start_) {
+        if (!kept && vertex_stamp_[v] <= update_start_) {
           vertex_stamp_[v] = id;
           vertex_support_[v] = supported(source.position(v)) ? 1 : 0;
         }
-        if (vertex_support_[v]) kept = true;
+        if (!kept && vertex_stamp_[v] > update_start_ && vertex_support_[v]) kept = true;
         for (const std::uint32_t u : incident_[v]) {
           if (tri_stamp_[u] > update_start_ && tri_stamp_[u] != id) kept = true;  // an earlier kept one
           if (tri_stamp_[u] <= update_start_) {
@@ -118,7 +122,7 @@ void SupportFilter::search(const LiveMesh& source, const std::vector<std::uint32
             reached.push_back(u);
           }
         }
-        if (kept) break;
+        if (kept && !flood) break;
       }
     }
     if (kept) {
@@ -145,7 +149,7 @@ void SupportFilter::update(const LiveMesh& source, const MeshDelta& delta, const
     for (std::uint32_t t = 0; t < source.triangle_capacity(); ++t)
       if (source.is_triangle(t)) seeds.push_back(t);
   if (supported) {
-    search(source, seeds, supported);
+    search(source, seeds, supported, delta.full || recheck_all);
   } else {
     hidden_components_ = 0;
     for (const std::uint32_t t : hidden_)

@@ -39,7 +39,7 @@ class SupportFilter {
 
  private:
   void track_source(const LiveMesh& source, const MeshDelta& delta, std::vector<std::uint32_t>& seeds);
-  void search(const LiveMesh& source, const std::vector<std::uint32_t>& seeds, const Supported& supported);
+  void search(const LiveMesh& source, const std::vector<std::uint32_t>& seeds, const Supported& supported, bool flood);
   void show(const LiveMesh& source, std::uint32_t t);
   void hide(std::uint32_t t);
   std::uint32_t view_vertex(const LiveMesh& source, std::uint32_t v);

@@ -42,6 +42,14 @@ namespace {
 
 using namespace polygonizer_detail;
 
+/// The Delaunay tree's options as the polygonizer's options ask (history kept or not, bulk threads).
+TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
+  TriangulationOptions t;
+  t.keep_history = options.keep_history;
+  t.threads = options.keep_history ? 1 : options.threads;
+  return t;
+}
+
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
 // Thin features: an edge with ends of one sign that is probably crossed twice is refined only when the
 // gradients at its ends point into opposite half-spaces (cosine below this): the crossings then belong to
@@ -118,7 +126,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
                                    : nullptr),
       f_(closed_ ? *closed_ : f),
       options_(options),
-      tri_(domain),
+      tri_(domain, triangulation_options(options)),
       precision_(std::numeric_limits<double>::infinity()),
       surface_(std::make_unique<SurfaceTracker>()) {
   const auto t0 = Clock::now();

@@ -3,12 +3,20 @@
 // The off-surface constraints f(p +- d n) = +-d make the zero set pass through the points with the
 // given normals and fix the sign: f < 0 inside, f > 0 outside. The only trap is a thin part, where
 // p + d n may land closer to the opposite sheet than to p; such constraints would contradict each other,
-// so d is halved for that point (a uniform grid finds the surface points within d), up to 4 times.
+// so d is halved for that point (a kd-tree of the surface points answers "any point within d?"), up to 4
+// times. Samples of a real scan hold near-duplicates (closer than the fits' duplicate tolerance), which
+// would make the fit singular: they are merged first, in input order (near_duplicates.cpp), and an
+// off-surface constraint that lands on another constraint is dropped the same way. The per-point work
+// (the off-surface queries) runs on threads; the result does not depend on their number.
 
 #include "vitri/rbf/constraints.hpp"
 
+#include "near_duplicates.hpp"
+#include "parallel.hpp"
+#include "spatial_order.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
+#include "vitri/rbf/point_index.hpp"
 
 #include <Eigen/Geometry>
 
@@ -16,9 +24,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <map>
 #include <string>
-#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -33,52 +39,103 @@ std::uint64_t splitmix64(std::uint64_t& s) {
   return z ^ (z >> 31);
 }
 
-// Uniform grid over points for radius queries.
-class PointGrid {
- public:
-  PointGrid(const std::vector<Point3>& pts, double cell) : pts_(pts), cell_(cell) {
-    for (const auto& p : pts) box_.extend(p);
-    for (std::size_t i = 0; i < pts.size(); ++i) cells_[key(pts[i])].push_back(i);
+/// Throws InvalidPoint for a non-finite position or normal or a zero normal.
+void validate_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals) {
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!is_finite(points[i])) throw InvalidPoint(i, "non-finite coordinate (NaN or infinity)");
+    if (!is_finite(normals[i])) throw InvalidPoint(i, "non-finite normal");
+    if (!(norm(normals[i]) > 0)) throw InvalidPoint(i, "zero normal");
   }
-  // True when a point other than `self` lies strictly closer than r to q (r <= cell).
-  bool any_within(const Point3& q, double r, std::size_t self) const {
-    const auto k = coords(q);
-    for (std::int64_t dx = -1; dx <= 1; ++dx)
-      for (std::int64_t dy = -1; dy <= 1; ++dy)
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-          auto it = cells_.find(pack(k[0] + dx, k[1] + dy, k[2] + dz));
-          if (it == cells_.end()) continue;
-          for (std::size_t j : it->second)
-            if (j != self && squared_distance(pts_[j], q) < r * r) return true;
-        }
-    return false;
-  }
+}
 
- private:
-  std::array<std::int64_t, 3> coords(const Point3& p) const {
-    return {static_cast<std::int64_t>(std::floor((p.x - box_.lo.x) / cell_)),
-            static_cast<std::int64_t>(std::floor((p.y - box_.lo.y) / cell_)),
-            static_cast<std::int64_t>(std::floor((p.z - box_.lo.z) / cell_))};
+/// Indices of the points kept by the near-duplicate merge (input order); counts the others in `report`.
+std::vector<std::size_t> merged_surface_points(const std::vector<Point3>& points, double tol, unsigned threads,
+                                               ConstraintBuildReport& report) {
+  const std::vector<std::size_t> merged_into = rbf_detail::merge_near_duplicates(points, tol, threads);
+  std::vector<std::size_t> keep;
+  keep.reserve(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+    if (merged_into[i] == rbf_detail::kKept) keep.push_back(i);
+  report.merged_points = points.size() - keep.size();
+  return keep;
+}
+
+/// Uniform random subsample (partial Fisher-Yates, splitmix64) of `keep` down to m indices, order kept.
+void subsample(std::vector<std::size_t>& keep, std::size_t m, std::uint64_t seed) {
+  if (keep.size() <= m) return;
+  std::uint64_t state = seed;
+  for (std::size_t i = 0; i < m; ++i) {
+    const std::size_t j = i + static_cast<std::size_t>(splitmix64(state) % (keep.size() - i));
+    std::swap(keep[i], keep[j]);
   }
-  static std::uint64_t pack(std::int64_t x, std::int64_t y, std::int64_t z) {
-    auto u = [](std::int64_t v) { return static_cast<std::uint64_t>(v + (1LL << 20)) & 0x1FFFFFULL; };
-    return (u(x) << 42) | (u(y) << 21) | u(z);
+  keep.resize(m);
+  std::sort(keep.begin(), keep.end());
+}
+
+/// The signed offset of each off-surface constraint: for kept point k and side s (0: +d outside, 1: -d
+/// inside), offsets[2k + s] is the distance used (d0 halved until no surface point lies within 0.999 x
+/// it of the constraint, up to 4 times, while 0.999 d > tol: a constraint is never a near-duplicate of a
+/// surface point), 0 when the side is not wanted or every try was too close.
+/// Each point is independent: the queries run on the threads (PointIndex is const-queryable).
+std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                                        const std::vector<std::size_t>& keep, const PointIndex& surface,
+                                        double d0, double tol, const ConstraintBuildOptions& opt) {
+  std::vector<double> offsets(2 * keep.size(), 0.0);
+  // Queries in the index's spatial order: consecutive queries visit the same kd-tree leaves.
+  std::vector<Point3> kept_points(keep.size());
+  for (std::size_t k = 0; k < keep.size(); ++k) kept_points[k] = points[keep[k]];
+  const std::vector<std::size_t> order = rbf_detail::spatial_order(kept_points);
+  rbf_detail::parallel_chunks(keep.size(), opt.threads, 4096, [&](std::size_t b, std::size_t e) {
+    for (std::size_t o = b; o < e; ++o) {
+      const std::size_t k = order[o], i = keep[k];
+      const Point3 n = normals[i] / norm(normals[i]);
+      for (int s = 0; s < 2; ++s) {
+        const double side = s == 0 ? 1.0 : -1.0;
+        if ((s == 0 && opt.sides == OffSurface::Inside) || (s == 1 && opt.sides == OffSurface::Outside)) continue;
+        double d = d0;
+        for (int tries = 0; tries < 5 && 0.999 * d > tol; ++tries, d *= 0.5) {
+          const Point3 q = points[i] + (side * d) * n;
+          // Too close to another surface point: the constraint would contradict that part of the surface.
+          // (p_i itself lies at distance d, outside the strict ball.)
+          if (surface.count_ball(q, (0.999 * d) * (0.999 * d), 0) == 0) {
+            offsets[2 * k + static_cast<std::size_t>(s)] = side * d;
+            break;
+          }
+        }
+      }
+    }
+  });
+  return offsets;
+}
+
+/// Appends the off-surface constraints (per kept point, +d then -d) that are not near-duplicates of an
+/// earlier off-surface constraint: two of them closer than tol (neighbouring points with diverging
+/// normals, or offsets halved on a thin part) would make the fit singular, so the later one is dropped
+/// and counted. None can be that close to a surface point: off_surface_offsets() keeps every surface
+/// point more than tol away.
+void add_off_surface(Constraints& c, const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                     const std::vector<std::size_t>& keep, const std::vector<double>& offsets, double tol,
+                     unsigned threads, ConstraintBuildReport& report) {
+  Constraints off;
+  for (std::size_t k = 0; k < keep.size(); ++k)
+    for (std::size_t s = 0; s < 2; ++s) {
+      const double d = offsets[2 * k + s];
+      if (d == 0) continue;
+      const std::size_t i = keep[k];
+      off.add(points[i] + d * (normals[i] / norm(normals[i])), d);
+    }
+  const std::vector<std::size_t> merged_into = rbf_detail::merge_near_duplicates(off.points, tol, threads);
+  for (std::size_t j = 0; j < off.size(); ++j) {
+    if (merged_into[j] == rbf_detail::kKept) c.add(off.points[j], off.values[j]);
+    else ++report.merged_off_surface;
   }
-  std::uint64_t key(const Point3& p) const {
-    const auto c = coords(p);
-    return pack(c[0], c[1], c[2]);
-  }
-  const std::vector<Point3>& pts_;
-  double cell_;
-  Box3 box_;
-  std::unordered_map<std::uint64_t, std::vector<std::size_t>> cells_;
-};
+}
 
 }  // namespace
 
 Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
                                              const std::vector<Point3>& normals,
-                                             const ConstraintBuildOptions& opt) {
+                                             const ConstraintBuildOptions& opt, ConstraintBuildReport* report) {
   if (points.empty()) throw InvalidArgument("no points to build constraints from");
   if (normals.empty())
     throw InvalidArgument(
@@ -89,71 +146,52 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
                           " normals");
   if (!(opt.offset > 0) || !std::isfinite(opt.offset))
     throw InvalidArgument("constraint offset must be a positive fraction of the diagonal");
-  // Validate and merge exact duplicates (first kept).
-  std::vector<std::size_t> keep;
-  {
-    std::map<std::tuple<double, double, double>, std::size_t> seen;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (!is_finite(points[i])) throw InvalidPoint(i, "non-finite coordinate (NaN or infinity)");
-      if (!is_finite(normals[i])) throw InvalidPoint(i, "non-finite normal");
-      if (!(norm(normals[i]) > 0)) throw InvalidPoint(i, "zero normal");
-      if (seen.emplace(std::make_tuple(points[i].x, points[i].y, points[i].z), i).second) keep.push_back(i);
-    }
-  }
+  if (!(opt.merge_tolerance >= 0) || !std::isfinite(opt.merge_tolerance))
+    throw InvalidArgument("constraint merge_tolerance must be a finite fraction >= 0 of the diagonal");
   const std::size_t per = opt.sides == OffSurface::Both ? 3 : 2;
   if (opt.max_constraints && opt.max_constraints < per)
     throw InvalidArgument("max_constraints " + std::to_string(opt.max_constraints) + " is smaller than the " +
                           std::to_string(per) + " constraints made per surface point (0 means no limit)");
-  if (opt.max_constraints) {
-    const std::size_t m = opt.max_constraints / per;
-    if (keep.size() > m) {
-      std::uint64_t state = opt.seed;
-      for (std::size_t i = 0; i < m; ++i) {  // partial Fisher-Yates
-        const std::size_t j = i + static_cast<std::size_t>(splitmix64(state) % (keep.size() - i));
-        std::swap(keep[i], keep[j]);
-      }
-      keep.resize(m);
-      std::sort(keep.begin(), keep.end());
-    }
-  }
+  validate_oriented_points(points, normals);
   Box3 box;
   for (const auto& p : points) box.extend(p);
   const double d0 = opt.offset * box.diagonal();
   if (!(d0 > 0)) throw InvalidArgument("all points coincide: no surface to fit");
-  // Grid over all (merged) surface points, not only the subsample: thin parts are judged on the data.
-  std::vector<Point3> surf;
-  surf.reserve(keep.size());
+  // The tolerance is relative to the box of every constraint (the surface points' box grown by d0 on
+  // each side), the box the fits measure their duplicate tolerance on.
+  Box3 grown = box;
+  grown.extend(box.lo - Point3{d0, d0, d0});
+  grown.extend(box.hi + Point3{d0, d0, d0});
+  const double tol = opt.merge_tolerance * grown.diagonal();
+  ConstraintBuildReport local_report;
+  ConstraintBuildReport& rep = report ? *report : local_report;
+  rep = {};
+  std::vector<std::size_t> keep = merged_surface_points(points, tol, opt.threads, rep);
+  // Index over all merged surface points, not only the subsample: thin parts are judged on the data.
+  // Built in spatial order (ids are not used): a leaf's points share cache lines.
+  std::vector<Point3> surf(keep.size());
   {
-    std::map<std::tuple<double, double, double>, bool> seen;
-    for (std::size_t i = 0; i < points.size(); ++i)
-      if (seen.emplace(std::make_tuple(points[i].x, points[i].y, points[i].z), true).second)
-        surf.push_back(points[i]);
+    std::vector<Point3> merged(keep.size());
+    for (std::size_t k = 0; k < keep.size(); ++k) merged[k] = points[keep[k]];
+    const std::vector<std::size_t> order = rbf_detail::spatial_order(merged);
+    for (std::size_t k = 0; k < order.size(); ++k) surf[k] = merged[order[k]];
   }
-  PointGrid grid(surf, d0);
+  const PointIndex surface(surf);
+  if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
+  const std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d0, tol, opt);
   Constraints c;
+  c.points.reserve(keep.size() * per);
+  c.values.reserve(keep.size() * per);
   for (std::size_t i : keep) c.add(points[i], 0.0);
-  for (std::size_t i : keep) {
-    const Point3 n = normals[i] / norm(normals[i]);
-    for (int side : {+1, -1}) {
-      if ((side > 0 && opt.sides == OffSurface::Inside) || (side < 0 && opt.sides == OffSurface::Outside))
-        continue;
-      double d = d0;
-      for (int tries = 0; tries < 5; ++tries, d *= 0.5) {
-        const Point3 q = points[i] + (side * d) * n;
-        // Too close to another surface point: the constraint would contradict that part of the surface.
-        if (!grid.any_within(q, 0.999 * d, static_cast<std::size_t>(-1) /* p_i itself is at distance d */)) {
-          c.add(q, side * d);
-          break;
-        }
-      }
-    }
-  }
+  add_off_surface(c, points, normals, keep, offsets, tol, opt.threads, rep);
   return c;
 }
 
-Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options) {
+Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options,
+                                   ConstraintBuildReport* report) {
   if (points.empty()) throw InvalidArgument("no points to build constraints from");
-  return constraints_from_oriented_points(points, estimate_oriented_normals(points, options.normals), options);
+  return constraints_from_oriented_points(points, estimate_oriented_normals(points, options.normals), options,
+                                          report);
 }
 
 Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
@@ -212,7 +250,7 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
 }
 
 Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                  const ConstraintBuildOptions& options) {
+                                  const ConstraintBuildOptions& options, ConstraintBuildReport* report) {
   const Eigen::MatrixXd N = closed_mesh_vertex_normals(V, F);
   std::vector<bool> used(static_cast<std::size_t>(V.rows()), false);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
@@ -233,7 +271,7 @@ Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixX
       throw InvalidPoint(vi, "mesh vertex with a non-finite area-weighted normal (coordinates too large?)");
     if (!(norm(n.back()) > 0)) throw InvalidPoint(vi, "mesh vertex with a zero area-weighted normal");
   }
-  return constraints_from_oriented_points(p, n, options);
+  return constraints_from_oriented_points(p, n, options, report);
 }
 
 }  // namespace vitri

@@ -4,6 +4,8 @@
 
 #include "local_patch.hpp"
 #include "local_tree.hpp"
+#include "parallel.hpp"
+#include "spatial_order.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/point_index.hpp"
 
@@ -30,35 +32,7 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// Runs body(begin, end) over [0, n) in chunks of `grain` on up to `threads` threads; rethrows the first
-/// exception of any chunk.
-void parallel_chunks(std::size_t n, unsigned threads, std::size_t grain,
-                     const std::function<void(std::size_t, std::size_t)>& body) {
-  const std::size_t chunks = (n + grain - 1) / grain;
-  const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(threads, chunks));
-  if (workers <= 1) {
-    if (n) body(0, n);
-    return;
-  }
-  std::atomic<std::size_t> next{0};
-  std::exception_ptr error;
-  std::mutex error_mutex;
-  auto work = [&] {
-    for (std::size_t k; (k = next.fetch_add(1)) < chunks;) {
-      try {
-        body(k * grain, std::min(n, (k + 1) * grain));
-      } catch (...) {
-        std::lock_guard<std::mutex> lock(error_mutex);
-        if (!error) error = std::current_exception();
-      }
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 1; t < workers; ++t) pool.emplace_back(work);
-  work();
-  for (auto& t : pool) t.join();
-  if (error) std::rethrow_exception(error);
-}
+using rbf_detail::parallel_chunks;
 
 std::string format_point(const Point3& p) {
   std::ostringstream s;
@@ -640,17 +614,6 @@ double LocalRbf::value_gradient(const Point3& p, Point3& gradient) const { retur
 
 namespace {
 
-/// Spreads the low 21 bits of v to every third bit (Morton interleaving).
-std::uint64_t spread_bits(std::uint64_t v) {
-  v &= 0x1fffff;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
 /// Order in which a large batch is evaluated: along a Morton curve of the root cube, so that consecutive
 /// points visit the same patches (their coefficients stay in cache). Results do not depend on the order.
 std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, const Box3& root) {
@@ -660,7 +623,7 @@ std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, cons
     std::uint64_t code = 0;
     for (int a = 0; a < 3; ++a) {
       const double t = std::min(std::max((points[i][a] - root.lo[a]) * scale, 0.0), double((1 << 21) - 1));
-      code |= spread_bits(static_cast<std::uint64_t>(t)) << a;
+      code |= rbf_detail::spread_bits3(static_cast<std::uint64_t>(t)) << a;
     }
     keyed[i] = {code, static_cast<std::uint32_t>(i)};
   }

@@ -96,7 +96,11 @@ void PointIndex::fill_node(std::uint32_t index, Id* first, Id* last) {
   if (extent.z > extent[axis]) axis = 2;
   if (count <= kBucket || !(extent[axis] > 0)) {  // small, or all points at one position
     nodes_[index].bucket.assign(first, last);
-    for (Id* it = first; it != last; ++it) leaf_of_[*it] = index;
+    nodes_[index].bucket_points.clear();
+    for (Id* it = first; it != last; ++it) {
+      leaf_of_[*it] = index;
+      nodes_[index].bucket_points.push_back(position_[*it]);
+    }
     return;
   }
   auto coordinate = [&](Id a) { return position_[a][axis]; };
@@ -110,6 +114,8 @@ void PointIndex::fill_node(std::uint32_t index, Id* first, Id* last) {
   double cut = coordinate(*middle);  // the smallest coordinate on the right: left < cut <= right
   for (Id* it = middle; it != last; ++it) cut = std::min(cut, coordinate(*it));
   nodes_[index].bucket.clear();
+  nodes_[index].bucket_points.clear();
+  nodes_[index].bucket_points.shrink_to_fit();
   nodes_[index].axis = static_cast<std::uint8_t>(axis);
   nodes_[index].split = cut;
   const std::uint32_t left = make_subtree(first, middle);
@@ -142,6 +148,7 @@ void PointIndex::insert(Id id, const Point3& p) {
     node = nodes_[node].children[p[nodes_[node].axis] < nodes_[node].split ? 0 : 1];
   }
   nodes_[node].bucket.push_back(id);
+  nodes_[node].bucket_points.push_back(p);
   leaf_of_[id] = node;
   ++size_;
   if (nodes_[node].bucket.size() > 2 * kBucket) split_leaf(node);
@@ -154,11 +161,14 @@ void PointIndex::split_leaf(std::uint32_t node) {
 
 void PointIndex::erase(Id id) {
   if (!contains(id)) throw InvalidPoint(id, "no point with this id in the spatial index");
-  auto& bucket = nodes_[leaf_of_[id]].bucket;
-  const auto it = std::find(bucket.begin(), bucket.end(), id);
-  assert(it != bucket.end());
-  *it = bucket.back();
-  bucket.pop_back();
+  Node& leaf = nodes_[leaf_of_[id]];
+  const auto it = std::find(leaf.bucket.begin(), leaf.bucket.end(), id);
+  assert(it != leaf.bucket.end());
+  const auto k = static_cast<std::size_t>(it - leaf.bucket.begin());
+  *it = leaf.bucket.back();
+  leaf.bucket.pop_back();
+  leaf.bucket_points[k] = leaf.bucket_points.back();
+  leaf.bucket_points.pop_back();
   leaf_of_[id] = kNoNode;
   --size_;
 }
@@ -172,8 +182,8 @@ void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out
     stack.pop_back();
     if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
     if (n.leaf()) {
-      for (Id id : n.bucket)
-        if (squared_distance(position_[id], center) < radius2) out.push_back(id);
+      for (std::size_t k = 0; k < n.bucket.size(); ++k)
+        if (squared_distance(n.bucket_points[k], center) < radius2) out.push_back(n.bucket[k]);
     } else {
       stack.push_back(n.children[0]);
       stack.push_back(n.children[1]);
@@ -193,7 +203,7 @@ std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::si
     stack.pop_back();
     if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
     if (n.leaf()) {
-      for (Id id : n.bucket) count += squared_distance(position_[id], center) < radius2;
+      for (const Point3& p : n.bucket_points) count += squared_distance(p, center) < radius2;
       if (count > limit) return limit + 1;
     } else {
       stack.push_back(n.children[0]);
@@ -206,9 +216,9 @@ std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::si
 void PointIndex::nearest_recurse(std::uint32_t index, NearestState& state) const {
   const Node& n = nodes_[index];
   if (n.leaf()) {
-    for (Id id : n.bucket) {
-      const double d2 = squared_distance(position_[id], state.query);
-      if (d2 <= state.bound()) state.offer(d2, id);
+    for (std::size_t k = 0; k < n.bucket.size(); ++k) {
+      const double d2 = squared_distance(n.bucket_points[k], state.query);
+      if (d2 <= state.bound()) state.offer(d2, n.bucket[k]);
     }
     return;
   }

@@ -5,9 +5,11 @@
 #include <catch2/catch.hpp>
 
 #include "support/surface_metrics.hpp"
+#include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
 #include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/rbf/point_index.hpp"
 
 #include <algorithm>
 #include <array>
@@ -15,6 +17,7 @@
 #include <map>
 #include <random>
 #include <string>
+#include <vector>
 
 using namespace vitri;
 
@@ -110,6 +113,104 @@ TEST_CASE("unsupported components are dropped unless the whole zero set is asked
     if (!keep)
       for (const Point3& v : mesher.surface().vertices) REQUIRE(std::abs(norm(v) - 1.0) < 0.1);
   }
+}
+
+namespace {
+
+// Two meshes of the same surface at one precision: about as many vertices (2%), every vertex of mb within
+// the precision of a vertex of ma.
+void require_close(const SurfaceMesh& ma, const SurfaceMesh& mb, double precision) {
+  const double na = static_cast<double>(ma.vertices.size()), nb = static_cast<double>(mb.vertices.size());
+  CHECK(std::abs(na - nb) <= 0.02 * na);
+  const PointIndex index(ma.vertices);
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  double worst = 0;
+  for (const Point3& q : mb.vertices) {
+    index.nearest(q, 1, ids, &d2);
+    worst = std::max(worst, std::sqrt(d2[0]));
+  }
+  CHECK(worst <= precision);
+}
+
+}  // namespace
+
+// A batch run (PolygonizerOptions::keep_history = false, what the CLI does without --edits) keeps no
+// Delaunay history. The refinement visits tetrahedra in an order that follows their ids, which the tree
+// recycles without history, so the mesh is not bit for bit the default's: it must be an equally good mesh
+// of the same surface: closed with the same topology, about as many vertices, every vertex within the
+// precision of the default mesh. Edits still work on it.
+TEST_CASE("batch option: no Delaunay history, an equivalent mesh", "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  MesherOptions batch = o;
+  batch.polygonizer.keep_history = false;
+  Mesher a = Mesher::from_mesh(in.V, in.F, o), b = Mesher::from_mesh(in.V, in.F, batch);
+  REQUIRE(a.polygonizer().triangulation().keeps_history());
+  REQUIRE_FALSE(b.polygonizer().triangulation().keeps_history());
+  for (double p : {0.03, 0.015}) {
+    a.refine(p * a.diagonal());
+    b.refine(p * b.diagonal());
+    require_closed(b.surface(), 0);
+    require_close(a.surface(), b.surface(), p * a.diagonal());
+  }
+  // An edit on the batch structure: still closed, still close to the same edit with history.
+  const Point3 moved = a.constraints().points[5] + 0.01 * a.diagonal() * Point3{1, 0, 0};
+  a.move_constraint(5, moved);
+  b.move_constraint(5, moved);
+  require_closed(b.surface(), 0);
+  require_close(a.surface(), b.surface(), 0.015 * a.diagonal());
+}
+
+// A batch run with threads for the seeds' bulk insertion (what the CLI does without --edits): the
+// insertion really runs in parallel, gives the serial tetrahedralization (same vertex and tetrahedron
+// counts, same transverse tetrahedra), and the refined mesh is closed and equivalent to the serial one
+// (tetrahedron ids, hence the refinement order, may differ).
+TEST_CASE("batch option with bulk threads: the serial tetrahedralization, an equivalent mesh", "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions serial;
+  serial.function = FunctionKind::Local;
+  serial.polygonizer.keep_history = false;
+  serial.polygonizer.sampling_fraction = 0;  // the seeds' insertion is then the tree's last bulk insertion
+  MesherOptions threaded = serial;
+  threaded.polygonizer.threads = 2;
+  Mesher a = Mesher::from_mesh(in.V, in.F, serial), b = Mesher::from_mesh(in.V, in.F, threaded);
+  REQUIRE(a.polygonizer().triangulation().last_bulk_stats().parallel == 0);
+  REQUIRE(b.polygonizer().triangulation().last_bulk_stats().parallel > 0);
+  const PolygonizerStats sa = a.polygonizer().stats(), sb = b.polygonizer().stats();
+  CHECK(sb.vertices == sa.vertices);
+  CHECK(sb.tetrahedra == sa.tetrahedra);
+  CHECK(sb.transverse == sa.transverse);
+  const double p = 0.015 * a.diagonal();
+  a.refine(p);
+  b.refine(p);
+  require_closed(b.surface(), 0);
+  require_close(a.surface(), b.surface(), p);
+}
+
+TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the count", "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  const std::size_t start = mesher.stats().polygonizer.vertices;
+  Mesher unlimited = Mesher::from_mesh(in.V, in.F, o);
+  unlimited.refine(0.01 * unlimited.diagonal());
+  const std::size_t needed = unlimited.stats().polygonizer.vertices;
+  REQUIRE(needed > start + 10000);
+  o.max_vertices = start + 1000;
+  Mesher limited = Mesher::from_mesh(in.V, in.F, o);
+  try {
+    limited.refine(0.01 * limited.diagonal());
+    FAIL("no exception");
+  } catch (const LimitError& e) {
+    const std::string what = e.what();
+    CHECK(what.find("max_vertices = " + std::to_string(start + 1000)) != std::string::npos);
+    CHECK(what.find("refinement stopped at ") != std::string::npos);
+  }
+  // The structure stays valid: a coarse level within the limit still meshes.
+  CHECK(limited.stats().polygonizer.vertices < needed);
 }
 
 namespace {

@@ -30,6 +30,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -96,6 +97,17 @@ struct MesherOptions {
   /// Once collecting, at most this many removals per edit plus as many as the edit inserted, the rest at
   /// the next edits: no edit pays for a whole batch (Polygonizer::collect_garbage).
   std::size_t garbage_per_edit = 64;
+  /// refine() stops and throws LimitError (naming the count) once the Delaunay tree holds more than
+  /// this many vertices; 0: no limit. A precision far below the data's spacing asks for a number of
+  /// vertices that grows as 1 / precision^2 (precision^-3 for a zero set that fills space): the limit
+  /// turns an out-of-memory end into a clear error. The structure stays valid at the size reached (the
+  /// check runs between refinement rounds, so it may overshoot by a few thousand vertices). The CLI sets
+  /// it from the machine's memory (docs/guide.md).
+  std::size_t max_vertices = 0;
+  /// Called by the constructor when a long phase starts: "fit" (the implicit function) and then
+  /// "tetrahedralization" (Delaunay insertion of the constraints, evaluation and classification), so
+  /// that a caller can report progress (the CLI does). Empty: nothing is called.
+  std::function<void(const char* phase)> on_phase;
 };
 
 /// Counters and timings (seconds). `polygonizer` holds the refinement/extraction numbers.
@@ -144,7 +156,8 @@ class Mesher {
   /// Refines until every transverse tetrahedron has circumradius <= precision (absolute). A smaller
   /// precision than the previous call continues the refinement (levels of detail). Quality mode: then
   /// refines the quality mesh (built at the first call, seeded at `precision`) to options().quality.
-  /// @return false when the progress callback cancelled. @throws InvalidArgument for precision <= 0.
+  /// @return false when the progress callback cancelled. @throws InvalidArgument for precision <= 0;
+  ///         LimitError past options().max_vertices.
   bool refine(double precision, const ProgressCallback& progress = {});
 
   /// The current mesh (extracted on demand, cached until the next refine or edit), compact.

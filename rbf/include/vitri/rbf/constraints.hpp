@@ -37,25 +37,47 @@ struct ConstraintBuildOptions {
   std::size_t max_constraints = 0;
   /// Seed of the subsampling (deterministic on every platform: splitmix64, no std distributions).
   std::uint64_t seed = 1;
+  /// Near-duplicate surface points are merged: a point closer than merge_tolerance x D to an earlier
+  /// kept point (input order) is dropped, D being the diagonal of the surface points' bounding box grown
+  /// by the off-surface distance on every side (the box of all the constraints, on which the fits measure
+  /// their duplicate_tolerance). An off-surface constraint that close to an earlier off-surface
+  /// constraint is dropped too (an off-surface constraint is never that close to a surface point). 2e-6 by default: twice the fits' default duplicate_tolerance (1e-6), so that the result always
+  /// fits. 0 merges exact duplicates only. Counted in ConstraintBuildReport.
+  double merge_tolerance = 2e-6;
+  /// Threads of the merge and of the off-surface queries: 0 = hardware concurrency, 1 = the calling
+  /// thread. The result does not depend on it.
+  unsigned threads = 0;
   /// Normal estimation and orientation of unoriented points (constraints_from_points() only).
   NormalOptions normals;
 };
 
+/// What a constraint builder merged or dropped.
+struct ConstraintBuildReport {
+  /// Surface points merged into an earlier point closer than ConstraintBuildOptions::merge_tolerance.
+  std::size_t merged_points = 0;
+  /// Off-surface constraints dropped for lying that close to an earlier off-surface constraint.
+  std::size_t merged_off_surface = 0;
+};
+
 /// Constraints from oriented points. Normals need not be unit length (they are normalized) and must
-/// point outwards (f > 0 outside). Exact duplicate positions are merged (the first one is kept).
+/// point outwards (f > 0 outside). Near-duplicate positions (closer than options.merge_tolerance x the
+/// constraints' diagonal, exact duplicates included) are merged: the first one in input order is kept;
+/// `report`, when given, counts the merges. Deterministic.
 /// @throws InvalidPoint (index of the point) for non-finite data or a zero normal; InvalidArgument for
 ///         mismatched sizes, an empty input, a missing normal array (use constraints_from_points() for
 ///         points without normals) or max_constraints below the per-point count.
 Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
                                              const std::vector<Point3>& normals,
-                                             const ConstraintBuildOptions& options = {});
+                                             const ConstraintBuildOptions& options = {},
+                                             ConstraintBuildReport* report = nullptr);
 
 /// Constraints from unoriented points (samples of closed surfaces): outward normals estimated and
 /// oriented by estimate_oriented_normals() with options.normals, then constraints_from_oriented_points().
 /// @throws as both: InvalidPoint (index) for non-finite data, DegenerateNeighbourhood (index) for a
 ///         collinear neighbourhood, OrientationError (index) where the orientation cannot be made
 ///         consistent, InvalidArgument for too few points.
-Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options = {});
+Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options = {},
+                                   ConstraintBuildReport* report = nullptr);
 
 /// Area-weighted vertex normals of a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3),
 /// oriented outwards: when the signed volume is negative (triangles wound inwards) every normal is
@@ -70,6 +92,7 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
 /// vertex index (row of V, unreferenced vertices included) for a non-finite coordinate or a zero or
 /// non-finite normal.
 Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                  const ConstraintBuildOptions& options = {});
+                                  const ConstraintBuildOptions& options = {},
+                                  ConstraintBuildReport* report = nullptr);
 
 }  // namespace vitri

@@ -31,7 +31,7 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 double peak_mb() {
   rusage r{};
   getrusage(RUSAGE_SELF, &r);
-  return r.ru_maxrss / 1024.0;
+  return static_cast<double>(r.ru_maxrss) / 1024.0;
 }
 
 }  // namespace
@@ -107,7 +107,7 @@ int main(int argc, char** argv) {
   std::printf("constraints %zu  build %.3f s  local fit %.3f s  patches %zu (far %zu, mean %.1f, max %zu, depth %d)  "
               "eval+grad %.2f Mpts/s  edit median %.3f ms p90 %.3f ms  global fit %s  peak %.0f MB\n",
               c.size(), build_s, fit_s, rep.patches, rep.far_patches, rep.mean_fitted, rep.max_fitted, rep.depth,
-              ne / eval_s / 1e6, 1e3 * edit[edit.size() / 2], 1e3 * edit[edit.size() * 9 / 10],
+              static_cast<double>(ne) / eval_s / 1e6, 1e3 * edit[edit.size() / 2], 1e3 * edit[edit.size() * 9 / 10],
               global ? (std::to_string(global_s) + " s").c_str() : "-", peak_mb());
   return 0;
 }

@@ -10,6 +10,7 @@
 // component filter, delta). Prints the setup phases, then median / 90th percentile / max per edit and the
 // delta sizes. Results: docs/benchmarks.md ("Edits at scale").
 #include "support/sample_mesh.hpp"
+#include "support/timing.hpp"
 #include "vitri/mesher.hpp"
 
 #include <sys/resource.h>
@@ -24,14 +25,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-double peak_mb() {
-  rusage r{};
-  getrusage(RUSAGE_SELF, &r);
-  return static_cast<double>(r.ru_maxrss) / 1024.0;
-}
+using vitri::bench::Clock;
+using vitri::bench::peak_mb;
+using vitri::bench::since;
 
 double percentile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());

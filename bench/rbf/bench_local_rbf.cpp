@@ -7,6 +7,7 @@
 // normals, then turned into normal constraints (constraints_from_oriented_points). Peak memory is the
 // process's maximum resident set (run one size per process). Results: docs/benchmarks.md.
 #include "support/sample_mesh.hpp"
+#include "support/timing.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/local_rbf.hpp"
@@ -25,14 +26,9 @@
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-double peak_mb() {
-  rusage r{};
-  getrusage(RUSAGE_SELF, &r);
-  return static_cast<double>(r.ru_maxrss) / 1024.0;
-}
+using vitri::bench::Clock;
+using vitri::bench::peak_mb;
+using vitri::bench::since;
 
 }  // namespace
 

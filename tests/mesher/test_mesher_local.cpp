@@ -4,6 +4,7 @@
 // vertex value equal to f.
 #include <catch2/catch.hpp>
 
+#include "support/mesh_checks.hpp"
 #include "support/surface_metrics.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
@@ -213,24 +214,7 @@ TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the 
   CHECK(limited.stats().polygonizer.vertices < needed);
 }
 
-namespace {
-
-using Corner = std::array<double, 3>;
-using Tri = std::array<Corner, 3>;
-
-std::vector<Tri> canonical(const SurfaceMesh& m) {
-  std::vector<Tri> out;
-  for (const auto& t : m.triangles) {
-    Tri tri;
-    for (int i = 0; i < 3; ++i) tri[i] = {m.vertices[t[i]].x, m.vertices[t[i]].y, m.vertices[t[i]].z};
-    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
-    out.push_back(tri);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
-
-}  // namespace
+using test::canonical;
 
 TEST_CASE("local function: edits send small deltas that keep a client's copy exact", "[mesher][local]") {
   MesherOptions o;

@@ -54,23 +54,7 @@ class BumpedSphere final : public ImplicitFunction {
   }
 };
 
-using Corner = std::array<double, 3>;
-using Tri = std::array<Corner, 3>;
-
-/// The triangles of a mesh as position triples, each rotated to start at its smallest corner, sorted:
-/// equal for two meshes with the same triangles on the same positions, whatever the numbering.
-std::vector<Tri> canonical(const SurfaceMesh& m) {
-  std::vector<Tri> out;
-  for (const auto& t : m.triangles) {
-    Tri tri;
-    for (int i = 0; i < 3; ++i) tri[i] = {m.vertices[t[i]].x, m.vertices[t[i]].y, m.vertices[t[i]].z};
-    const auto first = std::min_element(tri.begin(), tri.end()) - tri.begin();
-    std::rotate(tri.begin(), tri.begin() + first, tri.end());
-    out.push_back(tri);
-  }
-  std::sort(out.begin(), out.end());
-  return out;
-}
+using test::canonical;
 
 /// A client's copy of a LiveMesh, kept by applying deltas only.
 struct Client {

@@ -8,9 +8,28 @@
 #include "vitri/core/box.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstddef>
+#include <vector>
 
 namespace vitri::test {
+
+/// A triangle as its three corner positions.
+using CanonicalTriangle = std::array<std::array<double, 3>, 3>;
+
+/// The triangles of a mesh as position triples, each rotated to start at its smallest corner, sorted:
+/// equal for two meshes with the same triangles on the same positions, whatever the numbering.
+inline std::vector<CanonicalTriangle> canonical(const SurfaceMesh& m) {
+  std::vector<CanonicalTriangle> out;
+  for (const auto& t : m.triangles) {
+    CanonicalTriangle tri;
+    for (int i = 0; i < 3; ++i) tri[i] = {m.vertices[t[i]].x, m.vertices[t[i]].y, m.vertices[t[i]].z};
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    out.push_back(tri);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
 
 /// Smallest triangle area over the square of the diagonal of the mesh's bounding box (1 when empty).
 inline double min_relative_area(const SurfaceMesh& m) {

@@ -21,6 +21,11 @@
 // fallback points used when the circumcenter leaves the box are checked explicitly. Points at mutual
 // distance >= d_min in a bounded box are finitely many (packing), each queue entry is either dropped or
 // causes an insertion, and entries are created only by insertions: the loop ends.
+//
+// Files: this one (construction, evaluation, classification, lone zeros, queue, refinement), thin
+// features (thin_features.cpp), vertex edits (vertex_edits.cpp), function changes and garbage collection
+// (function_changes.cpp), extraction (extract.cpp over surface_tracker.hpp), the closing function of
+// close_at_box (box_closure.cpp).
 #include "vitri/polygonize/polygonizer.hpp"
 
 #include "polygonizer_internal.hpp"
@@ -33,7 +38,6 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
-#include <sstream>
 #include <string>
 
 namespace vitri {
@@ -56,7 +60,6 @@ constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of e
 // sheets facing each other. A chord of one smooth sheet has nearly parallel end gradients. (Measured on
 // hand.off, largest-first at 0.015: an edge at 85 degrees still bridges a gap; a 60-degree bound, with
 // or without a smaller proximity for these points, made hand.off worse at 0.03-0.04: see the docs.)
-constexpr double kThinCosine = 0.0;
 // Proximity distance of thin-feature points, as a fraction of the refinement's (1: the same rule).
 constexpr double kThinDistance = 1.0;
 
@@ -76,12 +79,6 @@ void set_listed(std::vector<std::uint32_t>& list, std::vector<std::uint32_t>& po
   }
 }
 
-std::string describe(const Point3& p) {
-  std::ostringstream s;
-  s.precision(17);
-  s << "(" << p.x << ", " << p.y << ", " << p.z << ")";
-  return s.str();
-}
 
 }  // namespace
 
@@ -600,224 +597,6 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   queue_valid_ = completed;
   stats_.refine_seconds = seconds_since(t0);
   return completed;
-}
-
-// ---- Thin features -------------------------------------------------------------------------------------
-// Marching tetrahedra sees only the signs at the vertices. Where two sheets of the surface are closer
-// than the Delaunay edges (two fingers, a thin wall), an edge can join two vertices of one sign across a
-// thin layer of the other sign: the tetrahedra around it bridge the gap (or punch through the wall) and
-// the mesh gets a spurious handle, although every transverse tetrahedron is smaller than the precision.
-// Test of an edge (a, b) with ends of one sign (made negative by flipping f if needed): the tangent
-// lines of f along the edge at a and at b (slopes from the stored gradients) both rise towards the
-// other end, the first reaches 0 at t_a, the second (going back from b) at t_b, and t_a < t_b: to first
-// order f is >= 0 on [t_a, t_b], i.e. the edge is crossed twice. Required too: grad f(a) . grad f(b) < 0,
-// the two crossings belong to sheets facing each other (one smooth sheet crossed twice by a short chord,
-// near-tangent, has nearly parallel gradients: that is a geometric error, not a topological one, and
-// refining it would refine the whole surface). The point inserted is where the two tangent lines meet
-// (the predicted extremum of f), with the usual proximity rule. If f there has the other sign, the edge
-// is replaced by two crossed edges and ordinary refinement follows the new sheets; if not, the two
-// halves are checked again with the new gradient. Termination: these points too are >= dmin from every
-// vertex (docs/polygonize.md).
-
-bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
-  double fa = values_[a], fb = values_[b];
-  if (is_negative(fa) != is_negative(fb)) return false;
-  const Point3& ga = grad_[a];
-  const Point3& gb = grad_[b];
-  // Facing sheets: the normals at the ends differ by more than 90 degrees (false when a gradient is
-  // unknown, NaN).
-  if (!(dot(ga, gb) < kThinCosine * std::sqrt(dot(ga, ga) * dot(gb, gb)))) return false;
-  const Point3 e = tri_.point(b) - tri_.point(a);
-  if (dot(e, e) < min_length * min_length) return false;
-  double da = dot(ga, e), db = -dot(gb, e);  // slopes of f per unit t, at a towards b, at b towards a
-  if (!is_negative(fa)) {
-    fa = -fa;
-    fb = -fb;
-    da = -da;
-    db = -db;
-  }
-  if (!(da > 0.0 && db > 0.0)) return false;
-  const double ta = -fa / da, tb = 1.0 + fb / db;
-  if (!(ta < tb)) return false;
-  s = std::clamp((fb - fa + db) / (da + db), std::max(ta, 0.0), std::min(tb, 1.0));
-  return s > 0.0 && s < 1.0;
-}
-
-void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) {
-  const std::size_t first = thin_.size();
-  for (const TetId t : tets) {
-    if (!tri_.is_live(t)) continue;
-    const auto v = tri_.tet_vertices(t);
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        double s;
-        if (crossed_twice(v[i], v[j], min_length, s)) thin_.push_back({v[i], v[j], t, s});
-      }
-  }
-  // An edge is in several of these tetrahedra: keep one entry per edge.
-  const auto key = [](const ThinEdge& e) { return std::make_pair(std::min(e.a, e.b), std::max(e.a, e.b)); };
-  std::sort(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
-            [&](const ThinEdge& x, const ThinEdge& y) { return key(x) < key(y); });
-  thin_.erase(std::unique(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
-                          [&](const ThinEdge& x, const ThinEdge& y) { return key(x) == key(y); }),
-              thin_.end());
-}
-
-// Between refine() calls: remember what the next one must test (bounded: past the live tetrahedra
-// count, test everything instead).
-void Polygonizer::note_thin_vertex(VertexId v) {
-  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
-  thin_vertices_.push_back(v);
-  if (thin_vertices_.size() > tri_.num_vertices()) thin_all_ = true;
-}
-
-void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
-  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
-  thin_tets_.insert(thin_tets_.end(), tets.begin(), tets.end());
-  if (thin_tets_.size() > tri_.num_tetrahedra()) thin_all_ = true;
-}
-
-std::vector<TetId> Polygonizer::thin_recheck_set() {
-  std::vector<TetId> tets;
-  tet_marks_.begin(tri_.tet_capacity());
-  vertex_marks_.begin(tri_.vertex_capacity());
-  const auto add = [&](TetId t) {
-    if (tet_marks_.first_visit(t)) tets.push_back(t);
-  };
-  for (const TetId t : thin_tets_)
-    if (t < tri_.tet_capacity()) add(t);
-  for (const VertexId v : thin_vertices_) {
-    if (!tri_.is_vertex(v) || !vertex_marks_.first_visit(v)) continue;
-    for (const TetId t : tri_.incident_tetrahedra(v)) add(t);
-  }
-  std::sort(tets.begin(), tets.end());  // the order of the full check (ascending ids)
-  return tets;
-}
-
-bool Polygonizer::insert_thin_point(double min_distance, std::vector<TetId>& created) {
-  const ThinEdge e = thin_.back();
-  thin_.pop_back();
-  if (!tri_.is_vertex(e.a) || !tri_.is_vertex(e.b)) return false;
-  // A tetrahedron that still has the edge (the one that flagged it may have died; if the edge survived,
-  // a tetrahedron around a or b has it).
-  TetId t = kNoTet;
-  if (tri_.is_live(e.t) && tri_.vertex_index(e.t, e.a) >= 0 && tri_.vertex_index(e.t, e.b) >= 0) {
-    t = e.t;
-  } else {
-    for (const TetId u : tri_.incident_tetrahedra(e.a))
-      if (tri_.vertex_index(u, e.b) >= 0) {
-        t = u;
-        break;
-      }
-  }
-  if (t == kNoTet) return false;  // the edge is gone
-  const Point3& pa = tri_.point(e.a);
-  const Point3 p = pa + e.s * (tri_.point(e.b) - pa);
-  if (!is_finite(p) || !strictly_inside(tri_.box(), p)) return false;
-  // p is on the edge, so strictly inside the circumball of every tetrahedron around it: in conflict.
-  if (!insert_point(p, t, min_distance, VertexKind::Refinement, created)) return false;
-  ++stats_.thin_insertions;
-  return true;
-}
-
-// ---- Dynamic editing ----------------------------------------------------------------------------------
-
-VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value, VertexKind kind) {
-  if (!is_finite(p)) throw InvalidPoint(0, "coordinates are not finite");
-  if (!strictly_inside(tri_.box(), p))
-    throw InvalidPoint(0, "point " + describe(p) + " is not strictly inside the domain box");
-  if (value && !std::isfinite(*value)) throw InvalidPoint(0, "value is not finite");
-  changes_.clear();
-  InsertResult r = tri_.insert(p, 0.0, &changes_);
-  if (r.status != InsertStatus::Inserted) {
-    const auto k = static_cast<VertexKind>(kind_[r.nearest]);
-    if (k != VertexKind::Sampling && k != VertexKind::Refinement) return kNoVertex;
-    remove_vertex(r.nearest);
-    changes_.clear();
-    r = tri_.insert(p, 0.0, &changes_);
-    if (r.status != InsertStatus::Inserted) return kNoVertex;
-  }
-  grow_vertex_arrays();
-  grow_tet_arrays();
-  const VertexId v = r.vertex;
-  kind_[v] = static_cast<std::uint8_t>(kind);
-  tcount_[v] = 0;
-  if (kind == VertexKind::Refinement) idle_.push_back(v);
-  if (value) {
-    set_value(v, *value);
-    fixed_[v] = 1;
-  } else {
-    fixed_[v] = 0;
-    pending_.push_back(v);
-    evaluate_pending();
-  }
-  on_killed(changes_);
-  std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
-  classify_created(created);
-  return v;
-}
-
-void Polygonizer::remove_vertex(VertexId v) {
-  if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("remove_vertex: not a removable vertex");
-  set_lonely(v, false);
-  changes_.clear();
-  tri_.remove(v, &changes_);
-  on_killed(changes_);
-  std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
-  classify_created(created);
-}
-
-bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double> value) {
-  if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("move_vertex: not a movable vertex");
-  if (!is_finite(p)) throw InvalidPoint(0, "coordinates are not finite");
-  if (!strictly_inside(tri_.box(), p))
-    throw InvalidPoint(0, "point " + describe(p) + " is not strictly inside the domain box");
-  changes_.clear();
-  InsertResult r = tri_.move(v, p, 0.0, &changes_);
-  if (r.status != InsertStatus::Inserted) {
-    absorb_renumbering();  // nothing moved, but the tetrahedra may have been renumbered first
-    const auto k = static_cast<VertexKind>(kind_[r.nearest]);
-    if (r.nearest == v) return true;  // moved onto itself
-    if (k != VertexKind::Sampling && k != VertexKind::Refinement) return false;
-    remove_vertex(r.nearest);
-    changes_.clear();
-    r = tri_.move(v, p, 0.0, &changes_);
-    if (r.status != InsertStatus::Inserted) {
-      absorb_renumbering();
-      return false;
-    }
-  }
-  grow_tet_arrays();
-  surface_->note_moved(v);
-  note_thin_vertex(v);  // its star changed shape
-  if (value) {
-    set_value(v, *value);
-    fixed_[v] = 1;
-  } else if (!fixed_[v]) {
-    pending_.push_back(v);
-    evaluate_pending();
-  }
-  on_killed(changes_);
-  std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
-  classify_created(created);
-  // Tetrahedra around v that the move kept alive changed shape: re-measure and re-queue them.
-  // The star of a lone zero v is re-queued too (settle_zeros only sees the created tetrahedra).
-  for (const TetId t : tri_.incident_tetrahedra(v)) {
-    classify(t, true);
-    if (lpos_[v] != kNotListed) push_if_big(t);
-  }
-  if (values_[v] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(v);
-  settle_zeros({});
-  return true;
-}
-
-void Polygonizer::set_vertex_value(VertexId v, double value) {
-  if (!tri_.is_vertex(v)) throw InvalidArgument("set_vertex_value: not a vertex");
-  if (!std::isfinite(value)) throw InvalidArgument("set_vertex_value: value is not finite");
-  set_value(v, value);
-  fixed_[v] = 1;
-  for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, false);
-  settle_zeros({});
 }
 
 PolygonizerStats Polygonizer::stats() const {

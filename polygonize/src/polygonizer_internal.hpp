@@ -1,9 +1,12 @@
 #pragma once
-// Definitions shared by the Polygonizer's source files (polygonizer.cpp, function_changes.cpp).
+// Definitions shared by the Polygonizer's source files (polygonizer.cpp, function_changes.cpp,
+// thin_features.cpp, vertex_edits.cpp, extract.cpp).
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
 #include <chrono>
+#include <sstream>
+#include <string>
 #include <cstdint>
 #include <limits>
 
@@ -22,6 +25,14 @@ inline bool is_negative(double v) { return v < 0.0; }
 /// The Delaunay tree accepts points strictly inside its box only (the corners alone are on the hull).
 inline bool strictly_inside(const Box3& b, const Point3& p) {
   return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
+}
+
+/// A point in error messages, with every digit.
+inline std::string describe(const Point3& p) {
+  std::ostringstream s;
+  s.precision(17);
+  s << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+  return s.str();
 }
 
 }  // namespace vitri::polygonizer_detail

@@ -1,0 +1,138 @@
+// Thin features: the Polygonizer's test and refinement of Delaunay edges crossed twice by the surface
+// (docs/polygonize.md, "Thin features"). Split from polygonizer.cpp.
+#include "vitri/polygonize/polygonizer.hpp"
+
+#include "polygonizer_internal.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+#include <vector>
+
+namespace vitri {
+
+using namespace polygonizer_detail;
+
+namespace {
+constexpr double kThinCosine = 0.0;  // the gradients at the two ends must point at each other (below)
+}  // namespace
+
+// ---- Thin features -------------------------------------------------------------------------------------
+// Marching tetrahedra sees only the signs at the vertices. Where two sheets of the surface are closer
+// than the Delaunay edges (two fingers, a thin wall), an edge can join two vertices of one sign across a
+// thin layer of the other sign: the tetrahedra around it bridge the gap (or punch through the wall) and
+// the mesh gets a spurious handle, although every transverse tetrahedron is smaller than the precision.
+// Test of an edge (a, b) with ends of one sign (made negative by flipping f if needed): the tangent
+// lines of f along the edge at a and at b (slopes from the stored gradients) both rise towards the
+// other end, the first reaches 0 at t_a, the second (going back from b) at t_b, and t_a < t_b: to first
+// order f is >= 0 on [t_a, t_b], i.e. the edge is crossed twice. Required too: grad f(a) . grad f(b) < 0,
+// the two crossings belong to sheets facing each other (one smooth sheet crossed twice by a short chord,
+// near-tangent, has nearly parallel gradients: that is a geometric error, not a topological one, and
+// refining it would refine the whole surface). The point inserted is where the two tangent lines meet
+// (the predicted extremum of f), with the usual proximity rule. If f there has the other sign, the edge
+// is replaced by two crossed edges and ordinary refinement follows the new sheets; if not, the two
+// halves are checked again with the new gradient. Termination: these points too are >= dmin from every
+// vertex (docs/polygonize.md).
+
+bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
+  double fa = values_[a], fb = values_[b];
+  if (is_negative(fa) != is_negative(fb)) return false;
+  const Point3& ga = grad_[a];
+  const Point3& gb = grad_[b];
+  // Facing sheets: the normals at the ends differ by more than 90 degrees (false when a gradient is
+  // unknown, NaN).
+  if (!(dot(ga, gb) < kThinCosine * std::sqrt(dot(ga, ga) * dot(gb, gb)))) return false;
+  const Point3 e = tri_.point(b) - tri_.point(a);
+  if (dot(e, e) < min_length * min_length) return false;
+  double da = dot(ga, e), db = -dot(gb, e);  // slopes of f per unit t, at a towards b, at b towards a
+  if (!is_negative(fa)) {
+    fa = -fa;
+    fb = -fb;
+    da = -da;
+    db = -db;
+  }
+  if (!(da > 0.0 && db > 0.0)) return false;
+  const double ta = -fa / da, tb = 1.0 + fb / db;
+  if (!(ta < tb)) return false;
+  s = std::clamp((fb - fa + db) / (da + db), std::max(ta, 0.0), std::min(tb, 1.0));
+  return s > 0.0 && s < 1.0;
+}
+
+void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) {
+  const std::size_t first = thin_.size();
+  for (const TetId t : tets) {
+    if (!tri_.is_live(t)) continue;
+    const auto v = tri_.tet_vertices(t);
+    for (int i = 0; i < 4; ++i)
+      for (int j = i + 1; j < 4; ++j) {
+        double s;
+        if (crossed_twice(v[i], v[j], min_length, s)) thin_.push_back({v[i], v[j], t, s});
+      }
+  }
+  // An edge is in several of these tetrahedra: keep one entry per edge.
+  const auto key = [](const ThinEdge& e) { return std::make_pair(std::min(e.a, e.b), std::max(e.a, e.b)); };
+  std::sort(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
+            [&](const ThinEdge& x, const ThinEdge& y) { return key(x) < key(y); });
+  thin_.erase(std::unique(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
+                          [&](const ThinEdge& x, const ThinEdge& y) { return key(x) == key(y); }),
+              thin_.end());
+}
+
+// Between refine() calls: remember what the next one must test (bounded: past the live tetrahedra
+// count, test everything instead).
+void Polygonizer::note_thin_vertex(VertexId v) {
+  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
+  thin_vertices_.push_back(v);
+  if (thin_vertices_.size() > tri_.num_vertices()) thin_all_ = true;
+}
+
+void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
+  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
+  thin_tets_.insert(thin_tets_.end(), tets.begin(), tets.end());
+  if (thin_tets_.size() > tri_.num_tetrahedra()) thin_all_ = true;
+}
+
+std::vector<TetId> Polygonizer::thin_recheck_set() {
+  std::vector<TetId> tets;
+  tet_marks_.begin(tri_.tet_capacity());
+  vertex_marks_.begin(tri_.vertex_capacity());
+  const auto add = [&](TetId t) {
+    if (tet_marks_.first_visit(t)) tets.push_back(t);
+  };
+  for (const TetId t : thin_tets_)
+    if (t < tri_.tet_capacity()) add(t);
+  for (const VertexId v : thin_vertices_) {
+    if (!tri_.is_vertex(v) || !vertex_marks_.first_visit(v)) continue;
+    for (const TetId t : tri_.incident_tetrahedra(v)) add(t);
+  }
+  std::sort(tets.begin(), tets.end());  // the order of the full check (ascending ids)
+  return tets;
+}
+
+bool Polygonizer::insert_thin_point(double min_distance, std::vector<TetId>& created) {
+  const ThinEdge e = thin_.back();
+  thin_.pop_back();
+  if (!tri_.is_vertex(e.a) || !tri_.is_vertex(e.b)) return false;
+  // A tetrahedron that still has the edge (the one that flagged it may have died; if the edge survived,
+  // a tetrahedron around a or b has it).
+  TetId t = kNoTet;
+  if (tri_.is_live(e.t) && tri_.vertex_index(e.t, e.a) >= 0 && tri_.vertex_index(e.t, e.b) >= 0) {
+    t = e.t;
+  } else {
+    for (const TetId u : tri_.incident_tetrahedra(e.a))
+      if (tri_.vertex_index(u, e.b) >= 0) {
+        t = u;
+        break;
+      }
+  }
+  if (t == kNoTet) return false;  // the edge is gone
+  const Point3& pa = tri_.point(e.a);
+  const Point3 p = pa + e.s * (tri_.point(e.b) - pa);
+  if (!is_finite(p) || !strictly_inside(tri_.box(), p)) return false;
+  // p is on the edge, so strictly inside the circumball of every tetrahedron around it: in conflict.
+  if (!insert_point(p, t, min_distance, VertexKind::Refinement, created)) return false;
+  ++stats_.thin_insertions;
+  return true;
+}
+
+}  // namespace vitri

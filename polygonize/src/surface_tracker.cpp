@@ -23,6 +23,18 @@ namespace vitri {
 
 namespace {
 
+// A slot of `records`: a free one, else a new one at the end.
+template <class Record>
+std::uint32_t take_slot(std::vector<Record>& records, std::vector<std::uint32_t>& free) {
+  if (free.empty()) {
+    records.emplace_back();
+    return static_cast<std::uint32_t>(records.size() - 1);
+  }
+  const std::uint32_t slot = free.back();
+  free.pop_back();
+  return slot;
+}
+
 inline std::uint64_t edge_key(VertexId a, VertexId b) {
   return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
 }
@@ -193,14 +205,7 @@ void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
     if (old != kNone) w.old_polygons.push_back(old);
     polygon_of_[t] = kNone;
     if (cell.corners == 0) continue;
-    std::uint32_t p;
-    if (!free_polygons_.empty()) {
-      p = free_polygons_.back();
-      free_polygons_.pop_back();
-    } else {
-      p = static_cast<std::uint32_t>(polygons_.size());
-      polygons_.emplace_back();
-    }
+    const std::uint32_t p = take_slot(polygons_, free_polygons_);
     Polygon poly;
     poly.corners = static_cast<std::uint8_t>(cell.corners);
     poly.tet = t;
@@ -225,14 +230,7 @@ bool SurfaceTracker::mark_if_touched(std::uint32_t e, Work& w) {
 std::uint32_t SurfaceTracker::edge_slot(VertexId neg, VertexId pos, Work& w) {
   std::uint32_t* const slot = edge_index_.try_emplace(edge_key(neg, pos), kNone).first;
   if (*slot == kNone) {
-    std::uint32_t e;
-    if (!free_edges_.empty()) {
-      e = free_edges_.back();
-      free_edges_.pop_back();
-    } else {
-      e = static_cast<std::uint32_t>(edges_.size());
-      edges_.emplace_back();
-    }
+    const std::uint32_t e = take_slot(edges_, free_edges_);
     edges_[e] = Edge{};
     edges_[e].pos = pos;
     edges_[e].neg = neg;

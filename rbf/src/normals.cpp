@@ -23,6 +23,8 @@
 
 #include "vitri/rbf/normals.hpp"
 
+#include "parallel.hpp"
+
 #include "vitri/rbf/point_index.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -99,24 +101,8 @@ void check_options(const NormalOptions& opt, std::size_t distinct) {
                           " needed (k = " + std::to_string(opt.k) + " neighbours)");
 }
 
-/// Runs body(begin, end) over [0, count) in contiguous chunks on the threads.
-void parallel_chunks(std::size_t count, unsigned threads,
-                     const std::function<void(std::size_t, std::size_t)>& body) {
-  unsigned t = threads ? threads : std::max(1u, std::thread::hardware_concurrency());
-  if (count < 2048) t = 1;
-  t = static_cast<unsigned>(std::min<std::size_t>(t, count));
-  if (t <= 1) {
-    body(0, count);
-    return;
-  }
-  std::vector<std::thread> pool;
-  const std::size_t chunk = (count + t - 1) / t;
-  for (unsigned c = 0; c < t; ++c) {
-    const std::size_t b = c * chunk, e = std::min(count, b + chunk);
-    if (b < e) pool.emplace_back(body, b, e);
-  }
-  for (auto& th : pool) th.join();
-}
+// Loops of at least this many points run on the threads (rbf_detail::parallel_chunks).
+constexpr std::size_t kGrain = 2048;
 
 /// The k nearest neighbours of every distinct point (itself excluded): row u of a k-column table.
 class NeighbourTable {
@@ -124,7 +110,7 @@ class NeighbourTable {
   NeighbourTable(const std::vector<Point3>& points, std::size_t k, unsigned threads)
       : k_(k), ids_(points.size() * k) {
     const PointIndex index(points);
-    parallel_chunks(points.size(), threads, [&](std::size_t b, std::size_t e) {
+    rbf_detail::parallel_chunks(points.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
       std::vector<Id> found;
       for (std::size_t u = b; u < e; ++u) {
         index.nearest(points[u], k + 1, found);
@@ -183,7 +169,7 @@ std::vector<Point3> pca_normals(const DistinctPoints& d, const NeighbourTable& t
   const std::size_t n = d.points.size();
   std::vector<Point3> normals(n);
   std::vector<double> planarity(n);  // middle over largest eigenvalue
-  parallel_chunks(n, opt.threads, [&](std::size_t b, std::size_t e) {
+  rbf_detail::parallel_chunks(n, opt.threads, kGrain, [&](std::size_t b, std::size_t e) {
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
     for (std::size_t u = b; u < e; ++u) {
       // Coordinates relative to the point itself: the covariance is translation invariant, and small

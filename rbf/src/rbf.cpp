@@ -34,6 +34,7 @@
 
 #include "dense.hpp"
 #include "memory.hpp"
+#include "parallel.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
 
@@ -380,7 +381,7 @@ struct Rbf::Impl {
   void sums(const double* q, std::size_t m, double* f, double* g) const {
     const auto& ops = rbf_detail::dense_ops();
     const long nn = static_cast<long>(cx.size());
-    unsigned t = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+    unsigned t = rbf_detail::thread_count(opt.threads);
     const double work = static_cast<double>(m) * static_cast<double>(nn);
     if (work < 4e5) t = 1;
     t = static_cast<unsigned>(std::min<std::size_t>(t, m));

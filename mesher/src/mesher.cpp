@@ -258,8 +258,9 @@ std::size_t Mesher::add_constraint(const Point3& p, double value) {
   else region = local_->add_constraint(p, value);
   const double t_rbf = now_seconds() - t0;
   if (rebuild_if_outside(p, t0, t_rbf)) return size() - 1;
-  vertex_of_.push_back(poly_->insert_vertex(p, value, VertexKind::Seed));
-  track_zero(vertex_of_.back(), p, value);
+  const VertexId v = poly_->insert_vertex(p, value, VertexKind::Seed);
+  vertex_of_.push_back(v);
+  track_zero(v, p, value);
   after_edit(t_rbf, t0, local_ ? &region : nullptr);
   return size() - 1;
 }

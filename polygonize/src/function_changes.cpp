@@ -23,19 +23,6 @@ namespace vitri {
 
 using namespace polygonizer_detail;
 
-namespace {
-
-// Squared distance from p to the box [lo, hi].
-double squared_distance_to_box(const Point3& p, const Point3& lo, const Point3& hi) {
-  double d2 = 0.0;
-  for (std::size_t k = 0; k < 3; ++k) {
-    const double d = std::max({lo[k] - p[k], 0.0, p[k] - hi[k]});
-    d2 += d * d;
-  }
-  return d2;
-}
-
-}  // namespace
 
 void Polygonizer::function_changed() { function_changed([](const Point3&) { return true; }); }
 
@@ -66,7 +53,7 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
   const Box3& box = tri_.box();
   for (const Ball& b : balls) {
     const double r = b.radius + pad;
-    if (squared_distance_to_box(b.center, box.lo, box.hi) <= r * r) grown.push_back({b.center, r});
+    if (box.squared_distance(b.center) <= r * r) grown.push_back({b.center, r});
   }
   std::vector<VertexId> out;
   if (grown.empty()) return out;
@@ -92,12 +79,10 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
     reach.extend(b.center + Point3{b.radius, b.radius, b.radius});
   }
   std::size_t last = 0;
-  const auto meets = [&](const Point3& lo, const Point3& hi) {
+  const auto meets = [&](const Box3& b) {
     for (std::size_t k = 0; k < 3; ++k)
-      if (hi[k] < reach.lo[k] || lo[k] > reach.hi[k]) return false;
-    const auto hit = [&](std::size_t i) {
-      return squared_distance_to_box(grown[i].center, lo, hi) <= grown[i].radius * grown[i].radius;
-    };
+      if (b.hi[k] < reach.lo[k] || b.lo[k] > reach.hi[k]) return false;
+    const auto hit = [&](std::size_t i) { return b.squared_distance(grown[i].center) <= grown[i].radius * grown[i].radius; };
     if (hit(last)) return true;
     for (std::size_t i = 0; i < grown.size(); ++i)
       if (i != last && hit(i)) {
@@ -112,9 +97,9 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
     Box3 tb;
     const auto v = tri_.tet_vertices(t);
     for (const VertexId u : v) tb.extend(tri_.point(u));
-    if (!meets(tb.lo, tb.hi)) continue;
+    if (!meets(tb)) continue;
     for (const VertexId u : v)
-      if (vertex_marks_.first_visit(u) && meets(tri_.point(u), tri_.point(u))) out.push_back(u);
+      if (vertex_marks_.first_visit(u) && meets(Box3{tri_.point(u), tri_.point(u)})) out.push_back(u);
     for (int i = 0; i < 4; ++i) {
       const TetId n = tri_.tet_neighbor(t, i);
       if (n != kNoTet && first_visit(n)) stack.push_back(n);

@@ -1,6 +1,8 @@
 // vitri::PointIndex: a bucket kd-tree with stable ids (see point_index.hpp).
 #include "vitri/rbf/point_index.hpp"
 
+#include "vitri/core/box.hpp"
+
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
@@ -16,18 +18,6 @@ namespace {
 
 /// Leaves hold at most this many ids after a build; an insertion splits a leaf past twice as many.
 constexpr std::size_t kBucket = 16;
-
-/// Squared distance from q to the box [lo, hi] (0 inside).
-double box_distance2(const Point3& q, const Point3& lo, const Point3& hi) {
-  double d2 = 0;
-  for (int a = 0; a < 3; ++a) {
-    const double below = lo[a] - q[a];
-    const double above = q[a] - hi[a];
-    if (below > 0) d2 += below * below;
-    else if (above > 0) d2 += above * above;
-  }
-  return d2;
-}
 
 void grow(Point3& lo, Point3& hi, const Point3& p) {
   for (int a = 0; a < 3; ++a) {
@@ -180,7 +170,7 @@ void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out
   while (!stack.empty()) {
     const Node& n = nodes_[stack.back()];
     stack.pop_back();
-    if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
+    if (!(Box3{n.lo, n.hi}.squared_distance(center) < radius2)) continue;
     if (n.leaf()) {
       for (std::size_t k = 0; k < n.bucket.size(); ++k)
         if (squared_distance(n.bucket_points[k], center) < radius2) out.push_back(n.bucket[k]);
@@ -201,7 +191,7 @@ std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::si
   while (!stack.empty()) {
     const Node& n = nodes_[stack.back()];
     stack.pop_back();
-    if (!(box_distance2(center, n.lo, n.hi) < radius2)) continue;
+    if (!(Box3{n.lo, n.hi}.squared_distance(center) < radius2)) continue;
     if (n.leaf()) {
       for (const Point3& p : n.bucket_points) count += squared_distance(p, center) < radius2;
       if (count > limit) return limit + 1;
@@ -223,8 +213,8 @@ void PointIndex::nearest_recurse(std::uint32_t index, NearestState& state) const
     return;
   }
   const std::uint32_t a = n.children[0], b = n.children[1];
-  const double da = box_distance2(state.query, nodes_[a].lo, nodes_[a].hi);
-  const double db = box_distance2(state.query, nodes_[b].lo, nodes_[b].hi);
+  const double da = Box3{nodes_[a].lo, nodes_[a].hi}.squared_distance(state.query);
+  const double db = Box3{nodes_[b].lo, nodes_[b].hi}.squared_distance(state.query);
   const std::uint32_t first = da <= db ? a : b, second = da <= db ? b : a;
   const double dfirst = std::min(da, db), dsecond = std::max(da, db);
   // <= keeps points at the bound's distance reachable: ties are broken by id.

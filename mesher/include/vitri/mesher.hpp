@@ -239,7 +239,6 @@ class Mesher {
       live_ = slots_.size();
     }
     VertexId& operator[](std::size_t i) { return slots_[ranks_.select(i)]; }
-    VertexId back() const { return slots_.back(); }  // of the last push_back
     void push_back(VertexId v) {
       slots_.push_back(v);
       ranks_.push_back_alive();

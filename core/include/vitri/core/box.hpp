@@ -37,6 +37,17 @@ struct Box3 {
   /// Length of the main diagonal; 0 for a single point.
   double diagonal() const { return empty() ? 0.0 : norm(hi - lo); }
 
+  /// Squared distance from p to the box (0 inside).
+  double squared_distance(const Point3& p) const {
+    double d2 = 0.0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const double below = lo[k] - p[k], above = p[k] - hi[k];
+      if (below > 0) d2 += below * below;
+      else if (above > 0) d2 += above * above;
+    }
+    return d2;
+  }
+
   /// Closed containment test.
   bool contains(const Point3& p) const {
     return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;

@@ -2,9 +2,10 @@
 //
 // Snapping, as one pass in increasing vertex id would do it: the crossings anchored at z (the set S_z)
 // collapse onto z when the triangles around S_z that keep exactly one S_z corner have links forming a
-// single cycle of length >= 3 (a disk around the new vertex, one fan per neighbour) and each keeps a
-// positive area and its orientation; triangles with two S_z corners vanish. The test sees the collapses
-// of lower ids already applied (their corners at their vertex, their vanished triangles gone) and the
+// single cycle of length >= 3 (a disk around the new vertex, one fan per neighbour) and each is not flat
+// afterwards and keeps its orientation (a flat one has none to keep); triangles with two S_z corners
+// vanish. A crossing whose anchor does not collapse is kept off it (place_edges). The test sees the
+// collapses of lower ids already applied (their corners at their vertex, their vanished triangles gone) and the
 // higher ones not yet. An update re-decides the vertices of the tetrahedra it rebuilt in increasing id;
 // when a decision flips, the higher anchored vertices of the flipped vertex's star are re-decided too
 // (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
@@ -42,6 +43,15 @@ inline std::uint64_t edge_key(VertexId a, VertexId b) {
 Point3 unit_or_zero(const Point3& g) {
   const double l = norm(g);
   return (l > 0.0 && std::isfinite(l)) ? g / l : Point3{0.0, 0.0, 0.0};
+}
+
+// A triangle (a, b, c) with normal n = (b - a) x (c - a) is flat when |n| (twice its area) is at most
+// kFlatRatio times its longest squared edge: its largest angle is within about 2 kFlatRatio of 180
+// degrees, or its corners coincide. Flat triangles have no reliable orientation in doubles.
+constexpr double kFlatRatio = 1e-8;
+bool is_flat(const Point3& n, const Point3& a, const Point3& b, const Point3& c) {
+  const double l2 = std::max({squared_norm(b - a), squared_norm(c - b), squared_norm(a - c)});
+  return !(squared_norm(n) > kFlatRatio * kFlatRatio * l2 * l2);
 }
 
 void sort_unique(std::vector<std::uint32_t>& v) {
@@ -260,7 +270,7 @@ void SurfaceTracker::set_anchor(std::uint32_t e, VertexId anchor) {
 
 // Places a vertex on every edge marked in this update (warm start from its previous root when neither
 // end moved), and anchors it: at the positive end when f is exactly 0 there, at an end the root lies
-// within snap_fraction of (the root is kept at least that far from the ends).
+// within snap_fraction of (the vertex is then kept at least that far from the ends; t keeps the root).
 void SurfaceTracker::place_edges(const TrackerInput& in, Work& w) {
   std::vector<marching::Crossing> crossings(w.placed.size());
   for (std::size_t i = 0; i < w.placed.size(); ++i) {
@@ -281,6 +291,7 @@ void SurfaceTracker::place_edges(const TrackerInput& in, Work& w) {
   report_.root_evaluations += evaluations;
   report_.placed_edges = w.placed.size();
   const double lo = in.snap_fraction, hi = 1.0 - in.snap_fraction;
+  std::vector<std::uint32_t> pushed;
   for (std::size_t i = 0; i < w.placed.size(); ++i) {
     Edge& e = edges_[w.placed[i]];
     e.x = placed[i].x;
@@ -292,6 +303,37 @@ void SurfaceTracker::place_edges(const TrackerInput& in, Work& w) {
     if (in.values[e.pos] == 0.0 || e.t <= lo) anchor = e.pos;
     else if (e.t >= hi) anchor = e.neg;
     set_anchor(w.placed[i], anchor);
+    // An anchored crossing is used where it lies only when its anchor does not collapse (a fold test
+    // refused it). Its vertex is then kept about snap_fraction of the edge away from the anchor, so that
+    // the triangles around an uncollapsed anchor are not 1e-6 of an edge wide (below 1e-14 x diagonal^2).
+    const double clamped = std::clamp(e.t, lo, hi);
+    if (anchor != kNoVertex && clamped != e.t) {
+      const Point3& a = in.tri.point(e.pos);
+      e.x = a + clamped * (in.tri.point(e.neg) - a);
+      pushed.push_back(w.placed[i]);
+    }
+  }
+  project_pushed(in, pushed);
+}
+
+// The pushed vertices go back onto the surface by one Newton step along the gradient (at most twice
+// snap_fraction of the edge long; else they stay on the edge), in one batch call; that gradient is their
+// normal.
+void SurfaceTracker::project_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed) {
+  std::vector<Point3> at(pushed.size()), g(pushed.size());
+  std::vector<double> value(pushed.size());
+  for (std::size_t k = 0; k < pushed.size(); ++k) at[k] = edges_[pushed[k]].x;
+  in.f.values_gradients(at.data(), at.size(), value.data(), g.data());
+  report_.evaluations += pushed.size();
+  report_.gradient_evaluations += pushed.size();
+  for (std::size_t k = 0; k < pushed.size(); ++k) {
+    Edge& e = edges_[pushed[k]];
+    const double g2 = dot(g[k], g[k]);
+    const Point3 step = (g2 > 0.0 ? value[k] / g2 : 0.0) * g[k];
+    const double reach = 2.0 * in.snap_fraction * norm(in.tri.point(e.neg) - in.tri.point(e.pos));
+    if (is_finite(step) && squared_norm(step) <= reach * reach) e.x = e.x - step;
+    e.gradient = g[k];
+    e.has_gradient = is_finite(g[k]);
   }
 }
 
@@ -391,9 +433,19 @@ bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
       if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) continue;  // gone with a lower collapse
       if (inside >= 2) continue;                                         // vanishes with this one
       const int i1 = (first + 1) % 3, i2 = (first + 2) % 3;
-      const Point3 old_n = cross(p[i1] - p[first], p[i2] - p[first]);
-      const Point3 new_n = cross(p[i1] - zp, p[i2] - zp);
-      if (!(dot(old_n, new_n) > 0.0) || !(squared_norm(new_n) > 0.0)) return false;
+      // The collapse must not make a flat triangle, nor turn one over; a triangle that is flat already has
+      // no orientation to keep. Exempt: a triangle whose two other corners are anchored at one later
+      // vertex y, which vanishes when y collapses too. That is the polygon of a flat tetrahedron (two
+      // samples with equal normals and their offset constraints make a rectangle, which the symbolic
+      // perturbation may close with a flat tetrahedron): its corners are anchored at the two samples.
+      const VertexId y = edges_[c[i1]].anchor;
+      const bool vanishes_later = y != kNoVertex && y > z && edges_[c[i2]].anchor == y;
+      if (!vanishes_later) {
+        const Point3 old_n = cross(p[i1] - p[first], p[i2] - p[first]);
+        const Point3 new_n = cross(p[i1] - zp, p[i2] - zp);
+        if (is_flat(new_n, zp, p[i1], p[i2])) return false;
+        if (!is_flat(old_n, p[first], p[i1], p[i2]) && !(dot(old_n, new_n) > 0.0)) return false;
+      }
       link.emplace_back(id[i1], id[i2]);
     }
   }

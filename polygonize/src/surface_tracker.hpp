@@ -119,6 +119,7 @@ class SurfaceTracker {
   bool mark_if_touched(std::uint32_t e, Work& w);
   void release_edge(std::uint32_t e);
   void place_edges(const TrackerInput& in, Work& w);
+  void project_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed);
   void set_anchor(std::uint32_t e, VertexId anchor);
   void split_polygons(Work& w);
   void decide_snapping(const TrackerInput& in, Work& w);

@@ -281,3 +281,81 @@ TEST_CASE("zero-valued and near-zero vertices: snapped, no tiny triangle", "[inc
     for (const Point3& p : m.vertices) REQUIRE(std::abs(norm(p) - 5.0) <= 1e-3 * precision);
   }
 }
+
+namespace {
+
+/// A rotated cube of half side 1 (the L-infinity ball in the frame of R, a rotation about a tilted axis):
+/// f(x) = max_k |(R^T x)_k| - 1, gradient the outward normal of the nearest face. Tilted, so that the
+/// rectangles below are cospherical only up to rounding, as on real data.
+class TiltedCube final : public ImplicitFunction {
+ public:
+  TiltedCube() {
+    const double c = std::cos(0.5), s = std::sin(0.5);  // about the unit axis (1, 2, 2) / 3
+    const double a[3] = {1.0 / 3.0, 2.0 / 3.0, 2.0 / 3.0};
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        double r = (i == j ? c : 0.0) + (1.0 - c) * a[i] * a[j];
+        const int k = 3 - i - j;
+        if (i != j) r += ((j - i + 3) % 3 == 1 ? -1.0 : 1.0) * s * a[k];
+        R[i][j] = r;
+      }
+  }
+  /// Column k of R: the outward normal of the faces +-k (times the sign).
+  Point3 axis(int k) const { return {R[0][k], R[1][k], R[2][k]}; }
+  double value(const Point3& p) const override {
+    Point3 g;
+    return value_gradient(p, g);
+  }
+  double value_gradient(const Point3& p, Point3& g) const override {
+    int best = 0;
+    double m = -1.0, sign = 1.0;
+    for (int k = 0; k < 3; ++k) {
+      const double q = dot(axis(k), p);
+      if (std::abs(q) > m) {
+        m = std::abs(q);
+        best = k;
+        sign = q >= 0.0 ? 1.0 : -1.0;
+      }
+    }
+    g = sign * axis(best);
+    return m - 1.0;
+  }
+  double R[3][3];
+};
+
+}  // namespace
+
+TEST_CASE("flat tetrahedra of samples with equal normals: no flat triangle", "[incremental]") {
+  // Samples of a face share its normal: two of them and their off-surface points (p +- d n) form a
+  // rectangle, four cospherical points that the symbolic perturbation may close with a flat
+  // tetrahedron. Its polygon's corners are anchored at the two samples (f = 0) and collinear: they must
+  // collapse, although the flat triangles have no orientation to keep.
+  const TiltedCube f;
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> u(-0.95, 0.95);
+  std::vector<Point3> seeds;
+  for (const double d : {0.05, 0.02})
+    for (int face = 0; face < 6; ++face) {
+      const int k = face / 2;
+      const double side = face % 2 ? -1.0 : 1.0;
+      const Point3 n = side * f.axis(k);
+      for (int i = 0; i < 150; ++i) {
+        double q[3] = {u(rng), u(rng), u(rng)};
+        q[k] = side;  // on the face, up to the rounding of the rotation
+        const Point3 p = q[0] * f.axis(0) + q[1] * f.axis(1) + q[2] * f.axis(2);
+        seeds.push_back(p);
+        seeds.push_back(p + d * n);
+        seeds.push_back(p - d * n);
+      }
+    }
+  for (const double precision : {0.15, 0.08}) {
+    INFO("precision " << precision);
+    Polygonizer poly(f, kCube, seeds);
+    REQUIRE(poly.refine(precision));
+    const SurfaceMesh m = poly.extract();
+    test::require_closed(m, 2, 1);
+    // Not only the collapsed vertices: every vertex is on the cube (roots, collapses and the vertices
+    // kept off an uncollapsed anchor, projected back).
+    for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3 * precision);
+  }
+}

@@ -52,6 +52,7 @@ T parse_unsigned(const std::string& flag, const std::string& s) {
 int run_eval(const Args& args) {
   std::string input, query;
   ConstraintBuildOptions opt;
+  opt.offset_spacings = kOffsetSpacings;  // the constraints of vitri mesh
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> const std::string& {
@@ -60,8 +61,10 @@ int run_eval(const Args& args) {
     };
     if (a == "--at")
       query = value();
-    else if (a == "--offset")
+    else if (a == "--offset") {
       opt.offset = parse_number(a, value());
+      opt.offset_spacings = 0.0;
+    }
     else if (a == "--max-constraints")
       opt.max_constraints = parse_unsigned<std::size_t>(a, value());
     else if (a == "--seed")
@@ -108,7 +111,7 @@ const char* eval_usage() {
          "       normals (3-column .xyz, a .ply / .off without faces): normals estimated from the K nearest\n"
          "       neighbours and oriented consistently (docs/normals.md).\n"
          "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal "
-         "(0.01)\n"
+         "(default: 2 x the median spacing of the points, at most 0.01)\n"
          "  --max-constraints N  subsample points / vertices to at most N constraints (0: all; else at\n"
          "                       least the 3 constraints made per point)\n"
          "  --seed S             seed of the subsampling (1)\n"

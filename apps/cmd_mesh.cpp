@@ -79,7 +79,7 @@ const char* const kUsage =
     "  --max-size S         quality mode: surface Delaunay ball radius (about the circumradius of each\n"
     "                       triangle) at most S x the diagonal\n"
     "  --offset D           off-surface constraint distance for points/meshes, fraction of the\n"
-    "                       diagonal (default 0.01)\n"
+    "                       diagonal (default: 2 x the median spacing of the points, at most 0.01)\n"
     "  --sides S            off-surface constraints per point for points/meshes: both (default; +D\n"
     "                       outside and -D inside, 3 constraints per point), outside or inside (2 per\n"
     "                       point: fewer constraints, a faster fit). Ignored for .xyzv input.\n"
@@ -198,6 +198,7 @@ int run_mesh(const Args& args) {
   bool quiet = false;
   MesherOptions options;
   options.function = FunctionKind::Auto;
+  options.constraint_build.offset_spacings = kOffsetSpacings;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&](std::string& out) {
@@ -233,6 +234,7 @@ int run_mesh(const Args& args) {
       if (!value(v) || !parse_double(v, d) || !(d > 0.0) || !std::isfinite(d))
         return usage_error("--offset needs a positive number");
       options.constraint_build.offset = d;
+      options.constraint_build.offset_spacings = 0.0;
     } else if (a == "--sides") {
       if (!value(v)) return usage_error("--sides needs both, inside or outside");
       if (v == "both") options.constraint_build.sides = OffSurface::Both;
@@ -303,6 +305,9 @@ int run_mesh(const Args& args) {
     std::fprintf(stderr, "merged %zu near-duplicate points and dropped %zu off-surface constraints on another "
                  "constraint (closer than %g x the diagonal)\n", merged.merged_points, merged.merged_off_surface,
                  options.constraint_build.merge_tolerance);
+  if (!quiet && merged.offset > 0)
+    std::fprintf(stderr, "off-surface constraints at distance %.4g (%s)\n", merged.offset,
+                 options.constraint_build.offset_spacings > 0 ? "the data's spacing, see --offset" : "--offset");
   if (default_precision) {
     // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
     phases.start("precision", "median spacing");

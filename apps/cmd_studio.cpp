@@ -78,6 +78,7 @@ struct StudioArgs {
 /// Parses the arguments into `out`; returns an empty string or the usage error.
 std::string parse_args(const Args& args, StudioArgs& out) {
   out.session.mesher.function = FunctionKind::Auto;  // as vitri mesh
+  out.session.mesher.constraint_build.offset_spacings = kOffsetSpacings;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     const bool has_value = i + 1 < args.size();
@@ -104,6 +105,7 @@ std::string parse_args(const Args& args, StudioArgs& out) {
     } else if (a == "--offset") {
       if (!parse_number(v, d) || !(d > 0)) return "--offset needs a positive number";
       out.session.mesher.constraint_build.offset = d;
+      out.session.mesher.constraint_build.offset_spacings = 0.0;
     } else if (a == "--sides") {
       if (v == "both")
         out.session.mesher.constraint_build.sides = OffSurface::Both;

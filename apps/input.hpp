@@ -8,6 +8,11 @@
 
 namespace vitri::cli {
 
+/// The commands' default off-surface distance for points and meshes: 2 median spacings of the points,
+/// at most the library's 0.01 x diagonal (ConstraintBuildOptions::offset_spacings; --offset D gives
+/// D x diagonal instead). Measured in docs/benchmarks.md "Off-surface distance".
+constexpr double kOffsetSpacings = 2.0;
+
 /// The constraints of an input: as read (.xyzv), or built from oriented points, unoriented points (normals
 /// estimated and oriented, build.normals) or a closed mesh exactly as Mesher::from_oriented_points /
 /// from_points / from_mesh build them (surface points first, then the off-surface constraints; see

@@ -335,20 +335,7 @@ double median_spacing(const Constraints& constraints) {
   for (std::size_t i = 0; i < constraints.size(); ++i)
     if (constraints.values[i] == 0) surface.push_back(constraints.points[i]);
   if (surface.size() < 2) surface = constraints.points;
-  const PointIndex index(surface);
-  const std::size_t step = std::max<std::size_t>(1, surface.size() / 100000);
-  std::vector<double> spacing;
-  std::vector<PointIndex::Id> ids;
-  std::vector<double> d2;
-  for (std::size_t i = 0; i < surface.size(); i += step) {
-    index.nearest(surface[i], 8, ids, &d2);
-    const auto first = std::find_if(d2.begin(), d2.end(), [](double d) { return d > 0; });
-    if (first != d2.end()) spacing.push_back(std::sqrt(*first));
-  }
-  if (spacing.empty()) throw InvalidArgument("median_spacing: fewer than 2 distinct constraint positions");
-  const auto mid = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
-  std::nth_element(spacing.begin(), mid, spacing.end());
-  return *mid;
+  return median_spacing(surface);
 }
 
 SurfaceMesh mesh_points(const Constraints& constraints, double precision, const MesherOptions& options) {

@@ -72,6 +72,24 @@ void subsample(std::vector<std::size_t>& keep, std::size_t m, std::uint64_t seed
   std::sort(keep.begin(), keep.end());
 }
 
+/// The median distance from points[i] to its nearest other point of `index` (which holds `points`),
+/// over at most 100,000 of them taken evenly, exact duplicates skipped; 0 when every point coincides.
+double spacing_median(const PointIndex& index, const std::vector<Point3>& points) {
+  const std::size_t step = std::max<std::size_t>(1, points.size() / 100000);
+  std::vector<double> spacing;
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  for (std::size_t i = 0; i < points.size(); i += step) {
+    index.nearest(points[i], 8, ids, &d2);
+    const auto first = std::find_if(d2.begin(), d2.end(), [](double d) { return d > 0; });
+    if (first != d2.end()) spacing.push_back(std::sqrt(*first));
+  }
+  if (spacing.empty()) return 0.0;
+  const auto mid = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
+  std::nth_element(spacing.begin(), mid, spacing.end());
+  return *mid;
+}
+
 /// The signed offset of each off-surface constraint: for kept point k and side s (0: +d outside, 1: -d
 /// inside), offsets[2k + s] is the distance used (d0 halved until no surface point lies within 0.999 x
 /// it of the constraint, up to 4 times, while 0.999 d > tol: a constraint is never a near-duplicate of a
@@ -146,6 +164,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
                           " normals");
   if (!(opt.offset > 0) || !std::isfinite(opt.offset))
     throw InvalidArgument("constraint offset must be a positive fraction of the diagonal");
+  if (!(opt.offset_spacings >= 0) || !std::isfinite(opt.offset_spacings))
+    throw InvalidArgument("constraint offset_spacings must be a finite number >= 0 (0: offset alone)");
   if (!(opt.merge_tolerance >= 0) || !std::isfinite(opt.merge_tolerance))
     throw InvalidArgument("constraint merge_tolerance must be a finite fraction >= 0 of the diagonal");
   const std::size_t per = opt.sides == OffSurface::Both ? 3 : 2;
@@ -177,14 +197,25 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
     for (std::size_t k = 0; k < order.size(); ++k) surf[k] = merged[order[k]];
   }
   const PointIndex surface(surf);
+  // The merge tolerance above stays measured on the box grown by the largest d.
+  const double d = opt.offset_spacings > 0 && surf.size() > 1
+                       ? std::min(d0, opt.offset_spacings * spacing_median(surface, surf))
+                       : d0;
+  rep.offset = d;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
-  const std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d0, tol, opt);
+  const std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);
   Constraints c;
   c.points.reserve(keep.size() * per);
   c.values.reserve(keep.size() * per);
   for (std::size_t i : keep) c.add(points[i], 0.0);
   add_off_surface(c, points, normals, keep, offsets, tol, opt.threads, rep);
   return c;
+}
+
+double median_spacing(const std::vector<Point3>& points) {
+  const double m = points.size() > 1 ? spacing_median(PointIndex(points), points) : 0.0;
+  if (!(m > 0)) throw InvalidArgument("median_spacing: fewer than 2 distinct positions");
+  return m;
 }
 
 Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options,

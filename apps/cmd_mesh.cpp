@@ -293,6 +293,8 @@ int run_mesh(const Args& args) {
   // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
   // memory (docs/mesher.md "Batch runs and memory").
   options.polygonizer.keep_history = !script.empty();
+  // Then the seeds go in on every core: the same mesh, bit for bit, as one thread (canonical ids).
+  options.polygonizer.threads = 0;
   // A precision far below the data's spacing would need more memory than the machine has: a LimitError
   // naming the count instead of an out-of-memory end.
   options.max_vertices = vertex_budget(options.polygonizer.keep_history);

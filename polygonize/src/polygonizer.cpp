@@ -154,7 +154,10 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
     if (!seed_values.empty() && std::isinf(seed_values[i])) throw InvalidPoint(i, "seed value is infinite");
   }
   // Batch insertion (randomized spatial order inside the Delaunay tree); exact duplicates are skipped.
+  // Without the history the tetrahedra are then renumbered canonically, so that everything after (the
+  // refinement order follows tetrahedron ids) is the same whatever the threads of the insertion.
   const std::vector<InsertResult> inserted = tri_.insert_points(seeds, 0.0, nullptr);
+  if (!options_.keep_history) tri_.canonicalize();
   grow_vertex_arrays();
   for (std::size_t i = 0; i < seeds.size(); ++i) {
     if (inserted[i].status != InsertStatus::Inserted) continue;

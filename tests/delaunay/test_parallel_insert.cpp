@@ -1,6 +1,7 @@
 // Parallel bulk insertion (TriangulationOptions::threads): the same tetrahedra over the same vertex ids,
 // and the same results, as the serial build, on inputs where the parallel passes defer many points.
 #include "vitri/delaunay/triangulation.hpp"
+#include "vitri/core/error.hpp"
 
 #include "test_points.hpp"
 
@@ -158,4 +159,86 @@ TEST_CASE("delaunay: parallel bulk insertion falls back to one thread where it d
   hw.insert_points(pts);
   CHECK(hw.last_bulk_stats().threads >= 1);
   REQUIRE_NOTHROW(hw.verify_topology());
+}
+
+namespace {
+
+// Every live tetrahedron in id order: its vertices and neighbours, as stored.
+std::vector<std::array<std::uint32_t, 9>> records(const Triangulation& tr) {
+  std::vector<std::array<std::uint32_t, 9>> r;
+  tr.for_each_tetrahedron([&](TetId t) {
+    const auto v = tr.tet_vertices(t);
+    r.push_back({t, v[0], v[1], v[2], v[3], tr.tet_neighbor(t, 0), tr.tet_neighbor(t, 1), tr.tet_neighbor(t, 2),
+                 tr.tet_neighbor(t, 3)});
+  });
+  return r;
+}
+
+// The canonical form's own invariants: ids 0 .. n-1 in the order of the sorted vertex ids, smallest
+// vertex first, the smallest of the other three second.
+void require_canonical(const Triangulation& tr) {
+  std::vector<std::array<VertexId, 4>> keys;
+  TetId expected = 0;
+  tr.for_each_tetrahedron([&](TetId t) {
+    REQUIRE(t == expected++);
+    auto v = tr.tet_vertices(t);
+    REQUIRE(v[0] < std::min({v[1], v[2], v[3]}));
+    REQUIRE(v[1] < std::min(v[2], v[3]));
+    std::sort(v.begin(), v.end());
+    keys.push_back(v);
+  });
+  REQUIRE(expected == tr.num_tetrahedra());
+  REQUIRE(tr.tet_capacity() == tr.num_tetrahedra());
+  REQUIRE(std::is_sorted(keys.begin(), keys.end()));
+}
+
+}  // namespace
+
+TEST_CASE("delaunay: canonicalize() gives the same records whatever the threads and the order") {
+  const Box3 unit{{-0.5, -0.5, -0.5}, {1.5, 1.5, 1.5}};
+  SECTION("uniform points, serial and 2 threads") {
+    const auto pts = uniform(30000, 11);
+    Triangulation serial(unit, no_history(1)), par(unit, no_history(2));
+    serial.insert_points(pts);
+    par.insert_points(pts);
+    REQUIRE(par.last_bulk_stats().parallel > 0);
+    const bool same_before = records(par) == records(serial);
+    REQUIRE_FALSE(same_before);  // ids differ before: the test can fail
+    serial.canonicalize();
+    par.canonicalize();
+    require_canonical(serial);
+    const bool same = records(par) == records(serial);
+    REQUIRE(same);
+    REQUIRE_NOTHROW(par.verify_topology());
+    REQUIRE_NOTHROW(par.verify_delaunay());
+    // Edits afterwards, identical in both.
+    for (const Point3& p : uniform(300, 12)) REQUIRE(par.insert(p).vertex == serial.insert(p).vertex);
+    for (VertexId v = 100; v < 1100; v += 5) {
+      serial.remove(v);
+      par.remove(v);
+    }
+    REQUIRE_NOTHROW(par.verify_topology());
+    REQUIRE_NOTHROW(par.verify_delaunay());
+    const bool same_after_edits = records(par) == records(serial);
+    REQUIRE(same_after_edits);
+  }
+  SECTION("the shuffled integer grid (cospherical everywhere)") {
+    const Box3 box{{-1, -1, -1}, {21, 21, 21}};
+    const auto pts = grid_with_duplicates(20, 0, 13);
+    Triangulation serial(box, no_history(1)), par(box, no_history(2));
+    serial.insert_points(pts);
+    par.insert_points(pts);
+    serial.canonicalize();
+    par.canonicalize();
+    require_canonical(par);
+    const bool same = records(par) == records(serial);
+    REQUIRE(same);
+    REQUIRE_NOTHROW(serial.verify_topology());
+    REQUIRE_NOTHROW(serial.verify_delaunay());
+  }
+  SECTION("refused with the history") {
+    Triangulation with_history(unit);
+    with_history.insert_points(uniform(100, 14));
+    REQUIRE_THROWS_AS(with_history.canonicalize(), InvalidArgument);
+  }
 }

@@ -168,7 +168,7 @@ TEST_CASE("batch option: no Delaunay history, an equivalent mesh", "[mesher][loc
 // insertion really runs in parallel, gives the serial tetrahedralization (same vertex and tetrahedron
 // counts, same transverse tetrahedra), and the refined mesh is closed and equivalent to the serial one
 // (tetrahedron ids, hence the refinement order, may differ).
-TEST_CASE("batch option with bulk threads: the serial tetrahedralization, an equivalent mesh", "[mesher][local]") {
+TEST_CASE("batch option with bulk threads: the serial tetrahedralization, the same mesh", "[mesher][local]") {
   const TriangleMesh in = read_mesh(kData + "/knot1.off");
   MesherOptions serial;
   serial.function = FunctionKind::Local;
@@ -187,7 +187,9 @@ TEST_CASE("batch option with bulk threads: the serial tetrahedralization, an equ
   a.refine(p);
   b.refine(p);
   require_closed(b.surface(), 0);
-  require_close(a.surface(), b.surface(), p);
+  // Canonical tetrahedron ids after the seeds (Triangulation::canonicalize): bit for bit the same.
+  REQUIRE(a.surface().triangles == b.surface().triangles);
+  REQUIRE(a.surface().vertices == b.surface().vertices);
 }
 
 TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the count", "[mesher][local]") {

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <set>
 
 using namespace vitri;
@@ -450,4 +451,28 @@ TEST_CASE("lone zeros: a zero vertex without a negative side terminates and mesh
   REQUIRE(poly.collect_garbage(0.0, star.size()) >= star.size());
   for (const VertexId u : star) REQUIRE_FALSE(poly.triangulation().is_vertex(u));
   require_closed(poly.extract(), 2, 1);
+}
+
+TEST_CASE("without the history, the seeds' threads do not change the mesh (canonical ids)", "[polygonizer]") {
+  // The refinement order follows tetrahedron ids; a parallel insertion numbers them by the threads'
+  // timing, so the Polygonizer renumbers them canonically after the seeds. Bit for bit the same mesh.
+  const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
+  std::mt19937_64 rng(21);
+  std::uniform_real_distribution<double> u(-1.9, 1.9);
+  std::vector<Point3> seeds(40000);
+  for (Point3& p : seeds) p = {u(rng), u(rng), u(rng)};
+  SurfaceMesh mesh[2];
+  for (int k = 0; k < 2; ++k) {
+    PolygonizerOptions o;
+    o.keep_history = false;
+    o.threads = k == 0 ? 1 : 2;
+    o.sampling_fraction = 0.0;  // no lattice: the last bulk insertion is the seeds'
+    Polygonizer poly(f, kCube, seeds, {}, o);
+    if (k == 1) REQUIRE(poly.triangulation().last_bulk_stats().parallel > 0);
+    REQUIRE(poly.refine(0.15));
+    mesh[k] = poly.extract();
+  }
+  require_closed(mesh[1], 0, 1);
+  REQUIRE(mesh[0].triangles == mesh[1].triangles);
+  REQUIRE(mesh[0].vertices == mesh[1].vertices);
 }

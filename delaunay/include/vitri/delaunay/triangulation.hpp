@@ -177,6 +177,13 @@ class Triangulation {
   /// (`changes->renumbered`). Vertex ids do not change. Frees the history of removed vertices and old
   /// positions of moved ones. O(n log n) expected. Without the history: does nothing.
   void rebuild_history(ChangeSet* changes = nullptr);
+  /// Renumbers the live tetrahedra canonically: ids 0 .. num_tetrahedra() - 1 in the order of their
+  /// sorted vertex ids, each tetrahedron's vertices from its smallest by an even permutation (the
+  /// orientation kept), the smallest of the other three second; no free slot left. Afterwards ids and
+  /// vertex orders depend only on the tetrahedralization, not on the insertion order nor the threads of
+  /// a parallel insert_points. Vertex ids do not change. O(n). Only without the history.
+  /// @throws InvalidArgument when the triangulation keeps its history.
+  void canonicalize();
   /// Number of history rebuilds so far (automatic or explicit).
   std::size_t history_rebuilds() const { return rebuilds_; }
   /// How the last insert_points split its work between serial and parallel insertion.

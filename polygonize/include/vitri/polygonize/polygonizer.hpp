@@ -131,15 +131,15 @@ struct PolygonizerOptions {
   /// descent, O(log n) for single insertions and edits, at about 1250 bytes per Delaunay vertex instead
   /// of about 250 for the live mesh alone. false suits a batch run that refines and extracts without
   /// editing (the CLI without --edits): an equivalent mesh (same precision guarantee; not bit for bit
-  /// the same, since the refinement order follows tetrahedron ids, which are recycled without the
-  /// history) in well under half the memory. Edits still work without it, with walking location
+  /// the same, since the refinement order follows tetrahedron ids, which are numbered canonically
+  /// after the seeds and recycled without the history) in well under half the memory. Edits still work without it, with walking location
   /// (slower on large models). See docs/mesher.md "Batch runs and memory".
   bool keep_history = true;
   /// Threads of the bulk insertion of the seeds at construction (TriangulationOptions::threads; 0 = all
-  /// hardware threads). Used only without the history (keep_history = false): the parallel build gives the
-  /// same tetrahedra as the serial one, but its tetrahedron ids may differ from run to run, and the
-  /// refinement order follows them, so a run with more than one thread is equivalent to (not bit for bit)
-  /// a serial one, and may differ from run to run within the precision. 1: serial, deterministic.
+  /// hardware threads). Used only without the history (keep_history = false). The parallel build gives
+  /// the same tetrahedra as the serial one, and without the history the tetrahedra are renumbered
+  /// canonically after the seeds (Triangulation::canonicalize()), so the result is the same, bit for
+  /// bit, for any number of threads.
   unsigned threads = 1;
 };
 

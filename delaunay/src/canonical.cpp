@@ -1,0 +1,101 @@
+// The Delaunay tree, canonical renumbering: ids and vertex orders of the live tetrahedra that depend
+// only on the tetrahedralization, not on how it was built (docs/delaunay.md, "Canonical order").
+//
+// The perturbed Delaunay tetrahedralization of a point set is unique, but the ids of its tetrahedra,
+// the order of the vertices inside each and the free slots depend on the insertion order, and a
+// parallel bulk insertion's on the threads' timing. Code that walks tetrahedra in id order (the
+// polygonizer's refinement queue) then gives results that depend on it. After canonicalize(): the live
+// tetrahedra are 0 .. n-1, sorted by their vertex ids (smallest first, then the rest in increasing
+// order), each written from its smallest vertex by an even permutation (orientation kept) with the
+// smallest of the other three second; no free slot is left.
+#include "scratch.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <array>
+#include <numeric>
+#include <vector>
+
+namespace vitri {
+
+namespace {
+
+// Even permutations of (0, 1, 2, 3) starting with each index: the other three in every cyclic order
+// of an even permutation (rotations of a 3-cycle keep parity).
+constexpr int kEvenFrom[4][3] = {{1, 2, 3}, {0, 3, 2}, {3, 0, 1}, {2, 1, 0}};
+
+// The canonical vertex order of a tetrahedron with vertex keys k: positions (p0, p1, p2, p3) such that
+// k[p0] is the smallest, k[p1] the smallest of the rest, and (p0 p1 p2 p3) is an even permutation.
+std::array<int, 4> canonical_order(const std::array<VertexId, 4>& k) {
+  int m = 0;
+  for (int i = 1; i < 4; ++i)
+    if (k[i] < k[m]) m = i;
+  const int* c = kEvenFrom[m];
+  int r = 0;  // rotation of the 3-cycle that puts the smallest of the rest second
+  for (int i = 1; i < 3; ++i)
+    if (k[c[i]] < k[c[r]]) r = i;
+  return {m, c[r], c[(r + 1) % 3], c[(r + 2) % 3]};
+}
+
+}  // namespace
+
+void Triangulation::canonicalize() {
+  if (keep_history_)
+    throw InvalidArgument("Triangulation::canonicalize: only without the history (its records hold ids)");
+  const std::size_t cap = tets_.size();
+  // Key of a live tetrahedron: its public vertex ids, sorted; bucketed by the smallest (a counting
+  // sort), then each bucket (a few tetrahedra) sorted by the other three.
+  std::vector<std::array<VertexId, 4>> key(cap);
+  std::vector<std::uint32_t> start(vertex_capacity() + 1, 0);
+  for (TetId t = 0; t < cap; ++t) {
+    if (tets_.is_dead(t)) continue;
+    std::array<VertexId, 4> k{};
+    for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
+    std::sort(k.begin(), k.end());
+    key[t] = k;
+    ++start[k[0] + 1];
+  }
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<TetId> order(num_live_tets_);
+  {
+    std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
+    for (TetId t = 0; t < cap; ++t)
+      if (!tets_.is_dead(t)) order[next[key[t][0]]++] = t;
+  }
+  for (std::size_t b = 0; b + 1 < start.size(); ++b)
+    std::sort(order.begin() + start[b], order.begin() + start[b + 1],
+              [&](TetId x, TetId y) { return key[x] < key[y]; });
+  std::vector<TetId> new_id(cap, kNoTet);
+  for (std::size_t n = 0; n < order.size(); ++n) new_id[order[n]] = static_cast<TetId>(n);
+
+  Store fresh(false);
+  fresh.append(order.size());
+  for (std::size_t n = 0; n < order.size(); ++n) {
+    const TetId t = order[n];
+    std::array<VertexId, 4> k{};
+    for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
+    const std::array<int, 4> o = canonical_order(k);
+    for (int i = 0; i < 4; ++i) {
+      fresh.set_vertex(static_cast<TetId>(n), i, tets_.vertex(t, o[i]));
+      const TetId across = tets_.neighbor(t, o[i]);  // the face opposite a vertex moves with it
+      fresh.set_neighbor(static_cast<TetId>(n), i, across == kNoTet ? kNoTet : new_id[across]);
+    }
+  }
+  tets_ = std::move(fresh);
+  free_head_ = kNoTet;
+  // The state that later operations start from must be canonical too, or they would number their new
+  // tetrahedra differently (a removal starts its star at vtet_, an insertion walks from a hint): each
+  // vertex's incident tetrahedron is its first one, the location grid is rebuilt in vertex id order, and
+  // walks without a hint start at tetrahedron 0.
+  for (TetId& t : vtet_)
+    if (t != kNoTet) t = kNoTet - 1;  // live, to be set below
+  for (TetId n = static_cast<TetId>(order.size()); n-- > 0;)
+    for (int i = 0; i < 4; ++i) vtet_[tets_.vertex(n, i)] = n;
+  last_tet_ = 0;
+  grid_.reset(box_, num_live_vertices_);
+  for (VertexId v = 0; v < vertex_capacity(); ++v)
+    if (is_vertex(v)) grid_.set(point(v), v);
+}
+
+}  // namespace vitri

@@ -102,7 +102,8 @@ struct LocalRbf::Impl {
   void refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created);
   void fit_leaf(std::uint32_t c, FitScratch& s);
   void fit_leaves(const std::vector<std::uint32_t>& leaves);
-  void link(const std::vector<std::uint32_t>& created);
+  /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).
+  void link(const std::vector<std::uint32_t>& created, bool every_leaf = false);
   void unlink(std::uint32_t c);
   void refresh_records(std::uint32_t leaf);
   /// Leaves whose records may be out of date (candidate list or a candidate's fit changed) during an edit.
@@ -136,11 +137,20 @@ bool LocalRbf::Impl::too_close(double d2) const { return d2 == 0 || d2 < duplica
 void LocalRbf::Impl::check_duplicates() const {
   std::size_t worst = std::numeric_limits<std::size_t>::max(), partner = 0;  // the later index of a pair
   std::mutex m;
+  const double r2 = duplicate_tolerance2();
   parallel_chunks(slot_point.size(), threads(), 4096, [&](std::size_t b, std::size_t e) {
     std::vector<PointIndex::Id> ids;
     std::vector<double> d2;
     for (std::size_t i = b; i < e; ++i) {
-      index.nearest(slot_point[i], 2, ids, &d2);
+      if (r2 > 0) {
+        // A ball of the tolerance's radius holds the point itself (distance 0) and its near-duplicates:
+        // much cheaper than a nearest-neighbour search, which must reach the next sample.
+        if (index.count_ball(slot_point[i], r2, 1) <= 1) continue;
+        index.ball(slot_point[i], r2, ids);
+        d2.assign(ids.size(), 0.0);
+      } else {
+        index.nearest(slot_point[i], 2, ids, &d2);
+      }
       for (std::size_t k = 0; k < ids.size(); ++k) {
         if (ids[k] == i || !too_close(d2[k])) continue;
         std::lock_guard<std::mutex> lock(m);
@@ -197,7 +207,7 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   }
   std::vector<std::uint32_t> created;
   refine_cell(0, created);
-  link(created);
+  link(created, true);
   fit_leaves(created);
   parallel_chunks(created.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
     for (std::size_t k = b; k < e; ++k) refresh_records(created[k]);
@@ -273,7 +283,7 @@ void LocalRbf::Impl::fit_leaves(const std::vector<std::uint32_t>& leaves) {
   });
 }
 
-void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created) {
+void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_leaf) {
   // Membership in `created` (sorted copy, binary search): no pass over all cells, so an edit stays O(local).
   std::vector<std::uint32_t> sorted_created = created;
   std::sort(sorted_created.begin(), sorted_created.end());
@@ -289,6 +299,8 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created) {
   std::vector<std::uint32_t> found;
   for (std::uint32_t n : created) {
     for (std::uint32_t l : tree.cell(n).candidates) tree.cell(l).listed_in.push_back(n);
+    // The older leaves whose cube n's ball meets list n too; in a full fit there is none.
+    if (every_leaf) continue;
     tree.leaves_in_ball(tree.cell(n).center, tree.cell(n).radius, found);
     for (std::uint32_t m : found) {
       if (is_new(m)) continue;

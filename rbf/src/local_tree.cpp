@@ -76,7 +76,8 @@ std::uint32_t LocalTree::locate(const Point3& p) const {
 template <class Enter, class Take>
 void LocalTree::collect_leaves(const Enter& enter, const Take& take, std::vector<std::uint32_t>& out) const {
   out.clear();
-  std::vector<std::uint32_t> stack{0};
+  thread_local std::vector<std::uint32_t> stack;  // reused: queries run per leaf, on every thread
+  stack.assign(1, 0);
   while (!stack.empty()) {
     const std::uint32_t c = stack.back();
     stack.pop_back();

@@ -105,9 +105,10 @@ struct LocalRbf::Impl {
   /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).
   void link(const std::vector<std::uint32_t>& created, bool every_leaf = false);
   void unlink(std::uint32_t c);
-  void refresh_records(std::uint32_t leaf);
-  /// Leaves whose records may be out of date (candidate list or a candidate's fit changed) during an edit.
-  std::vector<std::uint32_t> stale_records;
+  /// Writes the patch record of each of `leaves` (after their fit).
+  void publish(const std::vector<std::uint32_t>& leaves);
+  /// The patch record of each leaf, by cell id (PatchRecord); entries of dead or inner cells are unused.
+  std::vector<PatchRecord> patches;
   void restructure(std::uint32_t c, const Point3& q, std::vector<Ball>& removed, std::vector<std::uint32_t>& created);
   void fill_report();
 
@@ -209,10 +210,7 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   refine_cell(0, created);
   link(created, true);
   fit_leaves(created);
-  parallel_chunks(created.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
-    for (std::size_t k = b; k < e; ++k) refresh_records(created[k]);
-  });
-  stale_records.clear();
+  publish(created);
   for (std::size_t c2 = tree.capacity(); c2-- > 0;)  // children after parents: reach bottom-up
     if (tree.cell(static_cast<std::uint32_t>(c2)).alive) tree.compute_reach(static_cast<std::uint32_t>(c2));
   fitted = true;
@@ -309,7 +307,6 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_
                                        [&](auto x, auto y) { return cell_before(tree.cell(x), tree.cell(y)); });
       cand.insert(at, n);
       tree.cell(n).listed_in.push_back(m);
-      stale_records.push_back(m);
     }
   }
 }
@@ -323,21 +320,18 @@ void LocalRbf::Impl::unlink(std::uint32_t c) {
   for (std::uint32_t l : cell.listed_in) {
     auto& cand = tree.cell(l).candidates;
     cand.erase(std::remove(cand.begin(), cand.end(), c), cand.end());
-    stale_records.push_back(l);
   }
   cell.candidates.clear();
-  cell.records.clear();
   cell.listed_in.clear();
   cell.coef.clear();
   cell.terms = 0;
 }
 
-void LocalRbf::Impl::refresh_records(std::uint32_t leaf) {
-  Cell& cell = tree.cell(leaf);
-  cell.records.resize(cell.candidates.size());
-  for (std::size_t k = 0; k < cell.candidates.size(); ++k) {
-    const Cell& p = tree.cell(cell.candidates[k]);
-    cell.records[k] = PatchRecord{p.center, p.radius * p.radius, 1.0 / p.radius, p.coef.data(), p.terms};
+void LocalRbf::Impl::publish(const std::vector<std::uint32_t>& leaves) {
+  if (patches.size() < tree.capacity()) patches.resize(tree.capacity());
+  for (const std::uint32_t c : leaves) {
+    const Cell& p = tree.cell(c);
+    patches[c] = PatchRecord{p.center, p.radius * p.radius, 1.0 / p.radius, p.coef.data(), p.terms};
   }
 }
 
@@ -356,7 +350,7 @@ void LocalRbf::Impl::fill_report() {
     report.max_fitted = std::max<std::size_t>(report.max_fitted, cell.terms);
     bytes += cell.coef.capacity() * 8 + (cell.candidates.capacity() + cell.listed_in.capacity()) * 4;
   }
-  bytes += tree.capacity() * sizeof(Cell);
+  bytes += tree.capacity() * sizeof(Cell) + patches.capacity() * sizeof(PatchRecord);
   report.mean_fitted = rbf_patches ? double(fitted_terms) / double(rbf_patches) : 0.0;
   report.memory_bytes = bytes;
 }
@@ -367,7 +361,8 @@ double LocalRbf::Impl::evaluate_inside(const Point3& x, Point3* grad) const {
   const Cell& leaf = tree.cell(tree.locate(x));
   double sw = 0, swf = 0;
   Point3 gsw{0, 0, 0}, gswf{0, 0, 0};
-  for (const PatchRecord& p : leaf.records) {
+  for (const std::uint32_t id : leaf.candidates) {
+    const PatchRecord& p = patches[id];
     const Point3 d = x - p.center;
     const double d2 = squared_norm(d);
     if (!(d2 < p.radius2)) continue;
@@ -488,17 +483,8 @@ ChangedRegion LocalRbf::Impl::change(std::optional<Point3> old_pos, std::optiona
     fit_all(before, tree.root_box());
     throw;
   }
-  for (std::uint32_t c : touched) {
-    tree.update_reach(c);
-    stale_records.push_back(c);  // created leaves have new candidate lists
-    const auto& back = tree.cell(c).listed_in;
-    stale_records.insert(stale_records.end(), back.begin(), back.end());
-  }
-  std::sort(stale_records.begin(), stale_records.end());
-  stale_records.erase(std::unique(stale_records.begin(), stale_records.end()), stale_records.end());
-  for (std::uint32_t c : stale_records)
-    if (is_leaf(c)) refresh_records(c);
-  stale_records.clear();
+  for (std::uint32_t c : touched) tree.update_reach(c);
+  publish(touched);
   ChangedRegion region;
   region.balls = std::move(removed);
   for (std::uint32_t c : touched) region.balls.push_back({tree.cell(c).center, tree.cell(c).radius});
@@ -615,6 +601,11 @@ void LocalRbf::validate() const {
     if (want_children == cell.leaf())
       throw std::logic_error("local RBF: cell " + std::to_string(c) + " at " + format_point(cell.center) +
                              " breaks the split rule (" + std::to_string(n) + " constraints in its ball)");
+    if (!cell.leaf()) continue;
+    const PatchRecord* r = c < m.patches.size() ? &m.patches[c] : nullptr;
+    if (!r || r->center != cell.center || r->radius2 != cell.radius * cell.radius || r->coef != cell.coef.data() ||
+        r->terms != cell.terms)
+      throw std::logic_error("local RBF: the patch record of leaf " + std::to_string(c) + " is stale");
   }
   if (m.index.size() != m.live || m.ranks.rank(m.ranks.slots()) != m.live)
     throw std::logic_error("local RBF: constraint counts disagree");

@@ -154,13 +154,6 @@ void LocalTree::validate() const {
     leaves_meeting_cube(cell, found);
     std::sort(found.begin(), found.end(), [&](auto a, auto b) { return cell_before(cells_[a], cells_[b]); });
     if (found != cell.candidates) fail(c, "candidate list differs from the leaves whose ball meets the cell");
-    if (cell.records.size() != cell.candidates.size()) fail(c, "records and candidates differ in size");
-    for (std::size_t k = 0; k < cell.records.size(); ++k) {
-      const Cell& p = cells_[cell.candidates[k]];
-      const PatchRecord& r = cell.records[k];
-      if (r.center != p.center || r.radius2 != p.radius * p.radius || r.coef != p.coef.data() || r.terms != p.terms)
-        fail(c, "stale record of candidate " + std::to_string(cell.candidates[k]));
-    }
     for (std::uint32_t l : cell.candidates)
       if (std::find(cells_[l].listed_in.begin(), cells_[l].listed_in.end(), c) == cells_[l].listed_in.end())
         fail(c, "candidate " + std::to_string(l) + " does not list it back");

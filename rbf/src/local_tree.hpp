@@ -24,8 +24,10 @@ namespace vitri::local_detail {
 
 inline constexpr std::uint32_t kNone = 0xffffffffu;
 
-/// What evaluation reads of one candidate patch, stored contiguously in the leaf that lists it (no visit
-/// of the candidate's cell). Refreshed whenever the candidate list or a candidate's fit changes.
+/// What evaluation reads of one patch, in a flat array indexed by cell id (LocalRbf's `patches`), so that
+/// an evaluation reads compact records instead of visiting the candidates' cells. Written whenever the
+/// cell's patch is fitted. (Each leaf once held a copy per candidate: 56 bytes x about 25 candidates
+/// per leaf, the largest part of the local function's memory.)
 struct PatchRecord {
   Point3 center;
   double radius2 = 0;
@@ -46,8 +48,7 @@ struct Cell {
   double fit_r2 = 0;      ///< an edit at q touches the patch iff |q - center|^2 <= fit_r2
   std::uint32_t terms = 0;  ///< kernel terms in coef (0: linear patch)
   std::vector<double> coef;
-  std::vector<std::uint32_t> candidates;
-  std::vector<PatchRecord> records;  ///< records[k] describes candidates[k] (see PatchRecord)
+  std::vector<std::uint32_t> candidates;  ///< leaves whose support meets the cube, in cell_before order
   std::vector<std::uint32_t> listed_in;
   double fit_reach = 0;
   bool leaf() const { return first_child == kNone; }

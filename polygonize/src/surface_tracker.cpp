@@ -272,45 +272,53 @@ void SurfaceTracker::set_anchor(std::uint32_t e, VertexId anchor) {
 // end moved), and anchors it: at the positive end when f is exactly 0 there, at an end the root lies
 // within snap_fraction of (the vertex is then kept at least that far from the ends; t keeps the root).
 void SurfaceTracker::place_edges(const TrackerInput& in, Work& w) {
-  std::vector<marching::Crossing> crossings(w.placed.size());
-  for (std::size_t i = 0; i < w.placed.size(); ++i) {
-    const Edge& e = edges_[w.placed[i]];
-    marching::Crossing& c = crossings[i];
-    c.pos_point = in.tri.point(e.pos);
-    c.neg_point = in.tri.point(e.neg);
-    c.pos_value = in.values[e.pos];
-    c.neg_value = in.values[e.neg];
-    const bool moved = moved_stamp_[e.pos] == epoch_ || moved_stamp_[e.neg] == epoch_;
-    if (in.warm_start && !moved && e.t > 0.0 && e.t < 1.0) c.guess = e.t;
-    max_edge_ = std::max(max_edge_, norm(c.neg_point - c.pos_point));
-  }
-  const marching::RootSettings& settings = in.roots;
-  std::vector<marching::Placement> placed;
-  const std::size_t evaluations = marching::place_crossings(in.f, settings, crossings, placed);
-  report_.evaluations += evaluations;
-  report_.root_evaluations += evaluations;
-  report_.placed_edges = w.placed.size();
+  // In chunks: a full build places millions of edges, and the root finder's records of all of them at
+  // once would add hundreds of megabytes to the peak. Each edge's root does not depend on the others.
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
   const double lo = in.snap_fraction, hi = 1.0 - in.snap_fraction;
+  std::vector<marching::Crossing> crossings;
+  std::vector<marching::Placement> placed;
   std::vector<std::uint32_t> pushed;
-  for (std::size_t i = 0; i < w.placed.size(); ++i) {
-    Edge& e = edges_[w.placed[i]];
-    e.x = placed[i].x;
-    e.gradient = placed[i].gradient;
-    e.has_gradient = placed[i].has_gradient;
-    e.t = placed[i].t;
-    e.dirty = false;
-    VertexId anchor = kNoVertex;
-    if (in.values[e.pos] == 0.0 || e.t <= lo) anchor = e.pos;
-    else if (e.t >= hi) anchor = e.neg;
-    set_anchor(w.placed[i], anchor);
-    // An anchored crossing is used where it lies only when its anchor does not collapse (a fold test
-    // refused it). Its vertex is then kept about snap_fraction of the edge away from the anchor, so that
-    // the triangles around an uncollapsed anchor are not 1e-6 of an edge wide (below 1e-14 x diagonal^2).
-    const double clamped = std::clamp(e.t, lo, hi);
-    if (anchor != kNoVertex && clamped != e.t) {
-      const Point3& a = in.tri.point(e.pos);
-      e.x = a + clamped * (in.tri.point(e.neg) - a);
-      pushed.push_back(w.placed[i]);
+  report_.placed_edges = w.placed.size();
+  for (std::size_t first = 0; first < w.placed.size(); first += kChunk) {
+    const std::size_t n = std::min(kChunk, w.placed.size() - first);
+    crossings.assign(n, marching::Crossing{});
+    for (std::size_t i = 0; i < n; ++i) {
+      const Edge& e = edges_[w.placed[first + i]];
+      marching::Crossing& c = crossings[i];
+      c.pos_point = in.tri.point(e.pos);
+      c.neg_point = in.tri.point(e.neg);
+      c.pos_value = in.values[e.pos];
+      c.neg_value = in.values[e.neg];
+      const bool moved = moved_stamp_[e.pos] == epoch_ || moved_stamp_[e.neg] == epoch_;
+      if (in.warm_start && !moved && e.t > 0.0 && e.t < 1.0) c.guess = e.t;
+      max_edge_ = std::max(max_edge_, norm(c.neg_point - c.pos_point));
+    }
+    const std::size_t evaluations = marching::place_crossings(in.f, in.roots, crossings, placed);
+    report_.evaluations += evaluations;
+    report_.root_evaluations += evaluations;
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::uint32_t slot = w.placed[first + i];
+      Edge& e = edges_[slot];
+      e.x = placed[i].x;
+      e.gradient = placed[i].gradient;
+      e.has_gradient = placed[i].has_gradient;
+      e.t = placed[i].t;
+      e.dirty = false;
+      VertexId anchor = kNoVertex;
+      if (in.values[e.pos] == 0.0 || e.t <= lo) anchor = e.pos;
+      else if (e.t >= hi) anchor = e.neg;
+      set_anchor(slot, anchor);
+      // An anchored crossing is used where it lies only when its anchor does not collapse (a fold test
+      // refused it). Its vertex is then kept about snap_fraction of the edge away from the anchor, so
+      // that the triangles around an uncollapsed anchor are not 1e-6 of an edge wide (below 1e-14 x
+      // diagonal^2).
+      const double clamped = std::clamp(e.t, lo, hi);
+      if (anchor != kNoVertex && clamped != e.t) {
+        const Point3& a = in.tri.point(e.pos);
+        e.x = a + clamped * (in.tri.point(e.neg) - a);
+        pushed.push_back(slot);
+      }
     }
   }
   project_pushed(in, pushed);

@@ -183,7 +183,9 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
 void Polygonizer::grow_vertex_arrays() {
   const std::size_t n = tri_.vertex_capacity();
   if (values_.size() >= n) return;
-  const std::size_t cap = std::max(n, values_.size() * 2);
+  // resize(n) and not to twice the size: std::vector grows its capacity geometrically by itself, and only
+  // the first n elements are written (and so resident).
+  const std::size_t cap = n;
   values_.resize(cap, 0.0);
   kind_.resize(cap, static_cast<std::uint8_t>(VertexKind::Refinement));
   fixed_.resize(cap, 0);
@@ -196,7 +198,7 @@ void Polygonizer::grow_vertex_arrays() {
 void Polygonizer::grow_tet_arrays() {
   const std::size_t n = tri_.tet_capacity();
   if (tpos_.size() >= n) return;
-  const std::size_t cap = std::max(n, tpos_.size() * 2);
+  const std::size_t cap = n;  // as in grow_vertex_arrays
   tpos_.resize(cap, kNotListed);
   radius_.resize(cap, 0.0);
 }

@@ -86,13 +86,13 @@ void SurfaceTracker::note_moved(VertexId v) {
 }
 
 std::uint32_t& SurfaceTracker::polygon_of(TetId t) {
-  if (t >= polygon_of_.size()) polygon_of_.resize(std::max<std::size_t>(t + 1, 2 * polygon_of_.size()), kNone);
+  if (t >= polygon_of_.size()) polygon_of_.resize(t + 1, kNone);  // the capacity grows geometrically
   return polygon_of_[t];
 }
 
 void SurfaceTracker::grow_vertex_arrays(std::size_t n) {
   if (collapsed_.size() >= n) return;
-  const std::size_t cap = std::max(n, 2 * collapsed_.size());
+  const std::size_t cap = n;  // std::vector grows its capacity geometrically; only n elements are written
   collapsed_.resize(cap, 0);
   zero_out_.resize(cap, kNone);
   anchored_.resize(cap, 0);
@@ -493,7 +493,7 @@ std::uint32_t SurfaceTracker::out_vertex(const TrackerInput& in, std::uint32_t e
   const bool has_normal = owner == e && edges_[e].has_gradient;
   *slot = mesh_.add_vertex(p, has_normal ? unit_or_zero(edges_[e].gradient) : Point3{0.0, 0.0, 0.0});
   if (!has_normal) w.normals.push_back(*slot);
-  if (*slot >= owner_.size()) owner_.resize(std::max<std::size_t>(*slot + 1, 2 * owner_.size()), kNone);
+  if (*slot >= owner_.size()) owner_.resize(*slot + 1, kNone);
   owner_[*slot] = owner;
   return *slot;
 }

@@ -292,6 +292,7 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_
       tree.leaves_meeting_cube(cell, cell.candidates);
       std::sort(cell.candidates.begin(), cell.candidates.end(),
                 [&](auto x, auto y) { return cell_before(tree.cell(x), tree.cell(y)); });
+      cell.candidates.shrink_to_fit();  // grown by push_back: up to twice the memory otherwise
     }
   });
   std::vector<std::uint32_t> found;
@@ -309,6 +310,8 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_
       tree.cell(n).listed_in.push_back(m);
     }
   }
+  if (every_leaf)
+    for (std::uint32_t n : created) tree.cell(n).listed_in.shrink_to_fit();
 }
 
 void LocalRbf::Impl::unlink(std::uint32_t c) {

@@ -302,7 +302,7 @@ int run_mesh(const Args& args) {
   Input data = read_input(input);
   phases.start("constraints");
   ConstraintBuildReport merged;
-  const Constraints constraints = constraints_of(std::move(data), input, options.constraint_build, &merged);
+  Constraints constraints = constraints_of(std::move(data), input, options.constraint_build, &merged);
   if (!quiet && merged.merged_points + merged.merged_off_surface > 0)
     std::fprintf(stderr, "merged %zu near-duplicate points and dropped %zu off-surface constraints on another "
                  "constraint (closer than %g x the diagonal)\n", merged.merged_points, merged.merged_off_surface,
@@ -328,6 +328,7 @@ int run_mesh(const Args& args) {
                                     : name);
   };
   Mesher mesher(constraints, options);
+  constraints = Constraints{};  // the Mesher has its own copy: 32 bytes per constraint freed for the rest
   phases.stop();
   if (announce_fit && !quiet) std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
   const double diag = mesher.diagonal();

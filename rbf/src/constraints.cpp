@@ -198,9 +198,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   }
   const PointIndex surface(surf);
   // The merge tolerance above stays measured on the box grown by the largest d.
-  const double d = opt.offset_spacings > 0 && surf.size() > 1
-                       ? std::min(d0, opt.offset_spacings * spacing_median(surface, surf))
-                       : d0;
+  const double spacing = opt.offset_spacings > 0 && surf.size() > 1 ? spacing_median(surface, surf) : 0.0;
+  const double d = spacing > 0 ? std::min(d0, opt.offset_spacings * spacing) : d0;
   rep.offset = d;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
   const std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);

@@ -203,3 +203,37 @@ TEST_CASE("rbf on sphere926.pwn: a sphere, negative at its center", "[rbf][data]
   f.value_gradient(in.points.points[0], g);
   CHECK(dot(g, in.points.normals[0]) > 0);  // gradient points outwards
 }
+
+TEST_CASE("constraints: offset_spacings follows the data, at most offset x diagonal", "[rbf][constraints]") {
+  // Two 40 x 40 grids of step h (a power of two: every difference is exact) on the planes z = 0 and
+  // z = 1, normals pointing away from each other: the median spacing is h exactly.
+  const double h = 1.0 / 512.0;  // 2h is below the cap (0.01 x a diagonal of about 1)
+  std::vector<Point3> points, normals;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      points.push_back({i * h, j * h, 0.0});
+      normals.push_back({0.0, 0.0, -1.0});
+      points.push_back({i * h, j * h, 1.0});
+      normals.push_back({0.0, 0.0, 1.0});
+    }
+  REQUIRE(median_spacing(points) == h);
+  ConstraintBuildOptions o;
+  o.offset_spacings = 2.0;
+  ConstraintBuildReport report;
+  const Constraints c = constraints_from_oriented_points(points, normals, o, &report);
+  REQUIRE(report.offset == 2.0 * h);
+  // Every off-surface constraint has the value +-2h (its distance along the normal).
+  for (std::size_t k = points.size(); k < c.size(); ++k) REQUIRE(std::abs(c.values[k]) == 2.0 * h);
+  // Many spacings: the cap, 0.01 x the diagonal of the points' box.
+  o.offset_spacings = 1000.0;
+  constraints_from_oriented_points(points, normals, o, &report);
+  Box3 box;
+  for (const Point3& p : points) box.extend(p);
+  REQUIRE(report.offset == 0.01 * box.diagonal());
+  // Without it, the library's default.
+  o.offset_spacings = 0.0;
+  constraints_from_oriented_points(points, normals, o, &report);
+  REQUIRE(report.offset == 0.01 * box.diagonal());
+  o.offset_spacings = -1.0;
+  REQUIRE_THROWS_AS(constraints_from_oriented_points(points, normals, o), InvalidArgument);
+}

@@ -88,8 +88,6 @@ void Triangulation::canonicalize() {
   // tetrahedra differently (a removal starts its star at vtet_, an insertion walks from a hint): each
   // vertex's incident tetrahedron is its first one, the location grid is rebuilt in vertex id order, and
   // walks without a hint start at tetrahedron 0.
-  for (TetId& t : vtet_)
-    if (t != kNoTet) t = kNoTet - 1;  // live, to be set below
   for (TetId n = static_cast<TetId>(order.size()); n-- > 0;)
     for (int i = 0; i < 4; ++i) vtet_[tets_.vertex(n, i)] = n;
   last_tet_ = 0;

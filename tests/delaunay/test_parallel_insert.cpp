@@ -192,26 +192,36 @@ void require_canonical(const Triangulation& tr) {
   REQUIRE(std::is_sorted(keys.begin(), keys.end()));
 }
 
+// Inserts pts into `serial` (one thread) and `par` (two, the parallel passes used), canonicalizes both
+// and requires identical records, in the canonical form, of a valid Delaunay tetrahedralization.
+void require_same_canonical(Triangulation& serial, Triangulation& par, const std::vector<Point3>& pts) {
+  serial.insert_points(pts);
+  par.insert_points(pts);
+  REQUIRE(par.last_bulk_stats().parallel > 0);
+  serial.canonicalize();
+  par.canonicalize();
+  require_canonical(par);
+  const bool same = records(par) == records(serial);
+  REQUIRE(same);
+  REQUIRE_NOTHROW(par.verify_topology());
+  REQUIRE_NOTHROW(par.verify_delaunay());
+}
+
 }  // namespace
 
 TEST_CASE("delaunay: canonicalize() gives the same records whatever the threads and the order") {
   const Box3 unit{{-0.5, -0.5, -0.5}, {1.5, 1.5, 1.5}};
-  SECTION("uniform points, serial and 2 threads") {
+  SECTION("uniform points, serial and 2 threads, then the same edits") {
     const auto pts = uniform(30000, 11);
+    {  // ids differ without it: the test can fail
+      Triangulation serial(unit, no_history(1)), par(unit, no_history(2));
+      serial.insert_points(pts);
+      par.insert_points(pts);
+      const bool same_before = records(par) == records(serial);
+      REQUIRE_FALSE(same_before);
+    }
     Triangulation serial(unit, no_history(1)), par(unit, no_history(2));
-    serial.insert_points(pts);
-    par.insert_points(pts);
-    REQUIRE(par.last_bulk_stats().parallel > 0);
-    const bool same_before = records(par) == records(serial);
-    REQUIRE_FALSE(same_before);  // ids differ before: the test can fail
-    serial.canonicalize();
-    par.canonicalize();
-    require_canonical(serial);
-    const bool same = records(par) == records(serial);
-    REQUIRE(same);
-    REQUIRE_NOTHROW(par.verify_topology());
-    REQUIRE_NOTHROW(par.verify_delaunay());
-    // Edits afterwards, identical in both.
+    require_same_canonical(serial, par, pts);
     for (const Point3& p : uniform(300, 12)) REQUIRE(par.insert(p).vertex == serial.insert(p).vertex);
     for (VertexId v = 100; v < 1100; v += 5) {
       serial.remove(v);
@@ -224,17 +234,8 @@ TEST_CASE("delaunay: canonicalize() gives the same records whatever the threads 
   }
   SECTION("the shuffled integer grid (cospherical everywhere)") {
     const Box3 box{{-1, -1, -1}, {21, 21, 21}};
-    const auto pts = grid_with_duplicates(20, 0, 13);
     Triangulation serial(box, no_history(1)), par(box, no_history(2));
-    serial.insert_points(pts);
-    par.insert_points(pts);
-    serial.canonicalize();
-    par.canonicalize();
-    require_canonical(par);
-    const bool same = records(par) == records(serial);
-    REQUIRE(same);
-    REQUIRE_NOTHROW(serial.verify_topology());
-    REQUIRE_NOTHROW(serial.verify_delaunay());
+    require_same_canonical(serial, par, grid_with_duplicates(20, 0, 13));
   }
   SECTION("refused with the history") {
     Triangulation with_history(unit);

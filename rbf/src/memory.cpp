@@ -1,6 +1,6 @@
 // Memory needed by the dense fit, and the budget it is checked against (see RbfOptions::max_memory_bytes).
 //
-// What Rbf::fit allocates, read from rbf.cpp: with the Cholesky solver, the factor L of the reduced
+// What Rbf::fit allocates, read from rbf_fit.cpp: with the Cholesky solver, the factor L of the reduced
 // (N - 4) x (N - 4) system with 1/8 headroom plus 16 rows for edits, column-major doubles (the system
 // is assembled in place in L); with FullLu, the (N + 4)^2 saddle matrix and Eigen's LU copy of it. Both
 // also keep O(N) arrays (scaled positions, weights, basis rows, permutations, residuals): a generous 512

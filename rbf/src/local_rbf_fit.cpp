@@ -1,0 +1,197 @@
+// vitri::LocalRbf, the fit: input checks, the duplicate check, the root cube, the octree refined by the
+// split rule, the patch fits of the leaves (in parallel), and the report.
+#include "local_rbf_impl.hpp"
+
+#include "local_patch.hpp"
+#include "parallel.hpp"
+#include "vitri/core/error.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <string>
+#include <vector>
+
+namespace vitri {
+
+using namespace local_detail;
+using rbf_detail::parallel_chunks;
+
+double LocalRbf::Impl::duplicate_tolerance2() const {
+  const double tol = opt.duplicate_tolerance * fit_diagonal;
+  return tol * tol;
+}
+
+bool LocalRbf::Impl::too_close(double d2) const { return d2 == 0 || d2 < duplicate_tolerance2(); }
+
+void LocalRbf::Impl::check_duplicates() const {
+  std::size_t worst = std::numeric_limits<std::size_t>::max(), partner = 0;  // the later index of a pair
+  std::mutex m;
+  const double r2 = duplicate_tolerance2();
+  parallel_chunks(slot_point.size(), threads(), 4096, [&](std::size_t b, std::size_t e) {
+    std::vector<PointIndex::Id> ids;
+    std::vector<double> d2;
+    const auto note = [&](std::size_t i, std::size_t j) {  // i and j are near-duplicates
+      std::lock_guard<std::mutex> lock(m);
+      if (std::max(i, j) < worst) {
+        worst = std::max(i, j);
+        partner = std::min(i, j);
+      }
+    };
+    for (std::size_t i = b; i < e; ++i) {
+      if (r2 > 0) {
+        // A ball of the tolerance's radius holds the point itself (distance 0) and its near-duplicates:
+        // much cheaper than a nearest-neighbour search, which must reach the next sample.
+        if (index.count_ball(slot_point[i], r2, 1) <= 1) continue;
+        index.ball(slot_point[i], r2, ids);
+        for (const PointIndex::Id j : ids)
+          if (j != i) note(i, j);
+      } else {  // tolerance 0: exact duplicates only
+        index.nearest(slot_point[i], 2, ids, &d2);
+        for (std::size_t k = 0; k < ids.size(); ++k)
+          if (ids[k] != i && too_close(d2[k])) note(i, ids[k]);
+      }
+    }
+  });
+  if (worst != std::numeric_limits<std::size_t>::max())
+    throw InvalidPoint(worst, "duplicates constraint " + std::to_string(partner) + " (closer than " +
+                                  std::to_string(opt.duplicate_tolerance) + " x the bounding-box diagonal)");
+}
+
+void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (c.points.size() != c.values.size())
+    throw InvalidArgument("local RBF: " + std::to_string(c.points.size()) + " points but " +
+                          std::to_string(c.values.size()) + " values");
+  if (c.size() < 4) throw InvalidArgument("local RBF: at least 4 constraints are needed, got " + std::to_string(c.size()));
+  if (c.size() >= PointIndex::kNoId - 1)
+    throw LimitError("local RBF: " + std::to_string(c.size()) + " constraints exceed the 2^32 - 2 ids");
+  std::size_t nz = 0;
+  Box3 box;
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (!is_finite(c.points[i])) throw InvalidPoint(i, "non-finite constraint position");
+    if (!std::isfinite(c.values[i])) throw InvalidPoint(i, "non-finite constraint value");
+    nz += c.values[i] != 0;
+    box.extend(c.points[i]);
+  }
+  if (nz == 0) throw InvalidArgument("local RBF: every constraint value is 0 (f would vanish everywhere)");
+  fitted = false;
+  slot_point = c.points;
+  slot_value = c.values;
+  slot_alive.assign(c.size(), 1);
+  ranks.reset(c.size());
+  live = c.size();
+  nonzero = nz;
+  cache_valid = false;
+  index.build(slot_point);
+  fit_diagonal = box.diagonal();
+  check_duplicates();
+  tree.overlap = opt.overlap;
+  if (domain.empty()) {
+    const Point3 ext = box.extent();
+    reset_root(box.center(), 0.5 * opt.domain_factor * std::max({ext.x, ext.y, ext.z}));
+  } else {
+    const Point3 ext = domain.extent();
+    reset_root(domain.center(), 0.5 * std::max({ext.x, ext.y, ext.z}));
+    const Box3 root = tree.root_box();
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (!root.contains(c.points[i])) throw InvalidPoint(i, "constraint outside the given domain");
+  }
+  std::vector<std::uint32_t> created;
+  refine_cell(0, created);
+  link(created, true);
+  fit_leaves(created);
+  publish(created);
+  for (std::size_t c2 = tree.capacity(); c2-- > 0;)  // children after parents: reach bottom-up
+    if (tree.cell(static_cast<std::uint32_t>(c2)).alive) tree.compute_reach(static_cast<std::uint32_t>(c2));
+  fitted = true;
+  fill_report();
+  report.refitted = created.size();
+  report.removed = 0;
+  report.seconds = seconds_since(t0);
+}
+
+void LocalRbf::Impl::reset_root(const Point3& center, double half) {
+  // A power-of-two half side and a center on a grid of half / 2^30: every cell's center and bounds are then
+  // exact in floating point, and domain() given back as options.domain rebuilds the very same cube.
+  if (!(half > 0) || !std::isfinite(half)) throw InvalidArgument("local RBF: the constraints span no volume");
+  int e = 0;
+  const double mantissa = std::frexp(half, &e);
+  const double h = mantissa == 0.5 ? half : std::ldexp(1.0, e), q = std::ldexp(h, -30);
+  const Point3 c{std::round(center.x / q) * q, std::round(center.y / q) * q, std::round(center.z / q) * q};
+  tree.reset(c, h);
+}
+
+void LocalRbf::Impl::refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created) {
+  const double r = tree.cell(c).radius;
+  const std::size_t n = index.count_ball(tree.cell(c).center, r * r, opt.max_per_patch);
+  if (n > opt.max_per_patch && tree.cell(c).depth < opt.max_depth) {
+    const std::uint32_t first = tree.split(c);
+    for (std::uint32_t k = 0; k < 8; ++k) refine_cell(first + k, created);
+  } else {
+    created.push_back(c);
+  }
+}
+
+void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s) {
+  Cell& cell = tree.cell(c);
+  const double r2 = cell.radius * cell.radius;
+  index.ball(cell.center, r2, s.ids);
+  const bool far = s.ids.empty();
+  if (s.ids.size() < opt.min_per_patch) {
+    index.nearest(cell.center, opt.min_per_patch, s.ids, &s.d2);
+    cell.fit_r2 = s.ids.size() < opt.min_per_patch ? std::numeric_limits<double>::infinity()
+                                                    : std::max(r2, s.d2.back());
+    std::sort(s.ids.begin(), s.ids.end());
+  } else {
+    cell.fit_r2 = r2;
+  }
+  s.points.clear();
+  s.values.clear();
+  for (PointIndex::Id id : s.ids) {
+    s.points.push_back(slot_point[id]);
+    s.values.push_back(slot_value[id]);
+  }
+  const double inv = 1.0 / cell.radius;
+  if (far) {
+    fit_linear_patch(cell.center, inv, s.points, s.values, cell.coef);
+    cell.terms = 0;
+    return;
+  }
+  if (!fit_rbf_patch(cell.center, inv, s.points, s.values, opt.smoothing, cell.coef))
+    throw NumericalError("local RBF: the patch at " + format_point(cell.center) + " (radius " +
+                         std::to_string(cell.radius) + ", " + std::to_string(s.points.size()) +
+                         " constraints) has no positive definite system: near-duplicate constraints?");
+  cell.terms = static_cast<std::uint32_t>(s.points.size());
+}
+
+void LocalRbf::Impl::fit_leaves(const std::vector<std::uint32_t>& leaves) {
+  parallel_chunks(leaves.size(), threads(), 64, [&](std::size_t b, std::size_t e) {
+    FitScratch s;
+    for (std::size_t k = b; k < e; ++k) fit_leaf(leaves[k], s);
+  });
+}
+
+void LocalRbf::Impl::fill_report() {
+  report = LocalFitReport{};
+  report.constraints = live;
+  std::size_t fitted_terms = 0, rbf_patches = 0;
+  std::size_t bytes = slot_point.size() * (sizeof(Point3) + sizeof(double) + 1 + 8) + index.size() * 40;
+  for (std::uint32_t c : tree.leaves()) {
+    const Cell& cell = tree.cell(c);
+    ++report.patches;
+    report.depth = std::max(report.depth, cell.depth);
+    if (cell.terms == 0) ++report.far_patches;
+    else ++rbf_patches;
+    fitted_terms += cell.terms;
+    report.max_fitted = std::max<std::size_t>(report.max_fitted, cell.terms);
+    bytes += cell.coef.capacity() * 8 + (cell.candidates.capacity() + cell.listed_in.capacity()) * 4;
+  }
+  bytes += tree.capacity() * sizeof(Cell) + patches.capacity() * sizeof(PatchRecord);
+  report.mean_fitted = rbf_patches ? double(fitted_terms) / double(rbf_patches) : 0.0;
+  report.memory_bytes = bytes;
+}
+
+}  // namespace vitri

@@ -1,0 +1,101 @@
+#pragma once
+// The local RBF (internal): the state of LocalRbf::Impl, shared by the files of its operations:
+// local_rbf.cpp (the object, options, accessors, validate), local_rbf_fit.cpp (the octree and the patch
+// fits), local_rbf_links.cpp (candidate lists and patch records, what evaluation reads),
+// local_rbf_evaluate.cpp (the partition-of-unity sum), local_rbf_edit.cpp (edits). See docs/local_rbf.md.
+
+#include "vitri/rbf/local_rbf.hpp"
+#include "vitri/core/slot_ranks.hpp"
+
+#include "local_tree.hpp"
+#include "parallel.hpp"
+#include "vitri/rbf/point_index.hpp"
+
+#include <chrono>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace vitri::local_detail {
+
+inline double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+inline std::string format_point(const Point3& p) {
+  std::ostringstream s;
+  s.precision(9);
+  s << "(" << p.x << ", " << p.y << ", " << p.z << ")";
+  return s.str();
+}
+
+/// Per-thread buffers of a patch fit.
+struct FitScratch {
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  std::vector<Point3> points;
+  std::vector<double> values;
+};
+
+}  // namespace vitri::local_detail
+
+namespace vitri {
+
+struct LocalRbf::Impl {
+  LocalRbfOptions opt;
+  LocalFitReport report;
+  bool fitted = false;
+  local_detail::LocalTree tree;
+  PointIndex index;  // ids are slots
+  std::vector<Point3> slot_point;
+  std::vector<double> slot_value;
+  std::vector<std::uint8_t> slot_alive;
+  SlotRanks ranks;
+  std::size_t live = 0;
+  std::size_t nonzero = 0;
+  double fit_diagonal = 0;  // bounding-box diagonal of the constraints at the last fit (duplicate tolerance)
+  mutable std::mutex cache_mutex;
+  mutable Constraints cache;
+  mutable bool cache_valid = false;
+
+  unsigned threads() const { return rbf_detail::thread_count(opt.threads); }
+  double duplicate_tolerance2() const;
+  /// True when two constraints at squared distance d2 are (near-)duplicates.
+  bool too_close(double d2) const;
+
+  /// Fits everything; the root cube comes from `domain` when not empty, else from the constraints' box.
+  void fit_all(const Constraints& c, const Box3& domain);
+  void check_duplicates() const;
+  void reset_root(const Point3& center, double half);
+  void refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created);
+  void fit_leaf(std::uint32_t c, local_detail::FitScratch& s);
+  void fit_leaves(const std::vector<std::uint32_t>& leaves);
+  /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).
+  void link(const std::vector<std::uint32_t>& created, bool every_leaf = false);
+  void unlink(std::uint32_t c);
+  /// Writes the patch record of each of `leaves` (after their fit).
+  void publish(const std::vector<std::uint32_t>& leaves);
+  /// The patch record of each leaf, by cell id (PatchRecord); entries of dead or inner cells are unused.
+  std::vector<local_detail::PatchRecord> patches;
+  void restructure(std::uint32_t c, const Point3& q, std::vector<Ball>& removed, std::vector<std::uint32_t>& created);
+  void fill_report();
+
+  double evaluate(const Point3& x, Point3* grad) const;
+  double evaluate_inside(const Point3& x, Point3* grad) const;
+
+  std::size_t slot_of(std::size_t i) const;
+  void check_new_position(const Point3& p, std::size_t index, std::optional<std::uint32_t> moving) const;
+  ChangedRegion change(std::optional<Point3> old_pos, std::optional<Point3> new_pos,
+                       const std::function<void()>& apply, const std::function<void()>& undo);
+  ChangedRegion refit_everything(const Constraints& c);
+  void compact_if_sparse();
+  /// Marks a slot dead (its constraint removed) or alive again, keeping the index and counts in step.
+  void kill_slot(std::uint32_t slot);
+  void revive_slot(std::uint32_t slot);
+};
+
+}  // namespace vitri

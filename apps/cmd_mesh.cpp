@@ -2,6 +2,7 @@
 // optionally replay an edit script (the paper's Tables 1, 2 and 3).
 #include "commands.hpp"
 #include "input.hpp"
+#include "mesh_view.hpp"
 #include "phases.hpp"
 
 #include "vitri/core/error.hpp"
@@ -141,11 +142,7 @@ std::string level_path(const std::string& out, std::size_t k) {
   return out.substr(0, dot) + "-" + std::to_string(k) + out.substr(dot);
 }
 
-void write_current(Mesher& mesher, const std::string& path) {
-  TriangleMesh tm;
-  mesher.mesh(tm.V, tm.F, tm.N);
-  write_mesh(path, tm);
-}
+void write_current(Mesher& mesher, const std::string& path) { write_mesh(path, view_of(mesher.surface())); }
 
 /// From this many constraints on, the fit is announced with its constraint count and its time (every
 /// phase is announced on stderr as it starts, see PhaseTimes).

@@ -2,6 +2,7 @@
 #include "api.hpp"
 
 #include "input.hpp"
+#include "mesh_view.hpp"
 #include "json.hpp"
 
 #include "vitri/core/error.hpp"
@@ -364,9 +365,7 @@ ApiResponse Api::export_file(const ApiRequest& r) {
     const Constraints& c = session_.mesher().constraints();
     write_xyzv(path, PointValues{c.points, c.values});
   } else if (format == "obj" || format == "ply" || format == "off") {
-    TriangleMesh tm;
-    session_.mesher().mesh(tm.V, tm.F, tm.N);
-    write_mesh(path, tm);
+    write_mesh(path, cli::view_of(session_.mesher().surface()));
   } else {
     throw BadRequest("\"format\" must be xyzv, obj, ply or off, got '" + format + "'");
   }

@@ -45,15 +45,7 @@ std::string slurp(const std::string& path) {
   return rest.str();
 }
 
-}  // namespace io_detail
-
-using io_detail::LineScanner;
-
-namespace {
-
-constexpr long long kMaxIndex = std::numeric_limits<int>::max();
-
-std::ofstream open_out(const std::string& path, bool binary = false) {
+std::ofstream open_out(const std::string& path, bool binary) {
   std::ofstream out(path, binary ? std::ios::binary : std::ios::out);
   if (!out) throw ParseError(path, 0, "cannot open file for writing");
   return out;
@@ -64,25 +56,22 @@ void finish_out(std::ofstream& out, const std::string& path) {
   if (!out) throw ParseError(path, 0, "write error");
 }
 
-// Full precision, locale-independent.
 std::string num(double v) {
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
 }
 
-bool has_normals(const TriangleMesh& m) {
-  return m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0;
-}
+}  // namespace io_detail
 
-void check_mesh_shape(const TriangleMesh& m, const std::string& path) {
-  if (m.V.cols() != 3 || m.F.cols() != 3) throw InvalidArgument(path + ": mesh V and F must have 3 columns");
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-    for (int k = 0; k < 3; ++k)
-      if (m.F(f, k) < 0 || m.F(f, k) >= m.V.rows())
-        throw InvalidArgument(path + ": triangle " + std::to_string(f) + " has vertex index " +
-                              std::to_string(m.F(f, k)) + " out of range");
-}
+using io_detail::finish_out;
+using io_detail::LineScanner;
+using io_detail::num;
+using io_detail::open_out;
+
+namespace {
+
+constexpr long long kMaxIndex = std::numeric_limits<int>::max();
 
 // Fan-triangulates polygon `poly` into tris.
 void add_polygon(std::vector<int>& tris, const std::vector<int>& poly) {
@@ -365,7 +354,7 @@ TriangleMesh parse_obj(std::string_view text, const std::string& name) {
   return make_mesh(v, tris, n);
 }
 
-// ------------------------------------------------------------------ mesh dispatch and writers
+// ------------------------------------------------------------------ mesh dispatch (writers: mesh_writers.cpp)
 TriangleMesh read_mesh(const std::string& path) {
   const std::string e = file_extension(path);
   if (e == "off") return parse_off(io_detail::slurp(path), path);
@@ -374,58 +363,13 @@ TriangleMesh read_mesh(const std::string& path) {
   throw ParseError(path, 0, "unknown mesh extension '." + e + "' (expected .off, .obj or .ply)");
 }
 
-void write_off(const std::string& path, const TriangleMesh& m) {
-  check_mesh_shape(m, path);
-  const bool n = has_normals(m);
-  auto out = open_out(path);
-  out << (n ? "NOFF\n" : "OFF\n") << m.V.rows() << ' ' << m.F.rows() << " 0\n";
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
-    out << num(m.V(i, 0)) << ' ' << num(m.V(i, 1)) << ' ' << num(m.V(i, 2));
-    if (n) out << ' ' << num(m.N(i, 0)) << ' ' << num(m.N(i, 1)) << ' ' << num(m.N(i, 2));
-    out << '\n';
-  }
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f)
-    out << "3 " << m.F(f, 0) << ' ' << m.F(f, 1) << ' ' << m.F(f, 2) << '\n';
-  finish_out(out, path);
-}
-
-void write_obj(const std::string& path, const TriangleMesh& m) {
-  check_mesh_shape(m, path);
-  const bool n = has_normals(m);
-  auto out = open_out(path);
-  out << "# vitri\n";
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i)
-    out << "v " << num(m.V(i, 0)) << ' ' << num(m.V(i, 1)) << ' ' << num(m.V(i, 2)) << '\n';
-  if (n)
-    for (Eigen::Index i = 0; i < m.N.rows(); ++i)
-      out << "vn " << num(m.N(i, 0)) << ' ' << num(m.N(i, 1)) << ' ' << num(m.N(i, 2)) << '\n';
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
-    out << 'f';
-    for (int k = 0; k < 3; ++k) {
-      const long long i = m.F(f, k) + 1LL;
-      out << ' ' << i;
-      if (n) out << "//" << i;
-    }
-    out << '\n';
-  }
-  finish_out(out, path);
-}
-
-void write_mesh(const std::string& path, const TriangleMesh& mesh, PlyEncoding ply) {
-  const std::string e = file_extension(path);
-  if (e == "off") return write_off(path, mesh);
-  if (e == "obj") return write_obj(path, mesh);
-  if (e == "ply") return write_ply(path, mesh, ply);
-  throw InvalidArgument(path + ": unknown mesh extension '." + e + "' (expected .off, .obj or .ply)");
-}
-
 // ------------------------------------------------------------------ any input
 namespace {
 
 // The vertices (and normals, when every vertex has one) of a mesh file without faces.
 Input point_cloud(TriangleMesh m) {
   Input in;
-  const bool normals = has_normals(m);
+  const bool normals = m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0;
   in.kind = normals ? InputKind::OrientedPoints : InputKind::Points;
   in.points.points.reserve(static_cast<std::size_t>(m.V.rows()));
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {

@@ -72,18 +72,11 @@ PlyType parse_type(const LineScanner& s, std::string_view t) {
   s.fail("unknown PLY property type '" + std::string(t) + "'");
 }
 
-bool host_little_endian() {
-  const std::uint16_t one = 1;
-  unsigned char b;
-  std::memcpy(&b, &one, 1);
-  return b == 1;
-}
-
 // Bounds-checked little-endian reader over the binary payload.
 class BinaryReader {
  public:
   BinaryReader(std::string_view bytes, std::size_t offset, const std::string& name)
-      : bytes_(bytes), pos_(offset), name_(name), swap_(!host_little_endian()) {}
+      : bytes_(bytes), pos_(offset), name_(name), swap_(!io_detail::host_little_endian()) {}
 
   double read(PlyType t, const char* what, std::size_t index) {
     const std::size_t n = type_size(t);
@@ -354,53 +347,6 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
   else
     m.N.resize(0, 3);
   return m;
-}
-
-void write_ply(const std::string& path, const TriangleMesh& m, PlyEncoding encoding) {
-  if (m.V.cols() != 3 || m.F.cols() != 3) throw InvalidArgument(path + ": mesh V and F must have 3 columns");
-  const bool n = m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0;
-  const bool bin = encoding == PlyEncoding::BinaryLittleEndian;
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw ParseError(path, 0, "cannot open file for writing");
-  out << "ply\nformat " << (bin ? "binary_little_endian" : "ascii") << " 1.0\ncomment vitri\n"
-      << "element vertex " << m.V.rows() << "\nproperty double x\nproperty double y\nproperty double z\n";
-  if (n) out << "property double nx\nproperty double ny\nproperty double nz\n";
-  out << "element face " << m.F.rows() << "\nproperty list uchar int vertex_indices\nend_header\n";
-  const bool swap = !host_little_endian();
-  auto put = [&](const void* p, std::size_t size) {
-    unsigned char b[8];
-    std::memcpy(b, p, size);
-    if (swap) std::reverse(b, b + size);
-    out.write(reinterpret_cast<const char*>(b), static_cast<std::streamsize>(size));
-  };
-  char buf[32];
-  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
-    double row[6] = {m.V(i, 0), m.V(i, 1), m.V(i, 2), 0, 0, 0};
-    if (n) row[3] = m.N(i, 0), row[4] = m.N(i, 1), row[5] = m.N(i, 2);
-    const int k = n ? 6 : 3;
-    for (int j = 0; j < k; ++j) {
-      if (bin) {
-        put(&row[j], 8);
-      } else {
-        std::snprintf(buf, sizeof buf, "%.17g", row[j]);
-        out << buf << (j + 1 < k ? ' ' : '\n');
-      }
-    }
-  }
-  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
-    if (bin) {
-      const unsigned char three = 3;
-      put(&three, 1);
-      for (int k = 0; k < 3; ++k) {
-        const std::int32_t idx = m.F(f, k);
-        put(&idx, 4);
-      }
-    } else {
-      out << "3 " << m.F(f, 0) << ' ' << m.F(f, 1) << ' ' << m.F(f, 2) << '\n';
-    }
-  }
-  out.flush();
-  if (!out) throw ParseError(path, 0, "write error");
 }
 
 }  // namespace vitri

@@ -6,6 +6,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <fstream>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -107,5 +110,18 @@ class LineScanner {
 
 /// Reads a whole file; ParseError(path, 0, ...) when it cannot be opened.
 std::string slurp(const std::string& path);
+/// Opens `path` for writing; ParseError(path, 0, ...) when it cannot be opened.
+std::ofstream open_out(const std::string& path, bool binary = false);
+/// Flushes; ParseError(path, 0, "write error") when the stream failed.
+void finish_out(std::ofstream& out, const std::string& path);
+/// Whether this machine stores integers little-endian (binary PLY is read and written in that order).
+inline bool host_little_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+/// A double with 17 significant digits (round-trips exactly), locale-independent.
+std::string num(double v);
 
 }  // namespace vitri::io_detail

@@ -1,7 +1,11 @@
 // SupportFilter (support_filter.hpp): the live mesh without unsupported components, kept from deltas.
 #include "support_filter.hpp"
 
+#include "vitri/core/error.hpp"
+
 #include <algorithm>
+#include <cassert>
+#include <string>
 
 namespace vitri {
 
@@ -18,7 +22,9 @@ void SupportFilter::clear() {
   view_.clear();
   corners_.clear();
   view_tri_.clear();
-  incident_.clear();
+  first_.clear();
+  last_.clear();
+  next_.clear();
   view_vertex_.clear();
   source_of_.clear();
   hidden_.clear();
@@ -59,30 +65,60 @@ void SupportFilter::hide(std::uint32_t t) {
     }
 }
 
+// Appends triangle t's corners to the lists of its vertices.
+void SupportFilter::link_corners(std::uint32_t t) {
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    const std::uint32_t v = corners_[t][k], c = 3 * t + k;
+    next_[c] = kNone;
+    if (last_[v] == kNone)
+      first_[v] = c;
+    else
+      next_[last_[v]] = c;
+    last_[v] = c;
+  }
+}
+
+// Takes triangle t's corners off the lists of its vertices (a walk of the vertex's degree each).
+void SupportFilter::unlink_corners(std::uint32_t t) {
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    const std::uint32_t v = corners_[t][k], c = 3 * t + k;
+    std::uint32_t prev = kNone;
+    for (std::uint32_t at = first_[v]; at != c; at = next_[at]) {
+      assert(at != kNone && "corner missing from its vertex's list");
+      prev = at;
+    }
+    (prev == kNone ? first_[v] : next_[prev]) = next_[c];
+    if (last_[v] == c) last_[v] = prev;
+    next_[c] = kNone;
+  }
+}
+
 // Mirrors the source's connectivity (corners of each triangle, triangles of each vertex) and lists the
 // triangles from which the search starts.
 void SupportFilter::track_source(const LiveMesh& source, const MeshDelta& delta, std::vector<std::uint32_t>& seeds) {
   grow(corners_, source.triangle_capacity(), std::array<std::uint32_t, 3>{kNone, kNone, kNone});
   grow(view_tri_, source.triangle_capacity(), kNone);
-  grow(incident_, source.vertex_capacity(), std::vector<std::uint32_t>{});
+  if (source.triangle_capacity() > (kNone - 1) / 3)  // corner ids 3 t + k must stay below kNone
+    throw LimitError("support filter: " + std::to_string(source.triangle_capacity()) +
+                     " mesh triangles, more than its 32-bit corner ids hold (" + std::to_string((kNone - 1) / 3) + ")");
+  grow(first_, source.vertex_capacity(), kNone);
+  grow(last_, source.vertex_capacity(), kNone);
+  grow(next_, 3 * source.triangle_capacity(), kNone);
   grow(view_vertex_, source.vertex_capacity(), kNone);
   std::vector<std::uint32_t> split_at;  // surviving corners of removed triangles
   for (const std::uint32_t t : delta.removed_triangles) {
-    for (const std::uint32_t v : corners_[t]) {
-      auto& inc = incident_[v];
-      inc.erase(std::find(inc.begin(), inc.end(), t));
-      split_at.push_back(v);
-    }
+    unlink_corners(t);
+    split_at.insert(split_at.end(), corners_[t].begin(), corners_[t].end());
     corners_[t] = {kNone, kNone, kNone};
   }
   for (const std::uint32_t t : delta.added_triangles) {
     corners_[t] = source.triangle(t);
-    for (const std::uint32_t v : corners_[t]) incident_[v].push_back(t);
+    link_corners(t);
     seeds.push_back(t);
   }
   split_at.insert(split_at.end(), delta.moved_vertices.begin(), delta.moved_vertices.end());
   for (const std::uint32_t v : split_at)
-    if (source.is_vertex(v)) seeds.insert(seeds.end(), incident_[v].begin(), incident_[v].end());
+    if (source.is_vertex(v)) for_each_incident(v, [&](std::uint32_t u) { seeds.push_back(u); });
   for (const std::uint32_t t : hidden_)
     if (source.is_triangle(t)) seeds.push_back(t);
 }
@@ -115,13 +151,13 @@ void SupportFilter::search(const LiveMesh& source, const std::vector<std::uint32
           vertex_support_[v] = supported(source.position(v)) ? 1 : 0;
         }
         if (!kept && vertex_stamp_[v] > update_start_ && vertex_support_[v]) kept = true;
-        for (const std::uint32_t u : incident_[v]) {
+        for_each_incident(v, [&](std::uint32_t u) {
           if (tri_stamp_[u] > update_start_ && tri_stamp_[u] != id) kept = true;  // an earlier kept one
           if (tri_stamp_[u] <= update_start_) {
             tri_stamp_[u] = id;
             reached.push_back(u);
           }
-        }
+        });
         if (kept && !flood) break;
       }
     }

@@ -43,13 +43,25 @@ class SupportFilter {
   void show(const LiveMesh& source, std::uint32_t t);
   void hide(std::uint32_t t);
   std::uint32_t view_vertex(const LiveMesh& source, std::uint32_t v);
+  void link_corners(std::uint32_t t);
+  void unlink_corners(std::uint32_t t);
+  /// Calls fn(t) for each triangle at source vertex v, in the order they were linked.
+  template <class Fn>
+  void for_each_incident(std::uint32_t v, Fn&& fn) const {
+    for (std::uint32_t c = first_[v]; c != kNone; c = next_[c]) fn(c / 3);
+  }
 
   LiveMesh view_;
   // Per source triangle: its corners (kept to know those of removed triangles), its view triangle.
   std::vector<std::array<std::uint32_t, 3>> corners_;
   std::vector<std::uint32_t> view_tri_;
-  // Per source vertex: its triangles (unordered), its view vertex.
-  std::vector<std::vector<std::uint32_t>> incident_;
+  // The triangles of each source vertex, as an intrusive list in the order they were added (the order the
+  // search visits them): corner c = 3 t + k is corner k of triangle t; first_[v] / last_[v] are v's first
+  // and last corners (kNone: none), next_[c] the next corner at the same vertex (kNone at the end). Every
+  // live source triangle's three corners are on the lists of its three vertices, and no other corner.
+  // (28 bytes per mesh vertex, against about 70 for a vector per vertex: 60 MB at 10^6 points.)
+  std::vector<std::uint32_t> first_, last_, next_;
+  // Per source vertex: its view vertex.
   std::vector<std::uint32_t> view_vertex_;
   std::vector<std::uint32_t> source_of_;  // per view vertex: its source vertex
   std::vector<std::uint32_t> hidden_;     // source triangles hidden (may hold stale entries)

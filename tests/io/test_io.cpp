@@ -10,6 +10,9 @@
 #include <fstream>
 #include <iterator>
 #include <random>
+#include <array>
+#include <cstdint>
+#include <vector>
 #include <string>
 
 using namespace vitri;
@@ -73,6 +76,56 @@ TEST_CASE("io mesh writers round-trip through the readers exactly", "[io]") {
       std::remove(path.c_str());
     }
   }
+}
+
+namespace {
+
+std::string file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+}  // namespace
+
+TEST_CASE("io mesh writers on a view write the same bytes as on the Eigen mesh", "[io]") {
+  const bool normals = GENERATE(false, true);
+  const TriangleMesh m = tetra(normals);
+  std::vector<Point3> v, n;
+  std::vector<std::array<std::uint32_t, 3>> f;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    v.push_back({m.V(i, 0), m.V(i, 1), m.V(i, 2)});
+    if (normals) n.push_back({m.N(i, 0), m.N(i, 1), m.N(i, 2)});
+  }
+  for (Eigen::Index i = 0; i < m.F.rows(); ++i)
+    f.push_back({static_cast<std::uint32_t>(m.F(i, 0)), static_cast<std::uint32_t>(m.F(i, 1)),
+                 static_cast<std::uint32_t>(m.F(i, 2))});
+  TriangleMeshView view{v.data(), v.size(), f.data(), f.size(), normals ? n.data() : nullptr};
+  for (const char* ext : {"off", "obj", "ply"}) {
+    for (PlyEncoding enc : {PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian}) {
+      const std::string a = tmp(std::string("eigen.") + ext), b = tmp(std::string("view.") + ext);
+      write_mesh(a, m, enc);
+      write_mesh(b, view, enc);
+      const std::string bytes = file_bytes(a);
+      REQUIRE(!bytes.empty());
+      CHECK(file_bytes(b) == bytes);
+      const TriangleMesh r = read_mesh(b);
+      CHECK(r.V == m.V);
+      CHECK(r.F == m.F);
+      CHECK(r.N.rows() == (normals ? 4 : 0));
+      std::remove(a.c_str());
+      std::remove(b.c_str());
+    }
+  }
+  // A bad index is named, and nothing is written.
+  f[2][1] = 4;
+  const std::string bad = tmp("view_bad.ply");
+  std::remove(bad.c_str());
+  CHECK_THROWS_WITH(write_mesh(bad, view), Catch::Contains("triangle 2") && Catch::Contains("out of range"));
+  CHECK_FALSE(std::ifstream(bad).good());
+  // A count without its array.
+  TriangleMeshView empty;
+  empty.num_vertices = 3;
+  CHECK_THROWS_AS(write_mesh(tmp("view_null.off"), empty), InvalidArgument);
 }
 
 TEST_CASE("io constraints and points round-trip", "[io]") {

@@ -120,12 +120,21 @@ TEST_CASE("EdgeMap: the same answers as std::unordered_map under random inserts 
       REQUIRE(*value == it->second);
     }
     REQUIRE(map.size() == ref.size());
+    REQUIRE(4 * map.size() <= 3 * map.capacity());  // load <= 3/4
   }
   for (const auto& [k, v] : ref) REQUIRE(*map.try_emplace(k, 0).first == v);  // every key still found
   REQUIRE(map.size() == ref.size());
   map.clear();
   REQUIRE(map.size() == 0);
   REQUIRE_FALSE(map.erase(ref.begin()->first));
+  // reserve(n) makes room for n entries: no rehash while inserting them, at most 8/3 slots per entry.
+  EdgeMap reserved;
+  reserved.reserve(3000);
+  const std::size_t capacity = reserved.capacity();
+  REQUIRE(capacity * 3 <= 3000 * 8);
+  for (std::uint64_t k = 0; k < 3000; ++k) reserved.try_emplace(k << 32 | (k * 7919 % 3000), 0);
+  REQUIRE(reserved.size() == 3000);
+  REQUIRE(reserved.capacity() == capacity);
 }
 
 TEST_CASE("march_tetrahedron: every sign pattern gives a polygon facing the positive side", "[incremental]") {

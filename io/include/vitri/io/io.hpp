@@ -18,7 +18,9 @@
 
 #include <Eigen/Core>
 
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -46,6 +48,17 @@ struct TriangleMesh {
   Eigen::MatrixXd V;  ///< #V x 3 vertex positions.
   Eigen::MatrixXi F;  ///< #F x 3 zero-based vertex indices, counter-clockwise seen from outside.
   Eigen::MatrixXd N;  ///< Empty (0 x 3) or #V x 3 vertex normals.
+};
+
+/// A triangle mesh held elsewhere, written as it is, without a copy (e.g. a SurfaceMesh's vectors:
+/// `{m.vertices.data(), m.vertices.size(), m.triangles.data(), m.triangles.size(),
+/// m.normals.size() == m.vertices.size() ? m.normals.data() : nullptr}`). The arrays must outlive the call.
+struct TriangleMeshView {
+  const Point3* vertices = nullptr;                     ///< num_vertices positions
+  std::size_t num_vertices = 0;
+  const std::array<std::uint32_t, 3>* triangles = nullptr;  ///< num_triangles zero-based index triples, CCW from outside
+  std::size_t num_triangles = 0;
+  const Point3* normals = nullptr;                      ///< null, or num_vertices vertex normals
 };
 
 /// Encoding of a written PLY file.
@@ -88,6 +101,13 @@ void write_mesh(const std::string& path, const TriangleMesh& mesh, PlyEncoding p
 void write_off(const std::string& path, const TriangleMesh& mesh);
 void write_obj(const std::string& path, const TriangleMesh& mesh);
 void write_ply(const std::string& path, const TriangleMesh& mesh, PlyEncoding encoding = PlyEncoding::Ascii);
+/// The same writers on a view: the same bytes as for the TriangleMesh with the same values. An index
+/// out of range, or a mesh with more than 2^31 - 1 vertices (the formats' int indices), is an
+/// InvalidArgument naming the file and the triangle; nothing is written then.
+void write_mesh(const std::string& path, const TriangleMeshView& mesh, PlyEncoding ply = PlyEncoding::Ascii);
+void write_off(const std::string& path, const TriangleMeshView& mesh);
+void write_obj(const std::string& path, const TriangleMeshView& mesh);
+void write_ply(const std::string& path, const TriangleMeshView& mesh, PlyEncoding encoding = PlyEncoding::Ascii);
 
 // ----- any input -----
 /// What read_input() found.

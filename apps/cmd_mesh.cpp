@@ -142,6 +142,17 @@ std::string level_path(const std::string& out, std::size_t k) {
   return out.substr(0, dot) + "-" + std::to_string(k) + out.substr(dot);
 }
 
+/// The extraction's own steps (stderr, beside the progress lines): where the time of a large mesh goes.
+void print_extraction_split(const PolygonizerStats& s, double extract_ms) {
+  const double tracked = 1e3 * (s.extract_polygons_seconds + s.extract_placement_seconds + s.extract_snapping_seconds +
+                                s.extract_mesh_seconds);
+  std::fprintf(stderr,
+               "  extraction: polygons %.0f ms, crossings %.0f ms, collapses %.0f ms, mesh %.0f ms, "
+               "components and copy %.0f ms\n",
+               1e3 * s.extract_polygons_seconds, 1e3 * s.extract_placement_seconds,
+               1e3 * s.extract_snapping_seconds, 1e3 * s.extract_mesh_seconds, std::max(0.0, extract_ms - tracked));
+}
+
 void write_current(Mesher& mesher, const std::string& path) { write_mesh(path, view_of(mesher.surface())); }
 
 /// From this many constraints on, the fit is announced with its constraint count and its time (every
@@ -365,6 +376,7 @@ int run_mesh(const Args& args) {
     const auto t1 = Clock::now();
     const SurfaceMesh& m = mesher.surface();
     const double extract_ms = ms_since(t1);
+    if (!quiet) print_extraction_split(mesher.stats().polygonizer, extract_ms);
     total_ms += refine_ms + extract_ms;
     const std::string path = levels == 1 ? output : level_path(output, k);
     phases.start("writing", "writing " + path);

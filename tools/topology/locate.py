@@ -10,6 +10,19 @@ usage:
   locate.py localchi MODEL.off MESH.obj [R] balls of radius R (fraction, 0.015) centred on the model's
                                             surface where the MESH's Euler characteristic differs from
                                             the model's: where the extra handles and bubbles are
+  locate.py sweep REF MESH [N]              where MESH's topology departs from REF's (a mesh of the same
+                                            surface with the right topology, e.g. a coarser one: not a
+                                            coarse model, whose critical points sit elsewhere): along
+                                            each axis, chi of the sublevel sets {x_k <= h} of both, N
+                                            heights (2000); an extra handle is a lasting drop of 2 at
+                                            the same height on all three axes. Works at 10^6 vertices.
+  locate.py ballchi REF MESH X Y Z          chi of REF and MESH inside balls around (X, Y, Z) (radii
+                                            1e-4 to 3e-2 of the diagonal): a handle in the ball gives -1
+
+MESH and REF: .off, .obj or .ply (ascii or binary little-endian, as vitri writes them). sweep and ballchi
+use lower-star sublevel complexes (a vertex, edge or triangle belongs when all its vertices do), which
+have the topology of the sublevel sets of the piecewise-linear height or distance, whatever the mesh's
+resolution (localchi's clipped balls are ragged at 10^6 vertices).
 
 numpy and scipy (Debian python3-numpy, python3-scipy). Distances to the model are taken to dense
 area-weighted samples of its triangles (fixed seed); the side (in/out) from the nearest sample's normal.
@@ -50,8 +63,48 @@ def read_obj(path):
     return np.array(V), np.array(F)
 
 
+def read_ply(path):
+    with open(path, 'rb') as f:
+        nv = nf = 0
+        props, binary = 0, False
+        while True:
+            line = f.readline().decode('ascii', 'replace').strip()
+            if line.startswith('format'):
+                binary = 'binary_little_endian' in line
+            elif line.startswith('element vertex'):
+                nv, section = int(line.split()[2]), 'vertex'
+            elif line.startswith('element face'):
+                nf, section = int(line.split()[2]), 'face'
+            elif line.startswith('property') and section == 'vertex':
+                props += 1
+            elif line == 'end_header':
+                break
+        data = f.read()
+    if binary:  # vitri's layout: doubles per vertex, then uchar 3 + 3 int32 per face
+        V = np.frombuffer(data, '<f8', nv * props).reshape(nv, props)[:, :3]
+        face = np.dtype([('n', 'u1'), ('i', '<i4', 3)])
+        F = np.frombuffer(data, face, nf, nv * props * 8)['i'].astype(np.int64)
+        return V.copy(), F
+    lines = data.split(b'\n')
+    V = np.array(b' '.join(lines[:nv]).split(), dtype=float).reshape(nv, -1)[:, :3]
+    F = np.array(b' '.join(lines[nv:nv + nf]).split(), dtype=np.int64).reshape(nf, 4)[:, 1:]
+    return V, F
+
+
 def read_mesh(path):
-    return read_off(path) if path.endswith('.off') else read_obj(path)
+    if path.endswith('.off'):
+        return read_off(path)
+    return read_ply(path) if path.endswith('.ply') else read_obj(path)
+
+
+def lower_star_chi(V, F, height, levels):
+    """Euler characteristic of the sublevel complexes {height <= h} for each h of `levels`."""
+    E = np.unique(np.sort(np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]]), axis=1), axis=0)
+    hv = np.sort(height)
+    he = np.sort(np.maximum(height[E[:, 0]], height[E[:, 1]]))
+    ht = np.sort(height[F].max(1))
+    count = lambda h: np.searchsorted(h, levels, 'right')  # noqa: E731
+    return count(hv) - count(he) + count(ht)
 
 
 def diagonal(V):
@@ -200,9 +253,39 @@ def cmd_localchi(model, mesh, radius=0.015):
         print(f'  site {P[sel].mean(0).round(3)}: {len(sel)} balls, e.g. {[bad[k][1:] for k in sel[:4]]}')
 
 
+def cmd_sweep(ref, mesh, n=2000):
+    RV, RF = read_mesh(ref)
+    MV, MF = read_mesh(mesh)
+    top = np.array([np.inf])
+    print(f'chi: {ref} {lower_star_chi(RV, RF, RV[:, 0], top)[0]}, {mesh} {lower_star_chi(MV, MF, MV[:, 0], top)[0]}')
+    lo, hi = np.minimum(RV.min(0), MV.min(0)), np.maximum(RV.max(0), MV.max(0))
+    for axis in range(3):
+        h = np.linspace(lo[axis], hi[axis], int(n))
+        d = lower_star_chi(MV, MF, MV[:, axis], h) - lower_star_chi(RV, RF, RV[:, axis], h)
+        # Lasting changes: the difference at the end of each run of equal values longer than 1% of n.
+        runs, start = [], 0
+        for i in range(1, len(h) + 1):
+            if i == len(h) or d[i] != d[start]:
+                if i - start >= max(2, len(h) // 100) and (not runs or runs[-1][1] != d[start]):
+                    runs.append((h[start], d[start]))
+                start = i
+        steps = [f'{d0:+d} from {h0:.4f}' for (h0, d0) in runs]
+        print(f'axis {"xyz"[axis]}: ' + ', '.join(steps))
+
+
+def cmd_ballchi(ref, mesh, x, y, z):
+    RV, RF = read_mesh(ref)
+    MV, MF = read_mesh(mesh)
+    c = np.array([float(x), float(y), float(z)])
+    radii = np.array([1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 3e-2]) * diagonal(RV)
+    for name, (V, F) in ((ref, (RV, RF)), (mesh, (MV, MF))):
+        chi = lower_star_chi(V, F, np.linalg.norm(V - c, axis=1), radii)
+        print(f'{name}: ' + ', '.join(f'r {r:.2e}: {k}' for r, k in zip(radii, chi)))
+
+
 if __name__ == '__main__':
     commands = {'selfint': cmd_selfint, 'constraints': cmd_constraints, 'compare': cmd_compare,
-                'localchi': cmd_localchi}
+                'localchi': cmd_localchi, 'sweep': cmd_sweep, 'ballchi': cmd_ballchi}
     if len(sys.argv) < 3 or sys.argv[1] not in commands:
         sys.exit(__doc__)
     args = [float(a) if a.replace('.', '', 1).isdigit() else a for a in sys.argv[2:]]

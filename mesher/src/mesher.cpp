@@ -104,9 +104,11 @@ void Mesher::build() {
   for (std::size_t i = 0; i < c.size(); ++i) track_zero(vertex_of_[i], c.points[i], c.values[i]);
   quality_.reset();
   mesh_valid_ = false;
+  if (local_) local_->release_constraints_cache();  // read once here; 32 bytes per constraint freed
 }
 
 double Mesher::diagonal() const {
+  if (local_) return local_->bounding_box().diagonal();
   Box3 b;
   for (const Point3& p : constraints().points) b.extend(p);
   return b.diagonal();

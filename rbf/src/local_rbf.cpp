@@ -73,11 +73,26 @@ const Constraints& LocalRbf::constraints() const {
   std::lock_guard<std::mutex> lock(impl_->cache_mutex);
   if (!impl_->cache_valid) {
     impl_->cache = Constraints{};
+    impl_->cache.points.reserve(size());
+    impl_->cache.values.reserve(size());
     for (std::size_t s = 0; s < impl_->slot_point.size(); ++s)
       if (impl_->slot_alive[s]) impl_->cache.add(impl_->slot_point[s], impl_->slot_value[s]);
     impl_->cache_valid = true;
   }
   return impl_->cache;
+}
+
+void LocalRbf::release_constraints_cache() const {
+  std::lock_guard<std::mutex> lock(impl_->cache_mutex);
+  impl_->cache = Constraints{};
+  impl_->cache_valid = false;
+}
+
+Box3 LocalRbf::bounding_box() const {
+  Box3 b;
+  for (std::size_t s = 0; s < impl_->slot_point.size(); ++s)
+    if (impl_->slot_alive[s]) b.extend(impl_->slot_point[s]);
+  return b;
 }
 
 Point3 LocalRbf::point(std::size_t i) const {

@@ -86,6 +86,26 @@ TEST_CASE("LocalRbf interpolates every constraint and has a valid structure", "[
   }
 }
 
+TEST_CASE("LocalRbf: bounding box without the copy; the copy released and rebuilt the same", "[local_rbf]") {
+  const Constraints c = torus_constraints(600);
+  LocalRbf f(c);
+  vitri::Box3 box;
+  for (const Point3& p : c.points) box.extend(p);
+  const vitri::Box3 b = f.bounding_box();
+  CHECK(b.lo == box.lo);
+  CHECK(b.hi == box.hi);
+  const Constraints before = f.constraints();
+  f.release_constraints_cache();
+  const Constraints& again = f.constraints();
+  CHECK(again.points == before.points);
+  CHECK(again.values == before.values);
+  f.remove_constraint(0);  // the box follows edits
+  vitri::Box3 after;
+  for (std::size_t i = 0; i < f.size(); ++i) after.extend(f.point(i));
+  CHECK(f.bounding_box().lo == after.lo);
+  CHECK(f.bounding_box().hi == after.hi);
+}
+
 TEST_CASE("LocalRbf gradient matches finite differences", "[local_rbf]") {
   LocalRbf f(torus_constraints(800));
   const auto pts = random_points(300, 1.6, 5);

@@ -109,6 +109,11 @@ class LocalRbf : public ImplicitFunction {
   std::size_t size() const;
   /// Current constraints in the public numbering (built on demand after edits, O(N), then cached).
   const Constraints& constraints() const;
+  /// Frees the copy that constraints() keeps (32 bytes per constraint; rebuilt by its next call): for
+  /// callers that read the constraints once, e.g. the Mesher's seeds.
+  void release_constraints_cache() const;
+  /// Bounding box of the current constraints, O(N), without building constraints().
+  Box3 bounding_box() const;
   /// Position and value of constraint i, O(log N). @throws InvalidPoint when i >= size().
   Point3 point(std::size_t i) const;
   double value_of(std::size_t i) const;

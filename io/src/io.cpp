@@ -369,7 +369,7 @@ namespace {
 // The vertices (and normals, when every vertex has one) of a mesh file without faces.
 Input point_cloud(TriangleMesh m) {
   Input in;
-  const bool normals = m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0;
+  const bool normals = io_detail::has_vertex_normals(m);
   in.kind = normals ? InputKind::OrientedPoints : InputKind::Points;
   in.points.points.reserve(static_cast<std::size_t>(m.V.rows()));
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {

@@ -30,7 +30,7 @@ struct EigenRows {
   const TriangleMesh& m;
   std::size_t num_vertices() const { return static_cast<std::size_t>(m.V.rows()); }
   std::size_t num_triangles() const { return static_cast<std::size_t>(m.F.rows()); }
-  bool has_normals() const { return m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0; }
+  bool has_normals() const { return io_detail::has_vertex_normals(m); }
   double vertex(std::size_t i, int k) const { return m.V(static_cast<Eigen::Index>(i), k); }
   double normal(std::size_t i, int k) const { return m.N(static_cast<Eigen::Index>(i), k); }
   long long index(std::size_t f, int k) const { return m.F(static_cast<Eigen::Index>(f), k); }
@@ -42,10 +42,9 @@ struct ViewRows {
   std::size_t num_vertices() const { return m.num_vertices; }
   std::size_t num_triangles() const { return m.num_triangles; }
   bool has_normals() const { return m.normals != nullptr && m.num_vertices > 0; }
-  double vertex(std::size_t i, int k) const { return coordinate(m.vertices[i], k); }
-  double normal(std::size_t i, int k) const { return coordinate(m.normals[i], k); }
+  double vertex(std::size_t i, int k) const { return m.vertices[i][static_cast<std::size_t>(k)]; }
+  double normal(std::size_t i, int k) const { return m.normals[i][static_cast<std::size_t>(k)]; }
   long long index(std::size_t f, int k) const { return m.triangles[f][static_cast<std::size_t>(k)]; }
-  static double coordinate(const Point3& p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; }
 };
 
 void check_shape(const TriangleMesh& m, const std::string& path) {

@@ -2,6 +2,7 @@
 // Line- and token-level scanning of text files with line numbers for the error messages.
 
 #include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
 
 #include <charconv>
 #include <cmath>
@@ -120,6 +121,10 @@ inline bool host_little_endian() {
   unsigned char first = 0;
   std::memcpy(&first, &one, 1);
   return first == 1;
+}
+/// Whether the mesh has one normal per vertex (N is #V x 3, and there are vertices).
+inline bool has_vertex_normals(const TriangleMesh& m) {
+  return m.N.rows() == m.V.rows() && m.N.cols() == 3 && m.V.rows() > 0;
 }
 /// A double with 17 significant digits (round-trips exactly), locale-independent.
 std::string num(double v);

@@ -13,7 +13,9 @@ namespace {
 
 template <typename T>
 void grow(std::vector<T>& v, std::size_t n, const T& fill) {
-  if (v.size() < n) v.resize(std::max(n, 2 * v.size()), fill);
+  // To n, not to twice the size: the capacity grows geometrically by itself, and only the elements
+  // written are resident.
+  if (v.size() < n) v.resize(n, fill);
 }
 
 }  // namespace

@@ -4,8 +4,8 @@
 // extraction, then edited a few dozen at a time). One array of (key, value) pairs, no node per entry.
 //
 // Invariants: the capacity is a power of two and at least 4/3 of the size (load <= 3/4: short probe
-// runs with the multiplicative hash, and 16 bytes x 4/3 to 8/3 per entry); an empty slot holds kEmpty (never a key: an edge key packs two vertex ids below 2^32 - 1);
-// erase() shifts the following run back (no tombstones), so every key is reachable from its home slot
+// runs with the multiplicative hash, and 16 bytes x 4/3 to 8/3 per entry); an empty slot holds kEmpty
+// (never a key: an edge key packs two vertex ids below 2^32 - 1); erase() shifts the following run back (no tombstones), so every key is reachable from its home slot
 // without crossing an empty slot.
 #include <cassert>
 #include <cstdint>

@@ -185,22 +185,20 @@ void Polygonizer::grow_vertex_arrays() {
   if (values_.size() >= n) return;
   // resize(n) and not to twice the size: std::vector grows its capacity geometrically by itself, and only
   // the first n elements are written (and so resident).
-  const std::size_t cap = n;
-  values_.resize(cap, 0.0);
-  kind_.resize(cap, static_cast<std::uint8_t>(VertexKind::Refinement));
-  fixed_.resize(cap, 0);
-  tcount_.resize(cap, 0);
-  lpos_.resize(cap, kNotListed);
+  values_.resize(n, 0.0);
+  kind_.resize(n, static_cast<std::uint8_t>(VertexKind::Refinement));
+  fixed_.resize(n, 0);
+  tcount_.resize(n, 0);
+  lpos_.resize(n, kNotListed);
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  grad_.resize(cap, Point3{nan, nan, nan});
+  grad_.resize(n, Point3{nan, nan, nan});
 }
 
 void Polygonizer::grow_tet_arrays() {
   const std::size_t n = tri_.tet_capacity();
   if (tpos_.size() >= n) return;
-  const std::size_t cap = n;  // as in grow_vertex_arrays
-  tpos_.resize(cap, kNotListed);
-  radius_.resize(cap, 0.0);
+  tpos_.resize(n, kNotListed);
+  radius_.resize(n, 0.0);
 }
 
 // Vertices whose evaluation is due: every live vertex without a fixed value, and with

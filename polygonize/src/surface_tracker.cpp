@@ -92,13 +92,13 @@ std::uint32_t& SurfaceTracker::polygon_of(TetId t) {
 
 void SurfaceTracker::grow_vertex_arrays(std::size_t n) {
   if (collapsed_.size() >= n) return;
-  const std::size_t cap = n;  // std::vector grows its capacity geometrically; only n elements are written
-  collapsed_.resize(cap, 0);
-  zero_out_.resize(cap, kNone);
-  anchored_.resize(cap, 0);
-  stamp_.resize(cap, 0);
-  moved_stamp_.resize(cap, 0);
-  decide_stamp_.resize(cap, 0);
+  // resize(n): std::vector grows its capacity geometrically; only the n elements written are resident.
+  collapsed_.resize(n, 0);
+  zero_out_.resize(n, kNone);
+  anchored_.resize(n, 0);
+  stamp_.resize(n, 0);
+  moved_stamp_.resize(n, 0);
+  decide_stamp_.resize(n, 0);
 }
 
 std::uint32_t SurfaceTracker::corner_identity(std::uint32_t e) const {

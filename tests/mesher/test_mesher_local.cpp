@@ -166,8 +166,8 @@ TEST_CASE("batch option: no Delaunay history, an equivalent mesh", "[mesher][loc
 
 // A batch run with threads for the seeds' bulk insertion (what the CLI does without --edits): the
 // insertion really runs in parallel, gives the serial tetrahedralization (same vertex and tetrahedron
-// counts, same transverse tetrahedra), and the refined mesh is closed and equivalent to the serial one
-// (tetrahedron ids, hence the refinement order, may differ).
+// counts, same transverse tetrahedra), and the refined mesh is closed and the serial one, bit for bit
+// (the tetrahedra are renumbered canonically after the seeds, and the refinement order follows the ids).
 TEST_CASE("batch option with bulk threads: the serial tetrahedralization, the same mesh", "[mesher][local]") {
   const TriangleMesh in = read_mesh(kData + "/knot1.off");
   MesherOptions serial;

@@ -59,7 +59,7 @@ class SupportFilter {
   // search visits them): corner c = 3 t + k is corner k of triangle t; first_[v] / last_[v] are v's first
   // and last corners (kNone: none), next_[c] the next corner at the same vertex (kNone at the end). Every
   // live source triangle's three corners are on the lists of its three vertices, and no other corner.
-  // (28 bytes per mesh vertex, against about 70 for a vector per vertex: 60 MB at 10^6 points.)
+  // (About 32 bytes per mesh vertex, against about 70 for a vector per vertex.)
   std::vector<std::uint32_t> first_, last_, next_;
   // Per source vertex: its view vertex.
   std::vector<std::uint32_t> view_vertex_;

@@ -4,25 +4,31 @@
 /// A brief explanation. The inline filters in the header evaluate each determinant in doubles and
 /// certify its sign with a semi-static error bound. When the bound does not certify it (near-degenerate
 /// input, or magnitudes where under/overflow could break the bound), we come here and compute the same
-/// determinant exactly with expansion arithmetic (expansion.hpp):
+/// determinant exactly (double words, then expansion arithmetic: double_word.hpp, expansion.hpp):
 ///   1. Pre-scale all coordinates of the call by one power of two 2^k (exact; the sign of a homogeneous
 ///      determinant does not change) so that the largest |coordinate| lands just below 2^E, with E
 ///      chosen per predicate so that no intermediate can overflow (nor overflow Dekker's split) while
 ///      leaving as much room as possible below for small coordinates. Expansion arithmetic is exact on
 ///      the scaled values as long as the coordinates of one call span at most a predicate-dependent
 ///      number of binary orders (docs/predicates.md, "Valid input range"). Calls spread wider than that
-///      (say 1 and 1e-300 together) skip steps 2-4: every coordinate is written as an integer times
+///      (say 1 and 1e-300 together) skip steps 2-5: every coordinate is written as an integer times
 ///      2^kmin and the determinant is evaluated with integers modulo 2^N, N chosen from a bound on the
 ///      determinant (wide_int.hpp). Slow, but it cannot underflow or overflow, and such calls are rare.
 ///   2. Stage 1: the filter's expression in doubles, every operation checked for exactness.
-///   3. Stage 2: form the differences exactly as two-component expansions (two_diff) and evaluate the
+///   3. Stage 2 (double_word.hpp): the same expression in double-word arithmetic (about 106 bits) from
+///      the exact differences, with a certified error bound of order u^2: decides the near-degenerate
+///      calls whose determinant is tiny but not zero (rounded near-cospherical points), for a few hundred
+///      flops. Exact zeros, and calls within the bound, go on.
+///   4. Stage 3: form the differences exactly as two-component expansions (two_diff) and evaluate the
 ///      determinant with the same cofactor scheme as the filter, every product and sum exact, zero
 ///      components eliminated (on grids and nearby points most differences are exact single doubles and
 ///      the expansions stay a few components long).
-///   4. The sign is the sign of the largest component.
+///   5. The sign is the sign of the largest component.
 
 #include "vitri/core/predicates.hpp"
 
+#include "cofactors.hpp"
+#include "double_word.hpp"
 #include "expansion.hpp"
 #include "wide_int.hpp"
 
@@ -141,37 +147,6 @@ void to_wide_integers(const double* v, int n, int degree, WideInt* out) {
     out[i] = WideInt(mant[i], std::signbit(v[i]), mant[i] == 0 ? 0 : expo[i] - kmin, limbs);
 }
 
-/// The determinants' cofactor schemes (the filter's expressions, predicates.hpp), generic over the
-/// arithmetic: CheckedArithmetic on doubles (stage 1) and WideArithmetic on exact integers. `Arith`
-/// provides sub, add and mul on T.
-/// orient3d: v holds a, b, c, d (12 values); det[b - a, c - a, d - a].
-template <class Arith, class T>
-T orient3d_cofactors(Arith& f, const T* v) {
-  T m[3][3];
-  for (int r = 0; r < 3; ++r)
-    for (int k = 0; k < 3; ++k) m[r][k] = f.sub(v[3 * (r + 1) + k], v[k]);
-  const T m1 = f.sub(f.mul(m[1][1], m[2][2]), f.mul(m[1][2], m[2][1]));
-  const T m2 = f.sub(f.mul(m[1][2], m[2][0]), f.mul(m[1][0], m[2][2]));
-  const T m3 = f.sub(f.mul(m[1][0], m[2][1]), f.mul(m[1][1], m[2][0]));
-  return f.add(f.add(f.mul(m[0][0], m1), f.mul(m[0][1], m2)), f.mul(m[0][2], m3));
-}
-
-/// insphere from the differences q[r][k] = coordinate k of (point r - e), r = a, b, c, d.
-template <class Arith, class T>
-T insphere_cofactors(Arith& f, const T (&q)[4][3]) {
-  auto minor2 = [&](int i, int j) { return f.sub(f.mul(q[i][0], q[j][1]), f.mul(q[j][0], q[i][1])); };
-  const T ab = minor2(0, 1), bc = minor2(1, 2), cd = minor2(2, 3), da = minor2(3, 0), ac = minor2(0, 2),
-          bd = minor2(1, 3);
-  const T abc = f.add(f.sub(f.mul(q[0][2], bc), f.mul(q[1][2], ac)), f.mul(q[2][2], ab));
-  const T bcd = f.add(f.sub(f.mul(q[1][2], cd), f.mul(q[2][2], bd)), f.mul(q[3][2], bc));
-  const T cda = f.add(f.add(f.mul(q[2][2], da), f.mul(q[3][2], ac)), f.mul(q[0][2], cd));
-  const T dab = f.add(f.add(f.mul(q[3][2], ab), f.mul(q[0][2], bd)), f.mul(q[1][2], da));
-  T lift[4];
-  for (int r = 0; r < 4; ++r)
-    lift[r] = f.add(f.add(f.mul(q[r][0], q[r][0]), f.mul(q[r][1], q[r][1])), f.mul(q[r][2], q[r][2]));
-  return f.add(f.sub(f.mul(lift[0], bcd), f.mul(lift[1], cda)), f.sub(f.mul(lift[2], dab), f.mul(lift[3], abc)));
-}
-
 /// Exact integer arithmetic for the cofactor schemes.
 struct WideArithmetic {
   WideInt sub(const WideInt& a, const WideInt& b) const { return a - b; }
@@ -235,7 +210,7 @@ void combine3(const Expansion& p1, const Expansion& m1, double s1, const Expansi
 }  // namespace
 
 namespace {
-/// Stage 2 of orient3d_exact on the pre-scaled coordinates v (a, b, c, d): expansion arithmetic.
+/// Stage 3 of orient3d_exact on the pre-scaled coordinates v (a, b, c, d): expansion arithmetic.
 /// Kept out of line so that stage 1 does not pay for the large stack frame.
 [[gnu::noinline]] Sign orient3d_expansion(const double* v) {
   // Rows u = b - a, v = c - a, w = d - a; columns x, y, z.
@@ -278,11 +253,13 @@ Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
     const double det = orient3d_cofactors(f, v);
     if (f.exact) return sign_of(det);
   }
+  const DoubleWordResult dw = orient3d_double_word(v);  // stage 2
+  if (dw.decided()) return sign_of(dw.value.hi);
   return orient3d_expansion(v);
 }
 
 namespace {
-/// Stage 2 of insphere_exact on the pre-scaled coordinates v (a, b, c, d, e): expansion arithmetic.
+/// Stage 3 of insphere_exact on the pre-scaled coordinates v (a, b, c, d, e): expansion arithmetic.
 [[gnu::noinline]] Sign insphere_expansion(const double* v) {
   // q[r][k] = coordinate k of (point r - e), r = a, b, c, d.
   Expansion q[4][3];
@@ -351,6 +328,8 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
       if (f.exact) return sign_of(det);
     }
   }
+  const DoubleWordResult dw = insphere_double_word(v);  // stage 2
+  if (dw.decided()) return sign_of(dw.value.hi);
   return insphere_expansion(v);
 }
 

@@ -266,34 +266,35 @@ inline int oracle_insphere_sos(const Point3& a, const Point3& b, const Point3& c
   return lifted_sign(v, lift);
 }
 
-/// True when |value * 2^scale - center| <= radius exactly, for an integer value and doubles center,
-/// radius >= 0 (all brought to the smallest of the three exponents).
-inline bool within(const BigInt& value, int scale, double center, double radius) {
+/// True when |value * 2^scale - (center + center_lo)| <= radius exactly, for an integer value and
+/// doubles center, center_lo (a double word; 0 for a plain double), radius >= 0 (all brought to the
+/// smallest of their exponents).
+inline bool within(const BigInt& value, int scale, double center, double radius, double center_lo = 0.0) {
   int kc = 0, kr = 0;
-  const auto c = exact_integers({center}, &kc), r = exact_integers({radius}, &kr);
-  if (center == 0.0) kc = scale;
+  const auto c = exact_integers({center, center_lo}, &kc), r = exact_integers({radius}, &kr);
+  if (center == 0.0 && center_lo == 0.0) kc = scale;
   if (radius == 0.0) kr = scale;
   const int k = std::min(scale, std::min(kc, kr));
-  const BigInt diff = value.shifted(scale - k) - c[0].shifted(kc - k);
+  const BigInt diff = value.shifted(scale - k) - (c[0] + c[1]).shifted(kc - k);
   const BigInt rad = r[0].shifted(kr - k);
   return (diff - rad).sign() <= 0 && (diff + rad).sign() >= 0;
 }
 
-/// True when the exact value of det[b - a, c - a, d - a] lies within `radius` of `center`.
+/// True when the exact value of det[b - a, c - a, d - a] lies within `radius` of `center` (+ `center_lo`).
 inline bool orient3d_within(const Point3& a, const Point3& b, const Point3& c, const Point3& d, double center,
-                            double radius) {
+                            double radius, double center_lo = 0.0) {
   int kmin = 0;
   const auto v = exact_integers({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z}, &kmin);
   BigInt m[3][3];
   for (int r = 0; r < 3; ++r)
     for (int k = 0; k < 3; ++k)
       m[r][k] = v[static_cast<std::size_t>(3 * (r + 1) + k)] - v[static_cast<std::size_t>(k)];
-  return within(det3(m), 3 * kmin, center, radius);
+  return within(det3(m), 3 * kmin, center, radius, center_lo);
 }
 
-/// True when the exact value whose sign insphere() returns lies within `radius` of `center`.
+/// True when the exact value whose sign insphere() returns lies within `radius` of `center` (+ `center_lo`).
 inline bool insphere_within(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
-                            const Point3& e, double center, double radius) {
+                            const Point3& e, double center, double radius, double center_lo = 0.0) {
   int kmin = 0;
   const auto v =
       exact_integers({a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z}, &kmin);
@@ -302,7 +303,7 @@ inline bool insphere_within(const Point3& a, const Point3& b, const Point3& c, c
     const auto s = static_cast<std::size_t>(3 * p);
     lift[p] = v[s] * v[s] + v[s + 1] * v[s + 1] + v[s + 2] * v[s + 2];
   }
-  return within(lifted_value(v, lift), 5 * kmin, center, radius);
+  return within(lifted_value(v, lift), 5 * kmin, center, radius, center_lo);
 }
 
 }  // namespace vitri::test

@@ -2,6 +2,7 @@
 // vitri::core): every operation must be exact, checked against big integers, and keep the expansion
 // invariants (increasing magnitude, nonoverlapping, no zero components) that the sign relies on.
 
+#include "../../core/src/double_word.hpp"
 #include "../../core/src/expansion.hpp"
 
 #include "core/exact_oracle.hpp"
@@ -147,5 +148,67 @@ TEST_CASE("expansion sum, scale, product and compress are exact and keep the inv
     Expansion zero;
     vitri::detail::expansion_sum(twice, doubled, zero, -1.0);
     REQUIRE(zero.sign() == 0);
+  }
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Double words (core/src/double_word.hpp): the error model the predicates' stage 2 is derived from,
+// add within 4 u^2 (|X| + |Y|) and mul within 9 u^2 |X| |Y| of the exact result, and normalized results
+// (|lo| <= u |hi|), checked exactly with big integers on random operands, near cancellations included.
+
+namespace {
+
+using vitri::detail::DoubleWord;
+
+bool normalized(const DoubleWord& w) { return std::fabs(w.lo) <= 0x1p-53 * std::fabs(w.hi); }
+
+// A normalized double word near 2^e (e in [-20, 20]): hi + lo from an exact two_sum.
+DoubleWord random_word(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> m(-1.0, 1.0);
+  const double hi = std::ldexp(m(rng), static_cast<int>(rng() % 41) - 20);
+  DoubleWord w;
+  vitri::detail::two_sum(hi, hi * 0x1p-53 * m(rng), w.hi, w.lo);
+  return w;
+}
+
+BigInt absolute(const BigInt& v) { return v.sign() < 0 ? -v : v; }
+
+}  // namespace
+
+TEST_CASE("double words: add within 4 u^2 (|x| + |y|), mul within 9 u^2 |x| |y|, normalized",
+          "[expansion][double_word]") {
+  std::mt19937_64 rng(77);
+  for (int i = 0; i < 20000; ++i) {
+    const DoubleWord x = random_word(rng);
+    DoubleWord y = random_word(rng);
+    if (i % 3 == 0) {  // near cancellation: y = -x but for its low part
+      y = vitri::detail::dw_negate(x);
+      y.lo = std::ldexp(y.lo, -static_cast<int>(rng() % 8));
+    }
+    REQUIRE(normalized(y));
+
+    const DoubleWord s = vitri::detail::dw_add(x, y);
+    REQUIRE(normalized(s));
+    {
+      // |(s.hi + s.lo) - (x + y)| 2^106 <= 4 (|x| + |y|), every term an integer at the common scale.
+      const auto v = vitri::test::exact_integers({s.hi, s.lo, x.hi, x.lo, y.hi, y.lo});
+      const BigInt xv = v[2] + v[3], yv = v[4] + v[5];
+      const BigInt error = absolute(v[0] + v[1] - xv - yv);
+      INFO("add case " << i);
+      REQUIRE((error.shifted(106) - (absolute(xv) + absolute(yv)) * BigInt(4)).sign() <= 0);
+    }
+
+    const DoubleWord p = vitri::detail::dw_mul(x, y);
+    REQUIRE(normalized(p));
+    {
+      // The product of the operands' integers is at scale 2^(2 kmin); the result's at 2^kmin (kmin < 0).
+      int kmin = 0;
+      const auto v = vitri::test::exact_integers({p.hi, p.lo, x.hi, x.lo, y.hi, y.lo}, &kmin);
+      REQUIRE(kmin < 0);
+      const BigInt exact = (v[2] + v[3]) * (v[4] + v[5]);
+      const BigInt error = absolute((v[0] + v[1]).shifted(-kmin) - exact);
+      INFO("mul case " << i);
+      REQUIRE((error.shifted(106) - absolute(exact) * BigInt(9)).sign() <= 0);
+    }
   }
 }

@@ -4,6 +4,8 @@
 
 #include "vitri/core/predicates.hpp"
 
+#include "../../core/src/double_word.hpp"
+
 #include "core/exact_oracle.hpp"
 
 #include <catch2/catch.hpp>
@@ -903,4 +905,104 @@ TEST_CASE("filter bound: insphere on a tuple whose double value has the wrong si
   REQUIRE(det < -9.0 * bound / (vitri::detail::kInsphereBound / vitri::detail::kUnitRoundoff));
   CHECK(vitri::test::insphere_within(a, b, c, d, e, det, bound));
   CHECK(insphere(a, b, c, d, e) == Sign::Positive);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Stage 2 of the exact fallback (core/src/double_word.hpp): the determinant in double words from the
+// exact differences, with a certified bound of order u^2. Checked on near-degenerate input that the
+// filter cannot decide: the exact value must lie within the stage's bound of its double-word value, and
+// the predicate's sign must be the oracle's. The rectangles are the case that made this stage worth
+// having: a surface point, its off-surface point along a normal, and the same for a neighbour with the
+// same normal are four rounded cocircular points (insphere calls of a meshed point cloud).
+
+namespace {
+
+std::array<double, 15> coordinates(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
+                                   const Point3& e) {
+  return {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
+}
+
+// Three corners of a rounded rectangle (p, p + t n, q, q + t n) and one more point, then the fourth corner.
+std::array<Point3, 5> rounded_rectangle(std::mt19937_64& rng) {
+  const Point3 base = random_point(rng, -1, 1);
+  const Point3 n = unit_vector(rng);
+  const double spacing = std::ldexp(1.0, -static_cast<int>(8 + rng() % 8));
+  const Point3 p = base, q = base + spacing * unit_vector(rng);
+  const double t = spacing * std::uniform_real_distribution<double>(0.5, 2.0)(rng);
+  const Point3 corner[4] = {p, p + t * n, q, q + t * n};
+  std::array<int, 4> order = {0, 1, 2, 3};
+  std::shuffle(order.begin(), order.end(), rng);
+  const Point3 other = base + spacing * random_point(rng, -2, 2);
+  return {corner[order[0]], corner[order[1]], corner[order[2]], other, corner[order[3]]};
+}
+
+}  // namespace
+
+TEST_CASE("double-word stage: insphere near cospherical points lies within its certified bound",
+          "[predicates][double_word]") {
+  std::mt19937_64 rng(42);
+  int decided = 0, beyond_filter = 0;
+  for (int i = 0; i < 4000; ++i) {
+    std::array<Point3, 5> p;
+    if (i % 2 == 0) {
+      p = rounded_rectangle(rng);
+    } else {  // rounded points on a sphere about the origin or far from it, the fifth nudged
+      const Point3 center = (i % 4 == 1) ? 0.5 * random_point(rng, -1, 1) : scaled(random_point(rng, -1, 1), 1e5);
+      for (Point3& q : p) q = center + unit_vector(rng);
+      p[4] = nudged(rng, p[4], static_cast<int>(rng() % 8));
+    }
+    const auto v = coordinates(p[0], p[1], p[2], p[3], p[4]);
+    const vitri::detail::DoubleWordResult r = vitri::detail::insphere_double_word(v.data());
+    INFO("case " << i << " value " << r.value.hi << " + " << r.value.lo << " bound " << r.bound);
+    REQUIRE(vitri::test::insphere_within(p[0], p[1], p[2], p[3], p[4], r.value.hi, r.bound, r.value.lo));
+    const int oracle = vitri::test::oracle_insphere(p[0], p[1], p[2], p[3], p[4]);
+    REQUIRE(to_int(insphere(p[0], p[1], p[2], p[3], p[4])) == oracle);
+    if (r.decided()) {
+      ++decided;
+      REQUIRE(to_int(vitri::detail::sign_of(r.value.hi)) == oracle);
+      const double det = vitri::insphere_fast(p[0], p[1], p[2], p[3], p[4]);
+      beyond_filter += std::fabs(det) <= insphere_filter_bound(p[0], p[1], p[2], p[3], p[4]);
+    }
+  }
+  CHECK(decided > 3000);
+  CHECK(beyond_filter > 1000);  // the cases the stage exists for: the filter fails, the double words decide
+}
+
+TEST_CASE("double-word stage: orient3d near coplanar points lies within its certified bound",
+          "[predicates][double_word]") {
+  std::mt19937_64 rng(43);
+  int decided = 0, beyond_filter = 0;
+  for (int i = 0; i < 4000; ++i) {
+    const Point3 origin = (i % 2) ? scaled(random_point(rng, -1, 1), 1e6) : 0.25 * random_point(rng, -1, 1);
+    const Point3 u = random_point(rng, -1, 1), w = random_point(rng, -1, 1);
+    std::uniform_real_distribution<double> s(-2, 2);
+    const Point3 a = origin + s(rng) * u + s(rng) * w, b = origin + s(rng) * u + s(rng) * w,
+                 c = origin + s(rng) * u + s(rng) * w;
+    const Point3 d = nudged(rng, origin + s(rng) * u + s(rng) * w, static_cast<int>(rng() % 8));
+    const double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+    const vitri::detail::DoubleWordResult r = vitri::detail::orient3d_double_word(v);
+    INFO("case " << i << " value " << r.value.hi << " + " << r.value.lo << " bound " << r.bound);
+    REQUIRE(vitri::test::orient3d_within(a, b, c, d, r.value.hi, r.bound, r.value.lo));
+    const int oracle = vitri::test::oracle_orient3d(a, b, c, d);
+    REQUIRE(to_int(orient3d(a, b, c, d)) == oracle);
+    if (r.decided()) {
+      ++decided;
+      REQUIRE(to_int(vitri::detail::sign_of(r.value.hi)) == oracle);
+      beyond_filter += std::fabs(vitri::orient3d_fast(a, b, c, d)) <= orient3d_filter_bound(a, b, c, d);
+    }
+  }
+  CHECK(decided > 3000);
+  CHECK(beyond_filter > 1000);
+}
+
+TEST_CASE("double-word stage: exact zeros are never decided, the expansions answer them", "[predicates][double_word]") {
+  // Exactly cospherical and coplanar input (a cube's corners, points of a grid): the double-word value is
+  // within its bound of 0, so the stage must leave the call undecided.
+  const Point3 c0{0, 0, 0}, c1{1, 0, 0}, c2{0, 1, 0}, c3{0, 0, 1}, c4{1, 1, 1}, c5{1, 1, 0};
+  const auto v = coordinates(c0, c1, c2, c3, c4);
+  CHECK_FALSE(vitri::detail::insphere_double_word(v.data()).decided());
+  const double w[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  CHECK_FALSE(vitri::detail::orient3d_double_word(w).decided());
+  CHECK(insphere(c0, c1, c2, c3, c4) == Sign::Zero);
+  CHECK(orient3d(c0, c1, c2, c5) == Sign::Zero);
 }

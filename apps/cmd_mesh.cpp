@@ -153,6 +153,15 @@ void print_extraction_split(const PolygonizerStats& s, double extract_ms) {
                1e3 * s.extract_snapping_seconds, 1e3 * s.extract_mesh_seconds, std::max(0.0, extract_ms - tracked));
 }
 
+/// The local fit's own steps (stderr): where the time of a large fit goes.
+void print_fit_split(const LocalFitReport& r) {
+  std::fprintf(stderr,
+               "  fit: point index %.0f ms, duplicate check %.0f ms, octree %.0f ms, candidate lists %.0f ms, "
+               "patch fits %.0f ms\n",
+               1e3 * r.index_seconds, 1e3 * r.duplicates_seconds, 1e3 * r.tree_seconds, 1e3 * r.links_seconds,
+               1e3 * r.patches_seconds);
+}
+
 void write_current(Mesher& mesher, const std::string& path) { write_mesh(path, view_of(mesher.surface())); }
 
 /// From this many constraints on, the fit is announced with its constraint count and its time (every
@@ -338,7 +347,10 @@ int run_mesh(const Args& args) {
   Mesher mesher(constraints, options);
   constraints = Constraints{};  // the Mesher has its own copy: 32 bytes per constraint freed for the rest
   phases.stop();
-  if (announce_fit && !quiet) std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
+  if (announce_fit && !quiet) {
+    std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
+    if (const LocalRbf* local = mesher.local_function()) print_fit_split(local->report());
+  }
   const double diag = mesher.diagonal();
   const double build_ms = 1e3 * phases.elapsed();
   if (!quiet) {

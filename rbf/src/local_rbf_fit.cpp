@@ -85,9 +85,17 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   live = c.size();
   nonzero = nz;
   cache_valid = false;
+  double step_seconds[5] = {0, 0, 0, 0, 0};  // index, duplicates, tree, links, patches
+  auto t_step = std::chrono::steady_clock::now();
+  const auto end_step = [&](int k) {
+    step_seconds[k] = seconds_since(t_step);
+    t_step = std::chrono::steady_clock::now();
+  };
   index.build(slot_point);
   fit_diagonal = box.diagonal();
+  end_step(0);
   check_duplicates();
+  end_step(1);
   tree.overlap = opt.overlap;
   if (domain.empty()) {
     const Point3 ext = box.extent();
@@ -100,10 +108,14 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
       if (!root.contains(c.points[i])) throw InvalidPoint(i, "constraint outside the given domain");
   }
   std::vector<std::uint32_t> created;
+  t_step = std::chrono::steady_clock::now();
   refine_cell(0, created);
+  end_step(2);
   link(created, true);
+  end_step(3);
   fit_leaves(created);
   publish(created);
+  end_step(4);
   for (std::size_t c2 = tree.capacity(); c2-- > 0;)  // children after parents: reach bottom-up
     if (tree.cell(static_cast<std::uint32_t>(c2)).alive) tree.compute_reach(static_cast<std::uint32_t>(c2));
   fitted = true;
@@ -111,6 +123,11 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   report.refitted = created.size();
   report.removed = 0;
   report.seconds = seconds_since(t0);
+  report.index_seconds = step_seconds[0];
+  report.duplicates_seconds = step_seconds[1];
+  report.tree_seconds = step_seconds[2];
+  report.links_seconds = step_seconds[3];
+  report.patches_seconds = step_seconds[4];
 }
 
 void LocalRbf::Impl::reset_root(const Point3& center, double half) {

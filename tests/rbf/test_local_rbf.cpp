@@ -72,6 +72,16 @@ TEST_CASE("LocalRbf interpolates every constraint and has a valid structure", "[
   CHECK(rep.patches > 8);
   CHECK(rep.max_fitted <= LocalRbfOptions{}.max_per_patch);
   CHECK(max_residual(f, c) < 1e-9);  // values are +-0.01 x diagonal ~ 0.03: relative 3e-8
+  // The fit's steps are timed one after the other inside its total.
+  const double steps[5] = {rep.index_seconds, rep.duplicates_seconds, rep.tree_seconds, rep.links_seconds,
+                           rep.patches_seconds};
+  double sum = 0;
+  for (const double t : steps) {
+    CHECK(t >= 0);
+    sum += t;
+  }
+  CHECK(rep.patches_seconds > 0);
+  CHECK(sum <= rep.seconds);
   // Batch evaluation equals single evaluation, bit for bit, whatever the threads.
   const auto pts = random_points(5000, 2.0, 11);
   std::vector<double> v(pts.size()), vg(pts.size());

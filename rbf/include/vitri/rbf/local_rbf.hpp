@@ -83,6 +83,13 @@ struct LocalFitReport {
   std::size_t refitted = 0;       ///< last edit: patches refitted (created ones included)
   std::size_t removed = 0;        ///< last edit: patches removed by splits or merges
   double seconds = 0;             ///< last fit or edit, wall time
+  /// The steps of the last full fit (wall time; fit() only, edits leave them): the point index, the
+  /// duplicate check, the octree's split decisions, the candidate lists, the patch fits.
+  double index_seconds = 0;
+  double duplicates_seconds = 0;
+  double tree_seconds = 0;
+  double links_seconds = 0;
+  double patches_seconds = 0;
 };
 
 /// The local variational implicit function. Constraint numbering as vitri::Rbf: fit() order, add appends,

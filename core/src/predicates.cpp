@@ -5,6 +5,9 @@
 /// certify its sign with a semi-static error bound. When the bound does not certify it (near-degenerate
 /// input, or magnitudes where under/overflow could break the bound), we come here and compute the same
 /// determinant exactly (double words, then expansion arithmetic: double_word.hpp, expansion.hpp):
+///   0. Stage 0 (small_integer.hpp), on the coordinates as given: differences that are exact small
+///      multiples of one power of two (grids) make the plain double evaluation exact; taken when it
+///      applies, before anything else.
 ///   1. Pre-scale all coordinates of the call by one power of two 2^k (exact; the sign of a homogeneous
 ///      determinant does not change) so that the largest |coordinate| lands just below 2^E, with E
 ///      chosen per predicate so that no intermediate can overflow (nor overflow Dekker's split) while
@@ -30,6 +33,7 @@
 #include "cofactors.hpp"
 #include "double_word.hpp"
 #include "expansion.hpp"
+#include "small_integer.hpp"
 #include "wide_int.hpp"
 
 #include <algorithm>
@@ -244,6 +248,8 @@ Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
   ++predicate_stats().orient3d_exact;
 #endif
   double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+  double small;
+  if (small_integer_orient3d(v, small)) return sign_of(small);  // stage 0, unscaled
   const Range range = prescale(v, 12, kOrient3dExponent, kOrient3dMaxSpan);
   if (range == Range::NonFinite) return Sign::Zero;
   if (range == Range::TooWide) return orient3d_integer(v);
@@ -314,6 +320,8 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
   ++predicate_stats().insphere_exact;
 #endif
   double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
+  double small;
+  if (small_integer_insphere(v, small)) return sign_of(small);  // stage 0, unscaled
   const Range range = prescale(v, 15, kInsphereExponent, kInsphereMaxSpan);
   if (range == Range::NonFinite) return Sign::Zero;
   if (range == Range::TooWide) return insphere_integer(v);

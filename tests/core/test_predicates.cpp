@@ -5,6 +5,7 @@
 #include "vitri/core/predicates.hpp"
 
 #include "../../core/src/double_word.hpp"
+#include "../../core/src/small_integer.hpp"
 
 #include "core/exact_oracle.hpp"
 
@@ -1005,4 +1006,97 @@ TEST_CASE("double-word stage: exact zeros are never decided, the expansions answ
   CHECK_FALSE(vitri::detail::orient3d_double_word(w).decided());
   CHECK(insphere(c0, c1, c2, c3, c4) == Sign::Zero);
   CHECK(orient3d(c0, c1, c2, c5) == Sign::Zero);
+}
+
+// ---------------------------------------------------------------------------------------------------
+// Stage 0 of the exact fallback (core/src/small_integer.hpp): differences that are small multiples of
+// one power of two G (|q| < 2^9 G for insphere, 2^16 G for orient3d) are evaluated in plain doubles, which
+// must then be the exact value, at the largest allowed differences and at the ends of the exponent range.
+
+namespace {
+
+// A base point (at index `base_at`: the point the predicate subtracts) and the others at integer multiples
+// of G = 2^k from it in [-limit, limit] per coordinate, one of them at the limit (so that the stage's own G
+// is this one); all exact. `extreme`: every difference at +-limit.
+template <std::size_t N>
+std::array<Point3, N> small_multiple_points(std::mt19937_64& rng, int k, int limit, bool extreme, std::size_t base_at) {
+  const double g = std::ldexp(1.0, k);
+  std::uniform_int_distribution<int> step(-limit, limit), start(-8, 8);
+  const Point3 base = scaled(Point3{double(start(rng)), double(start(rng)), double(start(rng))}, g);
+  std::array<Point3, N> p;
+  for (std::size_t i = 0; i < N; ++i) {
+    Point3 d;
+    for (std::size_t c = 0; c < 3; ++c) d[c] = extreme ? ((rng() & 1) ? limit : -limit) : step(rng);
+    if (i == (base_at + 1) % N) d[0] = limit;
+    p[i] = i == base_at ? base : base + scaled(d, g);
+  }
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("small-integer stage: plain doubles are exact for differences below 2^9 G (insphere), 2^16 G (orient3d)",
+          "[predicates][small_integer]") {
+  std::mt19937_64 rng(44);
+  int taken = 0;
+  for (int i = 0; i < 3000; ++i) {
+    // Exponents of G across the range, its ends included (e = k + 8 for insphere, k + 15 for orient3d).
+    const int kinds[] = {0, -20, 30, -206 - 8 + 1, 202 - 8 - 1, -214, 194};
+    const int k = kinds[i % 7];
+    const bool extreme = (i / 7) % 2 == 0;
+    // Differences up to 1023 G every fourth time: beyond the stage's 2^9 G, so those must be declined or,
+    // where all of them happen to be even, taken with G doubled; either way any value given is exact.
+    const auto p = small_multiple_points<5>(rng, k, i % 4 == 3 ? 1023 : 511, extreme, 4);
+    const auto v = coordinates(p[0], p[1], p[2], p[3], p[4]);
+    double value = 0;
+    if (vitri::detail::small_integer_insphere(v.data(), value)) {
+      ++taken;
+      INFO("insphere case " << i << " k " << k << " value " << value);
+      REQUIRE(vitri::test::insphere_within(p[0], p[1], p[2], p[3], p[4], value, 0.0));
+    }
+    const int ko = (i % 7 == 3) ? -343 - 15 + 1 : (i % 7 == 4) ? 338 - 15 - 1 : k;
+    const auto q = small_multiple_points<4>(rng, ko, i % 4 == 3 ? 131071 : 65535, extreme, 0);
+    const double w[12] = {q[0].x, q[0].y, q[0].z, q[1].x, q[1].y, q[1].z, q[2].x, q[2].y, q[2].z, q[3].x, q[3].y, q[3].z};
+    if (vitri::detail::small_integer_orient3d(w, value)) {
+      ++taken;
+      INFO("orient3d case " << i << " k " << ko << " value " << value);
+      REQUIRE(vitri::test::orient3d_within(q[0], q[1], q[2], q[3], value, 0.0));
+    }
+  }
+  CHECK(taken > 4000);  // the in-range cases with differences below the limit are taken
+}
+
+TEST_CASE("small-integer stage declines what it cannot prove exact", "[predicates][small_integer]") {
+  const Point3 a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0}, d{0, 0, 1}, e{0.5, 0.5, 0.5};
+  double value = 0;
+  {  // exact small grid: taken
+    const auto v = coordinates(a, b, c, d, e);
+    REQUIRE(vitri::detail::small_integer_insphere(v.data(), value));
+    CHECK(value == vitri::insphere_fast(a, b, c, d, e));
+  }
+  {  // a difference of 1 next to one of 2^-9: 2^9 G would not hold it
+    const auto v = coordinates(a, b, c, d, Point3{0x1p-9, 0, 0});
+    CHECK_FALSE(vitri::detail::small_integer_insphere(v.data(), value));
+  }
+  {  // an inexact difference (0.1 - 0.3 rounds)
+    const auto v = coordinates(Point3{0.1, 0, 0}, b, c, d, Point3{0.3, 0.2, 0.7});
+    CHECK_FALSE(vitri::detail::small_integer_insphere(v.data(), value));
+  }
+  {  // out of range: G^5 would overflow, and would underflow
+    const auto big = coordinates(scaled(a, 0x1p250), scaled(b, 0x1p250), scaled(c, 0x1p250), scaled(d, 0x1p250),
+                                 scaled(e, 0x1p250));
+    CHECK_FALSE(vitri::detail::small_integer_insphere(big.data(), value));
+    const auto tiny = coordinates(scaled(a, 0x1p-250), scaled(b, 0x1p-250), scaled(c, 0x1p-250), scaled(d, 0x1p-250),
+                                  scaled(e, 0x1p-250));
+    CHECK_FALSE(vitri::detail::small_integer_insphere(tiny.data(), value));
+    CHECK(insphere(scaled(a, 0x1p-250), scaled(b, 0x1p-250), scaled(c, 0x1p-250), scaled(d, 0x1p-250),
+                   scaled(e, 0x1p-250)) == Sign::Positive);  // the later steps answer it
+  }
+  {  // non-finite input
+    const double inf = std::numeric_limits<double>::infinity();
+    const auto v = coordinates(a, b, c, d, Point3{inf, 0, 0});
+    CHECK_FALSE(vitri::detail::small_integer_insphere(v.data(), value));
+    const double w[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, std::nan(""), 0, 1};
+    CHECK_FALSE(vitri::detail::small_integer_orient3d(w, value));
+  }
 }

@@ -83,34 +83,44 @@ bool small_multiples(const double (&q)[Rows][3], double largest, int log_m, int 
   return true;
 }
 
-/// insphere of v = a, b, c, d, e (15 coordinates), exactly, when the differences are small multiples of
-/// a power of two (|q| < 2^9 G) in range; false otherwise (non-finite input included).
-inline bool small_integer_insphere(const double* v, double& value) {
-  double q[4][3], largest;
-  if (!exact_differences(v + 12, [&](int r) { return v + 3 * r; }, q, largest)) return false;
+/// The parameters of one predicate's small-integer evaluation: G = 2^(e - log_m), e in [e_min, e_max].
+struct SmallIntegerLimits {
+  int log_m;
+  int e_min;
+  int e_max;
+};
+
+/// The determinant `evaluate(q)` of the exact differences q[r] = row_at(r) - base, exactly, when they are
+/// small multiples of a power of two within `limits`; false otherwise (non-finite input included).
+template <int Rows, class RowAt, class Evaluate>
+bool small_integer_value(const double* base, const RowAt& row_at, SmallIntegerLimits limits,
+                         const Evaluate& evaluate, double& value) {
+  double q[Rows][3], largest;
+  if (!exact_differences(base, row_at, q, largest)) return false;
   if (largest == 0.0) {
     value = 0.0;
     return true;
   }
-  if (!small_multiples(q, largest, 8, -206, 202)) return false;
+  if (!small_multiples(q, largest, limits.log_m, limits.e_min, limits.e_max)) return false;
   PlainArithmetic f;
-  value = insphere_cofactors(f, q);
+  value = evaluate(f, q);
   return true;
+}
+
+/// insphere of v = a, b, c, d, e (15 coordinates), exactly, when the differences are small multiples of
+/// a power of two (|q| < 2^9 G) in range; false otherwise (non-finite input included).
+inline bool small_integer_insphere(const double* v, double& value) {
+  return small_integer_value<4>(
+      v + 12, [&](int r) { return v + 3 * r; }, SmallIntegerLimits{8, -206, 202},
+      [](PlainArithmetic& f, const double(&q)[4][3]) { return insphere_cofactors(f, q); }, value);
 }
 
 /// orient3d of v = a, b, c, d (12 coordinates), exactly, when the differences are small multiples of a
 /// power of two (|q| < 2^16 G) in range; false otherwise (non-finite input included).
 inline bool small_integer_orient3d(const double* v, double& value) {
-  double q[3][3], largest;
-  if (!exact_differences(v, [&](int r) { return v + 3 * (r + 1); }, q, largest)) return false;
-  if (largest == 0.0) {
-    value = 0.0;
-    return true;
-  }
-  if (!small_multiples(q, largest, 15, -343, 338)) return false;
-  PlainArithmetic f;
-  value = orient3d_from_differences(f, q);
-  return true;
+  return small_integer_value<3>(
+      v, [&](int r) { return v + 3 * (r + 1); }, SmallIntegerLimits{15, -343, 338},
+      [](PlainArithmetic& f, const double(&q)[3][3]) { return orient3d_from_differences(f, q); }, value);
 }
 
 }  // namespace vitri::detail

@@ -38,24 +38,33 @@ std::array<int, 4> canonical_order(const std::array<VertexId, 4>& k) {
   return {m, c[r], c[(r + 1) % 3], c[(r + 2) % 3]};
 }
 
+// Below this many tetrahedra canonicalize() runs on one thread (starting threads would cost more).
+constexpr std::size_t kParallelCanonicalMin = std::size_t(1) << 16;
+
 }  // namespace
 
 void Triangulation::canonicalize() {
   if (keep_history_)
     throw InvalidArgument("Triangulation::canonicalize: only without the history (its records hold ids)");
   const std::size_t cap = tets_.size();
+  // The passes over all tetrahedra run on the bulk insertion's threads (each writes only its own slice,
+  // bucket or new record); the result does not depend on them.
+  const unsigned threads = cap < kParallelCanonicalMin ? 1 : threads_;
   // Key of a live tetrahedron: its public vertex ids, sorted; bucketed by the smallest (a counting
   // sort), then each bucket (a few tetrahedra) sorted by the other three.
   std::vector<std::array<VertexId, 4>> key(cap);
+  detail::parallel_slices(cap, threads, [&](std::size_t lo, std::size_t hi) {
+    for (TetId t = TetId(lo); t < hi; ++t) {
+      if (tets_.is_dead(t)) continue;
+      std::array<VertexId, 4> k{};
+      for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
+      std::sort(k.begin(), k.end());
+      key[t] = k;
+    }
+  });
   std::vector<std::uint32_t> start(vertex_capacity() + 1, 0);
-  for (TetId t = 0; t < cap; ++t) {
-    if (tets_.is_dead(t)) continue;
-    std::array<VertexId, 4> k{};
-    for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
-    std::sort(k.begin(), k.end());
-    key[t] = k;
-    ++start[k[0] + 1];
-  }
+  for (TetId t = 0; t < cap; ++t)
+    if (!tets_.is_dead(t)) ++start[key[t][0] + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
   std::vector<TetId> order(num_live_tets_);
   {
@@ -63,25 +72,32 @@ void Triangulation::canonicalize() {
     for (TetId t = 0; t < cap; ++t)
       if (!tets_.is_dead(t)) order[next[key[t][0]]++] = t;
   }
-  for (std::size_t b = 0; b + 1 < start.size(); ++b)
-    std::sort(order.begin() + start[b], order.begin() + start[b + 1],
-              [&](TetId x, TetId y) { return key[x] < key[y]; });
+  detail::parallel_slices(start.size() - 1, threads, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t b = lo; b < hi; ++b)
+      std::sort(order.begin() + start[b], order.begin() + start[b + 1],
+                [&](TetId x, TetId y) { return key[x] < key[y]; });
+  });
   std::vector<TetId> new_id(cap, kNoTet);
-  for (std::size_t n = 0; n < order.size(); ++n) new_id[order[n]] = static_cast<TetId>(n);
+  detail::parallel_slices(order.size(), threads, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t n = lo; n < hi; ++n) new_id[order[n]] = static_cast<TetId>(n);
+  });
 
   Store fresh(false);
   fresh.append(order.size());
-  for (std::size_t n = 0; n < order.size(); ++n) {
-    const TetId t = order[n];
-    std::array<VertexId, 4> k{};
-    for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
-    const std::array<int, 4> o = canonical_order(k);
-    for (int i = 0; i < 4; ++i) {
-      fresh.set_vertex(static_cast<TetId>(n), i, tets_.vertex(t, o[i]));
-      const TetId across = tets_.neighbor(t, o[i]);  // the face opposite a vertex moves with it
-      fresh.set_neighbor(static_cast<TetId>(n), i, across == kNoTet ? kNoTet : new_id[across]);
+  detail::parallel_slices(order.size(), threads, [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t n = lo; n < hi; ++n) {
+      const TetId t = order[n];
+      if (n + 8 < hi) tets_.prefetch(order[n + 8]);  // the old records are read in key order: scattered
+      std::array<VertexId, 4> k{};
+      for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
+      const std::array<int, 4> o = canonical_order(k);
+      for (int i = 0; i < 4; ++i) {
+        fresh.set_vertex(static_cast<TetId>(n), i, tets_.vertex(t, o[i]));
+        const TetId across = tets_.neighbor(t, o[i]);  // the face opposite a vertex moves with it
+        fresh.set_neighbor(static_cast<TetId>(n), i, across == kNoTet ? kNoTet : new_id[across]);
+      }
     }
-  }
+  });
   tets_ = std::move(fresh);
   free_head_ = kNoTet;
   // The state that later operations start from must be canonical too, or they would number their new

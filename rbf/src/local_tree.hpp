@@ -18,6 +18,7 @@
 #include "vitri/core/point.hpp"
 
 #include <cstdint>
+#include <deque>
 #include <vector>
 
 namespace vitri::local_detail {
@@ -93,6 +94,10 @@ class LocalTree {
   std::uint32_t locate(const Point3& p) const;
   /// Leaves whose support ball meets the closed cube of cell `target` (|c_L - cube| < R_L).
   void leaves_meeting_cube(const Cell& target, std::vector<std::uint32_t>& out) const;
+  /// For every leaf at or below `top`, its candidates (leaves_meeting_cube of its cube), sorted in
+  /// cell_before order, in one descent that shares the work of sibling cells (see local_tree.cpp); the
+  /// leaves are processed on up to `threads` threads. Same lists as leaves_meeting_cube, leaf by leaf.
+  void fill_candidates(unsigned threads);
   /// Leaves whose cube meets the open support ball of leaf `source`.
   void leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const;
   /// Leaves with |q - center|^2 <= fit_r2.
@@ -112,6 +117,18 @@ class LocalTree {
   /// Leaves below the root reached through inner cells with enter(cell), kept when take(leaf).
   template <class Enter, class Take>
   void collect_leaves(const Enter& enter, const Take& take, std::vector<std::uint32_t>& out) const;
+
+  /// Cells whose ball meets the cube of `c`'s child k, from `frontier` (those meeting c's cube, each a
+  /// leaf or at least as deep as c): the ones meeting it, the too shallow inner ones replaced by their
+  /// children meeting it.
+  void narrow_frontier(std::uint32_t c, int k, const std::vector<std::uint32_t>& frontier,
+                       std::vector<std::uint32_t>& out) const;
+  /// fill_candidates below c, given c's frontier; `levels` holds one reusable frontier per depth below
+  /// (a deque: growing it keeps the references to the frontiers above valid).
+  void fill_candidates_below(std::uint32_t c, const std::vector<std::uint32_t>& frontier,
+                             std::deque<std::vector<std::uint32_t>>& levels, std::size_t level);
+  /// The candidates of leaf c from its frontier.
+  void finish_candidates(std::uint32_t c, const std::vector<std::uint32_t>& frontier);
 
   std::vector<Cell> cells_;
   std::vector<std::uint32_t> free_blocks_;

@@ -38,8 +38,7 @@ void LocalRbf::Impl::restructure(std::uint32_t c, const Point3& q, std::vector<B
   const Point3 center = tree.cell(c).center;
   const double r = tree.cell(c).radius;
   if (!(squared_distance(q, center) < r * r)) return;
-  const std::size_t n = index.count_ball(center, r * r, opt.max_per_patch);
-  const bool want_children = n > opt.max_per_patch && tree.cell(c).depth < opt.max_depth;
+  const bool want_children = wants_children(c);
   if (tree.cell(c).leaf()) {
     if (!want_children) return;
     unlink(c);

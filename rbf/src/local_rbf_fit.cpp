@@ -109,7 +109,7 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   }
   std::vector<std::uint32_t> created;
   t_step = std::chrono::steady_clock::now();
-  refine_cell(0, created);
+  refine_levels(created);
   end_step(2);
   link(created, true);
   end_step(3);
@@ -141,14 +141,51 @@ void LocalRbf::Impl::reset_root(const Point3& center, double half) {
   tree.reset(c, h);
 }
 
-void LocalRbf::Impl::refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created) {
+bool LocalRbf::Impl::wants_children(std::uint32_t c) const {
   const double r = tree.cell(c).radius;
   const std::size_t n = index.count_ball(tree.cell(c).center, r * r, opt.max_per_patch);
-  if (n > opt.max_per_patch && tree.cell(c).depth < opt.max_depth) {
+  return n > opt.max_per_patch && tree.cell(c).depth < opt.max_depth;
+}
+
+void LocalRbf::Impl::refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created) {
+  if (wants_children(c)) {
     const std::uint32_t first = tree.split(c);
     for (std::uint32_t k = 0; k < 8; ++k) refine_cell(first + k, created);
   } else {
     created.push_back(c);
+  }
+}
+
+void LocalRbf::Impl::refine_levels(std::vector<std::uint32_t>& created) {
+  // The same split rule as refine_cell, one depth at a time: the ball counts of a depth (the cost) on the
+  // threads, then the splits (they grow the cell array) on this one. Cell ids come out breadth first,
+  // which nothing depends on (candidate lists and sums follow cell_before, a geometric order).
+  std::vector<std::uint32_t> level{0}, next;
+  std::vector<std::uint8_t> split;
+  while (!level.empty()) {
+    split.assign(level.size(), 0);
+    parallel_chunks(level.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) split[i] = wants_children(level[i]) ? 1 : 0;
+    });
+    next.clear();
+    for (std::size_t i = 0; i < level.size(); ++i)
+      if (split[i]) {
+        const std::uint32_t first = tree.split(level[i]);
+        for (std::uint32_t k = 0; k < 8; ++k) next.push_back(first + k);
+      }
+    level.swap(next);
+  }
+  // The leaves in depth-first octant order, as refine_cell lists them: neighbours in space stay
+  // neighbours in the list, which the later passes over it read faster.
+  std::vector<std::uint32_t> stack{0};
+  while (!stack.empty()) {
+    const std::uint32_t c = stack.back();
+    stack.pop_back();
+    if (tree.cell(c).leaf()) {
+      created.push_back(c);
+      continue;
+    }
+    for (int k = 8; k-- > 0;) stack.push_back(tree.child(c, k));
   }
 }
 

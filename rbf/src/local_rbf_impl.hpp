@@ -71,7 +71,12 @@ struct LocalRbf::Impl {
   void fit_all(const Constraints& c, const Box3& domain);
   void check_duplicates() const;
   void reset_root(const Point3& center, double half);
+  /// The split rule: c's ball holds more than max_per_patch constraints and c is above max_depth.
+  bool wants_children(std::uint32_t c) const;
+  /// Splits c and its new children by the rule, depth first; the leaves below c go to `created`.
   void refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created);
+  /// The whole tree from the root alone, by the same rule, one depth at a time (the counts threaded).
+  void refine_levels(std::vector<std::uint32_t>& created);
   void fit_leaf(std::uint32_t c, local_detail::FitScratch& s);
   void fit_leaves(const std::vector<std::uint32_t>& leaves);
   /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).

@@ -27,32 +27,13 @@ double LocalRbf::Impl::duplicate_tolerance2() const {
 bool LocalRbf::Impl::too_close(double d2) const { return d2 == 0 || d2 < duplicate_tolerance2(); }
 
 void LocalRbf::Impl::check_duplicates() const {
-  std::size_t worst = std::numeric_limits<std::size_t>::max(), partner = 0;  // the later index of a pair
-  std::mutex m;
-  const double r2 = duplicate_tolerance2();
-  parallel_chunks(slot_point.size(), threads(), 4096, [&](std::size_t b, std::size_t e) {
-    std::vector<PointIndex::Id> ids;
-    std::vector<double> d2;
-    const auto note = [&](std::size_t i, std::size_t j) {  // i and j are near-duplicates
-      std::lock_guard<std::mutex> lock(m);
-      if (std::max(i, j) < worst) {
-        worst = std::max(i, j);
-        partner = std::min(i, j);
-      }
-    };
-    for (std::size_t i = b; i < e; ++i) {
-      if (r2 > 0) {
-        // A ball of the tolerance's radius holds the point itself (distance 0) and its near-duplicates:
-        // much cheaper than a nearest-neighbour search, which must reach the next sample.
-        if (index.count_ball(slot_point[i], r2, 1) <= 1) continue;
-        index.ball(slot_point[i], r2, ids);
-        for (const PointIndex::Id j : ids)
-          if (j != i) note(i, j);
-      } else {  // tolerance 0: exact duplicates only
-        index.nearest(slot_point[i], 2, ids, &d2);
-        for (std::size_t k = 0; k < ids.size(); ++k)
-          if (ids[k] != i && too_close(d2[k])) note(i, ids[k]);
-      }
+  // The pair whose later index is the smallest (then the smallest earlier one): near-duplicates within
+  // the tolerance, or coincident points when it is 0.
+  std::size_t worst = std::numeric_limits<std::size_t>::max(), partner = 0;
+  index.close_pairs(duplicate_tolerance2(), [&](PointIndex::Id i, PointIndex::Id j) {
+    if (j < worst || (j == worst && i < partner)) {
+      worst = j;
+      partner = i;
     }
   });
   if (worst != std::numeric_limits<std::size_t>::max())

@@ -203,6 +203,48 @@ std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::si
   return count;
 }
 
+void PointIndex::close_pairs(double radius2, const std::function<void(Id, Id)>& visit) const {
+  if (size_ == 0) return;
+  const double inf = std::numeric_limits<double>::infinity();
+  close_pairs_below(0, Point3{-inf, -inf, -inf}, Point3{inf, inf, inf}, radius2, visit);
+}
+
+void PointIndex::close_pairs_below(std::uint32_t index, Point3 lo, Point3 hi, double radius2,
+                                   const std::function<void(Id, Id)>& visit) const {
+  const Node& n = nodes_[index];
+  if (!n.leaf()) {
+    // Left: coordinate < split, right: >= split (the rule of insert() and of the build).
+    Point3 left_hi = hi, right_lo = lo;
+    left_hi[n.axis] = n.split;
+    right_lo[n.axis] = n.split;
+    close_pairs_below(n.children[0], lo, left_hi, radius2, visit);
+    close_pairs_below(n.children[1], right_lo, hi, radius2, visit);
+    return;
+  }
+  const auto emit = [&](Id i, Id j) { visit(std::min(i, j), std::max(i, j)); };
+  const std::size_t m = n.bucket.size();
+  for (std::size_t a = 0; a < m; ++a)
+    for (std::size_t b = a + 1; b < m; ++b) {
+      const double d2 = squared_distance(n.bucket_points[a], n.bucket_points[b]);
+      if (d2 < radius2 || d2 == 0.0) emit(n.bucket[a], n.bucket[b]);
+    }
+  if (!(radius2 > 0.0)) return;  // coincident points share a leaf (equal coordinates go the same way)
+  // A point of another leaf closer than the radius puts this leaf's border, and that leaf's, within the
+  // radius of each point: only such points look outside (with a relative margin for the rounding of the
+  // distances to the border), and a pair across two leaves is reported from the lower leaf only.
+  const double reach2 = radius2 * (1.0 + 1e-9);
+  std::vector<Id> found;
+  for (std::size_t a = 0; a < m; ++a) {
+    const Point3& p = n.bucket_points[a];
+    double border = std::numeric_limits<double>::infinity();
+    for (int k = 0; k < 3; ++k) border = std::min({border, p[k] - lo[k], hi[k] - p[k]});
+    if (border >= 0.0 && border * border >= reach2) continue;
+    ball(p, radius2, found);
+    for (const Id j : found)
+      if (leaf_of_[j] > index) emit(n.bucket[a], j);
+  }
+}
+
 void PointIndex::nearest_recurse(std::uint32_t index, NearestState& state) const {
   const Node& n = nodes_[index];
   if (n.leaf()) {

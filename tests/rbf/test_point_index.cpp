@@ -26,6 +26,17 @@ struct Brute {
     std::sort(out.begin(), out.end());
     return out;
   }
+  std::vector<std::pair<Id, Id>> close_pairs(double r2) const {
+    std::vector<std::pair<Id, Id>> out;
+    for (std::size_t a = 0; a < points.size(); ++a)
+      for (std::size_t b = a + 1; b < points.size(); ++b) {
+        const double d2 = vitri::squared_distance(points[a].second, points[b].second);
+        if (d2 < r2 || d2 == 0.0)
+          out.emplace_back(std::min(points[a].first, points[b].first), std::max(points[a].first, points[b].first));
+      }
+    std::sort(out.begin(), out.end());
+    return out;
+  }
   std::vector<Id> nearest(const Point3& q, std::size_t k) const {
     std::vector<std::pair<double, Id>> all;
     for (const auto& [id, p] : points) all.emplace_back(vitri::squared_distance(p, q), id);
@@ -38,6 +49,19 @@ struct Brute {
 
 void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rng) {
   REQUIRE(index.size() == brute.points.size());
+  // close_pairs: each pair once (no repeat after sorting), the same set as brute force; radii from
+  // coincident points only to pairs across many leaves.
+  for (const double r : {0.0, 1e-4, 0.02, 0.05}) {
+    std::vector<std::pair<Id, Id>> pairs;
+    index.close_pairs(r * r, [&](Id i, Id j) {
+      REQUIRE(i < j);
+      pairs.emplace_back(i, j);
+    });
+    std::sort(pairs.begin(), pairs.end());
+    REQUIRE(std::adjacent_find(pairs.begin(), pairs.end()) == pairs.end());
+    INFO("radius " << r);
+    REQUIRE(pairs == brute.close_pairs(r * r));
+  }
   std::uniform_real_distribution<double> u(-1.2, 1.2);
   std::vector<Id> got;
   for (int q = 0; q < 60; ++q) {

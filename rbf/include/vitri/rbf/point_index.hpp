@@ -20,6 +20,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace vitri {
@@ -56,6 +57,12 @@ class PointIndex {
   /// exceeds `limit` (the answer is then limit + 1), so that "more than n?" costs O(log size() + n).
   std::size_t count_ball(const Point3& center, double radius2,
                          std::size_t limit = static_cast<std::size_t>(-1)) const;
+  /// Calls visit(i, j), i < j, once for every pair of points closer than sqrt(radius2) (squared distance
+  /// < radius2) and every pair of coincident points whatever radius2, in no particular order. Meant for
+  /// small radii (near-duplicate checks): pairs inside one leaf are compared directly and only points
+  /// within the radius of their leaf's region look outside it, about O(size() + pairs) for a radius well
+  /// below the spacing of the points (many coincident points make it quadratic, as their pairs are).
+  void close_pairs(double radius2, const std::function<void(Id, Id)>& visit) const;
   /// The k nearest points to q (all of them when size() < k), by increasing (squared distance, id);
   /// `dist2`, when given, receives their squared distances. Both vectors are cleared first.
   void nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, std::vector<double>* dist2 = nullptr) const;
@@ -85,6 +92,9 @@ class PointIndex {
   void split_leaf(std::uint32_t node);
   void ensure_id(Id id);
   void nearest_recurse(std::uint32_t node, NearestState& state) const;
+  /// close_pairs below `node`, whose region (from the splits above it) is [lo, hi].
+  void close_pairs_below(std::uint32_t node, Point3 lo, Point3 hi, double radius2,
+                         const std::function<void(Id, Id)>& visit) const;
 
   std::vector<Node> nodes_;          // nodes_[0] is the root when size_ > 0 or after build()
   std::vector<Point3> position_;     // position_[id], meaningful when contains(id)

@@ -59,24 +59,24 @@ void PointIndex::build(const std::vector<Point3>& points) {
   position_ = points;
   leaf_of_.assign(points.size(), kNoNode);
   size_ = points.size();
-  std::vector<Id> ids(points.size());
-  std::iota(ids.begin(), ids.end(), Id{0});
+  std::vector<Entry> entries(points.size());
+  for (std::size_t i = 0; i < points.size(); ++i) entries[i] = {points[i], static_cast<Id>(i)};
   nodes_.reserve(2 * (points.size() / kBucket + 1));
-  make_subtree(ids.data(), ids.data() + ids.size());
+  make_subtree(entries.data(), entries.data() + entries.size());
 }
 
-std::uint32_t PointIndex::make_subtree(Id* first, Id* last) {
+std::uint32_t PointIndex::make_subtree(Entry* first, Entry* last) {
   const auto index = static_cast<std::uint32_t>(nodes_.size());
   nodes_.emplace_back();
   fill_node(index, first, last);
   return index;
 }
 
-void PointIndex::fill_node(std::uint32_t index, Id* first, Id* last) {
+void PointIndex::fill_node(std::uint32_t index, Entry* first, Entry* last) {
   Point3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
             std::numeric_limits<double>::infinity()};
   Point3 hi = -lo;
-  for (Id* it = first; it != last; ++it) grow(lo, hi, position_[*it]);
+  for (Entry* it = first; it != last; ++it) grow(lo, hi, it->p);
   nodes_[index].lo = lo;
   nodes_[index].hi = hi;
   const auto count = static_cast<std::size_t>(last - first);
@@ -85,24 +85,27 @@ void PointIndex::fill_node(std::uint32_t index, Id* first, Id* last) {
   if (extent.y > extent[axis]) axis = 1;
   if (extent.z > extent[axis]) axis = 2;
   if (count <= kBucket || !(extent[axis] > 0)) {  // small, or all points at one position
-    nodes_[index].bucket.assign(first, last);
+    nodes_[index].bucket.clear();
     nodes_[index].bucket_points.clear();
-    for (Id* it = first; it != last; ++it) {
-      leaf_of_[*it] = index;
-      nodes_[index].bucket_points.push_back(position_[*it]);
+    for (Entry* it = first; it != last; ++it) {
+      leaf_of_[it->id] = index;
+      nodes_[index].bucket.push_back(it->id);
+      nodes_[index].bucket_points.push_back(it->p);
     }
     return;
   }
-  auto coordinate = [&](Id a) { return position_[a][axis]; };
-  Id* middle = first + count / 2;
-  std::nth_element(first, middle, last, [&](Id a, Id b) { return coordinate(a) < coordinate(b); });
+  auto coordinate = [&](const Entry& a) { return a.p[axis]; };
+  Entry* middle = first + count / 2;
+  std::nth_element(first, middle, last,
+                   [&](const Entry& a, const Entry& b) { return coordinate(a) < coordinate(b); });
   // Left: strictly below the median value; when nothing is (the lower half sits at the median), left:
   // at most the median. Both sides are non-empty since the extent along the axis is positive.
   const double median = coordinate(*middle);
-  middle = std::partition(first, last, [&](Id a) { return coordinate(a) < median; });
-  if (middle == first) middle = std::partition(first, last, [&](Id a) { return !(coordinate(a) > median); });
+  middle = std::partition(first, last, [&](const Entry& a) { return coordinate(a) < median; });
+  if (middle == first)
+    middle = std::partition(first, last, [&](const Entry& a) { return !(coordinate(a) > median); });
   double cut = coordinate(*middle);  // the smallest coordinate on the right: left < cut <= right
-  for (Id* it = middle; it != last; ++it) cut = std::min(cut, coordinate(*it));
+  for (Entry* it = middle; it != last; ++it) cut = std::min(cut, coordinate(*it));
   nodes_[index].bucket.clear();
   nodes_[index].bucket_points.clear();
   nodes_[index].bucket_points.shrink_to_fit();
@@ -145,8 +148,9 @@ void PointIndex::insert(Id id, const Point3& p) {
 }
 
 void PointIndex::split_leaf(std::uint32_t node) {
-  std::vector<Id> ids = std::move(nodes_[node].bucket);
-  fill_node(node, ids.data(), ids.data() + ids.size());  // stays a leaf when all ids share one position
+  std::vector<Entry> entries(nodes_[node].bucket.size());
+  for (std::size_t k = 0; k < entries.size(); ++k) entries[k] = {nodes_[node].bucket_points[k], nodes_[node].bucket[k]};
+  fill_node(node, entries.data(), entries.data() + entries.size());  // stays a leaf when all share one position
 }
 
 void PointIndex::erase(Id id) {

@@ -58,8 +58,7 @@ void finish_out(std::ofstream& out, const std::string& path) {
 
 std::string num(double v) {
   char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
+  return std::string(buf, put_number(buf, v));
 }
 
 }  // namespace io_detail

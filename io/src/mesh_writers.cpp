@@ -11,7 +11,6 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <limits>
@@ -20,8 +19,8 @@
 namespace vitri {
 
 using io_detail::finish_out;
-using io_detail::num;
 using io_detail::open_out;
+using io_detail::TextWriter;
 
 namespace {
 
@@ -69,19 +68,27 @@ void check_indices(const Rows& r, const std::string& path) {
                               std::to_string(r.index(f, k)) + " out of range");
 }
 
+/// "3 a b c" lines (OFF and ascii PLY faces).
+template <class Rows>
+void put_triangles(TextWriter& w, const Rows& r) {
+  for (std::size_t f = 0; f < r.num_triangles(); ++f)
+    w.text("3 ").integer(r.index(f, 0)).put(' ').integer(r.index(f, 1)).put(' ').integer(r.index(f, 2)).put('\n');
+}
+
 template <class Rows>
 void off_rows(const std::string& path, const Rows& r) {
   check_indices(r, path);
   const bool n = r.has_normals();
   auto out = open_out(path);
   out << (n ? "NOFF\n" : "OFF\n") << r.num_vertices() << ' ' << r.num_triangles() << " 0\n";
+  TextWriter w(out);
   for (std::size_t i = 0; i < r.num_vertices(); ++i) {
-    out << num(r.vertex(i, 0)) << ' ' << num(r.vertex(i, 1)) << ' ' << num(r.vertex(i, 2));
-    if (n) out << ' ' << num(r.normal(i, 0)) << ' ' << num(r.normal(i, 1)) << ' ' << num(r.normal(i, 2));
-    out << '\n';
+    w.number(r.vertex(i, 0)).put(' ').number(r.vertex(i, 1)).put(' ').number(r.vertex(i, 2));
+    if (n) w.put(' ').number(r.normal(i, 0)).put(' ').number(r.normal(i, 1)).put(' ').number(r.normal(i, 2));
+    w.put('\n');
   }
-  for (std::size_t f = 0; f < r.num_triangles(); ++f)
-    out << "3 " << r.index(f, 0) << ' ' << r.index(f, 1) << ' ' << r.index(f, 2) << '\n';
+  put_triangles(w, r);
+  w.flush();
   finish_out(out, path);
 }
 
@@ -91,20 +98,22 @@ void obj_rows(const std::string& path, const Rows& r) {
   const bool n = r.has_normals();
   auto out = open_out(path);
   out << "# vitri\n";
+  TextWriter w(out);
   for (std::size_t i = 0; i < r.num_vertices(); ++i)
-    out << "v " << num(r.vertex(i, 0)) << ' ' << num(r.vertex(i, 1)) << ' ' << num(r.vertex(i, 2)) << '\n';
+    w.text("v ").number(r.vertex(i, 0)).put(' ').number(r.vertex(i, 1)).put(' ').number(r.vertex(i, 2)).put('\n');
   if (n)
     for (std::size_t i = 0; i < r.num_vertices(); ++i)
-      out << "vn " << num(r.normal(i, 0)) << ' ' << num(r.normal(i, 1)) << ' ' << num(r.normal(i, 2)) << '\n';
+      w.text("vn ").number(r.normal(i, 0)).put(' ').number(r.normal(i, 1)).put(' ').number(r.normal(i, 2)).put('\n');
   for (std::size_t f = 0; f < r.num_triangles(); ++f) {
-    out << 'f';
+    w.put('f');
     for (int k = 0; k < 3; ++k) {
       const long long i = r.index(f, k) + 1LL;
-      out << ' ' << i;
-      if (n) out << "//" << i;
+      w.put(' ').integer(i);
+      if (n) w.text("//").integer(i);
     }
-    out << '\n';
+    w.put('\n');
   }
+  w.flush();
   finish_out(out, path);
 }
 
@@ -125,32 +134,31 @@ void ply_rows(const std::string& path, const Rows& r, PlyEncoding encoding) {
     if (swap) std::reverse(b, b + size);
     out.write(reinterpret_cast<const char*>(b), static_cast<std::streamsize>(size));
   };
-  char buf[32];
+  TextWriter w(out);  // the ascii body
   const int k = n ? 6 : 3;
   for (std::size_t i = 0; i < r.num_vertices(); ++i) {
     double row[6] = {r.vertex(i, 0), r.vertex(i, 1), r.vertex(i, 2), 0, 0, 0};
     if (n) row[3] = r.normal(i, 0), row[4] = r.normal(i, 1), row[5] = r.normal(i, 2);
     for (int j = 0; j < k; ++j) {
-      if (bin) {
+      if (bin)
         put(&row[j], 8);
-      } else {
-        std::snprintf(buf, sizeof buf, "%.17g", row[j]);
-        out << buf << (j + 1 < k ? ' ' : '\n');
-      }
+      else
+        w.number(row[j]).put(j + 1 < k ? ' ' : '\n');
     }
   }
-  for (std::size_t f = 0; f < r.num_triangles(); ++f) {
-    if (bin) {
+  if (bin) {
+    for (std::size_t f = 0; f < r.num_triangles(); ++f) {
       const unsigned char three = 3;
       put(&three, 1);
       for (int c = 0; c < 3; ++c) {
         const auto idx = static_cast<std::int32_t>(r.index(f, c));  // checked: below 2^31
         put(&idx, 4);
       }
-    } else {
-      out << "3 " << r.index(f, 0) << ' ' << r.index(f, 1) << ' ' << r.index(f, 2) << '\n';
     }
+  } else {
+    put_triangles(w, r);
   }
+  w.flush();
   finish_out(out, path);
 }
 

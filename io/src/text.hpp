@@ -129,4 +129,53 @@ inline bool has_vertex_normals(const TriangleMesh& m) {
 /// A double with 17 significant digits (round-trips exactly), locale-independent.
 std::string num(double v);
 
+/// Writes v at p as printf's "%.17g" would (std::to_chars with the same format and precision: no locale,
+/// no varargs, several times faster); returns the end. p must have room for 32 characters.
+inline char* put_number(char* p, double v) {
+  return std::to_chars(p, p + 32, v, std::chars_format::general, 17).ptr;
+}
+
+/// Text formatted into a buffer and written to the stream in blocks of about 1 MB: the writers' numbers
+/// and indices without a stream insertion per token. flush() before checking the stream.
+class TextWriter {
+ public:
+  explicit TextWriter(std::ostream& out) : out_(out) { buf_.resize(kBlock + kSlack); }
+  TextWriter(const TextWriter&) = delete;
+  TextWriter& operator=(const TextWriter&) = delete;
+
+  TextWriter& number(double v) {
+    pos_ = static_cast<std::size_t>(put_number(buf_.data() + pos_, v) - buf_.data());
+    return after_token();
+  }
+  TextWriter& integer(long long v) {
+    pos_ = static_cast<std::size_t>(std::to_chars(buf_.data() + pos_, buf_.data() + pos_ + 24, v).ptr - buf_.data());
+    return after_token();
+  }
+  TextWriter& put(char c) {
+    buf_[pos_++] = c;
+    return after_token();
+  }
+  /// Short literal text (below kSlack characters).
+  TextWriter& text(std::string_view t) {
+    std::memcpy(buf_.data() + pos_, t.data(), t.size());
+    pos_ += t.size();
+    return after_token();
+  }
+  void flush() {
+    out_.write(buf_.data(), static_cast<std::streamsize>(pos_));
+    pos_ = 0;
+  }
+
+ private:
+  static constexpr std::size_t kBlock = std::size_t(1) << 20;
+  static constexpr std::size_t kSlack = 64;  // room for one more token past the block
+  TextWriter& after_token() {
+    if (pos_ >= kBlock) flush();
+    return *this;
+  }
+  std::ostream& out_;
+  std::vector<char> buf_;
+  std::size_t pos_ = 0;
+};
+
 }  // namespace vitri::io_detail

@@ -196,7 +196,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
     const std::vector<std::size_t> order = rbf_detail::spatial_order(merged);
     for (std::size_t k = 0; k < order.size(); ++k) surf[k] = merged[order[k]];
   }
-  const PointIndex surface(surf);
+  const PointIndex surface(surf, opt.threads);
   // The merge tolerance above stays measured on the box grown by the largest d.
   const double spacing = opt.offset_spacings > 0 && surf.size() > 1 ? spacing_median(surface, surf) : 0.0;
   const double d = spacing > 0 ? std::min(d0, opt.offset_spacings * spacing) : d0;

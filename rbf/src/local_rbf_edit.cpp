@@ -128,7 +128,7 @@ void LocalRbf::Impl::compact_if_sparse() {
   slot_value = std::move(values);
   slot_alive.assign(slot_point.size(), 1);
   ranks.reset(slot_point.size());
-  index.build(slot_point);
+  index.build(slot_point, threads());
 }
 
 void LocalRbf::Impl::kill_slot(std::uint32_t slot) {

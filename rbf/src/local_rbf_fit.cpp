@@ -72,7 +72,7 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
     step_seconds[k] = seconds_since(t_step);
     t_step = std::chrono::steady_clock::now();
   };
-  index.build(slot_point);
+  index.build(slot_point, threads());
   fit_diagonal = box.diagonal();
   end_step(0);
   check_duplicates();

@@ -109,7 +109,7 @@ class NeighbourTable {
  public:
   NeighbourTable(const std::vector<Point3>& points, std::size_t k, unsigned threads)
       : k_(k), ids_(points.size() * k) {
-    const PointIndex index(points);
+    const PointIndex index(points, threads);
     rbf_detail::parallel_chunks(points.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
       std::vector<Id> found;
       for (std::size_t u = b; u < e; ++u) {

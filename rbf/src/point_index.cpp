@@ -5,10 +5,13 @@
 
 #include "vitri/core/error.hpp"
 
+#include "parallel.hpp"
+
 #include <algorithm>
 #include <cassert>
 #include <limits>
 #include <queue>
+#include <thread>
 #include <utility>
 
 namespace vitri {
@@ -17,6 +20,8 @@ namespace {
 
 /// Leaves hold at most this many ids after a build; an insertion splits a leaf past twice as many.
 constexpr std::size_t kBucket = 16;
+/// From this many points on, build() with threads puts the root's right half on a second thread.
+constexpr std::size_t kParallelBuildMin = std::size_t(1) << 15;
 
 void grow(Point3& lo, Point3& hi, const Point3& p) {
   for (int a = 0; a < 3; ++a) {
@@ -49,7 +54,7 @@ struct PointIndex::NearestState {
   }
 };
 
-void PointIndex::build(const std::vector<Point3>& points) {
+void PointIndex::build(const std::vector<Point3>& points, unsigned threads) {
   if (points.size() >= static_cast<std::size_t>(kNoId))
     throw LimitError("PointIndex: " + std::to_string(points.size()) + " points exceed the 2^32 - 2 ids");
   for (std::size_t i = 0; i < points.size(); ++i)
@@ -61,40 +66,77 @@ void PointIndex::build(const std::vector<Point3>& points) {
   std::vector<Entry> entries(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) entries[i] = {points[i], static_cast<Id>(i)};
   nodes_.reserve(2 * (points.size() / kBucket + 1));
-  make_subtree(entries.data(), entries.data() + entries.size());
+  Entry* const first = entries.data();
+  Entry* const last = first + entries.size();
+  Point3 lo, hi;
+  std::uint8_t axis = 0;
+  double cut = 0;
+  Entry* middle = nullptr;
+  if (rbf_detail::thread_count(threads) < 2 || entries.size() < kParallelBuildMin ||
+      !split_entries(first, last, lo, hi, axis, cut, middle)) {
+    make_subtree(nodes_, first, last);
+    return;
+  }
+  // The root's split here, its left half on this thread and its right half on another into its own
+  // node array, appended after: the same nodes in the same order as the one-thread build (depth first,
+  // left before right), with the right half's indices shifted by where it lands.
+  nodes_.emplace_back();
+  nodes_[0].lo = lo;
+  nodes_[0].hi = hi;
+  nodes_[0].axis = axis;
+  nodes_[0].split = cut;
+  std::vector<Node> right;
+  right.reserve(nodes_.capacity() / 2);
+  std::exception_ptr right_error;
+  std::thread worker([&] {
+    try {
+      make_subtree(right, middle, last);
+    } catch (...) {
+      right_error = std::current_exception();
+    }
+  });
+  try {
+    nodes_[0].children[0] = make_subtree(nodes_, first, middle);
+  } catch (...) {
+    worker.join();
+    throw;
+  }
+  worker.join();
+  if (right_error) std::rethrow_exception(right_error);
+  const auto offset = static_cast<std::uint32_t>(nodes_.size());
+  nodes_[0].children[1] = offset;
+  for (Node& n : right) {
+    if (n.leaf()) {
+      for (const Id id : n.bucket) leaf_of_[id] += offset;
+    } else {
+      n.children[0] += offset;
+      n.children[1] += offset;
+    }
+    nodes_.push_back(std::move(n));
+  }
 }
 
-std::uint32_t PointIndex::make_subtree(Entry* first, Entry* last) {
-  const auto index = static_cast<std::uint32_t>(nodes_.size());
-  nodes_.emplace_back();
-  fill_node(index, first, last);
+std::uint32_t PointIndex::make_subtree(std::vector<Node>& nodes, Entry* first, Entry* last) {
+  const auto index = static_cast<std::uint32_t>(nodes.size());
+  nodes.emplace_back();
+  fill_node(nodes, index, first, last);
   return index;
 }
 
-void PointIndex::fill_node(std::uint32_t index, Entry* first, Entry* last) {
-  Point3 lo{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
-            std::numeric_limits<double>::infinity()};
-  Point3 hi = -lo;
+bool PointIndex::split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis_out,
+                               double& cut, Entry*& middle) {
+  lo = Point3{std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity(),
+              std::numeric_limits<double>::infinity()};
+  hi = -lo;
   for (Entry* it = first; it != last; ++it) grow(lo, hi, it->p);
-  nodes_[index].lo = lo;
-  nodes_[index].hi = hi;
   const auto count = static_cast<std::size_t>(last - first);
   const Point3 extent = hi - lo;
   int axis = 0;
   if (extent.y > extent[axis]) axis = 1;
   if (extent.z > extent[axis]) axis = 2;
-  if (count <= kBucket || !(extent[axis] > 0)) {  // small, or all points at one position
-    nodes_[index].bucket.clear();
-    nodes_[index].bucket_points.clear();
-    for (Entry* it = first; it != last; ++it) {
-      leaf_of_[it->id] = index;
-      nodes_[index].bucket.push_back(it->id);
-      nodes_[index].bucket_points.push_back(it->p);
-    }
-    return;
-  }
+  if (count <= kBucket || !(extent[axis] > 0)) return false;  // small, or all points at one position
   auto coordinate = [&](const Entry& a) { return a.p[axis]; };
-  Entry* middle = first + count / 2;
+  middle = first + count / 2;
   std::nth_element(first, middle, last,
                    [&](const Entry& a, const Entry& b) { return coordinate(a) < coordinate(b); });
   // Left: strictly below the median value; when nothing is (the lower half sits at the median), left:
@@ -103,17 +145,37 @@ void PointIndex::fill_node(std::uint32_t index, Entry* first, Entry* last) {
   middle = std::partition(first, last, [&](const Entry& a) { return coordinate(a) < median; });
   if (middle == first)
     middle = std::partition(first, last, [&](const Entry& a) { return !(coordinate(a) > median); });
-  double cut = coordinate(*middle);  // the smallest coordinate on the right: left < cut <= right
+  cut = coordinate(*middle);  // the smallest coordinate on the right: left < cut <= right
   for (Entry* it = middle; it != last; ++it) cut = std::min(cut, coordinate(*it));
-  nodes_[index].bucket.clear();
-  nodes_[index].bucket_points.clear();
-  nodes_[index].bucket_points.shrink_to_fit();
-  nodes_[index].axis = static_cast<std::uint8_t>(axis);
-  nodes_[index].split = cut;
-  const std::uint32_t left = make_subtree(first, middle);
-  const std::uint32_t right = make_subtree(middle, last);
-  nodes_[index].children[0] = left;
-  nodes_[index].children[1] = right;
+  axis_out = static_cast<std::uint8_t>(axis);
+  return true;
+}
+
+void PointIndex::fill_node(std::vector<Node>& nodes, std::uint32_t index, Entry* first, Entry* last) {
+  Point3 lo, hi;
+  std::uint8_t axis = 0;
+  double cut = 0;
+  Entry* middle = nullptr;
+  const bool inner = split_entries(first, last, lo, hi, axis, cut, middle);
+  nodes[index].lo = lo;
+  nodes[index].hi = hi;
+  nodes[index].bucket.clear();
+  nodes[index].bucket_points.clear();
+  if (!inner) {
+    for (Entry* it = first; it != last; ++it) {
+      leaf_of_[it->id] = index;
+      nodes[index].bucket.push_back(it->id);
+      nodes[index].bucket_points.push_back(it->p);
+    }
+    return;
+  }
+  nodes[index].bucket_points.shrink_to_fit();
+  nodes[index].axis = axis;
+  nodes[index].split = cut;
+  const std::uint32_t left = make_subtree(nodes, first, middle);
+  const std::uint32_t right = make_subtree(nodes, middle, last);
+  nodes[index].children[0] = left;
+  nodes[index].children[1] = right;
 }
 
 void PointIndex::ensure_id(Id id) {
@@ -149,7 +211,7 @@ void PointIndex::insert(Id id, const Point3& p) {
 void PointIndex::split_leaf(std::uint32_t node) {
   std::vector<Entry> entries(nodes_[node].bucket.size());
   for (std::size_t k = 0; k < entries.size(); ++k) entries[k] = {nodes_[node].bucket_points[k], nodes_[node].bucket[k]};
-  fill_node(node, entries.data(), entries.data() + entries.size());  // stays a leaf when all share one position
+  fill_node(nodes_, node, entries.data(), entries.data() + entries.size());  // a leaf when all share one position
 }
 
 void PointIndex::erase(Id id) {

@@ -113,6 +113,49 @@ TEST_CASE("PointIndex answers like brute force after build, insertions and remov
   REQUIRE(index.contains(1));
 }
 
+TEST_CASE("PointIndex built on two threads answers like the one-thread build and brute force", "[point_index]") {
+  // Enough points for the threaded build (the root's halves on two threads), with ties and duplicates.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Point3> pts;
+  for (int i = 0; i < 40000; ++i) pts.push_back({u(rng), u(rng), u(rng)});
+  for (int i = 0; i < 2000; ++i) pts.push_back({std::round(u(rng) * 8) / 8, 0.125, std::round(u(rng) * 8) / 8});
+  const PointIndex one(pts, 1), two(pts, 2);
+  Brute brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) brute.points.emplace_back(static_cast<Id>(i), pts[i]);
+  std::vector<Id> a, b;
+  for (int q = 0; q < 200; ++q) {
+    const Point3 c{u(rng), u(rng), u(rng)};
+    const double r2 = 0.001 * (q % 10 + 1);
+    one.ball(c, r2, a);
+    two.ball(c, r2, b);
+    REQUIRE(a == b);
+    if (q % 20 == 0) REQUIRE(b == brute.ball(c, r2));
+    one.nearest(c, 9, a);
+    two.nearest(c, 9, b);
+    REQUIRE(a == b);
+  }
+  std::vector<std::pair<Id, Id>> pa, pb;
+  one.close_pairs(1e-4, [&](Id i, Id j) { pa.emplace_back(i, j); });
+  two.close_pairs(1e-4, [&](Id i, Id j) { pb.emplace_back(i, j); });
+  std::sort(pa.begin(), pa.end());
+  std::sort(pb.begin(), pb.end());
+  REQUIRE(pa == pb);
+  REQUIRE_FALSE(pa.empty());
+  // The leaves of the half built on the second thread are found again by erase() (leaf_of_ shifted).
+  PointIndex edited(pts, 2);
+  Brute kept;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    if (i % 7 == 0) edited.erase(static_cast<Id>(i));
+    else kept.points.emplace_back(static_cast<Id>(i), pts[i]);
+  }
+  for (int q = 0; q < 20; ++q) {
+    const Point3 c{u(rng), u(rng), u(rng)};
+    edited.ball(c, 0.01, a);
+    REQUIRE(a == kept.ball(c, 0.01));
+  }
+}
+
 TEST_CASE("PointIndex rejects bad input with the culprit", "[point_index]") {
   PointIndex index(std::vector<Point3>{{0, 0, 0}, {1, 0, 0}});
   REQUIRE_THROWS_AS(index.insert(1, {2, 0, 0}), vitri::InvalidPoint);

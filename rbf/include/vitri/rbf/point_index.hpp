@@ -31,12 +31,13 @@ class PointIndex {
   static constexpr Id kNoId = 0xffffffffu;
 
   PointIndex() = default;
-  /// Same as build(points).
-  explicit PointIndex(const std::vector<Point3>& points) { build(points); }
+  /// Same as build(points, threads).
+  explicit PointIndex(const std::vector<Point3>& points, unsigned threads = 1) { build(points, threads); }
 
-  /// Replaces the content by points[i] with id i.
+  /// Replaces the content by points[i] with id i. With threads > 1 (0: the hardware's) and enough points,
+  /// the two halves below the root are built on two threads; the tree is the same whatever the threads.
   /// @throws InvalidPoint (index i) for a non-finite coordinate; LimitError for more than 2^32 - 2 points.
-  void build(const std::vector<Point3>& points);
+  void build(const std::vector<Point3>& points, unsigned threads = 1);
   /// Adds point p with the given id (any unused id below 2^32 - 1; ids need not be dense).
   /// @throws InvalidPoint (id) when p is not finite or the id is in use or kNoId.
   void insert(Id id, const Point3& p);
@@ -90,10 +91,15 @@ class PointIndex {
     Point3 p;
     Id id;
   };
-  /// Appends a node holding entries [first, last) (split recursively); returns its index.
-  std::uint32_t make_subtree(Entry* first, Entry* last);
-  /// Makes node `index` hold entries [first, last): a leaf, or an inner node whose children are appended.
-  void fill_node(std::uint32_t index, Entry* first, Entry* last);
+  /// Appends to `nodes` a node holding entries [first, last) (split recursively); returns its index.
+  std::uint32_t make_subtree(std::vector<Node>& nodes, Entry* first, Entry* last);
+  /// Makes nodes[index] hold entries [first, last): a leaf, or an inner node whose children are appended
+  /// to `nodes`. Writes leaf_of_ with indices into `nodes`.
+  void fill_node(std::vector<Node>& nodes, std::uint32_t index, Entry* first, Entry* last);
+  /// The split of entries [first, last) (reordered: left part first): false when they make a leaf
+  /// (few, or all at one position). lo / hi: their bounding box.
+  static bool split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis, double& cut,
+                            Entry*& middle);
   void split_leaf(std::uint32_t node);
   void ensure_id(Id id);
   void nearest_recurse(std::uint32_t node, NearestState& state) const;

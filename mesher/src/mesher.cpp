@@ -100,8 +100,15 @@ void Mesher::build() {
   filter_ = std::make_unique<SupportFilter>();  // a new polygonizer: the next delta is full
   filter_precision_ = 0;
   vertex_of_.assign(poly_->seed_vertices());
-  zero_index_ = PointIndex();
-  for (std::size_t i = 0; i < c.size(); ++i) track_zero(vertex_of_[i], c.points[i], c.values[i]);
+  // The on-surface constraints' vertices, in one balanced build (as many track_zero insertions before).
+  std::vector<PointIndex::Id> zero_ids;
+  std::vector<Point3> zero_points;
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (vertex_of_[i] != kNoVertex && c.values[i] == 0) {
+      zero_ids.push_back(vertex_of_[i]);
+      zero_points.push_back(c.points[i]);
+    }
+  zero_index_.build(zero_ids, zero_points, options_.polygonizer.threads);
   quality_.reset();
   mesh_valid_ = false;
   if (local_) local_->release_constraints_cache();  // read once here; 32 bytes per constraint freed

@@ -59,13 +59,45 @@ void PointIndex::build(const std::vector<Point3>& points, unsigned threads) {
     throw LimitError("PointIndex: " + std::to_string(points.size()) + " points exceed the 2^32 - 2 ids");
   for (std::size_t i = 0; i < points.size(); ++i)
     if (!is_finite(points[i])) throw InvalidPoint(i, "non-finite coordinate in the spatial index");
-  nodes_.clear();
   position_ = points;
   leaf_of_.assign(points.size(), kNoNode);
-  size_ = points.size();
   std::vector<Entry> entries(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) entries[i] = {points[i], static_cast<Id>(i)};
-  nodes_.reserve(2 * (points.size() / kBucket + 1));
+  build_entries(entries, threads);
+}
+
+void PointIndex::build(const std::vector<Id>& ids, const std::vector<Point3>& points, unsigned threads) {
+  if (ids.size() != points.size())
+    throw InvalidArgument("PointIndex::build: " + std::to_string(ids.size()) + " ids for " +
+                          std::to_string(points.size()) + " points");
+  Id top = 0;
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    if (ids[k] == kNoId) throw InvalidPoint(ids[k], "the id 2^32 - 1 is reserved in the spatial index");
+    if (!is_finite(points[k])) throw InvalidPoint(ids[k], "non-finite coordinate in the spatial index");
+    top = std::max(top, ids[k]);
+  }
+  const std::size_t slots = ids.empty() ? 0 : static_cast<std::size_t>(top) + 1;
+  {  // checked before anything changes
+    std::vector<std::uint8_t> seen(slots, 0);
+    for (const Id id : ids) {
+      if (seen[id]) throw InvalidPoint(id, "id already used in the spatial index");
+      seen[id] = 1;
+    }
+  }
+  position_.assign(slots, Point3{});
+  leaf_of_.assign(slots, kNoNode);
+  std::vector<Entry> entries(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    position_[ids[k]] = points[k];
+    entries[k] = {points[k], ids[k]};
+  }
+  build_entries(entries, threads);
+}
+
+void PointIndex::build_entries(std::vector<Entry>& entries, unsigned threads) {
+  nodes_.clear();
+  size_ = entries.size();
+  nodes_.reserve(2 * (entries.size() / kBucket + 1));
   Entry* const first = entries.data();
   Entry* const last = first + entries.size();
   Point3 lo, hi;

@@ -156,6 +156,47 @@ TEST_CASE("PointIndex built on two threads answers like the one-thread build and
   }
 }
 
+TEST_CASE("PointIndex built from sparse ids answers like one built by insertions", "[point_index]") {
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Id> ids;
+  std::vector<Point3> pts;
+  PointIndex inserted;
+  Brute brute;
+  for (Id k = 0; k < 3000; ++k) {
+    const Id id = 7 * k + (k % 3);  // sparse, not sorted by position
+    const Point3 p{u(rng), u(rng), u(rng)};
+    ids.push_back(id);
+    pts.push_back(p);
+    inserted.insert(id, p);
+    brute.points.emplace_back(id, p);
+  }
+  for (const unsigned threads : {1u, 2u}) {
+    PointIndex built;
+    built.build(ids, pts, threads);
+    REQUIRE(built.size() == ids.size());
+    REQUIRE(built.contains(8));  // k = 1
+    REQUIRE_FALSE(built.contains(7));
+    check_queries(built, brute, rng);
+    std::vector<Id> a, b;
+    for (int q = 0; q < 50; ++q) {
+      const Point3 c{u(rng), u(rng), u(rng)};
+      built.nearest(c, 5, a);
+      inserted.nearest(c, 5, b);
+      REQUIRE(a == b);
+    }
+    built.erase(ids[10]);  // still editable
+    built.insert(ids[10], pts[10]);
+    check_queries(built, brute, rng);
+  }
+  PointIndex bad;
+  REQUIRE_THROWS_AS(bad.build({1, 2}, {Point3{0, 0, 0}}), vitri::InvalidArgument);
+  REQUIRE_THROWS_AS(bad.build({4, 4}, {Point3{0, 0, 0}, Point3{1, 0, 0}}), vitri::InvalidPoint);
+  REQUIRE_THROWS_AS(bad.build({PointIndex::kNoId}, {Point3{0, 0, 0}}), vitri::InvalidPoint);
+  REQUIRE_THROWS_AS(bad.build({3}, {Point3{std::nan(""), 0, 0}}), vitri::InvalidPoint);
+  REQUIRE(bad.empty());  // nothing built by a refused call
+}
+
 TEST_CASE("PointIndex rejects bad input with the culprit", "[point_index]") {
   PointIndex index(std::vector<Point3>{{0, 0, 0}, {1, 0, 0}});
   REQUIRE_THROWS_AS(index.insert(1, {2, 0, 0}), vitri::InvalidPoint);

@@ -38,6 +38,11 @@ class PointIndex {
   /// the two halves below the root are built on two threads; the tree is the same whatever the threads.
   /// @throws InvalidPoint (index i) for a non-finite coordinate; LimitError for more than 2^32 - 2 points.
   void build(const std::vector<Point3>& points, unsigned threads = 1);
+  /// Replaces the content by points[k] with id ids[k] (any distinct ids below 2^32 - 1, as insert()
+  /// takes them): one balanced build instead of as many insertions.
+  /// @throws InvalidArgument for sizes that differ; InvalidPoint (the id) for a non-finite point, a
+  ///         repeated id or kNoId.
+  void build(const std::vector<Id>& ids, const std::vector<Point3>& points, unsigned threads = 1);
   /// Adds point p with the given id (any unused id below 2^32 - 1; ids need not be dense).
   /// @throws InvalidPoint (id) when p is not finite or the id is in use or kNoId.
   void insert(Id id, const Point3& p);
@@ -91,6 +96,8 @@ class PointIndex {
     Point3 p;
     Id id;
   };
+  /// The build from entries whose ids and positions are set (position_, leaf_of_ sized and cleared).
+  void build_entries(std::vector<Entry>& entries, unsigned threads);
   /// Appends to `nodes` a node holding entries [first, last) (split recursively); returns its index.
   std::uint32_t make_subtree(std::vector<Node>& nodes, Entry* first, Entry* last);
   /// Makes nodes[index] hold entries [first, last): a leaf, or an inner node whose children are appended

@@ -81,6 +81,8 @@ struct LocalRbf::Impl {
   void fit_leaves(const std::vector<std::uint32_t>& leaves);
   /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).
   void link(const std::vector<std::uint32_t>& created, bool every_leaf = false);
+  /// The reverse lists (listed_in) of a full fit, where `leaves` are all the leaves; threaded.
+  void list_back_all(const std::vector<std::uint32_t>& leaves);
   void unlink(std::uint32_t c);
   /// Writes the patch record of each of `leaves` (after their fit).
   void publish(const std::vector<std::uint32_t>& leaves);

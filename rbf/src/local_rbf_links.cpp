@@ -31,11 +31,14 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_
       }
     });
   }
+  if (every_leaf) {
+    list_back_all(created);
+    return;
+  }
   std::vector<std::uint32_t> found;
   for (std::uint32_t n : created) {
     for (std::uint32_t l : tree.cell(n).candidates) tree.cell(l).listed_in.push_back(n);
-    // The older leaves whose cube n's ball meets list n too; in a full fit there is none.
-    if (every_leaf) continue;
+    // The older leaves whose cube n's ball meets list n too.
     tree.leaves_in_ball(tree.cell(n).center, tree.cell(n).radius, found);
     for (std::uint32_t m : found) {
       if (is_new(m)) continue;
@@ -46,8 +49,35 @@ void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_
       tree.cell(n).listed_in.push_back(m);
     }
   }
-  if (every_leaf)
-    for (std::uint32_t n : created) tree.cell(n).listed_in.shrink_to_fit();
+}
+
+void LocalRbf::Impl::list_back_all(const std::vector<std::uint32_t>& leaves) {
+  // The reverse of the candidate lists, each in `leaves` order as one pass of push_back would give:
+  // `leaves` cut into one slice per thread; the slices count their entries per cell, the counts give
+  // each slice its place in every list (lower slices first), and the slices fill their places.
+  const std::size_t cells = tree.capacity();
+  const unsigned slices = std::max(1u, std::min<unsigned>(threads(), static_cast<unsigned>(leaves.size() / 4096 + 1)));
+  const std::size_t grain = (leaves.size() + slices - 1) / slices;
+  std::vector<std::vector<std::uint32_t>> at(slices, std::vector<std::uint32_t>(cells, 0));
+  parallel_chunks(leaves.size(), slices, grain, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t>& count = at[b / grain];
+    for (std::size_t k = b; k < e; ++k)
+      for (const std::uint32_t l : tree.cell(leaves[k]).candidates) ++count[l];
+  });
+  for (std::size_t l = 0; l < cells; ++l) {
+    std::uint32_t total = 0;
+    for (unsigned t = 0; t < slices; ++t) {
+      const std::uint32_t c = at[t][l];
+      at[t][l] = total;  // where slice t starts in the list of l
+      total += c;
+    }
+    if (total) tree.cell(static_cast<std::uint32_t>(l)).listed_in.assign(total, 0);
+  }
+  parallel_chunks(leaves.size(), slices, grain, [&](std::size_t b, std::size_t e) {
+    std::vector<std::uint32_t>& next = at[b / grain];
+    for (std::size_t k = b; k < e; ++k)
+      for (const std::uint32_t l : tree.cell(leaves[k]).candidates) tree.cell(l).listed_in[next[l]++] = leaves[k];
+  });
 }
 
 void LocalRbf::Impl::unlink(std::uint32_t c) {

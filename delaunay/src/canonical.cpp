@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <numeric>
 #include <vector>
 
@@ -38,6 +39,21 @@ std::array<int, 4> canonical_order(const std::array<VertexId, 4>& k) {
   return {m, c[r], c[(r + 1) % 3], c[(r + 2) % 3]};
 }
 
+// The four ids in increasing order (a sorting network: five compare-exchanges, no branches).
+std::array<VertexId, 4> sorted_ids(std::array<VertexId, 4> k) {
+  const auto exchange = [&](int i, int j) {
+    const VertexId lo = std::min(k[i], k[j]), hi = std::max(k[i], k[j]);
+    k[i] = lo;
+    k[j] = hi;
+  };
+  exchange(0, 1);
+  exchange(2, 3);
+  exchange(0, 2);
+  exchange(1, 3);
+  exchange(1, 2);
+  return k;
+}
+
 // Below this many tetrahedra canonicalize() runs on one thread (starting threads would cost more).
 constexpr std::size_t kParallelCanonicalMin = std::size_t(1) << 16;
 
@@ -52,14 +68,13 @@ void Triangulation::canonicalize() {
   const unsigned threads = cap < kParallelCanonicalMin ? 1 : threads_;
   // Key of a live tetrahedron: its public vertex ids, sorted; bucketed by the smallest (a counting
   // sort), then each bucket (a few tetrahedra) sorted by the other three.
-  std::vector<std::array<VertexId, 4>> key(cap);
+  // Written for the live tetrahedra only, and read only for them: left uninitialized (as new_id below).
+  const std::unique_ptr<std::array<VertexId, 4>[]> key(new std::array<VertexId, 4>[cap]);
   detail::parallel_slices(cap, threads, [&](std::size_t lo, std::size_t hi) {
     for (TetId t = TetId(lo); t < hi; ++t) {
       if (tets_.is_dead(t)) continue;
-      std::array<VertexId, 4> k{};
-      for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
-      std::sort(k.begin(), k.end());
-      key[t] = k;
+      key[t] = sorted_ids({vid(tets_.vertex(t, 0)), vid(tets_.vertex(t, 1)), vid(tets_.vertex(t, 2)),
+                           vid(tets_.vertex(t, 3))});
     }
   });
   std::vector<std::uint32_t> start(vertex_capacity() + 1, 0);
@@ -77,7 +92,7 @@ void Triangulation::canonicalize() {
       std::sort(order.begin() + start[b], order.begin() + start[b + 1],
                 [&](TetId x, TetId y) { return key[x] < key[y]; });
   });
-  std::vector<TetId> new_id(cap, kNoTet);
+  const std::unique_ptr<TetId[]> new_id(new TetId[cap]);  // read only at live ids, all written
   detail::parallel_slices(order.size(), threads, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t n = lo; n < hi; ++n) new_id[order[n]] = static_cast<TetId>(n);
   });
@@ -87,7 +102,15 @@ void Triangulation::canonicalize() {
   detail::parallel_slices(order.size(), threads, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t n = lo; n < hi; ++n) {
       const TetId t = order[n];
-      if (n + 8 < hi) tets_.prefetch(order[n + 8]);  // the old records are read in key order: scattered
+      // The old records are read in key order (scattered), and then the new ids of their neighbours:
+      // the records 16 ahead are fetched, and the new ids of the neighbours of the one 8 ahead (its
+      // record was fetched 8 iterations ago).
+      if (n + 16 < hi) tets_.prefetch(order[n + 16]);
+      if (n + 8 < hi)
+        for (int i = 0; i < 4; ++i) {
+          const TetId ahead = tets_.neighbor(order[n + 8], i);
+          if (ahead != kNoTet) __builtin_prefetch(&new_id[ahead]);
+        }
       std::array<VertexId, 4> k{};
       for (int i = 0; i < 4; ++i) k[i] = vid(tets_.vertex(t, i));
       const std::array<int, 4> o = canonical_order(k);

@@ -32,25 +32,23 @@ void grow(Point3& lo, Point3& hi, const Point3& p) {
 
 }  // namespace
 
-/// The running answer of nearest(): a max-heap on (squared distance, id) of at most k entries.
+/// The running answer of nearest(): the k smallest (squared distance, id) so far, kept sorted (for the
+/// small k of the callers an insertion into a short sorted array beats a heap's sift-downs).
 struct PointIndex::NearestState {
   Point3 query;
   std::size_t k = 0;
-  std::vector<std::pair<double, Id>> heap;
-  /// Squared distance beyond which nothing can enter the answer (infinity until the heap is full).
+  std::vector<std::pair<double, Id>> best;
+  /// Squared distance beyond which nothing can enter the answer (infinity until k are held).
   double bound() const {
-    return heap.size() < k ? std::numeric_limits<double>::infinity() : heap.front().first;
+    return best.size() < k ? std::numeric_limits<double>::infinity() : best.back().first;
   }
   void offer(double d2, Id id) {
     const std::pair<double, Id> entry(d2, id);
-    if (heap.size() < k) {
-      heap.push_back(entry);
-      std::push_heap(heap.begin(), heap.end());
-    } else if (entry < heap.front()) {
-      std::pop_heap(heap.begin(), heap.end());
-      heap.back() = entry;
-      std::push_heap(heap.begin(), heap.end());
+    if (best.size() == k) {
+      if (!(entry < best.back())) return;
+      best.pop_back();
     }
+    best.insert(std::upper_bound(best.begin(), best.end(), entry), entry);
   }
 };
 
@@ -368,11 +366,10 @@ void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, s
   NearestState state;
   state.query = q;
   state.k = k;
-  state.heap.reserve(std::min(k, size_) + 1);
+  state.best.reserve(std::min(k, size_) + 1);
   nearest_recurse(0, state);
-  std::sort_heap(state.heap.begin(), state.heap.end());
-  ids.reserve(state.heap.size());
-  for (const auto& [d2, id] : state.heap) {
+  ids.reserve(state.best.size());
+  for (const auto& [d2, id] : state.best) {
     ids.push_back(id);
     if (dist2) dist2->push_back(d2);
   }

@@ -341,6 +341,30 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
   return insphere_expansion(v);
 }
 
+Sign orient3d_after_filter(const Point3& a, const Point3& b, const Point3& c, const Point3& d, double det,
+                           double largest) {
+  const double v[12] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z};
+  if (small_multiple_coordinates(v, 12, largest, kOrient3dSmall)) {
+#ifdef VITRI_PREDICATE_STATS
+    ++predicate_stats().orient3d_exact;
+#endif
+    return sign_of(det);
+  }
+  return orient3d_exact(a, b, c, d);
+}
+
+Sign insphere_after_filter(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e,
+                           double det, double largest) {
+  const double v[15] = {a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z, d.x, d.y, d.z, e.x, e.y, e.z};
+  if (small_multiple_coordinates(v, 15, largest, kInsphereSmall)) {
+#ifdef VITRI_PREDICATE_STATS
+    ++predicate_stats().insphere_exact;
+#endif
+    return sign_of(det);
+  }
+  return insphere_exact(a, b, c, d, e);
+}
+
 Sign orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy) {
 #ifdef VITRI_PREDICATE_STATS
   ++predicate_stats().orient2d_exact;

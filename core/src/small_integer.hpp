@@ -107,11 +107,29 @@ bool small_integer_value(const double* base, const RowAt& row_at, SmallIntegerLi
   return true;
 }
 
+/// The filters' shortcut (predicates.cpp, *_after_filter): true when every one of the n coordinates v is
+/// a multiple of G = 2^(e - limits.log_m) below 2^51 G in magnitude, e the binary exponent of `largest`
+/// (the largest |difference| the filter saw) within the limits. Then every difference is an exact small
+/// multiple of G (an integer below 2^52 times G, at most `largest` < 2^(log_m + 1) G), so the filter's own
+/// double evaluation, which has the cofactor scheme's operations, made no rounding: its value is exact.
+inline bool small_multiple_coordinates(const double* v, int n, double largest, SmallIntegerLimits limits) {
+  const int e = binary_exponent(largest);  // NaN, infinity and subnormals are declined by the range
+  if (e < limits.e_min || e > limits.e_max) return false;
+  const double inv_g = normal_power_of_two(limits.log_m - e);
+  for (int i = 0; i < n; ++i)
+    if (!is_integer_below_2_51(v[i] * inv_g)) return false;
+  return true;
+}
+
+/// The limits of the two predicates (see the top of the file).
+constexpr SmallIntegerLimits kInsphereSmall{8, -206, 202};
+constexpr SmallIntegerLimits kOrient3dSmall{15, -343, 338};
+
 /// insphere of v = a, b, c, d, e (15 coordinates), exactly, when the differences are small multiples of
 /// a power of two (|q| < 2^9 G) in range; false otherwise (non-finite input included).
 inline bool small_integer_insphere(const double* v, double& value) {
   return small_integer_value<4>(
-      v + 12, [&](int r) { return v + 3 * r; }, SmallIntegerLimits{8, -206, 202},
+      v + 12, [&](int r) { return v + 3 * r; }, kInsphereSmall,
       [](PlainArithmetic& f, const double(&q)[4][3]) { return insphere_cofactors(f, q); }, value);
 }
 
@@ -119,7 +137,7 @@ inline bool small_integer_insphere(const double* v, double& value) {
 /// power of two (|q| < 2^16 G) in range; false otherwise (non-finite input included).
 inline bool small_integer_orient3d(const double* v, double& value) {
   return small_integer_value<3>(
-      v, [&](int r) { return v + 3 * (r + 1); }, SmallIntegerLimits{15, -343, 338},
+      v, [&](int r) { return v + 3 * (r + 1); }, kOrient3dSmall,
       [](PlainArithmetic& f, const double(&q)[3][3]) { return orient3d_from_differences(f, q); }, value);
 }
 

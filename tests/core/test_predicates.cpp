@@ -1100,3 +1100,38 @@ TEST_CASE("small-integer stage declines what it cannot prove exact", "[predicate
     CHECK_FALSE(vitri::detail::small_integer_orient3d(w, value));
   }
 }
+
+TEST_CASE("small-integer shortcut after the filter: the filter's value is taken only when it is exact",
+          "[predicates][small_integer]") {
+  // Points of integer grids (differences below 2^8, the insphere shortcut's range) with offsets that are
+  // multiples of a power of two, many of them cospherical or coplanar: the public predicates (which go
+  // through *_after_filter) and the shortcut itself must give the oracle's sign. Off-grid points make
+  // the shortcut decline (it must not take the rounded double value).
+  std::mt19937_64 rng(45);
+  std::uniform_int_distribution<int> cell(-3, 3), far(-100, 100);
+  int taken = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double g = std::ldexp(1.0, static_cast<int>(rng() % 41) - 20);
+    const Point3 base = scaled(Point3{double(far(rng)), double(far(rng)), double(far(rng))}, g);
+    std::array<Point3, 5> p;
+    for (Point3& q : p) q = base + scaled(Point3{double(cell(rng)), double(cell(rng)), double(cell(rng))}, g);
+    if (i % 5 == 4) p[4].x += 0.1 * g;  // off the grid: the filter's value may be rounded
+    const double det = vitri::insphere_fast(p[0], p[1], p[2], p[3], p[4]);
+    double largest = 0;
+    for (int r = 0; r < 4; ++r)
+      for (std::size_t k = 0; k < 3; ++k) largest = std::max(largest, std::fabs(p[std::size_t(r)][k] - p[4][k]));
+    const int oracle = vitri::test::oracle_insphere(p[0], p[1], p[2], p[3], p[4]);
+    INFO("case " << i);
+    REQUIRE(to_int(vitri::detail::insphere_after_filter(p[0], p[1], p[2], p[3], p[4], det, largest)) == oracle);
+    REQUIRE(to_int(insphere(p[0], p[1], p[2], p[3], p[4])) == oracle);
+    REQUIRE(to_int(orient3d(p[0], p[1], p[2], p[3])) == vitri::test::oracle_orient3d(p[0], p[1], p[2], p[3]));
+    const auto v = coordinates(p[0], p[1], p[2], p[3], p[4]);
+    taken += vitri::detail::small_multiple_coordinates(v.data(), 15, largest, vitri::detail::kInsphereSmall);
+  }
+  CHECK(taken > 10000);
+  // A wrong value is returned as it is when the shortcut applies (it trusts the filter's arithmetic):
+  // proof that the test above exercised the shortcut and not the exact path.
+  const Point3 a{0, 0, 0}, b{1, 0, 0}, c{0, 1, 0}, d{0, 0, 1}, e{1, 1, 1};
+  CHECK(vitri::detail::insphere_after_filter(a, b, c, d, e, -5.0, 1.0) == Sign::Negative);
+  CHECK(insphere(a, b, c, d, e) == Sign::Zero);
+}

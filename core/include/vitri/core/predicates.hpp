@@ -83,6 +83,13 @@ namespace detail {
 Sign orient3d_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d);
 Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e);
 Sign orient2d_exact(double ax, double ay, double bx, double by, double cx, double cy);
+/// The filters' fallbacks: `det` is the filter's double value and `largest` the largest |coordinate
+/// difference| it saw. When every coordinate is a small multiple of one power of two (grids), that
+/// value is already exact and its sign is returned; otherwise the exact fallback above runs.
+Sign orient3d_after_filter(const Point3& a, const Point3& b, const Point3& c, const Point3& d, double det,
+                           double largest);
+Sign insphere_after_filter(const Point3& a, const Point3& b, const Point3& c, const Point3& d, const Point3& e,
+                           double det, double largest);
 /// The symbolic perturbation of insphere_sos, run when the exact insphere is Zero.
 Sign insphere_sos_perturbed(const Point3& a, const Point3& b, const Point3& c, const Point3& d,
                             const Point3& e);
@@ -198,7 +205,7 @@ inline Sign orient3d(const Point3& a, const Point3& b, const Point3& c, const Po
   const double eps = detail::kOrient3dBound * (mx * my * mz);
   if (detail::filter_certifies(det, eps, detail::min3(mx, my, mz), detail::kOrient3dMinColumn))
     return detail::sign_of(det);
-  return detail::orient3d_exact(a, b, c, d);
+  return detail::orient3d_after_filter(a, b, c, d, det, detail::max3(mx, my, mz));
 }
 
 /// Exact in-sphere test. For a positively oriented (a, b, c, d): Positive when e is strictly inside the
@@ -238,7 +245,7 @@ inline Sign insphere(const Point3& a, const Point3& b, const Point3& c, const Po
   const double eps = detail::kInsphereBound * ((mx * my * mz) * lambda);
   if (detail::filter_certifies(det, eps, detail::min3(mx, my, mz), detail::kInsphereMinColumn))
     return detail::sign_of(det);
-  return detail::insphere_exact(a, b, c, d, e);
+  return detail::insphere_after_filter(a, b, c, d, e, det, detail::max3(mx, my, mz));
 }
 
 /// Exact sign of the orientation of the projection of (a, b, c) on the plane of coordinates (i, j):

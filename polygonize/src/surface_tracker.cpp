@@ -196,7 +196,19 @@ void SurfaceTracker::collect_tets(const TrackerInput& in, Work& w) {
 // New polygons for the tetrahedra of the work list (a polygon with the same crossed edges is kept, and
 // placed again when an end of one of its edges changed).
 void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
-  for (const TetId t : w.tets) {
+  // The edge table is read at random (a full build: millions of edges): the crossed edges of the
+  // tetrahedron kLookahead places ahead are prefetched, from its marching cell computed once more.
+  constexpr std::size_t kLookahead = 8;
+  const auto prefetch_edges = [&](TetId t) {
+    if (!in.tri.is_live(t)) return;
+    const std::array<VertexId, 4> v = in.tri.tet_vertices(t);
+    const marching::CellPolygon cell = marching::march_tetrahedron(
+        {in.values[v[0]] < 0.0, in.values[v[1]] < 0.0, in.values[v[2]] < 0.0, in.values[v[3]] < 0.0});
+    for (int i = 0; i < cell.corners; ++i) edge_index_.prefetch(edge_key(v[cell.edges[i][0]], v[cell.edges[i][1]]));
+  };
+  for (std::size_t k = 0; k < w.tets.size(); ++k) {
+    if (k + kLookahead < w.tets.size()) prefetch_edges(w.tets[k + kLookahead]);
+    const TetId t = w.tets[k];
     const std::uint32_t old = polygon_of(t);
     marching::CellPolygon cell;
     std::array<VertexId, 4> v{};
@@ -508,7 +520,13 @@ std::uint32_t SurfaceTracker::out_vertex(const TrackerInput& in, std::uint32_t e
 // corners merged into one vanishes. A triangle with the same corners as before keeps its id.
 void SurfaceTracker::remesh_polygons(const TrackerInput& in, Work& w) {
   sort_unique(w.remesh);
-  for (const std::uint32_t p : w.remesh) {
+  constexpr std::size_t kLookahead = 8;  // the edge records of the polygon that far ahead are prefetched
+  for (std::size_t at = 0; at < w.remesh.size(); ++at) {
+    if (at + kLookahead < w.remesh.size()) {
+      const Polygon& ahead = polygons_[w.remesh[at + kLookahead]];
+      for (int i = 0; i < ahead.corners; ++i) __builtin_prefetch(&edges_[ahead.e[i]]);
+    }
+    const std::uint32_t p = w.remesh[at];
     Polygon& poly = polygons_[p];
     if (poly.corners == 0) continue;
     for (int k = 0; k < 2; ++k) {

@@ -219,7 +219,13 @@ void Triangulation::for_each_tetrahedron(const std::function<void(TetId)>& fn) c
 
 std::vector<TetId> Triangulation::incident_tetrahedra(VertexId v) const {
   std::vector<TetId> out;
-  if (!is_vertex(v)) return out;
+  incident_tetrahedra(v, out);
+  return out;
+}
+
+void Triangulation::incident_tetrahedra(VertexId v, std::vector<TetId>& out) const {
+  out.clear();
+  if (!is_vertex(v)) return;
   const PointId pv = pid(v);
   // Visited tetrahedra: an open-addressing set on the stack (a star has ~27 tetrahedra, rarely over 100),
   // a hash set beyond half its size. O(1) per test, no allocation for usual stars.
@@ -250,7 +256,6 @@ std::vector<TetId> Triangulation::incident_tetrahedra(VertexId v) const {
       if (n != kNoTet && first_visit(n)) out.push_back(n);
     }
   }
-  return out;
 }
 
 Point3 Triangulation::circumcenter(TetId t) const {

@@ -55,7 +55,7 @@ bool is_flat(const Point3& n, const Point3& a, const Point3& b, const Point3& c)
 }
 
 void sort_unique(std::vector<std::uint32_t>& v) {
-  std::sort(v.begin(), v.end());
+  if (!std::is_sorted(v.begin(), v.end())) std::sort(v.begin(), v.end());  // a full build's are sorted
   v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
@@ -120,10 +120,12 @@ void SurfaceTracker::update(const TrackerInput& in) {
     t = now;
     return s;
   };
-  if (rebuild_)
+  if (rebuild_) {
     reset_all(in, w);
-  else
+    w.every_polygon = true;  // every polygon is new, hence in w.remesh already
+  } else {
     collect_tets(in, w);
+  }
   rebuild_polygons(in, w);
   report_.polygons_seconds = lap();
   place_edges(in, w);
@@ -376,29 +378,44 @@ void SurfaceTracker::split_polygons(Work& w) {
 // Re-decides, in increasing id, the anchored (or collapsed) vertices of the rebuilt tetrahedra and of
 // the stars of vertices whose decision flipped.
 void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
+  // The first offers are sorted once; those made while deciding (always above the vertex being decided)
+  // go to a heap, and the two are merged in increasing id.
+  std::vector<VertexId> first;
   std::priority_queue<VertexId, std::vector<VertexId>, std::greater<VertexId>> heap;
+  bool deciding = false;
   const std::uint32_t mark = epoch_;
   auto offer = [&](VertexId u) {
     if (u >= anchored_.size() || (anchored_[u] == 0 && !collapsed_[u]) || decide_stamp_[u] == mark) return;
     decide_stamp_[u] = mark;
-    heap.push(u);
+    if (deciding)
+      heap.push(u);
+    else
+      first.push_back(u);
   };
   for (const TetId t : w.tets)
     if (in.tri.is_live(t))
       for (const VertexId u : in.tri.tet_vertices(t)) offer(u);
   for (const VertexId u : touched_) offer(u);  // removed vertices among them drop their collapse
-  while (!heap.empty()) {
-    const VertexId z = heap.top();
-    heap.pop();
+  std::sort(first.begin(), first.end());
+  deciding = true;
+  std::size_t next = 0;
+  while (next < first.size() || !heap.empty()) {
+    VertexId z;
+    if (heap.empty() || (next < first.size() && first[next] < heap.top())) {
+      z = first[next++];
+    } else {
+      z = heap.top();
+      heap.pop();
+    }
     const bool now = can_collapse(in, z);  // leaves the star of a live z in star_
     if (now == static_cast<bool>(collapsed_[z])) continue;
     collapsed_[z] = now ? 1 : 0;
     num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
     if (!in.tri.is_vertex(z)) continue;  // its polygons died with it
     for (const TetId t : star_) {
-      if (polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
+      if (!w.every_polygon && polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
       for (const VertexId u : in.tri.tet_vertices(t))
-        if (u > z) offer(u);  // not decided yet (the heap pops in increasing id)
+        if (u > z) offer(u);  // not decided yet (the merge pops in increasing id)
     }
   }
 }
@@ -423,7 +440,7 @@ Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
 bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
   star_.clear();
   if (!in.tri.is_vertex(z)) return false;
-  star_ = in.tri.incident_tetrahedra(z);
+  in.tri.incident_tetrahedra(z, star_);
   if (!in.snap || anchored_[z] == 0) return false;
   const Point3 zp = snap_target(in, z);
   // Identity and position of a corner as the one-pass order sees it when z's turn comes.

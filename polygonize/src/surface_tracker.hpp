@@ -109,6 +109,7 @@ class SurfaceTracker {
     std::vector<std::uint32_t> remesh;       // polygons whose output triangles are recomputed
     std::vector<std::uint32_t> retire;       // LiveMesh triangles replaced
     std::vector<std::uint32_t> normals;      // LiveMesh vertices whose normal is evaluated
+    bool every_polygon = false;              // a full build: remesh holds every polygon, in order
   };
 
   void note_tet(std::vector<TetId>& list, TetId t);

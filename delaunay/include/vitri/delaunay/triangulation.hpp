@@ -237,6 +237,8 @@ class Triangulation {
   void for_each_tetrahedron(const std::function<void(TetId)>& fn) const;
   /// Live tetrahedra incident to vertex v.
   std::vector<TetId> incident_tetrahedra(VertexId v) const;
+  /// The same into `out` (cleared first; its capacity is reused: no allocation in a loop).
+  void incident_tetrahedra(VertexId v, std::vector<TetId>& out) const;
 
   /// Circumcenter of a live or dead tetrahedron (double arithmetic, robust formula).
   Point3 circumcenter(TetId t) const;

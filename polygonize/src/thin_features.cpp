@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -15,6 +16,7 @@ using namespace polygonizer_detail;
 
 namespace {
 constexpr double kThinCosine = 0.0;  // the gradients at the two ends must point at each other (below)
+constexpr std::size_t kThinSliceMin = std::size_t(1) << 16;  // tetrahedra per thread of check_thin, at least
 }  // namespace
 
 // ---- Thin features -------------------------------------------------------------------------------------
@@ -60,14 +62,34 @@ bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, doubl
 
 void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) {
   const std::size_t first = thin_.size();
-  for (const TetId t : tets) {
-    if (!tri_.is_live(t)) continue;
-    const auto v = tri_.tet_vertices(t);
-    for (int i = 0; i < 4; ++i)
-      for (int j = i + 1; j < 4; ++j) {
-        double s;
-        if (crossed_twice(v[i], v[j], min_length, s)) thin_.push_back({v[i], v[j], t, s});
-      }
+  const auto check = [&](std::size_t lo, std::size_t hi, std::vector<ThinEdge>& out) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      const TetId t = tets[k];
+      if (!tri_.is_live(t)) continue;
+      const auto v = tri_.tet_vertices(t);
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j) {
+          double s;
+          if (crossed_twice(v[i], v[j], min_length, s)) out.push_back({v[i], v[j], t, s});
+        }
+    }
+  };
+  // The first check of a refinement reads every live tetrahedron: on the threads of options_.threads,
+  // each slice of `tets` into its own list, the lists then appended in slice order (the same entries in
+  // the same order as one pass, so the same edges survive the deduplication below).
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t slices = std::min<std::size_t>(options_.threads ? options_.threads : hardware,
+                                                   tets.size() / kThinSliceMin + 1);
+  if (slices <= 1) {
+    check(0, tets.size(), thin_);
+  } else {
+    std::vector<std::vector<ThinEdge>> found(slices);
+    std::vector<std::thread> pool;
+    for (std::size_t k = 1; k < slices; ++k)
+      pool.emplace_back([&, k] { check(k * tets.size() / slices, (k + 1) * tets.size() / slices, found[k]); });
+    check(0, tets.size() / slices, found[0]);
+    for (std::thread& th : pool) th.join();
+    for (const auto& part : found) thin_.insert(thin_.end(), part.begin(), part.end());
   }
   // An edge is in several of these tetrahedra: keep one entry per edge.
   const auto key = [](const ThinEdge& e) { return std::make_pair(std::min(e.a, e.b), std::max(e.a, e.b)); };

@@ -139,7 +139,8 @@ struct PolygonizerOptions {
   /// hardware threads). Used only without the history (keep_history = false). The parallel build gives
   /// the same tetrahedra as the serial one, and without the history the tetrahedra are renumbered
   /// canonically after the seeds (Triangulation::canonicalize()), so the result is the same, bit for
-  /// bit, for any number of threads.
+  /// bit, for any number of threads. The first thin-feature check of a refinement (every live
+  /// tetrahedron) runs on them too, with any history setting (same result).
   unsigned threads = 1;
 };
 

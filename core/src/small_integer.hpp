@@ -112,6 +112,9 @@ bool small_integer_value(const double* base, const RowAt& row_at, SmallIntegerLi
 /// (the largest |difference| the filter saw) within the limits. Then every difference is an exact small
 /// multiple of G (an integer below 2^52 times G, at most `largest` < 2^(log_m + 1) G), so the filter's own
 /// double evaluation, which has the cofactor scheme's operations, made no rounding: its value is exact.
+/// Past 2^51 the integer test can only answer false for an integer, never true for a non-integer; an
+/// infinite v / G passes, but only a coordinate equal in every point can overflow so (any other
+/// difference would be at least its ulp, far above `largest`), and its differences are exact zeros.
 inline bool small_multiple_coordinates(const double* v, int n, double largest, SmallIntegerLimits limits) {
   const int e = binary_exponent(largest);  // NaN, infinity and subnormals are declined by the range
   if (e < limits.e_min || e > limits.e_max) return false;

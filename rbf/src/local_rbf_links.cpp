@@ -14,27 +14,22 @@ using namespace local_detail;
 using rbf_detail::parallel_chunks;
 
 void LocalRbf::Impl::link(const std::vector<std::uint32_t>& created, bool every_leaf) {
+  if (every_leaf) {  // a full fit: one shared descent for all leaves, then the reverse lists
+    tree.fill_candidates(threads());
+    list_back_all(created);
+    return;
+  }
+  parallel_chunks(created.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
+    for (std::size_t k = b; k < e; ++k) {
+      Cell& cell = tree.cell(created[k]);
+      tree.leaves_meeting_cube(cell, cell.candidates);
+      tree.order_candidates(cell);
+    }
+  });
   // Membership in `created` (sorted copy, binary search): no pass over all cells, so an edit stays O(local).
   std::vector<std::uint32_t> sorted_created = created;
   std::sort(sorted_created.begin(), sorted_created.end());
   auto is_new = [&](std::uint32_t c) { return std::binary_search(sorted_created.begin(), sorted_created.end(), c); };
-  if (every_leaf) {
-    tree.fill_candidates(threads());  // one shared descent for all leaves
-  } else {
-    parallel_chunks(created.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k) {
-        Cell& cell = tree.cell(created[k]);
-        tree.leaves_meeting_cube(cell, cell.candidates);
-        std::sort(cell.candidates.begin(), cell.candidates.end(),
-                  [&](auto x, auto y) { return cell_before(tree.cell(x), tree.cell(y)); });
-        cell.candidates.shrink_to_fit();  // grown by push_back: up to twice the memory otherwise
-      }
-    });
-  }
-  if (every_leaf) {
-    list_back_all(created);
-    return;
-  }
   std::vector<std::uint32_t> found;
   for (std::uint32_t n : created) {
     for (std::uint32_t l : tree.cell(n).candidates) tree.cell(l).listed_in.push_back(n);

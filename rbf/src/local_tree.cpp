@@ -145,8 +145,13 @@ void LocalTree::finish_candidates(std::uint32_t c, const std::vector<std::uint32
         for (int j = 0; j < 8; ++j) stack.push_back(child(m, j));
     }
   }
-  std::sort(out.begin(), out.end(), [&](auto x, auto y) { return cell_before(cells_[x], cells_[y]); });
-  out.shrink_to_fit();  // grown by push_back: up to twice the memory otherwise
+  order_candidates(leaf);
+}
+
+void LocalTree::order_candidates(Cell& leaf) const {
+  std::sort(leaf.candidates.begin(), leaf.candidates.end(),
+            [&](auto x, auto y) { return cell_before(cells_[x], cells_[y]); });
+  leaf.candidates.shrink_to_fit();  // grown by push_back: up to twice the memory otherwise
 }
 
 void LocalTree::fill_candidates_below(std::uint32_t c, const std::vector<std::uint32_t>& frontier,

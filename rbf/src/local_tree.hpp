@@ -98,6 +98,8 @@ class LocalTree {
   /// cell_before order, in one descent that shares the work of sibling cells (see local_tree.cpp); the
   /// leaves are processed on up to `threads` threads. Same lists as leaves_meeting_cube, leaf by leaf.
   void fill_candidates(unsigned threads);
+  /// Sorts leaf.candidates in cell_before order (the order sums run in) and trims their memory.
+  void order_candidates(Cell& leaf) const;
   /// Leaves whose cube meets the open support ball of leaf `source`.
   void leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const;
   /// Leaves with |q - center|^2 <= fit_r2.

@@ -17,6 +17,9 @@ namespace vitri::rbf_detail {
   void trsm_right_lower_t(const double* l, long nb, long ldl, double* b, long m, long ldb);                  \
   void rbf_sums(const double* cx, const double* cy, const double* cz, const double* w, long n,               \
                 const double* q, long m, double* f, double* g);                                              \
+  bool patch_weights(const double* ux, const double* uy, const double* uz, const double* h, long k, double s, \
+                     const double* qr, long ldqr, const double* tau, long nh, long rank, double* w, double* r, \
+                     double* work);                                                                          \
   }
 
 VITRI_DECLARE_DENSE_COPY(generic)
@@ -36,14 +39,14 @@ std::vector<DenseOps> dense_ops_supported() {
   if (__builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq") &&
       __builtin_cpu_supports("avx512vl"))
     out.push_back(DenseOps{avx512::cholesky_inplace, avx512::rbf_sums, avx512::gemm_nt_sub,
-                           avx512::trsm_right_lower_t, "avx512"});
+                           avx512::trsm_right_lower_t, avx512::patch_weights, "avx512"});
 #endif
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma"))
     out.push_back(DenseOps{avx2::cholesky_inplace, avx2::rbf_sums, avx2::gemm_nt_sub,
-                           avx2::trsm_right_lower_t, "avx2+fma"});
+                           avx2::trsm_right_lower_t, avx2::patch_weights, "avx2+fma"});
 #endif
   out.push_back(DenseOps{generic::cholesky_inplace, generic::rbf_sums, generic::gemm_nt_sub,
-                         generic::trsm_right_lower_t, "generic"});
+                         generic::trsm_right_lower_t, generic::patch_weights, "generic"});
   return out;
 }
 

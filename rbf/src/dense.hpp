@@ -13,6 +13,9 @@ struct DenseOps {
   void (*gemm_nt_sub)(const double* a, long m, long lda, const double* b, long k, long ldb, long nb,
                       double* c, long ldc);
   void (*trsm_right_lower_t)(const double* l, long nb, long ldl, double* b, long m, long ldb);
+  bool (*patch_weights)(const double* ux, const double* uy, const double* uz, const double* h, long k,
+                        double s, const double* qr, long ldqr, const double* tau, long nh, long rank, double* w,
+                        double* r, double* work);
   const char* name;
 };
 

@@ -3,11 +3,12 @@
 
 #include "dense.hpp"
 
-#include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <Eigen/QR>
 
 #include <cassert>
+#include <cmath>
+#include <vector>
 
 namespace vitri::local_detail {
 
@@ -39,47 +40,40 @@ Eigen::ColPivHouseholderQR<Eigen::MatrixXd> polynomial_qr(const Eigen::MatrixXd&
 
 bool fit_rbf_patch(const Point3& center, double inv_radius, const std::vector<Point3>& points,
                    const std::vector<double>& values, double smoothing, std::vector<double>& coef) {
+  PatchWork work;
+  return fit_rbf_patch(center, inv_radius, points, values, smoothing, coef, work);
+}
+
+bool fit_rbf_patch(const Point3& center, double inv_radius, const std::vector<Point3>& points,
+                   const std::vector<double>& values, double smoothing, std::vector<double>& coef,
+                   PatchWork& work) {
   assert(points.size() == values.size() && !points.empty());
-  const auto k = static_cast<Eigen::Index>(points.size());
+  static const rbf_detail::DenseOps& ops = rbf_detail::dense_ops();
+  const std::size_t k = points.size();
+  const auto ek = static_cast<Eigen::Index>(k);
   const Eigen::MatrixXd P = polynomial_block(center, inv_radius, points);
-  const Eigen::Map<const Eigen::VectorXd> h(values.data(), k);
-  Eigen::MatrixXd A(k, k);
-  for (Eigen::Index j = 0; j < k; ++j) {
-    A(j, j) = smoothing;
-    for (Eigen::Index i = j + 1; i < k; ++i) {
-      const double r2 = (P.row(i).tail<3>() - P.row(j).tail<3>()).squaredNorm();
-      A(i, j) = A(j, i) = r2 * std::sqrt(r2);
-    }
-  }
   const auto qr = polynomial_qr(P);
-  const Eigen::Index rank = qr.rank();
-  const Eigen::Index m = k - rank;  // dimension of the null space of P^T
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(k);
-  if (m > 0) {
-    // Q^T (A + s I) Q, whose trailing m x m block is Z^T (A + s I) Z, SPD for distinct points (the cubic
-    // kernel is conditionally positive definite of order 2).
-    Eigen::MatrixXd M = A;
-    M.applyOnTheLeft(qr.householderQ().adjoint());
-    M.applyOnTheRight(qr.householderQ());
-    Eigen::VectorXd g = h;
-    g.applyOnTheLeft(qr.householderQ().adjoint());
-    Eigen::LLT<Eigen::MatrixXd> llt(M.bottomRightCorner(m, m));
-    if (llt.info() != Eigen::Success) return false;
-    const Eigen::VectorXd y = llt.solve(g.tail(m));
-    if (!y.allFinite()) return false;
-    w.tail(m) = y;
-    w.applyOnTheLeft(qr.householderQ());  // w = Z y
-  }
+  // The weights on the null space of P^T (a Cholesky of Z^T (A + s I) Z) and h - (A + s I) w, by the
+  // dispatched kernel (dense_kernels.inc: patch_weights).
+  work.w.resize(k);
+  work.r.resize(k);
+  work.buffer.resize(2 * k * k + 3 * k);
+  const auto& QR = qr.matrixQR();
+  if (!ops.patch_weights(P.col(1).data(), P.col(2).data(), P.col(3).data(), values.data(), long(k), smoothing,
+                         QR.data(), long(QR.outerStride()), qr.hCoeffs().data(), long(qr.hCoeffs().size()),
+                         long(qr.rank()), work.w.data(), work.r.data(), work.buffer.data()))
+    return false;
   // P a = h - (A + s I) w, solved in the least-squares sense (exact when the system is consistent).
-  const Eigen::VectorXd a = qr.solve(h - A * w);
-  coef.assign(4 + 4 * static_cast<std::size_t>(k), 0.0);
+  const Eigen::VectorXd a = qr.solve(Eigen::Map<const Eigen::VectorXd>(work.r.data(), ek));
+  coef.assign(4 + 4 * k, 0.0);
   for (int c = 0; c < 4; ++c) coef[static_cast<std::size_t>(c)] = a(c);
-  for (Eigen::Index j = 0; j < k; ++j) {
+  for (std::size_t j = 0; j < k; ++j) {
+    const auto row = static_cast<Eigen::Index>(j);
     double* t = coef.data() + 4 + j;
-    t[0] = P(j, 1);
-    t[k] = P(j, 2);
-    t[2 * k] = P(j, 3);
-    t[3 * k] = w(j);
+    t[0] = P(row, 1);
+    t[k] = P(row, 2);
+    t[2 * k] = P(row, 3);
+    t[3 * k] = work.w[j];
   }
   return a.allFinite();
 }

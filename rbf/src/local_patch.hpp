@@ -22,6 +22,18 @@ namespace vitri::local_detail {
 bool fit_rbf_patch(const Point3& center, double inv_radius, const std::vector<Point3>& points,
                    const std::vector<double>& values, double smoothing, std::vector<double>& coef);
 
+/// Buffers of fit_rbf_patch, reused between fits (a fit allocates no large block once they have grown).
+struct PatchWork {
+  std::vector<double> w;       // kernel weights
+  std::vector<double> r;       // h - (A + s I) w, the polynomial's right-hand side
+  std::vector<double> buffer;  // the kernel matrix, its reduction and vectors (dense_kernels.inc)
+};
+
+/// The same fit with the caller's buffers (one PatchWork per thread).
+bool fit_rbf_patch(const Point3& center, double inv_radius, const std::vector<Point3>& points,
+                   const std::vector<double>& values, double smoothing, std::vector<double>& coef,
+                   PatchWork& work);
+
 /// Least-squares plane a0 + a . u through (points[j], values[j]); coef gets 4 entries.
 void fit_linear_patch(const Point3& center, double inv_radius, const std::vector<Point3>& points,
                       const std::vector<double>& values, std::vector<double>& coef);

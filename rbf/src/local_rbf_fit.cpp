@@ -194,7 +194,7 @@ void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s) {
     cell.terms = 0;
     return;
   }
-  if (!fit_rbf_patch(cell.center, inv, s.points, s.values, opt.smoothing, cell.coef))
+  if (!fit_rbf_patch(cell.center, inv, s.points, s.values, opt.smoothing, cell.coef, s.patch))
     throw NumericalError("local RBF: the patch at " + format_point(cell.center) + " (radius " +
                          std::to_string(cell.radius) + ", " + std::to_string(s.points.size()) +
                          " constraints) has no positive definite system: near-duplicate constraints?");

@@ -7,6 +7,7 @@
 #include "vitri/rbf/local_rbf.hpp"
 #include "vitri/core/slot_ranks.hpp"
 
+#include "local_patch.hpp"
 #include "local_tree.hpp"
 #include "parallel.hpp"
 #include "vitri/rbf/point_index.hpp"
@@ -39,6 +40,7 @@ struct FitScratch {
   std::vector<double> d2;
   std::vector<Point3> points;
   std::vector<double> values;
+  PatchWork patch;
 };
 
 }  // namespace vitri::local_detail

@@ -157,9 +157,9 @@ void print_extraction_split(const PolygonizerStats& s, double extract_ms) {
 void print_fit_split(const LocalFitReport& r) {
   std::fprintf(stderr,
                "  fit: point index %.0f ms, duplicate check %.0f ms, octree %.0f ms, candidate lists %.0f ms, "
-               "patch fits %.0f ms\n",
+               "patch fits %.0f ms (%zu patches, %.1f constraints each on average, at most %zu)\n",
                1e3 * r.index_seconds, 1e3 * r.duplicates_seconds, 1e3 * r.tree_seconds, 1e3 * r.links_seconds,
-               1e3 * r.patches_seconds);
+               1e3 * r.patches_seconds, r.patches, r.mean_fitted, r.max_fitted);
 }
 
 void write_current(Mesher& mesher, const std::string& path) { write_mesh(path, view_of(mesher.surface())); }

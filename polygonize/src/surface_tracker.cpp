@@ -12,6 +12,8 @@
 // result equals the one-pass result, which the tests check against a fresh tracker.
 #include "surface_tracker.hpp"
 
+#include "sorted_ids.hpp"
+
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
@@ -163,7 +165,7 @@ void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
   num_collapsed_ = num_anchored_ = 0;
   max_edge_ = 0.0;
   w.tets = in.transverse;
-  std::sort(w.tets.begin(), w.tets.end());
+  detail::sort_unique_ids(w.tets, id_bits_);  // distinct already: sorted
   // About 0.7 crossed edges per transverse tetrahedron (each edge is shared by the 5 or 6 tetrahedra
   // around it; 10^5 samples of man.off: 511,706 edges, 749,749 tetrahedra): room for 0.75.
   // The records are reserved too: grown by doubling, the edges were reallocated and copied up to 671 MB
@@ -192,7 +194,7 @@ void SurfaceTracker::collect_tets(const TrackerInput& in, Work& w) {
       w.tets.insert(w.tets.end(), star.begin(), star.end());
     }
   }
-  sort_unique(w.tets);
+  detail::sort_unique_ids(w.tets, id_bits_);
 }
 
 // New polygons for the tetrahedra of the work list (a polygon with the same crossed edges is kept, and
@@ -366,7 +368,7 @@ void SurfaceTracker::project_pushed(const TrackerInput& in, const std::vector<st
 }
 
 void SurfaceTracker::split_polygons(Work& w) {
-  sort_unique(w.remesh);
+  detail::sort_unique_ids(w.remesh, id_bits_);
   for (const std::uint32_t p : w.remesh) {
     Polygon& poly = polygons_[p];
     if (poly.corners == 4)
@@ -536,7 +538,7 @@ std::uint32_t SurfaceTracker::out_vertex(const TrackerInput& in, std::uint32_t e
 // The output triangles of the polygons to remesh: corners merged by the collapses; a triangle with two
 // corners merged into one vanishes. A triangle with the same corners as before keeps its id.
 void SurfaceTracker::remesh_polygons(const TrackerInput& in, Work& w) {
-  sort_unique(w.remesh);
+  detail::sort_unique_ids(w.remesh, id_bits_);
   constexpr std::size_t kLookahead = 8;  // the edge records of the polygon that far ahead are prefetched
   for (std::size_t at = 0; at < w.remesh.size(); ++at) {
     if (at + kLookahead < w.remesh.size()) {

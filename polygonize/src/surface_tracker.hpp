@@ -168,6 +168,7 @@ class SurfaceTracker {
   std::vector<TetId> star_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> link_;
   // Reported changes since the last update.
+  std::vector<std::uint64_t> id_bits_;  // scratch of sort_unique_ids (sorted_ids.hpp), all zero between calls
   std::vector<TetId> killed_, created_;
   std::vector<VertexId> touched_, moved_;
 };

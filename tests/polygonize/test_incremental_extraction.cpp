@@ -5,6 +5,7 @@
 
 #include "edge_map.hpp"
 #include "marching.hpp"
+#include "sorted_ids.hpp"
 #include "support/mesh_checks.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/analytic.hpp"
@@ -367,4 +368,26 @@ TEST_CASE("flat tetrahedra of samples with equal normals: no flat triangle", "[i
     // kept off an uncollapsed anchor, projected back).
     for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3 * precision);
   }
+}
+
+TEST_CASE("sort_unique_ids orders and deduplicates like std::sort + std::unique", "[extraction]") {
+  std::mt19937_64 rng(21);
+  std::vector<std::uint64_t> bits;
+  // Sizes and ranges on both sides of the bitmap's threshold: sparse lists (a comparison sort), dense
+  // ones with many duplicates (the bitmap), the empty list, one id, the largest 32-bit ids.
+  for (const auto& [n, range] : std::vector<std::pair<std::size_t, std::uint32_t>>{
+           {0, 1}, {1, 1}, {63, 10}, {64, 10}, {1000, 1000000}, {5000, 4000}, {20000, 300000}, {100000, 70000}}) {
+    std::uniform_int_distribution<std::uint32_t> id(0, range - 1);
+    std::vector<std::uint32_t> v(n);
+    for (auto& x : v) x = id(rng);
+    std::vector<std::uint32_t> expected = v;
+    std::sort(expected.begin(), expected.end());
+    expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+    vitri::detail::sort_unique_ids(v, bits);
+    CHECK(v == expected);
+    CHECK(std::all_of(bits.begin(), bits.end(), [](std::uint64_t b) { return b == 0; }));  // left clean
+  }
+  std::vector<std::uint32_t> high = {0xffffffffu, 7u, 0xfffffffeu, 7u};
+  vitri::detail::sort_unique_ids(high, bits);
+  CHECK(high == std::vector<std::uint32_t>{7u, 0xfffffffeu, 0xffffffffu});
 }

@@ -26,6 +26,7 @@ TrackerInput tracker_input(const Triangulation& tri, const std::vector<double>& 
   in.roots.tolerance = options.root_tolerance;
   in.roots.max_iterations = options.max_root_iterations;
   in.roots.zero_offset = options.zero_offset;
+  in.threads = options.threads;
   return in;
 }
 

@@ -21,6 +21,7 @@
 #include <cmath>
 #include <functional>
 #include <queue>
+#include <thread>
 
 namespace vitri {
 
@@ -197,55 +198,84 @@ void SurfaceTracker::collect_tets(const TrackerInput& in, Work& w) {
   detail::sort_unique_ids(w.tets, id_bits_);
 }
 
+// The vertices and marching cells of n tetrahedra of a rebuild. Each is independent of the others and
+// reads only the triangulation and the values: large batches run on slices of in.threads threads (the
+// slices' results land in their own places, so the serial pass that follows sees the same data).
+void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std::size_t n, Marched* out) {
+  const auto march = [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      Marched& m = out[k];
+      m.live = in.tri.is_live(tets[k]);
+      m.cell = marching::CellPolygon{};
+      if (!m.live) continue;
+      m.v = in.tri.tet_vertices(tets[k]);
+      m.cell = marching::march_tetrahedron({in.values[m.v[0]] < 0.0, in.values[m.v[1]] < 0.0,
+                                            in.values[m.v[2]] < 0.0, in.values[m.v[3]] < 0.0});
+    }
+  };
+  constexpr std::size_t kSliceMin = std::size_t(1) << 13;  // smaller batches: one thread
+  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
+  const std::size_t slices = std::min<std::size_t>(in.threads ? in.threads : hardware, n / kSliceMin + 1);
+  if (slices <= 1) return march(0, n);
+  std::vector<std::thread> pool;
+  for (std::size_t s = 1; s < slices; ++s) pool.emplace_back(march, s * n / slices, (s + 1) * n / slices);
+  march(0, n / slices);
+  for (std::thread& th : pool) th.join();
+}
+
 // New polygons for the tetrahedra of the work list (a polygon with the same crossed edges is kept, and
-// placed again when an end of one of its edges changed).
+// placed again when an end of one of its edges changed). In chunks: each chunk is marched ahead (on the
+// threads when large), then its polygons and edges are made in order by this thread.
 void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
   // The edge table is read at random (a full build: millions of edges): the crossed edges of the
-  // tetrahedron kLookahead places ahead are prefetched, from its marching cell computed once more.
+  // tetrahedron kLookahead places ahead are prefetched.
   constexpr std::size_t kLookahead = 8;
-  const auto prefetch_edges = [&](TetId t) {
-    if (!in.tri.is_live(t)) return;
-    const std::array<VertexId, 4> v = in.tri.tet_vertices(t);
-    const marching::CellPolygon cell = marching::march_tetrahedron(
-        {in.values[v[0]] < 0.0, in.values[v[1]] < 0.0, in.values[v[2]] < 0.0, in.values[v[3]] < 0.0});
-    for (int i = 0; i < cell.corners; ++i) edge_index_.prefetch(edge_key(v[cell.edges[i][0]], v[cell.edges[i][1]]));
-  };
-  for (std::size_t k = 0; k < w.tets.size(); ++k) {
-    if (k + kLookahead < w.tets.size()) prefetch_edges(w.tets[k + kLookahead]);
-    const TetId t = w.tets[k];
-    const std::uint32_t old = polygon_of(t);
-    marching::CellPolygon cell;
-    std::array<VertexId, 4> v{};
-    if (in.tri.is_live(t)) {
-      v = in.tri.tet_vertices(t);
-      cell = marching::march_tetrahedron(
-          {in.values[v[0]] < 0.0, in.values[v[1]] < 0.0, in.values[v[2]] < 0.0, in.values[v[3]] < 0.0});
-    }
-    if (old != kNone && cell.corners == polygons_[old].corners) {
-      bool same = true;
-      for (int i = 0; i < cell.corners && same; ++i) {
-        const Edge& e = edges_[polygons_[old].e[i]];
-        same = e.neg == v[cell.edges[i][0]] && e.pos == v[cell.edges[i][1]];
+  constexpr std::size_t kChunk = std::size_t(1) << 16;
+  std::vector<Marched> ahead;
+  for (std::size_t first = 0; first < w.tets.size(); first += kChunk) {
+    const std::size_t n = std::min(kChunk, w.tets.size() - first);
+    ahead.resize(n);
+    march_ahead(in, w.tets.data() + first, n, ahead.data());
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k + kLookahead < n) {
+        const Marched& a = ahead[k + kLookahead];
+        for (int i = 0; i < a.cell.corners; ++i)
+          edge_index_.prefetch(edge_key(a.v[a.cell.edges[i][0]], a.v[a.cell.edges[i][1]]));
       }
-      if (same) {
-        bool placed = false;
-        for (int i = 0; i < cell.corners; ++i) placed = mark_if_touched(polygons_[old].e[i], w) || placed;
-        if (placed) w.remesh.push_back(old);
-        continue;
-      }
+      rebuild_polygon(w.tets[first + k], ahead[k], w);
     }
-    if (old != kNone) w.old_polygons.push_back(old);
-    polygon_of_[t] = kNone;
-    if (cell.corners == 0) continue;
-    const std::uint32_t p = take_slot(polygons_, free_polygons_);
-    Polygon poly;
-    poly.corners = static_cast<std::uint8_t>(cell.corners);
-    poly.tet = t;
-    for (int i = 0; i < cell.corners; ++i) poly.e[i] = edge_slot(v[cell.edges[i][0]], v[cell.edges[i][1]], w);
-    polygons_[p] = poly;
-    polygon_of_[t] = p;
-    w.remesh.push_back(p);
   }
+}
+
+// The polygon of tetrahedron t from its marched cell m.
+void SurfaceTracker::rebuild_polygon(TetId t, const Marched& m, Work& w) {
+  const std::uint32_t old = polygon_of(t);
+  const marching::CellPolygon& cell = m.cell;
+  const std::array<VertexId, 4>& v = m.v;
+  if (old != kNone && cell.corners == polygons_[old].corners) {
+    bool same = true;
+    for (int i = 0; i < cell.corners && same; ++i) {
+      const Edge& e = edges_[polygons_[old].e[i]];
+      same = e.neg == v[cell.edges[i][0]] && e.pos == v[cell.edges[i][1]];
+    }
+    if (same) {
+      bool placed = false;
+      for (int i = 0; i < cell.corners; ++i) placed = mark_if_touched(polygons_[old].e[i], w) || placed;
+      if (placed) w.remesh.push_back(old);
+      return;
+    }
+  }
+  if (old != kNone) w.old_polygons.push_back(old);
+  polygon_of_[t] = kNone;
+  if (cell.corners == 0) return;
+  const std::uint32_t p = take_slot(polygons_, free_polygons_);
+  Polygon poly;
+  poly.corners = static_cast<std::uint8_t>(cell.corners);
+  poly.tet = t;
+  for (int i = 0; i < cell.corners; ++i) poly.e[i] = edge_slot(v[cell.edges[i][0]], v[cell.edges[i][1]], w);
+  polygons_[p] = poly;
+  polygon_of_[t] = p;
+  w.remesh.push_back(p);
 }
 
 // Marks edge e for placement when an end changed in this update; true when it is (or already was).

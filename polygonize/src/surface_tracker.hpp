@@ -44,6 +44,7 @@ struct TrackerInput {
   bool snap = true;                        ///< collapse anchored crossings onto their vertex
   double snap_fraction = 0.01;             ///< anchored when the root is this close to an end (fraction)
   bool warm_start = true;                  ///< start a re-placed edge from its previous root
+  unsigned threads = 1;                    ///< threads of the marching pass of large rebuilds (0: all)
 };
 
 /// Counters of the last update().
@@ -115,7 +116,15 @@ class SurfaceTracker {
   void note_tet(std::vector<TetId>& list, TetId t);
   void reset_all(const TrackerInput& in, Work& w);
   void collect_tets(const TrackerInput& in, Work& w);
+  /// A tetrahedron of a rebuild, marched ahead of the serial pass (on the threads for large rebuilds).
+  struct Marched {
+    std::array<VertexId, 4> v{};
+    marching::CellPolygon cell;  // no corners when the tetrahedron is dead
+    bool live = false;
+  };
   void rebuild_polygons(const TrackerInput& in, Work& w);
+  static void march_ahead(const TrackerInput& in, const TetId* tets, std::size_t n, Marched* out);
+  void rebuild_polygon(TetId t, const Marched& m, Work& w);
   std::uint32_t edge_slot(VertexId neg, VertexId pos, Work& w);
   bool mark_if_touched(std::uint32_t e, Work& w);
   void release_edge(std::uint32_t e);

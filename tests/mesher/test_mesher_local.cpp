@@ -186,6 +186,9 @@ TEST_CASE("batch option with bulk threads: the serial tetrahedralization, the sa
   const double p = 0.015 * a.diagonal();
   a.refine(p);
   b.refine(p);
+  // Enough transverse tetrahedra that b's extraction marches them on its 2 threads (slices of at least
+  // 2^13, surface_tracker.cpp): the threaded marching pass gives the same mesh too.
+  REQUIRE(b.polygonizer().stats().transverse >= 2 * 8192);
   require_closed(b.surface(), 0);
   // Canonical tetrahedron ids after the seeds (Triangulation::canonicalize): bit for bit the same.
   REQUIRE(a.surface().triangles == b.surface().triangles);

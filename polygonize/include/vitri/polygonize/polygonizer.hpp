@@ -140,7 +140,8 @@ struct PolygonizerOptions {
   /// the same tetrahedra as the serial one, and without the history the tetrahedra are renumbered
   /// canonically after the seeds (Triangulation::canonicalize()), so the result is the same, bit for
   /// bit, for any number of threads. The first thin-feature check of a refinement (every live
-  /// tetrahedron) runs on them too, with any history setting (same result).
+  /// tetrahedron) and the marching pass of a large extraction run on them too, with any history setting
+  /// (same result; docs/polygonize.md "Threads").
   unsigned threads = 1;
 };
 

@@ -11,8 +11,8 @@
 
 namespace vitri::detail {
 
-/// Sorts v and removes duplicates (exactly as std::sort + std::unique). `bits` is a scratch buffer,
-/// reused between calls (left all zero).
+/// Sorts v and removes duplicates (exactly as std::sort + std::unique; a sorted list is not sorted
+/// again). `bits` is a scratch buffer, reused between calls (left all zero).
 inline void sort_unique_ids(std::vector<std::uint32_t>& v, std::vector<std::uint64_t>& bits) {
   const std::size_t bound = v.empty() ? 0 : std::size_t(*std::max_element(v.begin(), v.end())) + 1;
   if (v.size() < 64 || v.size() * 16 < bound) {  // sparse: a comparison sort is cheaper than the scan

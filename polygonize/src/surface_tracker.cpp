@@ -57,11 +57,6 @@ bool is_flat(const Point3& n, const Point3& a, const Point3& b, const Point3& c)
   return !(squared_norm(n) > kFlatRatio * kFlatRatio * l2 * l2);
 }
 
-void sort_unique(std::vector<std::uint32_t>& v) {
-  if (!std::is_sorted(v.begin(), v.end())) std::sort(v.begin(), v.end());  // a full build's are sorted
-  v.erase(std::unique(v.begin(), v.end()), v.end());
-}
-
 }  // namespace
 
 void SurfaceTracker::note_tet(std::vector<TetId>& list, TetId t) {
@@ -205,9 +200,8 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
   const auto march = [&](std::size_t lo, std::size_t hi) {
     for (std::size_t k = lo; k < hi; ++k) {
       Marched& m = out[k];
-      m.live = in.tri.is_live(tets[k]);
       m.cell = marching::CellPolygon{};
-      if (!m.live) continue;
+      if (!in.tri.is_live(tets[k])) continue;
       m.v = in.tri.tet_vertices(tets[k]);
       m.cell = marching::march_tetrahedron({in.values[m.v[0]] < 0.0, in.values[m.v[1]] < 0.0,
                                             in.values[m.v[2]] < 0.0, in.values[m.v[3]] < 0.0});
@@ -654,7 +648,7 @@ void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
     if (!(mesh_.position(v) == q)) mesh_.move_vertex(v, q, mesh_.normal(v));
     w.normals.push_back(v);
   }
-  sort_unique(w.normals);
+  detail::sort_unique_ids(w.normals, id_bits_);
   std::vector<std::uint32_t> ids;
   for (const std::uint32_t v : w.normals)
     if (mesh_.is_vertex(v)) ids.push_back(v);

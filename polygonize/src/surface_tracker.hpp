@@ -119,8 +119,7 @@ class SurfaceTracker {
   /// A tetrahedron of a rebuild, marched ahead of the serial pass (on the threads for large rebuilds).
   struct Marched {
     std::array<VertexId, 4> v{};
-    marching::CellPolygon cell;  // no corners when the tetrahedron is dead
-    bool live = false;
+    marching::CellPolygon cell;  // no corners when the tetrahedron is dead (v is then not read)
   };
   void rebuild_polygons(const TrackerInput& in, Work& w);
   static void march_ahead(const TrackerInput& in, const TetId* tets, std::size_t n, Marched* out);
@@ -176,8 +175,8 @@ class SurfaceTracker {
   // and the directed link edges.
   std::vector<TetId> star_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> link_;
-  // Reported changes since the last update.
   std::vector<std::uint64_t> id_bits_;  // scratch of sort_unique_ids (sorted_ids.hpp), all zero between calls
+  // Reported changes since the last update.
   std::vector<TetId> killed_, created_;
   std::vector<VertexId> touched_, moved_;
 };

@@ -15,6 +15,7 @@
 //   without the hierarchy, which only slows removal down).
 // Memory: counters bytes_per_vertex (heap growth measured with mallinfo2 around the build), and for vitri
 // live_B_per_v / total_B_per_v from memory_live_bytes() / memory_total_bytes().
+#include "vitri/core/threads.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 
 #include <benchmark/benchmark.h>
@@ -128,7 +129,17 @@ void vitri_bulk_threads(benchmark::State& state) {
   state.counters["pass_cpu_s"] = stats.thread_cpu_seconds;
   state.counters["pass_slowest_s"] = stats.slowest_thread_cpu_seconds;
 }
-BENCHMARK(vitri_bulk_threads)->Args({100000, 1})->Args({100000, 2})->Args({1000000, 1})->Args({1000000, 2})->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
+// T = 1, 2, then doubling up to the machine's hardware threads (and that count itself): 1 and 2 on the
+// 2-core reference machine, up to 16 where there are 16.
+void bulk_thread_counts(benchmark::internal::Benchmark* b) {
+  const unsigned cores = std::max(2u, vitri::available_cpus());
+  for (long n : {100000L, 1000000L}) {
+    unsigned t = 1;
+    for (; t <= cores; t *= 2) b->Args({n, long(t)});
+    if (t / 2 != cores) b->Args({n, long(cores)});
+  }
+}
+BENCHMARK(vitri_bulk_threads)->Apply(bulk_thread_counts)->Unit(benchmark::kMillisecond)->Iterations(1)->Repetitions(3)->ReportAggregatesOnly(true)->UseRealTime();
 
 #ifdef VITRI_HAVE_CGAL
 void cgal_bulk(benchmark::State& state) {

@@ -2,6 +2,7 @@
 // allocation and release of tetrahedra and points, the commit steps that every operation shares, and
 // the queries. The record layout and its invariants are in vitri/delaunay/detail/tet_store.hpp.
 #include "scratch.hpp"
+#include "vitri/core/threads.hpp"
 
 #include "vitri/core/error.hpp"
 
@@ -18,10 +19,9 @@ namespace vitri {
 // ---- Construction ----------------------------------------------------------------------------------
 
 namespace {
-// TriangulationOptions::threads: 0 = the hardware's concurrency; at most 64 (one partition byte each).
+// TriangulationOptions::threads: 0 = the CPUs this process may run on; at most 64 (one partition byte each).
 unsigned resolve_threads(unsigned threads) {
-  if (threads == 0) threads = std::thread::hardware_concurrency();
-  return std::min(std::max(threads, 1u), 64u);
+  return std::min(resolve_thread_count(threads), 64u);
 }
 }  // namespace
 

@@ -11,6 +11,7 @@
 // (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
 // result equals the one-pass result, which the tests check against a fresh tracker.
 #include "surface_tracker.hpp"
+#include "vitri/core/threads.hpp"
 
 #include "sorted_ids.hpp"
 
@@ -208,8 +209,7 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
     }
   };
   constexpr std::size_t kSliceMin = std::size_t(1) << 13;  // smaller batches: one thread
-  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t slices = std::min<std::size_t>(in.threads ? in.threads : hardware, n / kSliceMin + 1);
+  const std::size_t slices = std::min<std::size_t>(resolve_thread_count(in.threads), n / kSliceMin + 1);
   if (slices <= 1) return march(0, n);
   std::vector<std::thread> pool;
   for (std::size_t s = 1; s < slices; ++s) pool.emplace_back(march, s * n / slices, (s + 1) * n / slices);

@@ -1,6 +1,7 @@
 // Thin features: the Polygonizer's test and refinement of Delaunay edges crossed twice by the surface
 // (docs/polygonize.md, "Thin features"). Split from polygonizer.cpp.
 #include "vitri/polygonize/polygonizer.hpp"
+#include "vitri/core/threads.hpp"
 
 #include "polygonizer_internal.hpp"
 
@@ -77,8 +78,7 @@ void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) 
   // The first check of a refinement reads every live tetrahedron: on the threads of options_.threads,
   // each slice of `tets` into its own list, the lists then appended in slice order (the same entries in
   // the same order as one pass, so the same edges survive the deduplication below).
-  const unsigned hardware = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t slices = std::min<std::size_t>(options_.threads ? options_.threads : hardware,
+  const std::size_t slices = std::min<std::size_t>(resolve_thread_count(options_.threads),
                                                    tets.size() / kThinSliceMin + 1);
   if (slices <= 1) {
     check(0, tets.size(), thin_);

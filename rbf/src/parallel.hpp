@@ -9,17 +9,19 @@
 #include <thread>
 #include <vector>
 
+#include "vitri/core/threads.hpp"
+
 namespace vitri {
 namespace rbf_detail {
 
-/// Threads to use: `requested`, or the hardware concurrency when it is 0 (at least 1).
+/// Threads to use: `requested`, or every CPU this process may run on when it is 0 (available_cpus).
 inline unsigned thread_count(unsigned requested) {
-  return requested ? requested : std::max(1u, std::thread::hardware_concurrency());
+  return resolve_thread_count(requested);
 }
 
-/// Runs body(begin, end) over [0, n) in chunks of `grain` on up to `threads` threads (0: hardware
-/// concurrency); chunks are taken in order from a shared counter. Rethrows the first exception of any
-/// chunk after every thread has stopped.
+/// Runs body(begin, end) over [0, n) in chunks of `grain` on up to `threads` threads (0: every CPU this
+/// process may run on); chunks are taken in order from a shared counter. Rethrows the first exception
+/// of any chunk after every thread has stopped.
 inline void parallel_chunks(std::size_t n, unsigned threads, std::size_t grain,
                             const std::function<void(std::size_t, std::size_t)>& body) {
   grain = std::max<std::size_t>(1, grain);

@@ -3,6 +3,7 @@
 // rbf_solve_dense_lu (tests).
 
 #include "rbf_impl.hpp"
+#include "vitri/core/threads.hpp"
 
 #include "dense.hpp"
 #include "memory.hpp"
@@ -73,7 +74,7 @@ void Rbf::Impl::factor_from_scratch() {
     }
   }
   const double knorm = n ? *std::max_element(colsum.begin(), colsum.end()) : 0.0;
-  const unsigned threads = opt.threads ? opt.threads : std::max(1u, std::thread::hardware_concurrency());
+  const unsigned threads = resolve_thread_count(opt.threads);
   if (!rbf_detail::cholesky_parallel(L.data(), static_cast<long>(m), static_cast<long>(L.rows()), threads))
     throw NumericalError("the reduced RBF system of " + std::to_string(N) +
                          " constraints is not numerically positive definite (near-duplicate or degenerate "

@@ -93,12 +93,12 @@ struct TriangulationOptions {
   /// otherwise through a scratch triangulation of the link (both give the same tetrahedra; a tuning
   /// knob, exposed so that tests can force either method).
   std::size_t max_wrap_link = 64;
-  /// Threads of a bulk insertion (insert_points); 0 = std::thread::hardware_concurrency(). With more
-  /// than one, insert_points inserts in parallel when the triangulation keeps no history, no ChangeSet
-  /// is requested, min_distance is 0 and no vertex has moved (otherwise serially). The parallel build
-  /// gives the same tetrahedra over the same vertex ids and the same results as the serial one (the
-  /// perturbed Delaunay tetrahedralization is unique); tetrahedron ids, the vertex order inside a
-  /// tetrahedron and the free slots may differ and may vary from run to run.
+  /// Threads of a bulk insertion (insert_points); 0 = vitri::available_cpus(), the CPUs this process may run
+  /// on. With more than one, insert_points inserts in parallel when the triangulation keeps no history, no
+  /// ChangeSet is requested, min_distance is 0 and no vertex has moved (otherwise serially). The parallel
+  /// build gives the same tetrahedra over the same vertex ids and the same results as the serial one (the
+  /// perturbed Delaunay tetrahedralization is unique); tetrahedron ids, the vertex order inside a tetrahedron
+  /// and the free slots may differ and may vary from run to run.
   unsigned threads = 1;
 };
 

@@ -135,13 +135,13 @@ struct PolygonizerOptions {
   /// after the seeds and recycled without the history) in well under half the memory. Edits still work without it, with walking location
   /// (slower on large models). See docs/mesher.md "Batch runs and memory".
   bool keep_history = true;
-  /// Threads of the bulk insertion of the seeds at construction (TriangulationOptions::threads; 0 = all
-  /// hardware threads). Used only without the history (keep_history = false). The parallel build gives
-  /// the same tetrahedra as the serial one, and without the history the tetrahedra are renumbered
-  /// canonically after the seeds (Triangulation::canonicalize()), so the result is the same, bit for
-  /// bit, for any number of threads. The first thin-feature check of a refinement (every live
-  /// tetrahedron) and the marching pass of a large extraction run on them too, with any history setting
-  /// (same result; docs/polygonize.md "Threads").
+  /// Threads of the bulk insertion of the seeds at construction (TriangulationOptions::threads; 0 = every CPU
+  /// this process may run on, vitri::available_cpus). Used only without the history (keep_history = false).
+  /// The parallel build gives the same tetrahedra as the serial one, and without the history the tetrahedra
+  /// are renumbered canonically after the seeds (Triangulation::canonicalize()), so the result is the same,
+  /// bit for bit, for any number of threads. The first thin-feature check of a refinement (every live
+  /// tetrahedron) and the marching pass of a large extraction run on them too, with any history setting (same
+  /// result; docs/polygonize.md "Threads").
   unsigned threads = 1;
 };
 

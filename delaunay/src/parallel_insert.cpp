@@ -12,6 +12,13 @@
 //     deferred points, so most of them are then far from a cut);
 //   - it allocates from its own free list and its own block of fresh records.
 //
+// On two threads the next pass cuts the same curve half an arc further (the two arcs of a circle share
+// both ends, so the points deferred near the old cuts are then in the middle of an arc). On more threads
+// a partition touches many others in space, not only its two neighbours along the curve, so shifting the
+// cuts along the curve leaves most old boundaries in place (16 threads, 10^6 points: 75% of the second
+// pass deferred again); there every later pass of a round cuts a Hilbert curve of a moved box
+// (bulk_rekey), whose boundaries fall elsewhere (the same pass: 35%).
+//
 // No two threads ever touch the same record: thread k writes owned tetrahedra and the neighbour slots
 // of tetrahedra across their faces, which have at least three vertices in partition k; it reads only
 // those (a walk or a cavity reads a neighbour of an owned tetrahedron, which shares a face with it).
@@ -31,6 +38,7 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 #include <numeric>
 #include <thread>
@@ -44,6 +52,7 @@ constexpr std::size_t kPrefixPerThread = 250;   // serial BRIO rounds up to abou
 constexpr std::size_t kMinPerThread = 256;      // a smaller pass is inserted serially
 constexpr std::size_t kMaxPasses = 12;          // per round; what is still deferred is inserted serially
 constexpr std::size_t kRoomPerPoint = 8;        // fresh records per point (6.75 live per vertex on average)
+constexpr std::size_t kRekeyAbove = 2;          // more threads: a round's later passes cut along new keys
 }  // namespace
 
 // The state of one thread of a pass; it persists over the passes (free slots, last tetrahedron).
@@ -72,7 +81,8 @@ struct Triangulation::Bulk {
   detail::BrioOrder brio;
   std::size_t prefix = 0;             // ranks [0, prefix) are inserted serially first
   PointId base = 0;                   // rank r >= prefix has the point id base + r - prefix
-  std::vector<std::uint64_t> key;     // by point id: Hilbert key
+  std::vector<std::uint64_t> key;     // by point id: Hilbert key (of the current pass, see bulk_rekey)
+  std::vector<std::uint64_t> saved_key;  // the BRIO keys while a round's later passes use other ones
   std::vector<std::uint8_t> part;     // by point id: partition in the current pass
   std::vector<std::uint64_t> splits;  // partition k holds the keys in [splits[k], splits[k + 1]) (circular)
   std::vector<Worker> workers;
@@ -140,7 +150,13 @@ void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
   std::vector<std::uint32_t> pending(hi - lo), next;
   std::iota(pending.begin(), pending.end(), std::uint32_t(lo));
   const std::size_t T = b.workers.size();
+  bool rekeyed = false;
   for (std::size_t pass = 0; pass < kMaxPasses && pending.size() >= kMinPerThread * T; ++pass) {
+    if (pass > 0 && T > kRekeyAbove) {
+      if (!rekeyed) b.saved_key = b.key;
+      rekeyed = true;
+      bulk_rekey(b, pending, pass);
+    }
     bulk_partition(b, pending, pass);
     for (Worker& w : b.workers) bulk_give_room(b, w, w.todo.size());
     std::vector<std::thread> threads;
@@ -171,6 +187,27 @@ void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
     if (slow) break;
   }
   bulk_insert_serial(b, pending);
+  if (rekeyed) b.key.swap(b.saved_key);
+}
+
+// Pass `pass` > 0 of a round with more than kRekeyAbove threads: every point id gets the Hilbert key of
+// its position in a box 1.5 times larger than the domain, moved by other fractions of it per axis and
+// per pass, and the pending points are sorted by it. The curve's cells then fall elsewhere, and the
+// points that the last pass deferred (near the boundaries of its partitions, which on more than two
+// threads touch many other partitions, not only the neighbours along the curve) are mostly inside the
+// new ones. Only the partition and the insertion order change, never the result.
+void Triangulation::bulk_rekey(Bulk& b, std::vector<std::uint32_t>& pending, std::size_t pass) {
+  const Point3 e = box_.extent();
+  auto frac = [](double x) { return x - std::floor(x); };
+  const double j = double(pass);
+  const Point3 shift{0.5 * e.x * frac(0.6180339887 * j), 0.5 * e.y * frac(0.7548776662 * j + 0.25),
+                     0.5 * e.z * frac(0.5698402910 * j + 0.5)};
+  const Box3 box{box_.lo - shift, box_.lo - shift + 1.5 * e};
+  detail::parallel_slices(b.key.size(), unsigned(b.workers.size()), [&](std::size_t lo, std::size_t hi) {
+    for (std::size_t q = lo; q < hi; ++q) b.key[q] = detail::point_key(pos_[q], box);
+  });
+  std::sort(pending.begin(), pending.end(),
+            [&](std::uint32_t x, std::uint32_t y) { return b.key[b.pid(x)] < b.key[b.pid(y)]; });
 }
 
 // The location grid learns the vertices of a pass (the next passes start their walks there).

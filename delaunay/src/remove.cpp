@@ -52,13 +52,12 @@ void Triangulation::remove(VertexId v, ChangeSet* changes) {
   const bool renumbered = maybe_rebuild();
   Star& star = scratch_->star;
   collect_star(pid(v), star);
-  remove_star(v, star, changes);
+  remove_star(pid(v), star, changes);
   if (renumbered) report_renumbered(changes);
 }
 
-// Removes v whose star the caller collected (marked) in `star`.
-void Triangulation::remove_star(VertexId v, Star& star, ChangeSet* changes) {
-  const PointId pv = pid(v);
+// Removes the point pv whose star the caller collected (marked) in `star`.
+void Triangulation::remove_star(PointId pv, Star& star, ChangeSet* changes) {
   collect_link(pv, star);
   if (star.link.size() <= max_wrap_link_)
     fill_hole_by_wrapping(pv, star, changes);

@@ -168,7 +168,8 @@ class Triangulation {
   /// Moves vertex v to p; v keeps its id. Returns TooClose (and leaves v where it was) when p is closer
   /// than min_distance to another vertex. @throws as remove() and insert().
   /// When every tetrahedron around v stays positively oriented and locally Delaunay at p, only the
-  /// star of v is rebuilt (same combinatorics); otherwise v is removed and reinserted.
+  /// star of v is rebuilt (same combinatorics); otherwise p is inserted under v's id and v's old
+  /// position removed.
   /// @note May rebuild the history first, as remove().
   InsertResult move(VertexId v, const Point3& p, double min_distance = 0.0, ChangeSet* changes = nullptr);
 
@@ -356,7 +357,7 @@ class Triangulation {
   // remove.cpp
   void collect_star(PointId v, Star& star);
   void collect_link(PointId pv, Star& star);
-  void remove_star(VertexId v, Star& star, ChangeSet* changes);
+  void remove_star(PointId pv, Star& star, ChangeSet* changes);
   void commit_removal(PointId pv, const Star& star, const std::vector<TetId>& created,
                       const std::vector<TetId>& hints, ChangeSet* changes);
   // hole_wrap.cpp (gift wrapping) and hole_sub.cpp (scratch triangulation of the link)

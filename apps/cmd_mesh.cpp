@@ -30,7 +30,7 @@ const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj [--precision P [--precision P2 ...]] [--edits SCRIPT]\n"
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--neighbours K]\n"
-    "                  [--function global|local|auto] [--smoothing S] [-q]\n"
+    "                  [--function global|local|auto] [--smoothing S] [--threads N] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -92,6 +92,9 @@ const char* const kUsage =
     "                       to 4000 constraints, local above). See docs/local_rbf.md.\n"
     "  --smoothing S        local function only: regularization of every patch (0 interpolates, the\n"
     "                       default; 1e-3..1e-1 smooths a noisy scan)\n"
+    "  --threads N          threads of the fit, the seeds' insertion and the extraction (default 0:\n"
+    "                       every CPU this process may run on, i.e. its affinity mask, so `taskset`\n"
+    "                       works too). The mesh is the same file whatever N.\n"
     "  -q, --quiet          no table, no progress\n"
     "\n"
     "Progress goes to stderr: a line as each phase starts (read, constraints, precision, fit,\n"
@@ -122,6 +125,8 @@ bool parse_double(const std::string& s, double& out) {
   out = std::strtod(b, &e);
   return e != b && *e == '\0';
 }
+
+constexpr std::size_t kMaxThreads = 1024;  // --threads
 
 bool parse_index(const std::string& s, std::size_t& out) {
   if (s.empty() || s[0] == '-' || s[0] == '+') return false;
@@ -213,6 +218,7 @@ int run_mesh(const Args& args) {
   std::vector<double> distances;  // quality mode: --max-distance per level (relative)
   double relative_size = std::numeric_limits<double>::infinity();  // quality mode: --max-size
   bool quiet = false;
+  unsigned threads = 0;  // --threads: 0 = every available CPU
   MesherOptions options;
   options.function = FunctionKind::Auto;
   options.constraint_build.offset_spacings = kOffsetSpacings;
@@ -273,6 +279,12 @@ int run_mesh(const Args& args) {
       if (!value(v) || !parse_double(v, sm) || !(sm >= 0.0) || !std::isfinite(sm))
         return usage_error("--smoothing needs a number >= 0");
       options.local.smoothing = sm;
+    } else if (a == "--threads") {
+      std::size_t k = 0;
+      if (!value(v) || !parse_index(v, k) || k > kMaxThreads)
+        return usage_error("--threads needs an integer from 0 (every available CPU) to " +
+                           std::to_string(kMaxThreads));
+      threads = unsigned(k);
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (!a.empty() && a[0] == '-') {
@@ -310,8 +322,13 @@ int run_mesh(const Args& args) {
   // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
   // memory (docs/mesher.md "Batch runs and memory").
   options.polygonizer.keep_history = !script.empty();
-  // Then the seeds go in on every core: the same mesh, bit for bit, as one thread (canonical ids).
-  options.polygonizer.threads = 0;
+  // Then the seeds go in on `threads` cores: the same mesh, bit for bit, as one thread (canonical ids).
+  // The fit, the constraints' construction and the normals give the same result on any thread count.
+  options.polygonizer.threads = threads;
+  options.local.threads = threads;
+  options.rbf.threads = threads;
+  options.constraint_build.threads = threads;
+  options.constraint_build.normals.threads = threads;
   // A precision far below the data's spacing would need more memory than the machine has: a LimitError
   // naming the count instead of an out-of-memory end.
   options.max_vertices = vertex_budget(options.polygonizer.keep_history);

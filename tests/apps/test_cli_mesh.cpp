@@ -254,6 +254,26 @@ TEST_CASE("vitri mesh without --precision: the data's resolution", "[cli][mesh]"
   CHECK(v < 6000);
 }
 
+TEST_CASE("vitri mesh --threads: the same file on one thread and on three", "[cli][mesh]") {
+  // 2000 oriented points: 6000 constraints, the local function (auto), seeds inserted in parallel on
+  // three threads (at least 256 per thread), the fit and the extraction threaded too.
+  const std::string in = write_sphere_points("mesh_threads.pwn", 2000);
+  const std::string one = kDir + "/mesh_threads_1.ply", three = kDir + "/mesh_threads_3.ply";
+  std::string o, e;
+  REQUIRE(run(in + " -o " + one + " --threads 1", o, e) == 0);
+  REQUIRE(run(in + " -o " + three + " --threads 3", o, e) == 0);
+  const std::string a = slurp(one), b = slurp(three);
+  REQUIRE(check_mesh(one) > 1000);
+  REQUIRE(a.size() > 1000);
+  CHECK(a == b);
+  for (const char* bad : {"abc", "-1", "1025", "2.5"}) {
+    INFO(bad);
+    REQUIRE(run(in + " -o " + one + " --threads " + bad, o, e) == 2);
+    REQUIRE(e.find("--threads") != std::string::npos);
+  }
+  REQUIRE(run(in + " -o " + one + " --threads", o, e) == 2);  // the option without its value
+}
+
 TEST_CASE("vitri mesh: unoriented points that cannot be oriented, and a fit too large for memory",
           "[cli][mesh][normals][errors]") {
   std::string o, e;

@@ -206,9 +206,11 @@ bool Triangulation::move_too_close(PointId pv, const Point3& p, TetId start, dou
 // Inserts p under v's id, then removes v's old point. `start` contains p. Inserting first shrinks the
 // star that the removal then fills: p, next to v after a small move, takes about half of v's Delaunay
 // neighbours, and the gift wrapping's cost grows with the square of the link (small moves 236-252 ->
-// 201-205 ms per 10^4 in alternating bench_delaunay runs). Both steps are sized before either changes
-// anything: the removal creates at most as many tetrahedra as v's star then holds, which is at most its
-// old star plus p's new tetrahedra.
+// 201-205 ms per 10^4 in alternating bench_delaunay runs). Both steps are sized against the tetrahedron
+// limit before either changes anything: after the insertion v's star has at most S = its old star plus
+// p's new tetrahedra, so its link (a triangulated sphere of S faces) at most L = S / 2 + 2 vertices, and
+// the hole is filled by part of their Delaunay tetrahedralization, at most (L^2 - 3L - 2) / 2 < L^2 / 2
+// tetrahedra (the upper bound for L points in 3D).
 InsertResult Triangulation::move_by_reinsertion(VertexId v, const Point3& p, TetId start, MoveState& m,
                                                 ChangeSet* changes) {
   const PointId pv = pid(v);
@@ -218,7 +220,8 @@ InsertResult Triangulation::move_by_reinsertion(VertexId v, const Point3& p, Tet
     throw std::logic_error("Triangulation::move: reinsertion rejected after the proximity check");
   PointId q;
   try {
-    check_tet_limit(2 * cav.boundary.size() + m.star.tets.size());
+    const std::size_t faces = m.star.tets.size() + cav.boundary.size(), link = faces / 2 + 2;
+    check_tet_limit(cav.boundary.size() + link * link / 2);
     q = alloc_point(p, v);
   } catch (...) {
     clear_cavity_marks(cav);

@@ -44,7 +44,9 @@ bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, doubl
   const Point3& gb = grad_[b];
   // Facing sheets: the normals at the ends differ by more than 90 degrees (false when a gradient is
   // unknown, NaN).
-  if (!(dot(ga, gb) < kThinCosine * std::sqrt(dot(ga, ga) * dot(gb, gb)))) return false;
+  const double gab = dot(ga, gb);
+  if (!(gab < 0.0)) return false;  // cheap reject first (kThinCosine <= 0): no square root
+  if (!(gab < kThinCosine * std::sqrt(dot(ga, ga) * dot(gb, gb)))) return false;
   const Point3 e = tri_.point(b) - tri_.point(a);
   if (dot(e, e) < min_length * min_length) return false;
   double da = dot(ga, e), db = -dot(gb, e);  // slopes of f per unit t, at a towards b, at b towards a

@@ -53,6 +53,7 @@ constexpr std::size_t kMinPerThread = 256;      // a smaller pass is inserted se
 constexpr std::size_t kMaxPasses = 12;          // per round; what is still deferred is inserted serially
 constexpr std::size_t kRoomPerPoint = 8;        // fresh records per point (6.75 live per vertex on average)
 constexpr std::size_t kRekeyAbove = 2;          // more threads: a round's later passes cut along new keys
+constexpr std::size_t kPassWorthRekeyed = 32;   // a rekeyed pass's bookkeeping: ~1/32 of an insertion per id
 }  // namespace
 
 // The state of one thread of a pass; it persists over the passes (free slots, last tetrahedron).
@@ -145,27 +146,35 @@ void Triangulation::bulk_assign_points(const std::vector<Point3>& points, Bulk& 
   b.part.assign(pos_.size(), 0);
 }
 
-// Ranks [lo, hi) (key order): parallel passes over what is pending until little is left.
+// Ranks [lo, hi) (key order): parallel passes over what is pending until little is left. A pass that
+// defers more than half of its points is followed, above two threads, by one on half as many threads
+// (larger partitions, fewer boundaries), and on two by the serial insertion of the rest. Above two
+// threads a later pass also runs only while it is worth its bookkeeping over every point id (new keys,
+// partition labels): pending x (T - 1) at least the point ids / kPassWorthRekeyed.
 void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
   std::vector<std::uint32_t> pending(hi - lo), next;
   std::iota(pending.begin(), pending.end(), std::uint32_t(lo));
-  const std::size_t T = b.workers.size();
+  const bool rekey = b.workers.size() > kRekeyAbove;
+  const std::size_t ids = b.part.size();
+  std::size_t T = b.workers.size();  // the workers of the current pass: b.workers[0, T)
   bool rekeyed = false;
   for (std::size_t pass = 0; pass < kMaxPasses && pending.size() >= kMinPerThread * T; ++pass) {
-    if (pass > 0 && T > kRekeyAbove) {
+    if (pass > 0 && rekey && pending.size() * (T - 1) * kPassWorthRekeyed < ids) break;
+    if (pass > 0 && rekey) {
       if (!rekeyed) b.saved_key = b.key;
       rekeyed = true;
       bulk_rekey(b, pending, pass);
     }
-    bulk_partition(b, pending, pass);
-    for (Worker& w : b.workers) bulk_give_room(b, w, w.todo.size());
+    bulk_partition(b, pending, pass, T);
+    for (std::size_t k = 0; k < T; ++k) bulk_give_room(b, b.workers[k], b.workers[k].todo.size());
     std::vector<std::thread> threads;
     for (std::size_t k = 1; k < T; ++k) threads.emplace_back([&, k] { bulk_work(b, b.workers[k]); });
     bulk_work(b, b.workers[0]);
     for (std::thread& t : threads) t.join();
     next.clear();
     double slowest = 0;
-    for (Worker& w : b.workers) {
+    for (std::size_t k = 0; k < T; ++k) {
+      Worker& w = b.workers[k];
       slowest = std::max(slowest, w.cpu_seconds);
       bulk_stats_.thread_cpu_seconds += w.cpu_seconds;
       if (w.error) std::rethrow_exception(w.error);
@@ -182,9 +191,10 @@ void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
     bulk_stats_.deferred += next.size();
     std::sort(next.begin(), next.end(),
               [&](std::uint32_t x, std::uint32_t y) { return b.key[b.pid(x)] < b.key[b.pid(y)]; });
-    const bool slow = 2 * next.size() > pending.size();  // the cuts no longer help: the rest serially
+    const bool slow = 2 * next.size() > pending.size();  // the cuts no longer help
     pending.swap(next);
-    if (slow) break;
+    if (slow && T <= 2) break;  // the rest serially
+    if (slow) T /= 2;
   }
   bulk_insert_serial(b, pending);
   if (rekeyed) b.key.swap(b.saved_key);
@@ -249,8 +259,9 @@ static double cut_phase(std::size_t j) {
 // Cuts the Hilbert curve, taken as a circle, into T arcs holding as many pending points each (key
 // order), starting at the phase of the pass; every point id gets the arc of its key. Worker k takes the
 // pending points of arc k and keeps its last tetrahedron if it still owns it.
-void Triangulation::bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pending, std::size_t pass) {
-  const std::size_t T = b.workers.size(), n = pending.size();
+void Triangulation::bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pending, std::size_t pass,
+                                   std::size_t T) {
+  const std::size_t n = pending.size();
   const double phase = cut_phase(pass);
   b.splits.resize(T);
   std::vector<std::size_t> cut(T);

@@ -117,10 +117,13 @@ TEST_CASE("delaunay: parallel bulk insertion gives the serial tetrahedra, ids an
     for (std::size_t i = 0; i < 300; ++i) second[7 * i] = first[13 * i];
     require_same_as_serial(unit, {first, second}, 2);
   }
-  // Above two threads the later passes of a round cut along Hilbert keys of a moved box (bulk_rekey).
+  // Above two threads the later passes of a round cut along Hilbert keys of a moved box (bulk_rekey), a
+  // pass that defers more than half is followed by one on half as many threads.
   SECTION("more than two threads: later passes on new keys, duplicates and a second batch included") {
     require_same_as_serial(unit, {uniform(40000, 7)}, 4);
     require_same_as_serial(unit, {uniform(60000, 8)}, 6);
+    // Clusters on five threads: the first pass defers most points, the next ones run on fewer threads.
+    require_same_as_serial(unit, {clusters(40000, 12)}, 5);
     const Box3 box{{-1, -1, -1}, {36, 36, 36}};
     require_same_as_serial(box, {grid_with_duplicates(35, 900, 9)}, 4);
     std::vector<Point3> first = uniform(30000, 10), second = uniform(30000, 11);

@@ -339,7 +339,7 @@ class Triangulation {
   void bulk_assign_points(const std::vector<Point3>& points, Bulk& b);
   void bulk_round(Bulk& b, std::size_t lo, std::size_t hi);
   void bulk_rekey(Bulk& b, std::vector<std::uint32_t>& pending, std::size_t pass);
-  void bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pending, std::size_t pass);
+  void bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pending, std::size_t pass, std::size_t T);
   void bulk_give_room(Bulk& b, Worker& w, std::size_t points);
   void bulk_work(const Bulk& b, Worker& w);
   bool bulk_insert_one(const Bulk& b, Worker& w, std::uint32_t rank);

@@ -205,8 +205,8 @@ bool Triangulation::move_too_close(PointId pv, const Point3& p, TetId start, dou
 
 // Inserts p under v's id, then removes v's old point. `start` contains p. Inserting first shrinks the
 // star that the removal then fills: p, next to v after a small move, takes about half of v's Delaunay
-// neighbours, and the gift wrapping's cost grows with the square of the link (small moves 236-252 ->
-// 201-205 ms per 10^4 in alternating bench_delaunay runs). Both steps are sized against the tetrahedron
+// neighbours, and the gift wrapping's cost grows with the square of the link (docs/benchmarks.md,
+// "Delaunay": about 15% faster small moves). Both steps are sized against the tetrahedron
 // limit before either changes anything: after the insertion v's star has at most S = its old star plus
 // p's new tetrahedra, so its link (a triangulated sphere of S faces) at most L = S / 2 + 2 vertices, and
 // the hole is filled by part of their Delaunay tetrahedralization, at most (L^2 - 3L - 2) / 2 < L^2 / 2

@@ -11,7 +11,6 @@
 #include <cmath>
 #include <numeric>
 #include <string>
-#include <thread>
 #include <unordered_set>
 
 namespace vitri {

@@ -17,6 +17,7 @@ using namespace polygonizer_detail;
 
 namespace {
 constexpr double kThinCosine = 0.0;  // the gradients at the two ends must point at each other (below)
+static_assert(kThinCosine <= 0.0, "crossed_twice rejects a non-negative dot product before the bound");
 constexpr std::size_t kThinSliceMin = std::size_t(1) << 16;  // tetrahedra per thread of check_thin, at least
 }  // namespace
 
@@ -45,7 +46,7 @@ bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, doubl
   // Facing sheets: the normals at the ends differ by more than 90 degrees (false when a gradient is
   // unknown, NaN).
   const double gab = dot(ga, gb);
-  if (!(gab < 0.0)) return false;  // cheap reject first (kThinCosine <= 0): no square root
+  if (!(gab < 0.0)) return false;  // implied by the bound below (kThinCosine <= 0), without a square root
   if (!(gab < kThinCosine * std::sqrt(dot(ga, ga) * dot(gb, gb)))) return false;
   const Point3 e = tri_.point(b) - tri_.point(a);
   if (dot(e, e) < min_length * min_length) return false;

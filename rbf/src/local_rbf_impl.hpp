@@ -64,7 +64,7 @@ struct LocalRbf::Impl {
   mutable Constraints cache;
   mutable bool cache_valid = false;
 
-  unsigned threads() const { return rbf_detail::thread_count(opt.threads); }
+  unsigned threads() const { return resolve_thread_count(opt.threads); }
   double duplicate_tolerance2() const;
   /// True when two constraints at squared distance d2 are (near-)duplicates.
   bool too_close(double d2) const;

@@ -14,11 +14,6 @@
 namespace vitri {
 namespace rbf_detail {
 
-/// Threads to use: `requested`, or every CPU this process may run on when it is 0 (available_cpus).
-inline unsigned thread_count(unsigned requested) {
-  return resolve_thread_count(requested);
-}
-
 /// Runs body(begin, end) over [0, n) in chunks of `grain` on up to `threads` threads (0: every CPU this
 /// process may run on); chunks are taken in order from a shared counter. Rethrows the first exception
 /// of any chunk after every thread has stopped.
@@ -26,7 +21,8 @@ inline void parallel_chunks(std::size_t n, unsigned threads, std::size_t grain,
                             const std::function<void(std::size_t, std::size_t)>& body) {
   grain = std::max<std::size_t>(1, grain);
   const std::size_t chunks = (n + grain - 1) / grain;
-  const unsigned workers = static_cast<unsigned>(std::min<std::size_t>(thread_count(threads), chunks));
+  const std::size_t available = resolve_thread_count(threads);
+  const unsigned workers = static_cast<unsigned>(std::min(available, chunks));
   if (workers <= 1) {
     if (n) body(0, n);
     return;

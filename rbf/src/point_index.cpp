@@ -102,7 +102,7 @@ void PointIndex::build_entries(std::vector<Entry>& entries, unsigned threads) {
   std::uint8_t axis = 0;
   double cut = 0;
   Entry* middle = nullptr;
-  if (rbf_detail::thread_count(threads) < 2 || entries.size() < kParallelBuildMin ||
+  if (resolve_thread_count(threads) < 2 || entries.size() < kParallelBuildMin ||
       !split_entries(first, last, lo, hi, axis, cut, middle)) {
     make_subtree(nodes_, first, last);
     return;

@@ -19,7 +19,7 @@ using rbf_detail::cube;
 void Rbf::Impl::sums(const double* q, std::size_t m, double* f, double* g) const {
   const auto& ops = rbf_detail::dense_ops();
   const long nn = static_cast<long>(cx.size());
-  unsigned t = rbf_detail::thread_count(opt.threads);
+  unsigned t = resolve_thread_count(opt.threads);
   const double work = static_cast<double>(m) * static_cast<double>(nn);
   if (work < 4e5) t = 1;
   t = static_cast<unsigned>(std::min<std::size_t>(t, m));

@@ -51,8 +51,8 @@ struct ConstraintBuildOptions {
   /// constraint is dropped too (an off-surface constraint is never that close to a surface point). 2e-6 by default: twice the fits' default duplicate_tolerance (1e-6), so that the result always
   /// fits. 0 merges exact duplicates only. Counted in ConstraintBuildReport.
   double merge_tolerance = 2e-6;
-  /// Threads of the merge and of the off-surface queries: 0 = every available CPU (vitri::available_cpus), 1 = the calling
-  /// thread. The result does not depend on it.
+  /// Threads of the merge and of the off-surface queries: 0 = every available CPU
+  /// (vitri::available_cpus), 1 = the calling thread. The result does not depend on it.
   unsigned threads = 0;
   /// Normal estimation and orientation of unoriented points (constraints_from_points() only).
   NormalOptions normals;

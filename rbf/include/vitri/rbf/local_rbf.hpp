@@ -55,7 +55,8 @@ struct LocalRbfOptions {
   double duplicate_tolerance = 1e-6;
   /// Deepest octree level (root 0). Cells at this level are never split, whatever their count.
   int max_depth = 20;
-  /// Threads of the fit (over patches) and of the batch evaluation: 0 = every available CPU (vitri::available_cpus).
+  /// Threads of the fit (over patches) and of the batch evaluation: 0 = every available CPU
+  /// (vitri::available_cpus).
   unsigned threads = 0;
 };
 

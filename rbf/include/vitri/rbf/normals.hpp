@@ -26,8 +26,8 @@ struct NormalOptions {
   /// noise and uneven sampling; smaller follows thin parts (two sheets closer than the neighbourhood
   /// radius get one tangent plane, a known limit of the method).
   std::size_t k = 10;
-  /// Threads of the PCA step: 0 = every available CPU (vitri::available_cpus), 1 = the calling thread. The result does not
-  /// depend on it.
+  /// Threads of the PCA step: 0 = every available CPU (vitri::available_cpus), 1 = the calling thread.
+  /// The result does not depend on it.
   unsigned threads = 0;
   /// A neighbourhood whose covariance has its middle eigenvalue below `collinear_tolerance` times the
   /// largest one is (nearly) collinear: its normal is undetermined and estimate_normals() throws

@@ -34,8 +34,9 @@ class PointIndex {
   /// Same as build(points, threads).
   explicit PointIndex(const std::vector<Point3>& points, unsigned threads = 1) { build(points, threads); }
 
-  /// Replaces the content by points[i] with id i. With threads > 1 (0: every available CPU) and enough points,
-  /// the two halves below the root are built on two threads; the tree is the same whatever the threads.
+  /// Replaces the content by points[i] with id i. With threads > 1 (0: every available CPU) and enough
+  /// points, the two halves below the root are built on two threads; the tree is the same whatever the
+  /// threads.
   /// @throws InvalidPoint (index i) for a non-finite coordinate; LimitError for more than 2^32 - 2 points.
   void build(const std::vector<Point3>& points, unsigned threads = 1);
   /// Replaces the content by points[k] with id ids[k] (any distinct ids below 2^32 - 1, as insert()

@@ -69,8 +69,9 @@ struct RbfOptions {
   /// flagged unreliable (FitReport::warning). Never fails on its own.
   double warn_condition = 1e13;
   /// Threads used by the fit (blocked Cholesky, N > ~600) and the batch evaluation values() /
-  /// values_gradients(): 0 = every available CPU (vitri::available_cpus), 1 = the calling thread only. Small problems always
-  /// run on the calling thread. The result does not depend on the number of threads.
+  /// values_gradients(): 0 = every available CPU (vitri::available_cpus), 1 = the calling thread only.
+  /// Small problems always run on the calling thread. The result does not depend on the number of
+  /// threads.
   unsigned threads = 0;
   /// Number of edits between two automatic drift checks (a residual computation, O(N^2) kernel
   /// evaluations, about the cost of one edit). When the relative residual exceeds both `warn_residual`

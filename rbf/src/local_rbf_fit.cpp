@@ -89,11 +89,12 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
   }
   std::vector<std::uint32_t> created;
   t_step = std::chrono::steady_clock::now();
-  refine_levels(created);
+  std::vector<std::uint32_t> ball_counts;
+  refine_levels(created, &ball_counts);
   end_step(2);
   link(created, true);
   end_step(3);
-  fit_leaves(created);
+  fit_leaves(created, &ball_counts);
   publish(created);
   end_step(4);
   for (std::size_t c2 = tree.capacity(); c2-- > 0;)  // children after parents: reach bottom-up
@@ -121,10 +122,10 @@ void LocalRbf::Impl::reset_root(const Point3& center, double half) {
   tree.reset(c, h);
 }
 
-bool LocalRbf::Impl::wants_children(std::uint32_t c) const {
+LocalRbf::Impl::SplitDecision LocalRbf::Impl::split_rule(std::uint32_t c) const {
   const double r = tree.cell(c).radius;
   const std::size_t n = index.count_ball(tree.cell(c).center, r * r, opt.max_per_patch);
-  return n > opt.max_per_patch && tree.cell(c).depth < opt.max_depth;
+  return {n > opt.max_per_patch && tree.cell(c).depth < opt.max_depth, static_cast<std::uint32_t>(n)};
 }
 
 void LocalRbf::Impl::refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created) {
@@ -136,20 +137,24 @@ void LocalRbf::Impl::refine_cell(std::uint32_t c, std::vector<std::uint32_t>& cr
   }
 }
 
-void LocalRbf::Impl::refine_levels(std::vector<std::uint32_t>& created) {
+void LocalRbf::Impl::refine_levels(std::vector<std::uint32_t>& created, std::vector<std::uint32_t>* ball_counts) {
   // The same split rule as refine_cell, one depth at a time: the ball counts of a depth (the cost) on the
   // threads, then the splits (they grow the cell array) on this one. Cell ids come out breadth first,
   // which nothing depends on (candidate lists and sums follow cell_before, a geometric order).
   std::vector<std::uint32_t> level{0}, next;
-  std::vector<std::uint8_t> split;
+  std::vector<SplitDecision> split;
   while (!level.empty()) {
-    split.assign(level.size(), 0);
+    split.assign(level.size(), SplitDecision{false, 0});
     parallel_chunks(level.size(), threads(), 256, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) split[i] = wants_children(level[i]) ? 1 : 0;
+      for (std::size_t i = b; i < e; ++i) split[i] = split_rule(level[i]);
     });
+    if (ball_counts) {
+      ball_counts->resize(tree.capacity(), kUnknownCount);
+      for (std::size_t i = 0; i < level.size(); ++i) (*ball_counts)[level[i]] = split[i].ball_count;
+    }
     next.clear();
     for (std::size_t i = 0; i < level.size(); ++i)
-      if (split[i]) {
+      if (split[i].split) {
         const std::uint32_t first = tree.split(level[i]);
         for (std::uint32_t k = 0; k < 8; ++k) next.push_back(first + k);
       }
@@ -169,18 +174,28 @@ void LocalRbf::Impl::refine_levels(std::vector<std::uint32_t>& created) {
   }
 }
 
-void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s) {
+void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s, std::uint32_t ball_count) {
   Cell& cell = tree.cell(c);
   const double r2 = cell.radius * cell.radius;
-  index.ball(cell.center, r2, s.ids);
-  const bool far = s.ids.empty();
-  if (s.ids.size() < opt.min_per_patch) {
+  // The fit set: the ball's constraints, or the min_per_patch nearest when the ball holds fewer (they then
+  // include every one of the ball's: a ball point is nearer than any point outside). With the ball count
+  // known (a full fit: the split rule counted it) one query gives the set; without, the nearest come
+  // first, and the ball holds min_per_patch or more exactly when the last of them lies strictly inside.
+  bool dense = false, far = false;
+  if (ball_count != kUnknownCount && ball_count >= opt.min_per_patch) {
+    dense = true;
+  } else {
     index.nearest(cell.center, opt.min_per_patch, s.ids, &s.d2);
+    dense = s.ids.size() == opt.min_per_patch && s.d2.back() < r2;
+    far = s.ids.empty() || !(s.d2.front() < r2);
+  }
+  if (dense) {
+    index.ball(cell.center, r2, s.ids);
+    cell.fit_r2 = r2;
+  } else {
     cell.fit_r2 = s.ids.size() < opt.min_per_patch ? std::numeric_limits<double>::infinity()
                                                     : std::max(r2, s.d2.back());
     std::sort(s.ids.begin(), s.ids.end());
-  } else {
-    cell.fit_r2 = r2;
   }
   s.points.clear();
   s.values.clear();
@@ -201,10 +216,12 @@ void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s) {
   cell.terms = static_cast<std::uint32_t>(s.points.size());
 }
 
-void LocalRbf::Impl::fit_leaves(const std::vector<std::uint32_t>& leaves) {
+void LocalRbf::Impl::fit_leaves(const std::vector<std::uint32_t>& leaves,
+                                const std::vector<std::uint32_t>* ball_counts) {
   parallel_chunks(leaves.size(), threads(), 64, [&](std::size_t b, std::size_t e) {
     FitScratch s;
-    for (std::size_t k = b; k < e; ++k) fit_leaf(leaves[k], s);
+    for (std::size_t k = b; k < e; ++k)
+      fit_leaf(leaves[k], s, ball_counts ? (*ball_counts)[leaves[k]] : kUnknownCount);
   });
 }
 

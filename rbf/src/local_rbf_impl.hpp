@@ -74,13 +74,23 @@ struct LocalRbf::Impl {
   void check_duplicates() const;
   void reset_root(const Point3& center, double half);
   /// The split rule: c's ball holds more than max_per_patch constraints and c is above max_depth.
-  bool wants_children(std::uint32_t c) const;
+  bool wants_children(std::uint32_t c) const { return split_rule(c).split; }
+  /// The split rule's answer and the ball count it saw (capped at max_per_patch + 1).
+  struct SplitDecision {
+    bool split;
+    std::uint32_t ball_count;
+  };
+  SplitDecision split_rule(std::uint32_t c) const;
   /// Splits c and its new children by the rule, depth first; the leaves below c go to `created`.
   void refine_cell(std::uint32_t c, std::vector<std::uint32_t>& created);
   /// The whole tree from the root alone, by the same rule, one depth at a time (the counts threaded).
-  void refine_levels(std::vector<std::uint32_t>& created);
-  void fit_leaf(std::uint32_t c, local_detail::FitScratch& s);
-  void fit_leaves(const std::vector<std::uint32_t>& leaves);
+  /// `ball_counts` (optional) receives, per cell id, the ball count the rule saw (capped as in split_rule).
+  void refine_levels(std::vector<std::uint32_t>& created, std::vector<std::uint32_t>* ball_counts = nullptr);
+  /// A ball count of kUnknownCount: fit_leaf finds the fit set without it (one more query for dense balls).
+  static constexpr std::uint32_t kUnknownCount = 0xffffffffu;
+  void fit_leaf(std::uint32_t c, local_detail::FitScratch& s, std::uint32_t ball_count = kUnknownCount);
+  /// Fits `leaves`; `ball_counts`, when given, holds each cell's ball count (refine_levels').
+  void fit_leaves(const std::vector<std::uint32_t>& leaves, const std::vector<std::uint32_t>* ball_counts = nullptr);
   /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).
   void link(const std::vector<std::uint32_t>& created, bool every_leaf = false);
   /// The reverse lists (listed_in) of a full fit, where `leaves` are all the leaves; threaded.

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cassert>
 #include <limits>
-#include <queue>
 #include <thread>
 #include <utility>
 
@@ -30,25 +29,69 @@ void grow(Point3& lo, Point3& hi, const Point3& p) {
   }
 }
 
+/// Squared distance from p to the box [lo, hi], 0 inside: Box3::squared_distance without its branches
+/// (the same operations in the same order, so never above the squared distance of a point in the box).
+inline double box_distance2(const Point3& lo, const Point3& hi, const Point3& p) {
+  const double ex = std::max(std::max(lo.x - p.x, p.x - hi.x), 0.0);
+  const double ey = std::max(std::max(lo.y - p.y, p.y - hi.y), 0.0);
+  const double ez = std::max(std::max(lo.z - p.z, p.z - hi.z), 0.0);
+  return (ex * ex + ey * ey) + ez * ez;
+}
+
+/// A depth-first stack of node indices: inline for ordinary depths, on the heap beyond.
+class NodeStack {
+ public:
+  void push(std::uint32_t n) {
+    if (size_ < kInline) inline_[size_] = n;
+    else spill_.push_back(n);
+    ++size_;
+  }
+  bool empty() const { return size_ == 0; }
+  std::uint32_t pop() {
+    --size_;
+    if (size_ < kInline) return inline_[size_];
+    const std::uint32_t n = spill_.back();
+    spill_.pop_back();
+    return n;
+  }
+
+ private:
+  static constexpr std::size_t kInline = 96;
+  std::uint32_t inline_[kInline];
+  std::vector<std::uint32_t> spill_;
+  std::size_t size_ = 0;
+};
+
 }  // namespace
 
-/// The running answer of nearest(): the k smallest (squared distance, id) so far, kept sorted (for the
-/// small k of the callers an insertion into a short sorted array beats a heap's sift-downs).
+/// The running answer of nearest(): the k smallest (squared distance, id) so far, kept sorted in the
+/// caller's vectors (for the small k of the callers an insertion into a short sorted array beats a
+/// heap's sift-downs; the vectors' capacity is reused from query to query).
 struct PointIndex::NearestState {
   Point3 query;
   std::size_t k = 0;
-  std::vector<std::pair<double, Id>> best;
+  std::vector<double>& d2;
+  std::vector<Id>& ids;
   /// Squared distance beyond which nothing can enter the answer (infinity until k are held).
-  double bound() const {
-    return best.size() < k ? std::numeric_limits<double>::infinity() : best.back().first;
-  }
-  void offer(double d2, Id id) {
-    const std::pair<double, Id> entry(d2, id);
-    if (best.size() == k) {
-      if (!(entry < best.back())) return;
-      best.pop_back();
+  double bound() const { return d2.size() < k ? std::numeric_limits<double>::infinity() : d2.back(); }
+  void offer(double dist2, Id id) {
+    std::size_t n = d2.size();
+    if (n == k) {
+      if (!(dist2 < d2.back() || (dist2 == d2.back() && id < ids.back()))) return;
+    } else {
+      d2.push_back(0.0);
+      ids.push_back(0);
+      ++n;
     }
-    best.insert(std::upper_bound(best.begin(), best.end(), entry), entry);
+    // Shift the larger entries up by one: the new one goes after every (d, i) < (dist2, id).
+    std::size_t at = n - 1;
+    while (at > 0 && (dist2 < d2[at - 1] || (dist2 == d2[at - 1] && id < ids[at - 1]))) {
+      d2[at] = d2[at - 1];
+      ids[at] = ids[at - 1];
+      --at;
+    }
+    d2[at] = dist2;
+    ids[at] = id;
   }
 };
 
@@ -94,63 +137,75 @@ void PointIndex::build(const std::vector<Id>& ids, const std::vector<Point3>& po
 
 void PointIndex::build_entries(std::vector<Entry>& entries, unsigned threads) {
   nodes_.clear();
+  buckets_.clear();
+  garbage_ = 0;
   size_ = entries.size();
-  nodes_.reserve(2 * (entries.size() / kBucket + 1));
+  nodes_.reserve(2 * (entries.size() / (kBucket / 2) + 1));
+  buckets_.reserve(entries.size());
   Entry* const first = entries.data();
   Entry* const last = first + entries.size();
   Point3 lo, hi;
   std::uint8_t axis = 0;
   double cut = 0;
   Entry* middle = nullptr;
+  Forest f{std::move(nodes_), std::move(buckets_)};
+  f.nodes.emplace_back();
   if (resolve_thread_count(threads) < 2 || entries.size() < kParallelBuildMin ||
       !split_entries(first, last, lo, hi, axis, cut, middle)) {
-    make_subtree(nodes_, first, last);
+    fill_node(f, 0, first, last);
+    nodes_ = std::move(f.nodes);
+    buckets_ = std::move(f.buckets);
     return;
   }
-  // The root's split here, its left half on this thread and its right half on another into its own
-  // node array, appended after: the same nodes in the same order as the one-thread build (depth first,
-  // left before right), with the right half's indices shifted by where it lands.
-  nodes_.emplace_back();
-  nodes_[0].lo = lo;
-  nodes_[0].hi = hi;
-  nodes_[0].axis = axis;
-  nodes_[0].split = cut;
-  std::vector<Node> right;
-  right.reserve(nodes_.capacity() / 2);
+  // The root's split here, its left subtree on this thread and its right subtree on another into its own
+  // forest, appended after: the same nodes and blocks in the same order as the one-thread build (the
+  // children pair, then the left subtree, then the right one), the right part's indices shifted by
+  // where it lands.
+  f.nodes[0].lo = lo;
+  f.nodes[0].hi = hi;
+  f.nodes[0].extra = axis;
+  f.nodes[0].split = cut;
+  f.nodes[0].child = 1;
+  f.nodes.resize(3);
+  Forest right;
+  right.nodes.reserve(f.nodes.capacity() / 2);
+  right.buckets.reserve(static_cast<std::size_t>(last - middle));
+  right.nodes.emplace_back();
   std::exception_ptr right_error;
   std::thread worker([&] {
     try {
-      make_subtree(right, middle, last);
+      fill_node(right, 0, middle, last);
     } catch (...) {
       right_error = std::current_exception();
     }
   });
   try {
-    nodes_[0].children[0] = make_subtree(nodes_, first, middle);
+    fill_node(f, 1, first, middle);
   } catch (...) {
     worker.join();
     throw;
   }
   worker.join();
   if (right_error) std::rethrow_exception(right_error);
-  const auto offset = static_cast<std::uint32_t>(nodes_.size());
-  nodes_[0].children[1] = offset;
-  for (Node& n : right) {
+  // right.nodes[0] becomes f.nodes[2]; right.nodes[k], k >= 1, becomes f.nodes[shift + k].
+  const auto shift = static_cast<std::uint32_t>(f.nodes.size() - 1);
+  const auto bucket_shift = static_cast<std::uint32_t>(f.buckets.size());
+  const auto place = [&](std::uint32_t k) { return k == 0 ? 2u : shift + k; };
+  for (std::uint32_t k = 0; k < right.nodes.size(); ++k) {
+    Node n = right.nodes[k];
     if (n.leaf()) {
-      for (const Id id : n.bucket) leaf_of_[id] += offset;
+      const Entry* b = right.buckets.data() + n.bucket.begin;
+      for (std::uint32_t i = 0; i < n.bucket.count; ++i) leaf_of_[b[i].id] = place(k);
+      n.bucket.begin += bucket_shift;
     } else {
-      n.children[0] += offset;
-      n.children[1] += offset;
+      n.child = place(n.child);
     }
-    nodes_.push_back(std::move(n));
+    if (k == 0) f.nodes[2] = n;
+    else f.nodes.push_back(n);
   }
-}
-
-std::uint32_t PointIndex::make_subtree(std::vector<Node>& nodes, Entry* first, Entry* last) {
-  const auto index = static_cast<std::uint32_t>(nodes.size());
-  nodes.emplace_back();
-  fill_node(nodes, index, first, last);
-  return index;
+  f.buckets.insert(f.buckets.end(), right.buckets.begin(), right.buckets.end());
+  nodes_ = std::move(f.nodes);
+  buckets_ = std::move(f.buckets);
 }
 
 bool PointIndex::split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis_out,
@@ -181,31 +236,33 @@ bool PointIndex::split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi
   return true;
 }
 
-void PointIndex::fill_node(std::vector<Node>& nodes, std::uint32_t index, Entry* first, Entry* last) {
+void PointIndex::fill_node(Forest& f, std::uint32_t index, Entry* first, Entry* last) {
   Point3 lo, hi;
   std::uint8_t axis = 0;
   double cut = 0;
   Entry* middle = nullptr;
   const bool inner = split_entries(first, last, lo, hi, axis, cut, middle);
-  nodes[index].lo = lo;
-  nodes[index].hi = hi;
-  nodes[index].bucket.clear();
-  nodes[index].bucket_points.clear();
+  Node& n = f.nodes[index];
+  n.lo = lo;
+  n.hi = hi;
   if (!inner) {
+    n.child = kNoNode;
+    n.bucket.begin = static_cast<std::uint32_t>(f.buckets.size());
+    n.bucket.count = static_cast<std::uint32_t>(last - first);
+    n.extra = n.bucket.count;
     for (Entry* it = first; it != last; ++it) {
       leaf_of_[it->id] = index;
-      nodes[index].bucket.push_back(it->id);
-      nodes[index].bucket_points.push_back(it->p);
+      f.buckets.push_back(*it);
     }
     return;
   }
-  nodes[index].bucket_points.shrink_to_fit();
-  nodes[index].axis = axis;
-  nodes[index].split = cut;
-  const std::uint32_t left = make_subtree(nodes, first, middle);
-  const std::uint32_t right = make_subtree(nodes, middle, last);
-  nodes[index].children[0] = left;
-  nodes[index].children[1] = right;
+  n.extra = axis;
+  n.split = cut;
+  const auto left = static_cast<std::uint32_t>(f.nodes.size());
+  n.child = left;  // n is not used past this point: the resize may move the array
+  f.nodes.resize(f.nodes.size() + 2);
+  fill_node(f, left, first, middle);
+  fill_node(f, left + 1, middle, last);
 }
 
 void PointIndex::ensure_id(Id id) {
@@ -213,6 +270,30 @@ void PointIndex::ensure_id(Id id) {
     leaf_of_.resize(static_cast<std::size_t>(id) + 1, kNoNode);
     position_.resize(static_cast<std::size_t>(id) + 1);
   }
+}
+
+void PointIndex::move_bucket(std::uint32_t node, std::size_t capacity) {
+  Node& n = nodes_[node];
+  const auto begin = static_cast<std::uint32_t>(buckets_.size());
+  buckets_.resize(buckets_.size() + capacity);
+  std::copy_n(buckets_.begin() + n.bucket.begin, n.bucket.count, buckets_.begin() + begin);
+  garbage_ += n.extra;
+  n.bucket.begin = begin;
+  n.extra = static_cast<std::uint32_t>(capacity);
+  if (garbage_ > 4 * kBucket && garbage_ > buckets_.size() / 2) compact_buckets();
+}
+
+void PointIndex::compact_buckets() {
+  std::vector<Entry> packed;
+  packed.reserve(buckets_.size() - garbage_);
+  for (Node& n : nodes_) {
+    if (!n.leaf()) continue;
+    const auto begin = static_cast<std::uint32_t>(packed.size());
+    packed.insert(packed.end(), buckets_.begin() + n.bucket.begin, buckets_.begin() + n.bucket.begin + n.extra);
+    n.bucket.begin = begin;
+  }
+  buckets_ = std::move(packed);
+  garbage_ = 0;
 }
 
 void PointIndex::insert(Id id, const Point3& p) {
@@ -224,36 +305,51 @@ void PointIndex::insert(Id id, const Point3& p) {
   if (nodes_.empty()) {
     nodes_.emplace_back();
     nodes_[0].lo = nodes_[0].hi = p;
+    nodes_[0].bucket.begin = static_cast<std::uint32_t>(buckets_.size());
+    nodes_[0].bucket.count = 0;
+    nodes_[0].extra = 0;
   }
   std::uint32_t node = 0;
   for (;;) {
-    grow(nodes_[node].lo, nodes_[node].hi, p);
-    if (nodes_[node].leaf()) break;
-    node = nodes_[node].children[p[nodes_[node].axis] < nodes_[node].split ? 0 : 1];
+    Node& n = nodes_[node];
+    grow(n.lo, n.hi, p);
+    if (n.leaf()) break;
+    node = n.child + (p[n.extra] < n.split ? 0 : 1);
   }
-  nodes_[node].bucket.push_back(id);
-  nodes_[node].bucket_points.push_back(p);
+  // A full block moves to the end with room to spare (a leaf of points at one position, which cannot
+  // split, doubles).
+  if (nodes_[node].bucket.count == nodes_[node].extra)
+    move_bucket(node, std::max<std::size_t>(2 * kBucket + 1, 2 * std::size_t(nodes_[node].bucket.count)));
+  Node& leaf = nodes_[node];
+  buckets_[leaf.bucket.begin + leaf.bucket.count] = Entry{p, id};
+  ++leaf.bucket.count;
   leaf_of_[id] = node;
   ++size_;
-  if (nodes_[node].bucket.size() > 2 * kBucket) split_leaf(node);
+  if (leaf.bucket.count > 2 * kBucket) split_leaf(node);
 }
 
 void PointIndex::split_leaf(std::uint32_t node) {
-  std::vector<Entry> entries(nodes_[node].bucket.size());
-  for (std::size_t k = 0; k < entries.size(); ++k) entries[k] = {nodes_[node].bucket_points[k], nodes_[node].bucket[k]};
-  fill_node(nodes_, node, entries.data(), entries.data() + entries.size());  // a leaf when all share one position
+  const Node& n = nodes_[node];
+  std::vector<Entry> entries(buckets_.begin() + n.bucket.begin, buckets_.begin() + n.bucket.begin + n.bucket.count);
+  // The leaf's block is freed, its points go to the new leaves' blocks (or back to a fresh block when
+  // they all share one position and the node stays a leaf).
+  garbage_ += n.extra;
+  Forest f{std::move(nodes_), std::move(buckets_)};
+  fill_node(f, node, entries.data(), entries.data() + entries.size());
+  nodes_ = std::move(f.nodes);
+  buckets_ = std::move(f.buckets);
+  if (garbage_ > 4 * kBucket && garbage_ > buckets_.size() / 2) compact_buckets();
 }
 
 void PointIndex::erase(Id id) {
   if (!contains(id)) throw InvalidPoint(id, "no point with this id in the spatial index");
   Node& leaf = nodes_[leaf_of_[id]];
-  const auto it = std::find(leaf.bucket.begin(), leaf.bucket.end(), id);
-  assert(it != leaf.bucket.end());
-  const auto k = static_cast<std::size_t>(it - leaf.bucket.begin());
-  *it = leaf.bucket.back();
-  leaf.bucket.pop_back();
-  leaf.bucket_points[k] = leaf.bucket_points.back();
-  leaf.bucket_points.pop_back();
+  Entry* const b = buckets_.data() + leaf.bucket.begin;
+  Entry* const e = b + leaf.bucket.count;
+  Entry* const it = std::find_if(b, e, [&](const Entry& x) { return x.id == id; });
+  assert(it != e);
+  *it = *(e - 1);
+  --leaf.bucket.count;
   leaf_of_[id] = kNoNode;
   --size_;
 }
@@ -261,17 +357,18 @@ void PointIndex::erase(Id id) {
 void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out) const {
   out.clear();
   if (size_ == 0) return;
-  std::vector<std::uint32_t> stack{0};
+  NodeStack stack;
+  stack.push(0);
   while (!stack.empty()) {
-    const Node& n = nodes_[stack.back()];
-    stack.pop_back();
-    if (!(Box3{n.lo, n.hi}.squared_distance(center) < radius2)) continue;
+    const Node& n = nodes_[stack.pop()];
+    if (!(box_distance2(n.lo, n.hi, center) < radius2)) continue;
     if (n.leaf()) {
-      for (std::size_t k = 0; k < n.bucket.size(); ++k)
-        if (squared_distance(n.bucket_points[k], center) < radius2) out.push_back(n.bucket[k]);
+      const Entry* b = bucket_begin(n);
+      for (std::uint32_t k = 0; k < n.bucket.count; ++k)
+        if (squared_distance(b[k].p, center) < radius2) out.push_back(b[k].id);
     } else {
-      stack.push_back(n.children[0]);
-      stack.push_back(n.children[1]);
+      stack.push(n.child + 1);
+      stack.push(n.child);
     }
   }
   std::sort(out.begin(), out.end());
@@ -280,19 +377,18 @@ void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out
 std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::size_t limit) const {
   if (size_ == 0) return 0;
   std::size_t count = 0;
-  std::vector<std::uint32_t> stack;
-  stack.reserve(64);
-  stack.push_back(0);
+  NodeStack stack;
+  stack.push(0);
   while (!stack.empty()) {
-    const Node& n = nodes_[stack.back()];
-    stack.pop_back();
-    if (!(Box3{n.lo, n.hi}.squared_distance(center) < radius2)) continue;
+    const Node& n = nodes_[stack.pop()];
+    if (!(box_distance2(n.lo, n.hi, center) < radius2)) continue;
     if (n.leaf()) {
-      for (const Point3& p : n.bucket_points) count += squared_distance(p, center) < radius2;
+      const Entry* b = bucket_begin(n);
+      for (std::uint32_t k = 0; k < n.bucket.count; ++k) count += squared_distance(b[k].p, center) < radius2;
       if (count > limit) return limit + 1;
     } else {
-      stack.push_back(n.children[0]);
-      stack.push_back(n.children[1]);
+      stack.push(n.child + 1);
+      stack.push(n.child);
     }
   }
   return count;
@@ -310,18 +406,19 @@ void PointIndex::close_pairs_below(std::uint32_t index, Point3 lo, Point3 hi, do
   if (!n.leaf()) {
     // Left: coordinate < split, right: >= split (the rule of insert() and of the build).
     Point3 left_hi = hi, right_lo = lo;
-    left_hi[n.axis] = n.split;
-    right_lo[n.axis] = n.split;
-    close_pairs_below(n.children[0], lo, left_hi, radius2, visit);
-    close_pairs_below(n.children[1], right_lo, hi, radius2, visit);
+    left_hi[n.extra] = n.split;
+    right_lo[n.extra] = n.split;
+    close_pairs_below(n.child, lo, left_hi, radius2, visit);
+    close_pairs_below(n.child + 1, right_lo, hi, radius2, visit);
     return;
   }
   const auto emit = [&](Id i, Id j) { visit(std::min(i, j), std::max(i, j)); };
-  const std::size_t m = n.bucket.size();
+  const Entry* const b = bucket_begin(n);
+  const std::size_t m = n.bucket.count;
   for (std::size_t a = 0; a < m; ++a)
-    for (std::size_t b = a + 1; b < m; ++b) {
-      const double d2 = squared_distance(n.bucket_points[a], n.bucket_points[b]);
-      if (d2 < radius2 || d2 == 0.0) emit(n.bucket[a], n.bucket[b]);
+    for (std::size_t c = a + 1; c < m; ++c) {
+      const double d2 = squared_distance(b[a].p, b[c].p);
+      if (d2 < radius2 || d2 == 0.0) emit(b[a].id, b[c].id);
     }
   if (!(radius2 > 0.0)) return;  // coincident points share a leaf (equal coordinates go the same way)
   // A point of another leaf closer than the radius puts this leaf's border, and that leaf's, within the
@@ -330,48 +427,71 @@ void PointIndex::close_pairs_below(std::uint32_t index, Point3 lo, Point3 hi, do
   const double reach2 = radius2 * (1.0 + 1e-9);
   std::vector<Id> found;
   for (std::size_t a = 0; a < m; ++a) {
-    const Point3& p = n.bucket_points[a];
+    const Point3 p = b[a].p;
+    const Id pid = b[a].id;
     double border = std::numeric_limits<double>::infinity();
     for (int k = 0; k < 3; ++k) border = std::min({border, p[k] - lo[k], hi[k] - p[k]});
     if (border >= 0.0 && border * border >= reach2) continue;
     ball(p, radius2, found);
     for (const Id j : found)
-      if (leaf_of_[j] > index) emit(n.bucket[a], j);
+      if (leaf_of_[j] > index) emit(pid, j);
   }
-}
-
-void PointIndex::nearest_recurse(std::uint32_t index, NearestState& state) const {
-  const Node& n = nodes_[index];
-  if (n.leaf()) {
-    for (std::size_t k = 0; k < n.bucket.size(); ++k) {
-      const double d2 = squared_distance(n.bucket_points[k], state.query);
-      if (d2 <= state.bound()) state.offer(d2, n.bucket[k]);
-    }
-    return;
-  }
-  const std::uint32_t a = n.children[0], b = n.children[1];
-  const double da = Box3{nodes_[a].lo, nodes_[a].hi}.squared_distance(state.query);
-  const double db = Box3{nodes_[b].lo, nodes_[b].hi}.squared_distance(state.query);
-  const std::uint32_t first = da <= db ? a : b, second = da <= db ? b : a;
-  const double dfirst = std::min(da, db), dsecond = std::max(da, db);
-  // <= keeps points at the bound's distance reachable: ties are broken by id.
-  if (dfirst <= state.bound()) nearest_recurse(first, state);
-  if (dsecond <= state.bound()) nearest_recurse(second, state);
 }
 
 void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, std::vector<double>* dist2) const {
   ids.clear();
-  if (dist2) dist2->clear();
+  thread_local std::vector<double> own_d2;
+  std::vector<double>& d2 = dist2 ? *dist2 : own_d2;
+  d2.clear();
   if (size_ == 0 || k == 0) return;
-  NearestState state;
-  state.query = q;
-  state.k = k;
-  state.best.reserve(std::min(k, size_) + 1);
-  nearest_recurse(0, state);
-  ids.reserve(state.best.size());
-  for (const auto& [d2, id] : state.best) {
-    ids.push_back(id);
-    if (dist2) dist2->push_back(d2);
+  NearestState state{q, k, d2, ids};
+  // Depth first, the nearer child first; a pending far child keeps its box distance so that it is
+  // skipped once the answer's bound drops below it.
+  struct Pending {
+    std::uint32_t node;
+    double dist2;
+  };
+  Pending inline_stack[96];
+  std::vector<Pending> spill;
+  std::size_t depth = 0;
+  const auto push = [&](std::uint32_t node, double dd) {
+    if (depth < 96) inline_stack[depth] = {node, dd};
+    else spill.push_back({node, dd});
+    ++depth;
+  };
+  const auto pop = [&]() {
+    --depth;
+    if (depth < 96) return inline_stack[depth];
+    const Pending p = spill.back();
+    spill.pop_back();
+    return p;
+  };
+  push(0, 0.0);
+  while (depth > 0) {
+    const Pending top = pop();
+    // <= keeps points at the bound's distance reachable: ties are broken by id.
+    if (!(top.dist2 <= state.bound())) continue;
+    std::uint32_t node = top.node;
+    for (;;) {
+      const Node& n = nodes_[node];
+      if (n.leaf()) {
+        const Entry* b = bucket_begin(n);
+        for (std::uint32_t i = 0; i < n.bucket.count; ++i) {
+          const double dd = squared_distance(b[i].p, q);
+          if (dd <= state.bound()) state.offer(dd, b[i].id);
+        }
+        break;
+      }
+      const Node& a = nodes_[n.child];
+      const Node& c = nodes_[n.child + 1];
+      const double da = box_distance2(a.lo, a.hi, q), dc = box_distance2(c.lo, c.hi, q);
+      const bool left_first = da <= dc;
+      const std::uint32_t near = left_first ? n.child : n.child + 1;
+      const double dnear = left_first ? da : dc, dfar = left_first ? dc : da;
+      if (dfar <= state.bound()) push(left_first ? n.child + 1 : n.child, dfar);
+      if (!(dnear <= state.bound())) break;
+      node = near;
+    }
   }
 }
 

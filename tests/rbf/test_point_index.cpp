@@ -197,6 +197,36 @@ TEST_CASE("PointIndex built from sparse ids answers like one built by insertions
   REQUIRE(bad.empty());  // nothing built by a refused call
 }
 
+TEST_CASE("PointIndex keeps answering through heavy churn: full blocks, unsplittable leaves, compaction",
+          "[point_index]") {
+  // Leaves store their points in blocks of one shared array: an insertion into a full block moves it,
+  // a split frees it, and the array is compacted once freed blocks outweigh the points. Many points at
+  // one position make a leaf that cannot split and must keep growing.
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  PointIndex index;
+  Brute brute;
+  Id next = 0;
+  for (int round = 0; round < 6; ++round) {
+    for (int i = 0; i < 700; ++i) {
+      const Point3 p = i % 5 == 0 ? Point3{0.25, -0.5, 0.75} : Point3{u(rng), u(rng), 0.3 * u(rng)};
+      index.insert(next, p);
+      brute.points.emplace_back(next, p);
+      ++next;
+    }
+    // Remove half of what is held, in an order unrelated to position.
+    std::shuffle(brute.points.begin(), brute.points.end(), rng);
+    const std::size_t keep = brute.points.size() / 2;
+    for (std::size_t i = keep; i < brute.points.size(); ++i) index.erase(brute.points[i].first);
+    brute.points.resize(keep);
+    check_queries(index, brute, rng);
+  }
+  std::vector<Id> got;
+  index.ball(Point3{0.25, -0.5, 0.75}, 1e-12, got);
+  REQUIRE(got == brute.ball(Point3{0.25, -0.5, 0.75}, 1e-12));
+  REQUIRE(got.size() > 2 * 16);  // the unsplittable leaf outgrew the split threshold
+}
+
 TEST_CASE("PointIndex rejects bad input with the culprit", "[point_index]") {
   PointIndex index(std::vector<Point3>{{0, 0, 0}, {1, 0, 0}});
   REQUIRE_THROWS_AS(index.insert(1, {2, 0, 0}), vitri::InvalidPoint);

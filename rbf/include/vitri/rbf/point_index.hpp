@@ -11,8 +11,10 @@
 ///
 /// Costs: build O(n log n); insert and erase O(depth) (a leaf that overflows is split; leaves that empty
 /// stay, so a tree that lost most of its points should be rebuilt); nearest O(log n + k log k) for
-/// well-spread points; ball O(log n + answer). Memory about 64 bytes per point (positions are kept twice:
-/// by id, and in each leaf beside its ids for cache-friendly scans).
+/// well-spread points; ball O(log n + answer). Memory about 70 bytes per point after a build (positions
+/// are kept twice: by id, and in each leaf's block beside the ids for cache-friendly scans; one 64-byte
+/// node per 8 to 16 points); insertions and removals leave freed blocks, compacted when they outweigh the
+/// points held.
 ///
 /// Thread safety: const queries may run concurrently; insert / erase / build need exclusive access.
 
@@ -76,46 +78,62 @@ class PointIndex {
 
  private:
   static constexpr std::uint32_t kNoNode = 0xffffffffu;
-  /// A node: an inner node splits its box at `split` along `axis` (children[0]: coordinate < split,
-  /// children[1]: >= split); a leaf (children[0] == kNoNode) holds the ids in `bucket` and their
-  /// positions in `bucket_points` (same order: a leaf's scan reads contiguous memory instead of one
-  /// cache line per point when ids are not spatially ordered). `lo`/`hi` bound every point below the
-  /// node (grown by insertions, never shrunk by removals).
-  struct Node {
-    Point3 lo, hi;
-    double split = 0;
-    std::uint32_t children[2] = {kNoNode, kNoNode};
-    std::uint8_t axis = 0;
-    std::vector<Id> bucket;
-    std::vector<Point3> bucket_points;
-    bool leaf() const { return children[0] == kNoNode; }
-  };
-  struct NearestState;
-  /// A point with its id, as the build moves them: the median selections and partitions then read and
-  /// move contiguous records instead of looking positions up by id (one cache miss per comparison).
+  /// A point with its id: a leaf's bucket holds these contiguously (a scan reads one block of memory),
+  /// and the build moves them (median selections read contiguous records, not positions by id).
   struct Entry {
     Point3 p;
     Id id;
   };
+  /// A node, one cache line. An inner node splits at `split` along `axis` (left child: coordinate <
+  /// split, right: >= split); its children are the adjacent nodes `child` and `child + 1`, so that a
+  /// query reads both boxes from consecutive memory. A leaf (child == kNoNode) owns the block
+  /// buckets_[begin, begin + capacity) of which the first `count` entries are its points. `lo`/`hi`
+  /// bound every point below the node (grown by insertions, never shrunk by removals).
+  struct Node {
+    Point3 lo, hi;
+    union {
+      double split;  // inner
+      struct {
+        std::uint32_t begin, count;
+      } bucket;  // leaf
+    };
+    std::uint32_t child = kNoNode;
+    std::uint32_t extra = 0;  // inner: the axis; leaf: the capacity of its block
+    Node() : split(0) {}
+    bool leaf() const { return child == kNoNode; }
+  };
+  static_assert(sizeof(Node) == 64, "a node is one cache line");
+  struct NearestState;
+  /// The node array and the bucket storage of a (sub)tree being built.
+  struct Forest {
+    std::vector<Node> nodes;
+    std::vector<Entry> buckets;
+  };
   /// The build from entries whose ids and positions are set (position_, leaf_of_ sized and cleared).
   void build_entries(std::vector<Entry>& entries, unsigned threads);
-  /// Appends to `nodes` a node holding entries [first, last) (split recursively); returns its index.
-  std::uint32_t make_subtree(std::vector<Node>& nodes, Entry* first, Entry* last);
-  /// Makes nodes[index] hold entries [first, last): a leaf, or an inner node whose children are appended
-  /// to `nodes`. Writes leaf_of_ with indices into `nodes`.
-  void fill_node(std::vector<Node>& nodes, std::uint32_t index, Entry* first, Entry* last);
+  /// Makes f.nodes[index] hold entries [first, last): a leaf, or an inner node whose two children are
+  /// appended to f.nodes (then their subtrees, left first). Writes leaf_of_ with indices into f.nodes
+  /// (shifted by the caller when f is a part built on its own).
+  void fill_node(Forest& f, std::uint32_t index, Entry* first, Entry* last);
   /// The split of entries [first, last) (reordered: left part first): false when they make a leaf
   /// (few, or all at one position). lo / hi: their bounding box.
   static bool split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis, double& cut,
                             Entry*& middle);
+  /// Gives leaf `node` a block of `capacity` entries at the end of buckets_ holding its current points
+  /// (its old block becomes garbage; the pool is compacted when garbage outweighs what is held).
+  void move_bucket(std::uint32_t node, std::size_t capacity);
+  /// Rewrites buckets_ with every leaf's points contiguous, in node order, without garbage.
+  void compact_buckets();
   void split_leaf(std::uint32_t node);
   void ensure_id(Id id);
-  void nearest_recurse(std::uint32_t node, NearestState& state) const;
+  const Entry* bucket_begin(const Node& n) const { return buckets_.data() + n.bucket.begin; }
   /// close_pairs below `node`, whose region (from the splits above it) is [lo, hi].
   void close_pairs_below(std::uint32_t node, Point3 lo, Point3 hi, double radius2,
                          const std::function<void(Id, Id)>& visit) const;
 
   std::vector<Node> nodes_;          // nodes_[0] is the root when size_ > 0 or after build()
+  std::vector<Entry> buckets_;       // the leaves' blocks (and garbage: freed blocks)
+  std::size_t garbage_ = 0;          // entries of buckets_ in no leaf's block
   std::vector<Point3> position_;     // position_[id], meaningful when contains(id)
   std::vector<std::uint32_t> leaf_of_;  // leaf node holding id, kNoNode when unused
   std::size_t size_ = 0;

@@ -162,6 +162,31 @@ struct WideArithmetic {
 /// when `exact` is still true at the end, the double result is the exact value. This is the cheap
 /// first stage of the fallback; it succeeds on grids and other inputs whose differences and products
 /// need few bits (exactly the degenerate inputs that Delaunay triangulations of grids produce).
+/// Significant bits of x (the width of its significand from the leading to the last nonzero bit), 0 for
+/// 0: a product of two doubles is exact when their widths sum to at most 53.
+inline int significant_bits(double x) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &x, sizeof bits);
+  const std::uint64_t fraction = bits & ((std::uint64_t(1) << 52) - 1);
+  const int exponent = int((bits >> 52) & 0x7ff);
+  if (exponent == 0 && fraction == 0) return 0;
+  // A normal number has the implicit leading bit 52; a subnormal one its highest set fraction bit.
+  const int top = exponent != 0 ? 52 : 63 - __builtin_clzll(fraction);
+  const std::uint64_t significand = exponent != 0 ? (fraction | (std::uint64_t(1) << 52)) : fraction;
+  return top + 1 - __builtin_ctzll(significand);
+}
+
+/// False when stage 1 of insphere (CheckedArithmetic) cannot be exact on these differences: the lifts
+/// square every difference, and the square of an odd significand of w >= 28 bits is odd and at least
+/// 2^(2w - 2) >= 2^54, more than a double holds. A necessary condition only: it skips a stage that
+/// would fail (rounded, near-cospherical input: every difference about 53 bits wide), never one that
+/// would succeed.
+inline bool narrow_enough_for_checked(const double* q, int n) {
+  int widest = 0;
+  for (int i = 0; i < n; ++i) widest = std::max(widest, significant_bits(q[i]));
+  return widest <= 27;
+}
+
 struct CheckedArithmetic {
   bool exact = true;
   double sub(double a, double b) {
@@ -331,7 +356,8 @@ Sign insphere_exact(const Point3& a, const Point3& b, const Point3& c, const Poi
     double q[4][3];
     for (int r = 0; r < 4; ++r)
       for (int k = 0; k < 3; ++k) q[r][k] = f.sub(v[3 * r + k], v[12 + k]);
-    if (f.exact) {  // worth going on only with exact differences
+    // Worth going on only with exact differences narrow enough for exact products.
+    if (f.exact && narrow_enough_for_checked(&q[0][0], 12)) {
       const double det = insphere_cofactors(f, q);
       if (f.exact) return sign_of(det);
     }

@@ -1,15 +1,5 @@
-// Incremental marching tetrahedra (surface_tracker.hpp; docs/polygonize.md, "Incremental extraction").
-//
-// Snapping, as one pass in increasing vertex id would do it: the crossings anchored at z (the set S_z)
-// collapse onto z when the triangles around S_z that keep exactly one S_z corner have links forming a
-// single cycle of length >= 3 (a disk around the new vertex, one fan per neighbour) and each is not flat
-// afterwards and keeps its orientation (a flat one has none to keep); triangles with two S_z corners
-// vanish. A crossing whose anchor does not collapse is kept off it (place_edges). The test sees the
-// collapses of lower ids already applied (their corners at their vertex, their vanished triangles gone) and the
-// higher ones not yet. An update re-decides the vertices of the tetrahedra it rebuilt in increasing id;
-// when a decision flips, the higher anchored vertices of the flipped vertex's star are re-decided too
-// (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
-// result equals the one-pass result, which the tests check against a fresh tracker.
+// Incremental marching tetrahedra (surface_tracker.hpp; docs/polygonize.md, "Incremental extraction"):
+// polygons, crossings and the live mesh. The collapse decisions (snapping) are in surface_snapping.cpp.
 #include "surface_tracker.hpp"
 #include "vitri/core/threads.hpp"
 
@@ -21,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <functional>
-#include <queue>
 #include <thread>
 
 namespace vitri {
@@ -47,15 +36,6 @@ inline std::uint64_t edge_key(VertexId a, VertexId b) {
 Point3 unit_or_zero(const Point3& g) {
   const double l = norm(g);
   return (l > 0.0 && std::isfinite(l)) ? g / l : Point3{0.0, 0.0, 0.0};
-}
-
-// A triangle (a, b, c) with normal n = (b - a) x (c - a) is flat when |n| (twice its area) is at most
-// kFlatRatio times its longest squared edge: its largest angle is within about 2 kFlatRatio of 180
-// degrees, or its corners coincide. Flat triangles have no reliable orientation in doubles.
-constexpr double kFlatRatio = 1e-8;
-bool is_flat(const Point3& n, const Point3& a, const Point3& b, const Point3& c) {
-  const double l2 = std::max({squared_norm(b - a), squared_norm(c - b), squared_norm(a - c)});
-  return !(squared_norm(n) > kFlatRatio * kFlatRatio * l2 * l2);
 }
 
 }  // namespace
@@ -399,140 +379,6 @@ void SurfaceTracker::split_polygons(Work& w) {
       poly.split = static_cast<std::uint8_t>(marching::quad_split(edges_[poly.e[0]].x, edges_[poly.e[1]].x,
                                                                   edges_[poly.e[2]].x, edges_[poly.e[3]].x));
   }
-}
-
-// Re-decides, in increasing id, the anchored (or collapsed) vertices of the rebuilt tetrahedra and of
-// the stars of vertices whose decision flipped.
-void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
-  // The first offers are sorted once; those made while deciding (always above the vertex being decided)
-  // go to a heap, and the two are merged in increasing id.
-  std::vector<VertexId> first;
-  std::priority_queue<VertexId, std::vector<VertexId>, std::greater<VertexId>> heap;
-  bool deciding = false;
-  const std::uint32_t mark = epoch_;
-  auto offer = [&](VertexId u) {
-    if (u >= anchored_.size() || (anchored_[u] == 0 && !collapsed_[u]) || decide_stamp_[u] == mark) return;
-    decide_stamp_[u] = mark;
-    if (deciding)
-      heap.push(u);
-    else
-      first.push_back(u);
-  };
-  for (const TetId t : w.tets)
-    if (in.tri.is_live(t))
-      for (const VertexId u : in.tri.tet_vertices(t)) offer(u);
-  for (const VertexId u : touched_) offer(u);  // removed vertices among them drop their collapse
-  std::sort(first.begin(), first.end());
-  deciding = true;
-  std::size_t next = 0;
-  while (next < first.size() || !heap.empty()) {
-    VertexId z;
-    if (heap.empty() || (next < first.size() && first[next] < heap.top())) {
-      z = first[next++];
-    } else {
-      z = heap.top();
-      heap.pop();
-    }
-    const bool now = can_collapse(in, z);  // leaves the star of a live z in star_
-    if (now == static_cast<bool>(collapsed_[z])) continue;
-    collapsed_[z] = now ? 1 : 0;
-    num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
-    if (!in.tri.is_vertex(z)) continue;  // its polygons died with it
-    for (const TetId t : star_) {
-      if (!w.every_polygon && polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
-      for (const VertexId u : in.tri.tet_vertices(t))
-        if (u > z) offer(u);  // not decided yet (the merge pops in increasing id)
-    }
-  }
-}
-
-// The collapse test of z (see the top of the file), with the lower collapses applied.
-Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
-  const Point3& p = in.tri.point(z);
-  const double value = in.values[z];
-  if (value == 0.0) return p;
-  const auto it = snap_target_.find(z);
-  if (it != snap_target_.end()) return it->second;
-  Point3 g;
-  const double fz = in.f.value_gradient(p, g);
-  ++report_.evaluations;
-  const double g2 = dot(g, g);
-  Point3 q = p;
-  if (g2 > 0.0 && std::isfinite(g2) && std::isfinite(fz)) q = p - (fz / g2) * g;
-  snap_target_.emplace(z, q);
-  return q;
-}
-
-bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
-  star_.clear();
-  if (!in.tri.is_vertex(z)) return false;
-  in.tri.incident_tetrahedra(z, star_);
-  if (!in.snap || anchored_[z] == 0) return false;
-  const Point3 zp = snap_target(in, z);
-  // Identity and position of a corner as the one-pass order sees it when z's turn comes.
-  const auto before = [&](std::uint32_t e, Point3& p) {
-    const VertexId a = edges_[e].anchor;
-    if (a != kNoVertex && a < z && collapsed_[a]) {
-      p = snap_target(in, a);
-      return kZeroTag | a;
-    }
-    p = edges_[e].x;
-    return e;
-  };
-  std::vector<std::pair<std::uint32_t, std::uint32_t>>& link = link_;  // directed (w1 -> w2)
-  link.clear();
-  for (const TetId t : star_) {
-    const std::uint32_t pi = polygon_of(t);
-    if (pi == kNone) continue;
-    const Polygon& poly = polygons_[pi];
-    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
-      const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
-      std::array<std::uint32_t, 3> c{}, id{};
-      std::array<Point3, 3> p;
-      int inside = 0, first = -1;
-      for (int i = 0; i < 3; ++i) {
-        c[i] = poly.e[idx[i]];
-        id[i] = before(c[i], p[i]);
-        if (edges_[c[i]].anchor == z) {
-          ++inside;
-          if (first < 0) first = i;
-        }
-      }
-      if (inside == 0) continue;
-      if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) continue;  // gone with a lower collapse
-      if (inside >= 2) continue;                                         // vanishes with this one
-      const int i1 = (first + 1) % 3, i2 = (first + 2) % 3;
-      // The collapse must not make a flat triangle, nor turn one over; a triangle that is flat already has
-      // no orientation to keep. Exempt: a triangle whose two other corners are anchored at one later
-      // vertex y, which vanishes when y collapses too. That is the polygon of a flat tetrahedron (two
-      // samples with equal normals and their offset constraints make a rectangle, which the symbolic
-      // perturbation may close with a flat tetrahedron): its corners are anchored at the two samples.
-      const VertexId y = edges_[c[i1]].anchor;
-      const bool vanishes_later = y != kNoVertex && y > z && edges_[c[i2]].anchor == y;
-      if (!vanishes_later) {
-        const Point3 old_n = cross(p[i1] - p[first], p[i2] - p[first]);
-        const Point3 new_n = cross(p[i1] - zp, p[i2] - zp);
-        if (is_flat(new_n, zp, p[i1], p[i2])) return false;
-        if (!is_flat(old_n, p[first], p[i1], p[i2]) && !(dot(old_n, new_n) > 0.0)) return false;
-      }
-      link.emplace_back(id[i1], id[i2]);
-    }
-  }
-  // One cycle through all link vertices, each once as a source and once as a target.
-  std::sort(link.begin(), link.end());
-  const std::size_t n = link.size();
-  if (n < 3) return false;
-  for (std::size_t i = 1; i < n; ++i)
-    if (link[i].first == link[i - 1].first) return false;
-  std::uint32_t cur = link[0].second;
-  std::size_t steps = 1;
-  while (cur != link[0].first && steps <= n) {
-    const auto it = std::lower_bound(link.begin(), link.end(), std::make_pair(cur, std::uint32_t{0}));
-    if (it == link.end() || it->first != cur) return false;
-    cur = it->second;
-    ++steps;
-  }
-  return cur == link[0].first && steps == n;
 }
 
 // The LiveMesh vertex of a corner: the collapsed vertex's, or the edge's own (created on first use).

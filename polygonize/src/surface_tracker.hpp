@@ -45,6 +45,9 @@ struct TrackerInput {
   double snap_fraction = 0.01;             ///< anchored when the root is this close to an end (fraction)
   bool warm_start = true;                  ///< start a re-placed edge from its previous root
   unsigned threads = 1;                    ///< threads of the marching pass of large rebuilds (0: all)
+  /// Large updates take the collapse tests' stars and fans from a lookahead on the threads; off, each is
+  /// gathered when its vertex is decided (the same decisions: the tests compare both).
+  bool snap_lookahead = true;
 };
 
 /// Counters of the last update().
@@ -63,6 +66,11 @@ struct TrackerReport {
 class SurfaceTracker {
  public:
   static constexpr std::uint32_t kNone = 0xffffffffu;
+  /// From this many first offers on, the collapse decisions look ahead (TrackerInput::snap_lookahead),
+  /// in chunks of kLookaheadChunk offers cut in slices of at least kLookaheadSlice per thread.
+  static constexpr std::size_t kLookaheadMin = std::size_t(1) << 12;
+  static constexpr std::size_t kLookaheadChunk = std::size_t(1) << 15;
+  static constexpr std::size_t kLookaheadSlice = std::size_t(1) << 11;
 
   // ---- What changed (called by the Polygonizer as it edits) -----------------------------------------
   // Tetrahedra are listed until the lists outgrow the mesh (a refinement), then the next update sweeps
@@ -132,7 +140,37 @@ class SurfaceTracker {
   void set_anchor(std::uint32_t e, VertexId anchor);
   void split_polygons(Work& w);
   void decide_snapping(const TrackerInput& in, Work& w);
+  /// A triangle around z with exactly one corner anchored at z (corner 0, the cyclic order kept): what
+  /// the collapse test of z reads of it, fixed while the decisions are made.
+  struct FanTriangle {
+    std::array<std::uint32_t, 3> e;  // the corners' edge slots
+    std::array<VertexId, 3> anchor;  // their anchors (e[0]'s is z)
+    std::array<Point3, 3> x;         // their placed positions
+  };
+  /// The stars and fans of a chunk of decide_snapping's first offers, computed ahead on the threads
+  /// (surface_snapping.cpp).
+  struct SnapLookahead {
+    struct Span {  // one offer's star and fan in slices[slice]
+      std::uint32_t slice = 0, star_first = 0, star_last = 0, fan_first = 0, fan_last = 0;
+    };
+    struct Slice {
+      std::vector<TetId> stars;
+      std::vector<FanTriangle> fans;
+      std::vector<std::pair<VertexId, Point3>> targets;  // snap targets evaluated by this slice
+    };
+    std::size_t begin = 0, end = 0;  // the offers first[begin, end) it covers
+    std::vector<Span> spans;         // per covered offer
+    std::vector<Slice> slices;
+    const Span& span(std::size_t offer) const { return spans[offer - begin]; }
+  };
+  void look_ahead(const TrackerInput& in, const std::vector<VertexId>& first, std::size_t from,
+                  SnapLookahead& look);
+  /// The star of z in star_, then collapse_test (false for a removed z).
   bool can_collapse(const TrackerInput& in, VertexId z);
+  /// The test of a live z whose star is in star_: its fan (gather_fan), then fan_test.
+  bool collapse_test(const TrackerInput& in, VertexId z);
+  void gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const;
+  bool fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count);
   void remesh_polygons(const TrackerInput& in, Work& w);
   std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);
   void drop_triangle(std::uint32_t t);
@@ -174,6 +212,7 @@ class SurfaceTracker {
   // can_collapse(z) scratch: the star of z (read again by decide_snapping when z's decision changes)
   // and the directed link edges.
   std::vector<TetId> star_;
+  std::vector<FanTriangle> fan_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> link_;
   std::vector<std::uint64_t> id_bits_;  // scratch of sort_unique_ids (sorted_ids.hpp), all zero between calls
   // Reported changes since the last update.

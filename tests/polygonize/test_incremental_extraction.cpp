@@ -6,6 +6,7 @@
 #include "edge_map.hpp"
 #include "marching.hpp"
 #include "sorted_ids.hpp"
+#include "surface_tracker.hpp"
 #include "support/mesh_checks.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/analytic.hpp"
@@ -368,6 +369,50 @@ TEST_CASE("flat tetrahedra of samples with equal normals: no flat triangle", "[i
     // kept off an uncollapsed anchor, projected back).
     for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3 * precision);
   }
+}
+
+TEST_CASE("collapse decisions looked ahead on the threads equal those made one at a time", "[incremental]") {
+  // Thousands of seeds on a sphere up to rounding (their crossings are anchored at them) with offset
+  // points inside and out: a full build offers more vertices than the lookahead's threshold, so the
+  // tracker gathers stars and fans ahead on two threads; the same input decided one vertex at a time
+  // must give the same mesh, bit for bit.
+  const QuadricSphereFunction f({0.1, -0.05, 0.02}, 1.0);
+  const Box3 box{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
+  std::vector<Point3> seeds;
+  const int n = 6000;
+  for (int k = 0; k < n; ++k) {  // a Fibonacci sphere
+    const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(1.0 - z * z), phi = 2.399963229728653 * k;
+    const Point3 u{r * std::cos(phi), r * std::sin(phi), z};
+    const Point3 c{0.1, -0.05, 0.02};
+    seeds.push_back(c + u);
+    if (k % 2 == 0) seeds.push_back(c + 1.03 * u);
+    else seeds.push_back(c + 0.97 * u);
+  }
+  Triangulation tri(box);
+  tri.insert_points(seeds);
+  std::vector<double> values(tri.vertex_capacity(), 0.0);
+  for (VertexId v = 0; v < tri.vertex_capacity(); ++v)
+    if (tri.is_vertex(v)) values[v] = f.value(tri.point(v));
+  std::vector<TetId> transverse;
+  for (const TetId t : tri.live_tetrahedra()) {
+    int negative = 0;
+    for (const VertexId v : tri.tet_vertices(t)) negative += values[v] < 0.0;
+    if (negative > 0 && negative < 4) transverse.push_back(t);
+  }
+  TrackerInput in{tri, values, transverse, f, {}, true, 0.01, false};
+  in.threads = 2;
+  SurfaceTracker ahead, one_by_one;
+  ahead.update(in);
+  in.snap_lookahead = false;
+  one_by_one.update(in);
+  REQUIRE(ahead.report().snapped > SurfaceTracker::kLookaheadMin);
+  REQUIRE(ahead.report().snapped == one_by_one.report().snapped);
+  REQUIRE(ahead.report().offset == one_by_one.report().offset);
+  REQUIRE(ahead.report().evaluations == one_by_one.report().evaluations);
+  const SurfaceMesh a = ahead.mesh().to_surface_mesh(), b = one_by_one.mesh().to_surface_mesh();
+  REQUIRE(a.vertices == b.vertices);
+  REQUIRE(a.triangles == b.triangles);
+  test::require_closed(a, 2, 1);
 }
 
 TEST_CASE("sort_unique_ids orders and deduplicates like std::sort + std::unique", "[extraction]") {

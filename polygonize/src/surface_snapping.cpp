@@ -1,0 +1,264 @@
+// Incremental marching tetrahedra (surface_tracker.hpp): the collapse decisions (snapping).
+//
+// Snapping, as one pass in increasing vertex id would do it: the crossings anchored at z (the set S_z)
+// collapse onto z when the triangles around S_z that keep exactly one S_z corner have links forming a
+// single cycle of length >= 3 (a disk around the new vertex, one fan per neighbour) and each is not flat
+// afterwards and keeps its orientation (a flat one has none to keep); triangles with two S_z corners
+// vanish. A crossing whose anchor does not collapse is kept off it (place_edges). The test sees the
+// collapses of lower ids already applied (their corners at their vertex, their vanished triangles gone) and the
+// higher ones not yet. An update re-decides the vertices of the tetrahedra it rebuilt in increasing id;
+// when a decision flips, the higher anchored vertices of the flipped vertex's star are re-decided too
+// (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
+// result equals the one-pass result, which the tests check against a fresh tracker.
+#include "surface_tracker.hpp"
+#include "vitri/core/threads.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <queue>
+#include <thread>
+
+namespace vitri {
+
+namespace {
+
+// A triangle (a, b, c) with normal n = (b - a) x (c - a) is flat when |n| (twice its area) is at most
+// kFlatRatio times its longest squared edge: its largest angle is within about 2 kFlatRatio of 180
+// degrees, or its corners coincide. Flat triangles have no reliable orientation in doubles.
+constexpr double kFlatRatio = 1e-8;
+bool is_flat(const Point3& n, const Point3& a, const Point3& b, const Point3& c) {
+  const double l2 = std::max({squared_norm(b - a), squared_norm(c - b), squared_norm(a - c)});
+  return !(squared_norm(n) > kFlatRatio * kFlatRatio * l2 * l2);
+}
+
+// z moved onto the surface by one Newton step from its value fz and gradient g (z itself when the step
+// is undefined).
+Point3 newton_target(const Point3& z, double fz, const Point3& g) {
+  const double g2 = dot(g, g);
+  if (g2 > 0.0 && std::isfinite(g2) && std::isfinite(fz)) return z - (fz / g2) * g;
+  return z;
+}
+
+}  // namespace
+
+// Re-decides, in increasing id, the anchored (or collapsed) vertices of the rebuilt tetrahedra and of
+// the stars of vertices whose decision flipped.
+void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
+  // The first offers are sorted once; those made while deciding (always above the vertex being decided)
+  // go to a heap, and the two are merged in increasing id.
+  std::vector<VertexId> first;
+  std::priority_queue<VertexId, std::vector<VertexId>, std::greater<VertexId>> heap;
+  bool deciding = false;
+  const std::uint32_t mark = epoch_;
+  auto offer = [&](VertexId u) {
+    if (u >= anchored_.size() || (anchored_[u] == 0 && !collapsed_[u]) || decide_stamp_[u] == mark) return;
+    decide_stamp_[u] = mark;
+    if (deciding)
+      heap.push(u);
+    else
+      first.push_back(u);
+  };
+  for (const TetId t : w.tets)
+    if (in.tri.is_live(t))
+      for (const VertexId u : in.tri.tet_vertices(t)) offer(u);
+  for (const VertexId u : touched_) offer(u);  // removed vertices among them drop their collapse
+  std::sort(first.begin(), first.end());
+  deciding = true;
+  // A large update (a full build: about one offer per on-surface constraint) takes the stars and snap
+  // targets of its first offers from a lookahead computed on the threads.
+  const bool ahead = in.snap_lookahead && first.size() >= kLookaheadMin;
+  SnapLookahead look;
+  std::size_t next = 0;
+  while (next < first.size() || !heap.empty()) {
+    VertexId z;
+    bool now;
+    if (heap.empty() || (next < first.size() && first[next] < heap.top())) {
+      if (ahead) {
+        if (next == look.end) look_ahead(in, first, next, look);
+        const SnapLookahead::Span& sp = look.span(next);
+        const SnapLookahead::Slice& slice = look.slices[sp.slice];
+        star_.assign(slice.stars.begin() + sp.star_first, slice.stars.begin() + sp.star_last);
+        z = first[next++];
+        now = in.tri.is_vertex(z) && in.snap && anchored_[z] != 0 &&
+              fan_test(in, z, slice.fans.data() + sp.fan_first, sp.fan_last - sp.fan_first);
+      } else {
+        z = first[next++];
+        now = can_collapse(in, z);
+      }
+    } else {
+      z = heap.top();
+      heap.pop();
+      now = can_collapse(in, z);  // leaves the star of a live z in star_
+    }
+    if (now == static_cast<bool>(collapsed_[z])) continue;
+    collapsed_[z] = now ? 1 : 0;
+    num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
+    if (!in.tri.is_vertex(z)) continue;  // its polygons died with it
+    for (const TetId t : star_) {
+      if (!w.every_polygon && polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
+      for (const VertexId u : in.tri.tet_vertices(t))
+        if (u > z) offer(u);  // not decided yet (the merge pops in increasing id)
+    }
+  }
+}
+
+// The stars, fans and snap targets of first[from, from + kLookaheadChunk): they depend on the
+// triangulation, the polygons, the crossings and the function only, not on any decision, so slices of
+// the chunk run on the threads and the serial pass reads what it would have computed. The targets join
+// the cache (the evaluations the serial pass would have made: same vertices, same calls of f).
+void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<VertexId>& first, std::size_t from,
+                                SnapLookahead& look) {
+  const std::size_t n = std::min(kLookaheadChunk, first.size() - from);
+  look.begin = from;
+  look.end = from + n;
+  const std::size_t slices = std::min<std::size_t>(resolve_thread_count(in.threads), n / kLookaheadSlice + 1);
+  look.slices.resize(slices);
+  look.spans.assign(n, SnapLookahead::Span{});
+  const auto work = [&](std::size_t s) {
+    SnapLookahead::Slice& out = look.slices[s];
+    out.stars.clear();
+    out.fans.clear();
+    out.targets.clear();
+    std::vector<TetId> star;
+    for (std::size_t k = s * n / slices; k < (s + 1) * n / slices; ++k) {
+      const VertexId z = first[from + k];
+      in.tri.incident_tetrahedra(z, star);
+      SnapLookahead::Span& sp = look.spans[k];
+      sp.slice = static_cast<std::uint32_t>(s);
+      sp.star_first = static_cast<std::uint32_t>(out.stars.size());
+      out.stars.insert(out.stars.end(), star.begin(), star.end());
+      sp.star_last = static_cast<std::uint32_t>(out.stars.size());
+      sp.fan_first = sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
+      if (!in.snap || star.empty() || anchored_[z] == 0) continue;  // the test reads nothing more
+      gather_fan(z, star, out.fans);
+      sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
+      if (in.values[z] == 0.0 || snap_target_.count(z)) continue;  // snap_target(z) evaluates nothing
+      const Point3& p = in.tri.point(z);
+      Point3 g;
+      const double fz = in.f.value_gradient(p, g);
+      out.targets.emplace_back(z, newton_target(p, fz, g));
+    }
+  };
+  std::vector<std::thread> pool;
+  for (std::size_t s = 1; s < slices; ++s) pool.emplace_back(work, s);
+  work(0);
+  for (std::thread& th : pool) th.join();
+  for (const SnapLookahead::Slice& slice : look.slices) {
+    report_.evaluations += slice.targets.size();
+    for (const auto& [z, q] : slice.targets) snap_target_.emplace(z, q);
+  }
+}
+
+Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
+  const Point3& p = in.tri.point(z);
+  const double value = in.values[z];
+  if (value == 0.0) return p;
+  const auto it = snap_target_.find(z);
+  if (it != snap_target_.end()) return it->second;
+  Point3 g;
+  const double fz = in.f.value_gradient(p, g);
+  ++report_.evaluations;
+  const Point3 q = newton_target(p, fz, g);
+  snap_target_.emplace(z, q);
+  return q;
+}
+
+bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
+  star_.clear();
+  if (!in.tri.is_vertex(z)) return false;
+  in.tri.incident_tetrahedra(z, star_);
+  return collapse_test(in, z);
+}
+
+// The collapse test of z (see the top of the file), with the lower collapses applied; star_ holds the
+// star of the live vertex z.
+bool SurfaceTracker::collapse_test(const TrackerInput& in, VertexId z) {
+  if (!in.snap || anchored_[z] == 0) return false;
+  fan_.clear();
+  gather_fan(z, star_, fan_);
+  return fan_test(in, z, fan_.data(), fan_.size());
+}
+
+// The triangles of the polygons of z's star with exactly one corner anchored at z, that corner first
+// (the cyclic order kept). Triangles with none do not change; those with two or more vanish.
+void SurfaceTracker::gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const {
+  for (const TetId t : star) {
+    const std::uint32_t pi = t < polygon_of_.size() ? polygon_of_[t] : kNone;
+    if (pi == kNone) continue;
+    const Polygon& poly = polygons_[pi];
+    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
+      const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
+      int inside = 0, first = -1;
+      for (int i = 0; i < 3; ++i)
+        if (edges_[poly.e[idx[i]]].anchor == z) {
+          ++inside;
+          if (first < 0) first = i;
+        }
+      if (inside != 1) continue;
+      FanTriangle f;
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t e = poly.e[idx[(first + i) % 3]];
+        f.e[i] = e;
+        f.anchor[i] = edges_[e].anchor;
+        f.x[i] = edges_[e].x;
+      }
+      out.push_back(f);
+    }
+  }
+}
+
+// The collapse test of z on its fan, with the collapses decided so far (all of lower ids) applied.
+bool SurfaceTracker::fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count) {
+  const Point3 zp = snap_target(in, z);
+  std::vector<std::pair<std::uint32_t, std::uint32_t>>& link = link_;  // directed (w1 -> w2)
+  link.clear();
+  for (std::size_t f = 0; f < count; ++f) {
+    const FanTriangle& tri = fan[f];
+    // Identity and position of each corner as the one-pass order sees it when z's turn comes.
+    std::array<std::uint32_t, 3> id{};
+    std::array<Point3, 3> p;
+    for (int i = 0; i < 3; ++i) {
+      const VertexId a = tri.anchor[i];
+      if (a != kNoVertex && a < z && collapsed_[a]) {
+        p[i] = snap_target(in, a);
+        id[i] = kZeroTag | a;
+      } else {
+        p[i] = tri.x[i];
+        id[i] = tri.e[i];
+      }
+    }
+    if (id[0] == id[1] || id[1] == id[2] || id[0] == id[2]) continue;  // gone with a lower collapse
+    // The collapse must not make a flat triangle, nor turn one over; a triangle that is flat already has
+    // no orientation to keep. Exempt: a triangle whose two other corners are anchored at one later
+    // vertex y, which vanishes when y collapses too. That is the polygon of a flat tetrahedron (two
+    // samples with equal normals and their offset constraints make a rectangle, which the symbolic
+    // perturbation may close with a flat tetrahedron): its corners are anchored at the two samples.
+    const VertexId y = tri.anchor[1];
+    const bool vanishes_later = y != kNoVertex && y > z && tri.anchor[2] == y;
+    if (!vanishes_later) {
+      const Point3 old_n = cross(p[1] - p[0], p[2] - p[0]);
+      const Point3 new_n = cross(p[1] - zp, p[2] - zp);
+      if (is_flat(new_n, zp, p[1], p[2])) return false;
+      if (!is_flat(old_n, p[0], p[1], p[2]) && !(dot(old_n, new_n) > 0.0)) return false;
+    }
+    link.emplace_back(id[1], id[2]);
+  }
+  // One cycle through all link vertices, each once as a source and once as a target.
+  std::sort(link.begin(), link.end());
+  const std::size_t n = link.size();
+  if (n < 3) return false;
+  for (std::size_t i = 1; i < n; ++i)
+    if (link[i].first == link[i - 1].first) return false;
+  std::uint32_t cur = link[0].second;
+  std::size_t steps = 1;
+  while (cur != link[0].first && steps <= n) {
+    const auto it = std::lower_bound(link.begin(), link.end(), std::make_pair(cur, std::uint32_t{0}));
+    if (it == link.end() || it->first != cur) return false;
+    cur = it->second;
+    ++steps;
+  }
+  return cur == link[0].first && steps == n;
+}
+
+}  // namespace vitri

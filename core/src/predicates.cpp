@@ -158,10 +158,6 @@ struct WideArithmetic {
   WideInt mul(const WideInt& a, const WideInt& b) const { return a * b; }
 };
 
-/// Double arithmetic that records whether every operation was exact (error-free transformations):
-/// when `exact` is still true at the end, the double result is the exact value. This is the cheap
-/// first stage of the fallback; it succeeds on grids and other inputs whose differences and products
-/// need few bits (exactly the degenerate inputs that Delaunay triangulations of grids produce).
 /// Significant bits of x (the width of its significand from the leading to the last nonzero bit), 0 for
 /// 0: a product of two doubles is exact when their widths sum to at most 53.
 inline int significant_bits(double x) {
@@ -187,6 +183,10 @@ inline bool narrow_enough_for_checked(const double* q, int n) {
   return widest <= 27;
 }
 
+/// Double arithmetic that records whether every operation was exact (error-free transformations):
+/// when `exact` is still true at the end, the double result is the exact value. This is the cheap
+/// first stage of the fallback; it succeeds on grids and other inputs whose differences and products
+/// need few bits (exactly the degenerate inputs that Delaunay triangulations of grids produce).
 struct CheckedArithmetic {
   bool exact = true;
   double sub(double a, double b) {

@@ -17,6 +17,9 @@
 // - bear.off local at 0.005: 3 places (the soles, one near the head) where a zero-valued constraint
 //   vertex cannot be collapsed (its crossings stay at 5% of the edges: a pinch of the piecewise-linear
 //   zero set under sign(0) = +) leave 4 handles that the function does not have (a polygonizer issue).
+//   Checked again on 2026-11-26: still chi -6 here (V 47977), while `vitri mesh bear.off --function
+//   local --precision 0.005` happens to give chi 2 (V 47677): the pinches depend on where the
+//   refinement puts its points, not fixed.
 // - elephant.off global at 0.01 with 3000 constraints: the subsample is too sparse, the fitted surface
 //   itself has an extra handle.
 // - building.ply: an open scan (the ground is sampled with upward normals, no floor, 25% of the points
@@ -105,6 +108,7 @@ TEST_CASE("topology: local elephant at the data's precision", "[topology][local]
 // tests/mesher/CMakeLists.txt).
 TEST_CASE("topology matrix: local function, every vertex", "[.][slow][topology][local]") {
   check_topology(GENERATE(TopologyCase{"elephant.off", FunctionKind::Local, 0, 0.01},
+                          TopologyCase{"elephant.off", FunctionKind::Local, 0, 0.005},
                           TopologyCase{"bear.off", FunctionKind::Local, 0, kDataPrecision},
                           TopologyCase{"bear.off", FunctionKind::Local, 0, 0.01},
                           TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.005}));

@@ -5,6 +5,8 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
+#include "radix_sort.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -42,7 +44,7 @@ inline std::vector<std::size_t> spatial_order(const std::vector<Point3>& points)
                     spread_bits3(cell(p.z, box.lo.z)),
                 i};
   }
-  std::sort(keyed.begin(), keyed.end());
+  sort_keyed(keyed);
   std::vector<std::size_t> order(points.size());
   for (std::size_t k = 0; k < keyed.size(); ++k) order[k] = keyed[k].second;
   return order;

@@ -69,7 +69,7 @@ void Triangulation::canonicalize() {
   // Key of a live tetrahedron: its public vertex ids, sorted; bucketed by the smallest (a counting
   // sort), then each bucket (a few tetrahedra) sorted by the other three.
   // Written for the live tetrahedra only, and read only for them: left uninitialized (as new_id below).
-  const std::unique_ptr<std::array<VertexId, 4>[]> key(new std::array<VertexId, 4>[cap]);
+  std::unique_ptr<std::array<VertexId, 4>[]> key(new std::array<VertexId, 4>[cap]);
   detail::parallel_slices(cap, threads, [&](std::size_t lo, std::size_t hi) {
     for (TetId t = TetId(lo); t < hi; ++t) {
       if (tets_.is_dead(t)) continue;
@@ -81,34 +81,43 @@ void Triangulation::canonicalize() {
   for (TetId t = 0; t < cap; ++t)
     if (!tets_.is_dead(t)) ++start[key[t][0] + 1];
   std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<TetId> order(num_live_tets_);
+  // The keys travel with the ids into their buckets (read in id order, as they were written), so that
+  // the bucket sorts compare contiguous records instead of looking each key up by id (the keys of a
+  // bucket lie anywhere in `key`). Keys of distinct tetrahedra differ: the order is the same whatever
+  // the sort.
+  struct Keyed {
+    std::array<VertexId, 4> key;
+    TetId t;
+  };
+  std::vector<Keyed> order(num_live_tets_);
   {
     std::vector<std::uint32_t> next(start.begin(), start.end() - 1);
     for (TetId t = 0; t < cap; ++t)
-      if (!tets_.is_dead(t)) order[next[key[t][0]]++] = t;
+      if (!tets_.is_dead(t)) order[next[key[t][0]]++] = {key[t], t};
   }
+  key.reset();
   detail::parallel_slices(start.size() - 1, threads, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t b = lo; b < hi; ++b)
       std::sort(order.begin() + start[b], order.begin() + start[b + 1],
-                [&](TetId x, TetId y) { return key[x] < key[y]; });
+                [](const Keyed& x, const Keyed& y) { return x.key < y.key; });
   });
   const std::unique_ptr<TetId[]> new_id(new TetId[cap]);  // read only at live ids, all written
   detail::parallel_slices(order.size(), threads, [&](std::size_t lo, std::size_t hi) {
-    for (std::size_t n = lo; n < hi; ++n) new_id[order[n]] = static_cast<TetId>(n);
+    for (std::size_t n = lo; n < hi; ++n) new_id[order[n].t] = static_cast<TetId>(n);
   });
 
   Store fresh(false);
   fresh.append(order.size());
   detail::parallel_slices(order.size(), threads, [&](std::size_t lo, std::size_t hi) {
     for (std::size_t n = lo; n < hi; ++n) {
-      const TetId t = order[n];
+      const TetId t = order[n].t;
       // The old records are read in key order (scattered), and then the new ids of their neighbours:
       // the records 16 ahead are fetched, and the new ids of the neighbours of the one 8 ahead (its
       // record was fetched 8 iterations ago).
-      if (n + 16 < hi) tets_.prefetch(order[n + 16]);
+      if (n + 16 < hi) tets_.prefetch(order[n + 16].t);
       if (n + 8 < hi)
         for (int i = 0; i < 4; ++i) {
-          const TetId ahead = tets_.neighbor(order[n + 8], i);
+          const TetId ahead = tets_.neighbor(order[n + 8].t, i);
           if (ahead != kNoTet) __builtin_prefetch(&new_id[ahead]);
         }
       std::array<VertexId, 4> k{};

@@ -19,8 +19,8 @@ namespace vitri {
 using namespace local_detail;
 using rbf_detail::parallel_chunks;
 
-double LocalRbf::Impl::evaluate_inside(const Point3& x, Point3* grad) const {
-  const Cell& leaf = tree.cell(tree.locate(x));
+double LocalRbf::Impl::evaluate_inside(const Point3& x, Point3* grad, std::uint32_t* leaf_hint) const {
+  const Cell& leaf = tree.cell(leaf_hint ? tree.locate(x, *leaf_hint) : tree.locate(x));
   double sw = 0, swf = 0;
   Point3 gsw{0, 0, 0}, gswf{0, 0, 0};
   for (const std::uint32_t id : leaf.candidates) {
@@ -51,15 +51,15 @@ double LocalRbf::Impl::evaluate_inside(const Point3& x, Point3* grad) const {
   return f;
 }
 
-double LocalRbf::Impl::evaluate(const Point3& x, Point3* grad) const {
+double LocalRbf::Impl::evaluate(const Point3& x, Point3* grad, std::uint32_t* leaf_hint) const {
   const Box3 root = tree.root_box();
   Point3 y = x;
   for (int a = 0; a < 3; ++a) y[a] = std::min(std::max(x[a], root.lo[a]), root.hi[a]);
-  if (y == x) return evaluate_inside(x, grad);
+  if (y == x) return evaluate_inside(x, grad, leaf_hint);
   // Outside the root cube: f(y) + |x - y|, continuous across the cube's faces.
   const Point3 d = x - y;
   const double dist = norm(d);
-  const double f = evaluate_inside(y, grad) + dist;
+  const double f = evaluate_inside(y, grad, leaf_hint) + dist;
   if (grad)
     for (int a = 0; a < 3; ++a)
       if (d[a] != 0) (*grad)[a] = d[a] / dist;
@@ -100,9 +100,10 @@ void LocalRbf::values(const Point3* points, std::size_t n, double* out) const {
   const std::vector<std::uint32_t> order =
       n >= kSortedBatch && n < PointIndex::kNoId ? batch_order(points, n, domain()) : std::vector<std::uint32_t>{};
   parallel_chunks(n, impl_->threads(), 2048, [&](std::size_t b, std::size_t e) {
+    std::uint32_t leaf = local_detail::kNone;
     for (std::size_t k = b; k < e; ++k) {
       const std::size_t i = order.empty() ? k : order[k];
-      out[i] = impl_->evaluate(points[i], nullptr);
+      out[i] = impl_->evaluate(points[i], nullptr, &leaf);
     }
   });
 }
@@ -111,9 +112,10 @@ void LocalRbf::values_gradients(const Point3* points, std::size_t n, double* val
   const std::vector<std::uint32_t> order =
       n >= kSortedBatch && n < PointIndex::kNoId ? batch_order(points, n, domain()) : std::vector<std::uint32_t>{};
   parallel_chunks(n, impl_->threads(), 2048, [&](std::size_t b, std::size_t e) {
+    std::uint32_t leaf = local_detail::kNone;
     for (std::size_t k = b; k < e; ++k) {
       const std::size_t i = order.empty() ? k : order[k];
-      values[i] = impl_->evaluate(points[i], &gradients[i]);
+      values[i] = impl_->evaluate(points[i], &gradients[i], &leaf);
     }
   });
 }

@@ -103,8 +103,10 @@ struct LocalRbf::Impl {
   void restructure(std::uint32_t c, const Point3& q, std::vector<Ball>& removed, std::vector<std::uint32_t>& created);
   void fill_report();
 
-  double evaluate(const Point3& x, Point3* grad) const;
-  double evaluate_inside(const Point3& x, Point3* grad) const;
+  /// f(x) (and its gradient); `leaf_hint` (optional) is the leaf of the previous point of a batch
+  /// (LocalTree::locate's hint), updated to x's.
+  double evaluate(const Point3& x, Point3* grad, std::uint32_t* leaf_hint = nullptr) const;
+  double evaluate_inside(const Point3& x, Point3* grad, std::uint32_t* leaf_hint = nullptr) const;
 
   std::size_t slot_of(std::size_t i) const;
   void check_new_position(const Point3& p, std::size_t index, std::optional<std::uint32_t> moving) const;

@@ -75,6 +75,19 @@ std::uint32_t LocalTree::locate(const Point3& p) const {
   return c;
 }
 
+std::uint32_t LocalTree::locate(const Point3& p, std::uint32_t& hint) const {
+  if (hint != kNone && hint < cells_.size()) {
+    const Cell& leaf = cells_[hint];
+    if (leaf.alive && leaf.leaf()) {
+      bool inside = true;
+      for (int a = 0; a < 3; ++a) inside = inside && p[a] >= leaf.center[a] - leaf.half && p[a] < leaf.center[a] + leaf.half;
+      if (inside) return hint;
+    }
+  }
+  hint = locate(p);
+  return hint;
+}
+
 template <class Enter, class Take>
 void LocalTree::collect_leaves(const Enter& enter, const Take& take, std::vector<std::uint32_t>& out) const {
   out.clear();

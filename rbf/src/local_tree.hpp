@@ -92,6 +92,11 @@ class LocalTree {
   void collapse(std::uint32_t c, std::vector<std::uint32_t>& freed_leaves);
   /// The leaf whose cube holds p (p clamped into the root cube).
   std::uint32_t locate(const Point3& p) const;
+  /// locate(p), answered without the descent when p lies in the half-open cube [c - h, c + h)^3 of the
+  /// live leaf `hint` (the cube the descent's `>= center` rule gives a leaf; centers and halves are exact
+  /// dyadics, so the test is exact and the answer the same). `hint` (kNone: none) becomes the answer:
+  /// consecutive points of a spatially sorted batch mostly share their leaf.
+  std::uint32_t locate(const Point3& p, std::uint32_t& hint) const;
   /// Leaves whose support ball meets the closed cube of cell `target` (|c_L - cube| < R_L).
   void leaves_meeting_cube(const Cell& target, std::vector<std::uint32_t>& out) const;
   /// For every leaf at or below `top`, its candidates (leaves_meeting_cube of its cube), sorted in

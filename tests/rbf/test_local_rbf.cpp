@@ -94,6 +94,32 @@ TEST_CASE("LocalRbf interpolates every constraint and has a valid structure", "[
     REQUIRE(vg[i] == f.value_gradient(pts[i], gi));
     REQUIRE(gi == g[i]);
   }
+  // A large batch is evaluated along a Morton curve, each point's leaf found from the previous one's when
+  // it lies in that leaf's half-open cube: the same leaves, so the same bits, also for points exactly on
+  // cell faces (dyadic fractions of the root cube) and on the root cube's upper faces.
+  const vitri::Box3 root = f.domain();
+  const Point3 lo = root.lo, ext = root.hi - root.lo;
+  std::vector<Point3> big = random_points(12000, 2.0, 13);
+  for (int i = 0; i <= 32; ++i)
+    for (int j = 0; j <= 32; j += 4)
+      for (int k = 0; k <= 32; k += 8)
+        big.push_back({lo.x + ext.x * (i / 32.0), lo.y + ext.y * (j / 32.0), lo.z + ext.z * (k / 32.0)});
+  for (std::size_t i = 0; i < 2000; ++i) {  // the surface region, where leaves are small: faces at 1/1024
+    const Point3 q = big[i % 12000];
+    big.push_back({lo.x + std::round((q.x - lo.x) / ext.x * 1024.0) * (ext.x / 1024.0), q.y,
+                   lo.z + std::round((q.z - lo.z) / ext.z * 1024.0) * (ext.z / 1024.0)});
+  }
+  REQUIRE(big.size() >= 8192);
+  std::vector<double> bv(big.size()), bvg(big.size());
+  std::vector<Point3> bg(big.size());
+  f.values(big.data(), big.size(), bv.data());
+  f.values_gradients(big.data(), big.size(), bvg.data(), bg.data());
+  for (std::size_t i = 0; i < big.size(); ++i) {
+    Point3 gi;
+    REQUIRE(bv[i] == f.value(big[i]));
+    REQUIRE(bvg[i] == f.value_gradient(big[i], gi));
+    REQUIRE(gi == bg[i]);
+  }
 }
 
 TEST_CASE("LocalRbf: bounding box without the copy; the copy released and rebuilt the same", "[local_rbf]") {

@@ -80,7 +80,7 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
         const SnapLookahead::Slice& slice = look.slices[sp.slice];
         star_.assign(slice.stars.begin() + sp.star_first, slice.stars.begin() + sp.star_last);
         z = first[next++];
-        now = in.tri.is_vertex(z) && in.snap && anchored_[z] != 0 &&
+        now = in.tri.is_vertex(z) && may_collapse(in, z) &&
               fan_test(in, z, slice.fans.data() + sp.fan_first, sp.fan_last - sp.fan_first);
       } else {
         z = first[next++];
@@ -130,7 +130,7 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
       out.stars.insert(out.stars.end(), star.begin(), star.end());
       sp.star_last = static_cast<std::uint32_t>(out.stars.size());
       sp.fan_first = sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
-      if (!in.snap || star.empty() || anchored_[z] == 0) continue;  // the test reads nothing more
+      if (star.empty() || !may_collapse(in, z)) continue;  // the test reads nothing more
       gather_fan(z, star, out.fans);
       sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
       if (in.values[z] == 0.0 || snap_target_.count(z)) continue;  // snap_target(z) evaluates nothing
@@ -174,7 +174,7 @@ bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
 // The collapse test of z (see the top of the file), with the lower collapses applied; star_ holds the
 // star of the live vertex z.
 bool SurfaceTracker::collapse_test(const TrackerInput& in, VertexId z) {
-  if (!in.snap || anchored_[z] == 0) return false;
+  if (!may_collapse(in, z)) return false;
   fan_.clear();
   gather_fan(z, star_, fan_);
   return fan_test(in, z, fan_.data(), fan_.size());

@@ -167,6 +167,8 @@ class SurfaceTracker {
                   SnapLookahead& look);
   /// The star of z in star_, then collapse_test (false for a removed z).
   bool can_collapse(const TrackerInput& in, VertexId z);
+  /// Snapping is on and z has anchored crossings: the collapse test has something to decide.
+  bool may_collapse(const TrackerInput& in, VertexId z) const { return in.snap && anchored_[z] != 0; }
   /// The test of a live z whose star is in star_: its fan (gather_fan), then fan_test.
   bool collapse_test(const TrackerInput& in, VertexId z);
   void gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const;

@@ -280,6 +280,10 @@ void PointIndex::move_bucket(std::uint32_t node, std::size_t capacity) {
   garbage_ += n.extra;
   n.bucket.begin = begin;
   n.extra = static_cast<std::uint32_t>(capacity);
+  compact_if_wasteful();
+}
+
+void PointIndex::compact_if_wasteful() {
   if (garbage_ > 4 * kBucket && garbage_ > buckets_.size() / 2) compact_buckets();
 }
 
@@ -338,7 +342,7 @@ void PointIndex::split_leaf(std::uint32_t node) {
   fill_node(f, node, entries.data(), entries.data() + entries.size());
   nodes_ = std::move(f.nodes);
   buckets_ = std::move(f.buckets);
-  if (garbage_ > 4 * kBucket && garbage_ > buckets_.size() / 2) compact_buckets();
+  compact_if_wasteful();
 }
 
 void PointIndex::erase(Id id) {

@@ -120,10 +120,12 @@ class PointIndex {
   static bool split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis, double& cut,
                             Entry*& middle);
   /// Gives leaf `node` a block of `capacity` entries at the end of buckets_ holding its current points
-  /// (its old block becomes garbage; the pool is compacted when garbage outweighs what is held).
+  /// (its old block becomes garbage; see compact_if_wasteful).
   void move_bucket(std::uint32_t node, std::size_t capacity);
   /// Rewrites buckets_ with every leaf's points contiguous, in node order, without garbage.
   void compact_buckets();
+  /// compact_buckets() once freed blocks outweigh the points held (amortized O(1) per freed entry).
+  void compact_if_wasteful();
   void split_leaf(std::uint32_t node);
   void ensure_id(Id id);
   const Entry* bucket_begin(const Node& n) const { return buckets_.data() + n.bucket.begin; }

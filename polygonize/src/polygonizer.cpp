@@ -24,8 +24,8 @@
 //
 // Files: this one (construction, evaluation, classification, lone zeros, queue, refinement), thin
 // features (thin_features.cpp), vertex edits (vertex_edits.cpp), function changes and garbage collection
-// (function_changes.cpp), extraction (extract.cpp over surface_tracker.hpp), the closing function of
-// close_at_box (box_closure.cpp).
+// (function_changes.cpp), extraction (extract.cpp over surface_tracker.hpp) and its repair of pinched
+// zeros (pinched_zeros.cpp), the closing function of close_at_box (box_closure.cpp).
 #include "vitri/polygonize/polygonizer.hpp"
 
 #include "polygonizer_internal.hpp"

@@ -1,6 +1,6 @@
 #pragma once
 // Definitions shared by the Polygonizer's source files (polygonizer.cpp, function_changes.cpp,
-// thin_features.cpp, vertex_edits.cpp, extract.cpp).
+// thin_features.cpp, vertex_edits.cpp, extract.cpp, pinched_zeros.cpp).
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 

@@ -11,17 +11,13 @@
 //   internal sheets (chi -348 and 4 bubbles at 0.01).
 // - turbine.off at its data precision (0.0145 of the diagonal) or 0.01, local: blades thinner than the
 //   precision and long CAD triangles whose interiors carry no constraint (the function bulges out by up
-//   to 6% of the diagonal between their corners). At 0.005 it is right (in the matrix; a tiny triangle
-//   there was fixed in the surface tracker). Global: a subsample that the O(N^3)
-//   fit can afford (1000 points) does not carry its 11 holes (chi -2).
-// - bear.off local at 0.005: 3 places (the soles, one near the head) where a zero-valued constraint
-//   vertex cannot be collapsed (its crossings stay at 5% of the edges: a pinch of the piecewise-linear
-//   zero set under sign(0) = +) leave 4 handles that the function does not have (a polygonizer issue).
-//   Checked again on 2026-11-26: still chi -6 here (V 47977), while `vitri mesh bear.off --function
-//   local --precision 0.005` happens to give chi 2 (V 47677): the pinches depend on where the
-//   refinement puts its points, not fixed.
-// - elephant.off global at 0.01 with 3000 constraints: the subsample is too sparse, the fitted surface
-//   itself has an extra handle.
+//   to 6% of the diagonal between their corners): chi -92 and -50 against -20 (-136 and -92 before the
+//   pinched-zero repair). At 0.005 it is right (in the matrix; a tiny triangle there was fixed in the
+//   surface tracker). Global: a subsample that the O(N^3) fit can afford (1000 points) does not carry
+//   its 11 holes (chi -2 to -4).
+// bear.off local at 0.005 and elephant.off global at 0.01 were left out for handles at zero-valued
+// constraints that joined two positive regions of their links; the extraction's pinched-zero repair
+// (docs/polygonize.md) fixed both.
 // - building.ply: an open scan (the ground is sampled with upward normals, no floor, 25% of the points
 //   in no segment): it has no Euler characteristic to compare with.
 #include <catch2/catch.hpp>
@@ -111,6 +107,7 @@ TEST_CASE("topology matrix: local function, every vertex", "[.][slow][topology][
                           TopologyCase{"elephant.off", FunctionKind::Local, 0, 0.005},
                           TopologyCase{"bear.off", FunctionKind::Local, 0, kDataPrecision},
                           TopologyCase{"bear.off", FunctionKind::Local, 0, 0.01},
+                          TopologyCase{"bear.off", FunctionKind::Local, 0, 0.005},
                           TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.005}));
 }
 
@@ -118,6 +115,7 @@ TEST_CASE("topology matrix: local function, every vertex", "[.][slow][topology][
 TEST_CASE("topology matrix: global function, subsampled", "[.][slow][topology][global]") {
   check_topology(GENERATE(TopologyCase{"elephant.off", FunctionKind::Global, 3000, kDataPrecision},
                           TopologyCase{"elephant.off", FunctionKind::Global, 3000, 0.02},
+                          TopologyCase{"elephant.off", FunctionKind::Global, 3000, 0.01},
                           TopologyCase{"bear.off", FunctionKind::Global, 3000, kDataPrecision},
                           TopologyCase{"bear.off", FunctionKind::Global, 3000, 0.01}));
 }

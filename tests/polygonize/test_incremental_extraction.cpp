@@ -4,6 +4,7 @@
 #include <catch2/catch.hpp>
 
 #include "edge_map.hpp"
+#include "link_signs.hpp"
 #include "marching.hpp"
 #include "sorted_ids.hpp"
 #include "surface_tracker.hpp"
@@ -168,6 +169,51 @@ TEST_CASE("march_tetrahedron: every sign pattern gives a polygon facing the posi
   // The shorter diagonal splits a quad.
   REQUIRE(marching::quad_split({0, 0, 0}, {1, 0, 0}, {1, 0.5, 0}, {0, 1, 0}) == 0);
   REQUIRE(marching::quad_split({0, 0, 0}, {1, 0, 0}, {1, 2, 0}, {0, 1, 0}) == 1);
+}
+
+// The star of vertex 0 in the octahedron around it: link vertices 1..6 at +x, -x, +y, -y, +z, -z; the
+// 8 tetrahedra (0, one of +-x, one of +-y, one of +-z). Opposite link vertices share no link edge.
+std::vector<std::array<VertexId, 4>> octahedron_star() {
+  std::vector<std::array<VertexId, 4>> star;
+  for (const VertexId x : {1u, 2u})
+    for (const VertexId y : {3u, 4u})
+      for (const VertexId z : {5u, 6u}) star.push_back({0u, x, y, z});
+  return star;
+}
+
+LinkSignGroups groups_with_negative(std::initializer_list<VertexId> negative) {
+  const std::vector<VertexId> neg(negative);
+  const auto is_negative = [&](VertexId u) { return std::find(neg.begin(), neg.end(), u) != neg.end(); };
+  return link_sign_groups(0, octahedron_star(), is_negative);
+}
+
+TEST_CASE("link_sign_groups: the sign groups of a hand-made link", "[incremental]") {
+  // A plane through the center: one group of each sign.
+  LinkSignGroups g = groups_with_negative({6});
+  CHECK((g.negative == 1 && g.positive == 1 && !g.pinched()));
+  g = groups_with_negative({2, 4, 6});
+  CHECK((g.negative == 1 && g.positive == 1 && !g.pinched()));
+  // A negative band between +z and -z (a slab thinner than the star): two positive caps, pinched.
+  g = groups_with_negative({1, 2, 3, 4});
+  CHECK((g.negative == 1 && g.positive == 2 && g.pinched()));
+  // The dual: two negative caps in a positive band (a gap between two parts): not pinched under
+  // sign(0) = +, the center keeps the caps apart.
+  g = groups_with_negative({5, 6});
+  CHECK((g.negative == 2 && g.positive == 1 && !g.pinched()));
+  // The band around the x axis: the caps +x and -x share no link edge.
+  g = groups_with_negative({3, 4, 5, 6});
+  CHECK((g.negative == 1 && g.positive == 2 && g.pinched()));
+  // +x and +z share one: a single positive group.
+  g = groups_with_negative({2, 3, 4, 6});
+  CHECK((g.negative == 1 && g.positive == 1 && !g.pinched()));
+  // No negative neighbour: nothing crosses, nothing to pinch.
+  g = groups_with_negative({});
+  CHECK((g.negative == 0 && g.positive == 1 && !g.pinched()));
+  // Tetrahedra without the center are ignored.
+  auto star = octahedron_star();
+  star.push_back({1, 3, 5, 7});
+  const auto none = [](VertexId) { return false; };
+  CHECK(link_sign_groups(0, star, none).positive == 1);
 }
 
 TEST_CASE("place_crossings: roots of a linear function, zero ends offset, warm starts", "[incremental]") {

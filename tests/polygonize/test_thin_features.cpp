@@ -12,6 +12,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <vector>
 
 using namespace vitri;
 
@@ -21,10 +22,12 @@ using test::metrics_of;
 
 /// Euler characteristic of a fresh polygonization of the mesher's RBF, built as vitri::Mesher (and so
 /// `vitri mesh`) builds it: constraint points as seeds with their values, domain = their box x 2.
-long long euler_at(const Mesher& mesher, double relative, QueueOrder order, bool thin = true) {
+long long euler_at(const Mesher& mesher, double relative, QueueOrder order, bool thin = true,
+                   bool pinches = true) {
   PolygonizerOptions o;
   o.order = order;
   o.refine_thin_features = thin;
+  o.refine_pinched_zeros = pinches;
   const Constraints& c = mesher.constraints();
   Polygonizer poly(mesher.function(), Polygonizer::domain_for(c.points, 2.0), c.points, c.values, o);
   REQUIRE(poly.refine(relative * mesher.diagonal()));
@@ -55,13 +58,70 @@ TEST_CASE("thin features: hand.off has the hand's topology at 0.02, 0.015 and 0.
   CHECK(euler_at(mesher, 0.02, QueueOrder::LargestFirst) == 2);
   CHECK(euler_at(mesher, 0.01, QueueOrder::LargestFirst) == 2);
   // Without the rule the handle is there (what this test guards against).
-  CHECK(euler_at(mesher, 0.015, QueueOrder::Fifo, false) == 0);
+  CHECK(euler_at(mesher, 0.015, QueueOrder::Fifo, false, false) == 0);
+  CHECK(euler_at(mesher, 0.015, QueueOrder::LargestFirst) == 2);
 }
 
-// Known gap (docs/polygonize.md, Thin features): largest-first at 0.015 still has one spurious handle
-// (chi 0; it was -2 before the rule): a gap whose end gradients are 85 degrees apart. Not a test, since a
-// test that is allowed to fail asserts nothing; reproduce with
-// `vitri mesh data/hand.off -o h.obj --precision 0.015` and QueueOrder::LargestFirst.
+// Largest-first at 0.015 used to keep one spurious handle after the rule (chi 0; -2 before it), a gap
+// whose end gradients are 85 degrees apart; the pinched-zero repair of the extraction removes it (the
+// last check above).
+
+/// A slab |z| < t (closed by the box into a flat closed pancake), with zero-valued seeds on its top face.
+class SlabFunction final : public ImplicitFunction {
+ public:
+  explicit SlabFunction(double t) : t_(t) {}
+  double value(const Point3& p) const override { return std::abs(p.z) - t_; }
+  double value_gradient(const Point3& p, Point3& gradient) const override {
+    gradient = {0.0, 0.0, p.z >= 0.0 ? 1.0 : -1.0};
+    return value(p);
+  }
+
+ private:
+  double t_;
+};
+
+// The slab is 0.03 thick, half the precision (0.06), so the stars of the seeds on its top face reach
+// below it: where a seed's link has positive vertices above and below with the slab's negative ones
+// between, the seed (f = 0, counted positive) joins them and the piecewise-linear zero set gets a handle
+// through the slab at it. The repair refines those stars below the precision until the slab shows.
+TEST_CASE("pinched zeros: seeds on a slab thinner than the precision give no handle", "[polygonize]") {
+  const double t = 0.015;
+  const SlabFunction f(t);
+  std::vector<Point3> seeds;
+  for (int i = 0; i <= 10; ++i)
+    for (int j = 0; j <= 10; ++j) {
+      const double x = -0.5 + 0.1 * i, y = -0.5 + 0.1 * j;
+      seeds.push_back({x + 0.013 * y, y + 0.007 * x, t});  // off the lattice's symmetries
+    }
+  const std::vector<double> zeros(seeds.size(), 0.0);
+  const Box3 box{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
+  for (const bool repair : {true, false}) {
+    PolygonizerOptions o;
+    o.refine_pinched_zeros = repair;
+    Polygonizer poly(f, box, seeds, zeros, o);
+    REQUIRE(poly.refine(0.06));
+    const MeshMetrics mm = metrics_of(poly.extract());
+    const PolygonizerStats s = poly.stats();
+    INFO((repair ? "with" : "without") << " the repair: chi " << mm.euler_characteristic << ", "
+                                       << s.pinch_insertions << " points for pinched zeros");
+    REQUIRE(mm.closed_manifold());
+    REQUIRE(mm.components == 1);
+    if (repair) {
+      CHECK(mm.euler_characteristic == 2);
+      CHECK(s.pinch_insertions > 0);
+      CHECK(s.pinched_zeros == 0);
+      // The repair's points are part of the state: a fresh extraction of it is the same mesh, and
+      // extracting again changes nothing.
+      CHECK(metrics_of(poly.extract_fresh()).euler_characteristic == 2);
+      const std::size_t vertices = poly.stats().vertices;
+      CHECK(metrics_of(poly.extract()).euler_characteristic == 2);
+      CHECK(poly.stats().vertices == vertices);
+    } else {
+      CHECK(mm.euler_characteristic < 2);  // the handles the repair removes
+      CHECK(s.pinch_insertions == 0);
+    }
+  }
+}
 
 // Two facing sheets closer than the precision: the union of two spheres of radius 1 whose gap (0.1) is
 // far below the circumradius bound (0.3). Without the rule the gap may be bridged; with it, every flagged

@@ -109,6 +109,15 @@ struct PolygonizerOptions {
   /// constraints). false restores the plain rule (only transverse tetrahedra are refined). See
   /// docs/polygonize.md.
   bool refine_lone_zeros = true;
+  /// Pinched zeros: a zero-valued vertex whose crossings cannot be collapsed and whose link has two or
+  /// more groups of non-negative vertices (LinkSignGroups::pinched) joins them through a point where
+  /// f = 0 under sign(0) = +: the piecewise-linear zero set gets a neck there (a spurious handle, e.g.
+  /// where the surface through an on-surface constraint bounds a part thinner than the star). The
+  /// extraction finds them (they are among the collapse tests it runs anyway), inserts the circumcenters
+  /// of their stars' tetrahedra larger than the proximity distance (min_distance_fraction x precision),
+  /// refines the new active tetrahedra to the precision and extracts again, until none is left or nothing
+  /// can be inserted. Only after a completed refine(). See docs/polygonize.md. false: no such points.
+  bool refine_pinched_zeros = true;
   /// Mesh f closed by the domain box (BoxClosedFunction, box_closure.hpp): within
   /// `box_band_fraction` (0.1, in (0, 0.5)) x the box's smallest side of its boundary the function is
   /// made positive (keep seeds out of that band: closing_band()), so a
@@ -170,13 +179,18 @@ struct PolygonizerStats {
   std::size_t zero_offset = 0;          ///< last extract(): vertices with anchored crossings left at their offset
   std::size_t lone_zeros = 0;           ///< current zero-valued vertices touched by no transverse tetrahedron
   std::size_t lone_zero_insertions = 0; ///< refinement points inserted for the stars of lone zeros
+  std::size_t pinch_insertions = 0;     ///< points inserted by extractions in the stars of pinched zeros
+  /// Last extraction: pinched zeros left after it (none of their stars' tetrahedra larger than the
+  /// proximity distance), counted among those it decided.
+  std::size_t pinched_zeros = 0;
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
   double refine_seconds = 0;            ///< last refine() call
   double extract_seconds = 0;           ///< last extract() call
   /// Of the last extraction: finding the changed polygons, placing crossings (evaluations of f),
-  /// deciding collapses, editing the live mesh (they add up to about extract_seconds).
+  /// deciding collapses, editing the live mesh, and the points and refinement for pinched zeros
+  /// (refine_pinched_zeros; its tracking is in the others); they add up to about extract_seconds.
   double extract_polygons_seconds = 0, extract_placement_seconds = 0, extract_snapping_seconds = 0,
-         extract_mesh_seconds = 0;
+         extract_mesh_seconds = 0, extract_pinch_seconds = 0;
   double update_seconds = 0;            ///< last function_changed() call
 };
 
@@ -319,6 +333,8 @@ class Polygonizer {
   const PolygonizerOptions& options() const { return options_; }
 
  private:
+  void track_surface();
+  void repair_pinched_zeros();
   bool is_negative_value(VertexId v) const { return values_[v] < 0.0; }  // sign(0) = +
   void grow_vertex_arrays();
   void grow_tet_arrays();
@@ -409,7 +425,7 @@ class Polygonizer {
       return true;
     }
   };
-  VisitMarks tet_marks_, vertex_marks_;  // vertices_near(), thin_recheck_set() (one traversal at a time)
+  VisitMarks tet_marks_, vertex_marks_;  // vertices_near() (one traversal at a time)
 };
 
 }  // namespace vitri

@@ -118,23 +118,27 @@ void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
 }
 
 std::vector<TetId> Polygonizer::thin_recheck_set() {
-  // Sorted and deduplicated, without marks per tetrahedron: the set is small (an edit, or the points an
-  // extraction added for pinched zeros), and a mark array over every tetrahedron would stay resident
-  // (4 bytes per tetrahedron, 0.1 GB at 10^6 input points) for a few thousand ids.
+  // With the history (an interactive session: a recheck per edit) repeated tetrahedra are dropped by
+  // marks, O(set); a batch run rechecks rarely (after the extraction's points for pinched zeros) and
+  // sorts the repeats out instead, so that no mark array over every tetrahedron (4 bytes each, 0.12 GB
+  // at 10^6 input points) stays resident for a few thousand ids.
+  const bool marks = options_.keep_history;
   std::vector<TetId> tets;
+  if (marks) tet_marks_.begin(tri_.tet_capacity());
+  vertex_marks_.begin(tri_.vertex_capacity());
+  const auto add = [&](TetId t) {
+    if (!marks || tet_marks_.first_visit(t)) tets.push_back(t);
+  };
   for (const TetId t : thin_tets_)
-    if (t < tri_.tet_capacity()) tets.push_back(t);
-  std::vector<VertexId> vertices(thin_vertices_);
-  std::sort(vertices.begin(), vertices.end());
-  vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    if (t < tri_.tet_capacity()) add(t);
   std::vector<TetId> star;
-  for (const VertexId v : vertices) {
-    if (!tri_.is_vertex(v)) continue;
+  for (const VertexId v : thin_vertices_) {
+    if (!tri_.is_vertex(v) || !vertex_marks_.first_visit(v)) continue;
     tri_.incident_tetrahedra(v, star);
-    tets.insert(tets.end(), star.begin(), star.end());
+    for (const TetId t : star) add(t);
   }
   std::sort(tets.begin(), tets.end());  // the order of the full check (ascending ids)
-  tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
+  if (!marks) tets.erase(std::unique(tets.begin(), tets.end()), tets.end());
   return tets;
 }
 

@@ -425,7 +425,7 @@ class Polygonizer {
       return true;
     }
   };
-  VisitMarks tet_marks_, vertex_marks_;  // vertices_near() (one traversal at a time)
+  VisitMarks tet_marks_, vertex_marks_;  // vertices_near(), thin_recheck_set() (one traversal at a time)
 };
 
 }  // namespace vitri

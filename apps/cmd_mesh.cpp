@@ -150,13 +150,20 @@ std::string level_path(const std::string& out, std::size_t k) {
 /// The extraction's own steps (stderr, beside the progress lines): where the time of a large mesh goes.
 void print_extraction_split(const PolygonizerStats& s, double extract_ms) {
   const double tracked = 1e3 * (s.extract_polygons_seconds + s.extract_placement_seconds + s.extract_snapping_seconds +
-                                s.extract_mesh_seconds + s.extract_pinch_seconds);
+                                s.extract_mesh_seconds);
   std::fprintf(stderr,
                "  extraction: polygons %.0f ms, crossings %.0f ms, collapses %.0f ms, mesh %.0f ms, "
-               "pinched zeros %.0f ms (%zu points), components and copy %.0f ms\n",
+               "components and copy %.0f ms\n",
                1e3 * s.extract_polygons_seconds, 1e3 * s.extract_placement_seconds,
-               1e3 * s.extract_snapping_seconds, 1e3 * s.extract_mesh_seconds, 1e3 * s.extract_pinch_seconds,
-               s.pinch_insertions, std::max(0.0, extract_ms - tracked));
+               1e3 * s.extract_snapping_seconds, 1e3 * s.extract_mesh_seconds, std::max(0.0, extract_ms - tracked));
+}
+
+/// The neck checks of the refinement (stderr, docs/polygonize.md "Necks"): their share of its time.
+void print_neck_split(const PolygonizerStats& s) {
+  std::fprintf(stderr,
+               "  refinement: neck checks and their points %.0f ms (%zu vertices checked, %zu points, "
+               "%zu left)\n",
+               1e3 * s.neck_seconds, s.neck_checks, s.neck_insertions, s.necks_left);
 }
 
 /// The local fit's own steps (stderr): where the time of a large fit goes.
@@ -402,6 +409,7 @@ int run_mesh(const Args& args) {
     });
     if (reported) std::fprintf(stderr, "\n");
     const double refine_ms = ms_since(t0);
+    if (!quiet) print_neck_split(mesher.stats().polygonizer);
     phases.start("extraction");
     const auto t1 = Clock::now();
     const SurfaceMesh& m = mesher.surface();

@@ -36,16 +36,6 @@ Polygonizer::~Polygonizer() = default;
 
 MeshDelta Polygonizer::update_surface() {
   const auto t0 = std::chrono::steady_clock::now();
-  stats_.extract_polygons_seconds = stats_.extract_placement_seconds = 0;
-  stats_.extract_snapping_seconds = stats_.extract_mesh_seconds = stats_.extract_pinch_seconds = 0;
-  track_surface();
-  repair_pinched_zeros();  // pinched_zeros.cpp: refines and tracks again while a zero vertex is pinched
-  MeshDelta delta = surface_->mesh().take_delta();
-  stats_.extract_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return delta;
-}
-
-void Polygonizer::track_surface() {
   evaluate_pending();
   const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, options_);
   surface_->update(in);
@@ -55,10 +45,13 @@ void Polygonizer::track_surface() {
   stats_.gradient_evaluations += r.gradient_evaluations;
   stats_.zero_snapped = r.snapped;
   stats_.zero_offset = r.offset;
-  stats_.extract_polygons_seconds += r.polygons_seconds;
-  stats_.extract_placement_seconds += r.placement_seconds;
-  stats_.extract_snapping_seconds += r.snapping_seconds;
-  stats_.extract_mesh_seconds += r.mesh_seconds;
+  stats_.extract_polygons_seconds = r.polygons_seconds;
+  stats_.extract_placement_seconds = r.placement_seconds;
+  stats_.extract_snapping_seconds = r.snapping_seconds;
+  stats_.extract_mesh_seconds = r.mesh_seconds;
+  MeshDelta delta = surface_->mesh().take_delta();
+  stats_.extract_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return delta;
 }
 
 const LiveMesh& Polygonizer::live_surface() const { return surface_->mesh(); }

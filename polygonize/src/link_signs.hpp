@@ -1,74 +1,106 @@
 #pragma once
 // The sign groups of a vertex's link: a pure function of its star, testable on a hand-made one
-// (docs/polygonize.md, "Pinched zeros").
+// (docs/polygonize.md, "Necks").
 //
-// The link of an interior Delaunay vertex z is the triangulated sphere of the faces opposite z in its
-// tetrahedra. Colour its vertices by sign (sign(0) = +) and join two vertices of one colour when a link
-// edge joins them: the groups of each colour are the regions the zero set cuts the small sphere around z
-// into. Where f is smooth and the star is small against the surface's features, f is close to linear
-// there and the link has exactly one group of each sign.
+// The link of an interior Delaunay vertex v is the triangulated sphere of the faces opposite v in its
+// tetrahedra. Split its vertices into those of v's own sign (sign(0) = +) and the others, and join two
+// of one kind when a link edge joins them: the groups are the regions the zero set cuts a small sphere
+// around v into. Where f is close to linear across the star there is one group of each kind.
 #include "vitri/delaunay/triangulation.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cstddef>
-#include <numeric>
+#include <cstdint>
 #include <vector>
 
 namespace vitri {
 
-struct LinkSignGroups {
-  int negative = 0;  ///< groups of negative link vertices
-  int positive = 0;  ///< groups of non-negative link vertices
-  /// A zero-valued z counts as positive (sign(0) = +), so it joins the positive groups of its link
-  /// through a point where f = 0: with two or more of them and a negative one between, the
-  /// piecewise-linear zero set has a neck of zero width at z (a handle or a tube that f itself need not
-  /// have: f = 0 at z only says the surface passes through z).
-  bool pinched() const { return negative >= 1 && positive >= 2; }
+struct LinkGroups {
+  int own = 0;    ///< groups of link vertices of the center's sign
+  int other = 0;  ///< groups of link vertices of the other sign
+  /// Two or more groups of the center's sign with the other sign between them: the region of that sign
+  /// passes through the center alone, and the piecewise-linear zero set has a tube around it (a handle
+  /// the function need not have). One group of each, or several of the other sign (a gap the center
+  /// keeps apart, the disks around each), is not a neck.
+  bool neck() const { return other >= 1 && own >= 2; }
 };
 
-/// The groups of the link of `center` in `star` (the tetrahedra around it, as vertex quadruples, each
-/// should hold center; others are ignored); negative(u) is the sign of link vertex u. O(k log k) for k link vertices.
-template <class Negative>
-LinkSignGroups link_sign_groups(VertexId center, const std::vector<std::array<VertexId, 4>>& star,
-                                Negative&& negative) {
-  std::vector<VertexId> ids;
-  ids.reserve(3 * star.size());
-  const auto holds_center = [&](const std::array<VertexId, 4>& t) {
-    return std::find(t.begin(), t.end(), center) != t.end();
+/// Buffers of link_groups(), reused between calls: an open-addressing table from link vertex ids to
+/// local indices (slots stamped with the call's number, so that nothing is cleared between calls), and
+/// the union-find forest over the local indices.
+struct LinkScratch {
+  std::vector<VertexId> key;
+  std::vector<std::uint32_t> local;
+  std::vector<std::uint32_t> stamp;
+  std::uint32_t call = 0;
+  std::vector<std::uint32_t> parent;
+  std::vector<std::uint8_t> other;
+};
+
+/// The groups of the link of `center` in the tetrahedra star[0, n) (vertex quadruples; those without
+/// center are ignored); differs(u) tells whether link vertex u has the other sign. O(n) expected, no
+/// allocation once the scratch has grown.
+template <class Differs>
+LinkGroups link_groups(VertexId center, const std::array<VertexId, 4>* star, std::size_t n, Differs&& differs,
+                       LinkScratch& s) {
+  // A table of at least twice the possible link vertices (3 per tetrahedron), a power of two.
+  std::size_t size = 16;
+  while (size < 6 * n) size *= 2;
+  if (s.key.size() < size) {
+    s.key.assign(size, 0);
+    s.local.assign(size, 0);
+    s.stamp.assign(size, 0);
+    s.call = 0;
+  }
+  if (++s.call == 0) {  // the stamps wrapped: old ones could match again
+    std::fill(s.stamp.begin(), s.stamp.end(), 0);
+    s.call = 1;
+  }
+  const std::size_t mask = size - 1;
+  s.parent.clear();
+  s.other.clear();
+  const auto index_of = [&](VertexId u) {
+    std::size_t h = (static_cast<std::size_t>(u) * 0x9E3779B1u) & mask;
+    while (s.stamp[h] == s.call) {
+      if (s.key[h] == u) return s.local[h];
+      h = (h + 1) & mask;
+    }
+    const auto i = static_cast<std::uint32_t>(s.parent.size());
+    s.stamp[h] = s.call;
+    s.key[h] = u;
+    s.local[h] = i;
+    s.parent.push_back(i);
+    s.other.push_back(differs(u) ? 1 : 0);
+    return i;
   };
-  for (const auto& t : star)
-    if (holds_center(t))
-      for (const VertexId u : t)
-        if (u != center) ids.push_back(u);
-  std::sort(ids.begin(), ids.end());
-  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  const auto slot = [&](VertexId u) {
-    return static_cast<std::size_t>(std::lower_bound(ids.begin(), ids.end(), u) - ids.begin());
-  };
-  std::vector<std::size_t> parent(ids.size());
-  std::iota(parent.begin(), parent.end(), std::size_t{0});
-  const auto root = [&](std::size_t a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  const auto root = [&](std::uint32_t a) {
+    while (s.parent[a] != a) a = s.parent[a] = s.parent[s.parent[a]];
     return a;
   };
-  std::vector<char> neg(ids.size());
-  for (std::size_t i = 0; i < ids.size(); ++i) neg[i] = negative(ids[i]) ? 1 : 0;
-  for (const auto& t : star) {
-    if (!holds_center(t)) continue;  // not a tetrahedron of center's star
-    std::array<std::size_t, 3> face{};
-    int k = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::array<VertexId, 4>& t = star[i];
+    if (t[0] != center && t[1] != center && t[2] != center && t[3] != center) continue;  // not in the star
+    std::array<std::uint32_t, 3> face{};
+    int j = 0;
     for (const VertexId u : t)
-      if (u != center) face[k++] = slot(u);
+      if (u != center) face[j++] = index_of(u);
     for (int a = 0; a < 3; ++a) {
-      const std::size_t x = face[a], y = face[(a + 1) % 3];
-      if (neg[x] == neg[y]) parent[root(x)] = root(y);
+      const std::uint32_t x = face[a], y = face[(a + 1) % 3];
+      if (s.other[x] == s.other[y]) s.parent[root(x)] = root(y);
     }
   }
-  LinkSignGroups g;
-  for (std::size_t i = 0; i < ids.size(); ++i)
-    if (root(i) == i) ++(neg[i] ? g.negative : g.positive);
+  LinkGroups g;
+  for (std::uint32_t i = 0; i < s.parent.size(); ++i)
+    if (root(i) == i) ++(s.other[i] ? g.other : g.own);
   return g;
+}
+
+/// The same with a star as a vector and fresh buffers.
+template <class Differs>
+LinkGroups link_groups(VertexId center, const std::vector<std::array<VertexId, 4>>& star, Differs&& differs) {
+  LinkScratch s;
+  return link_groups(center, star.data(), star.size(), differs, s);
 }
 
 }  // namespace vitri

@@ -24,8 +24,8 @@
 //
 // Files: this one (construction, evaluation, classification, lone zeros, queue, refinement), thin
 // features (thin_features.cpp), vertex edits (vertex_edits.cpp), function changes and garbage collection
-// (function_changes.cpp), extraction (extract.cpp over surface_tracker.hpp) and its repair of pinched
-// zeros (pinched_zeros.cpp), the closing function of close_at_box (box_closure.cpp).
+// (function_changes.cpp), necks (necks.cpp), extraction (extract.cpp over surface_tracker.hpp), the
+// closing function of close_at_box (box_closure.cpp).
 #include "vitri/polygonize/polygonizer.hpp"
 
 #include "polygonizer_internal.hpp"
@@ -55,13 +55,6 @@ TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
 }
 
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
-// Thin features: an edge with ends of one sign that is probably crossed twice is refined only when the
-// gradients at its ends point into opposite half-spaces (cosine below this): the crossings then belong to
-// sheets facing each other. A chord of one smooth sheet has nearly parallel end gradients. (Measured on
-// hand.off, largest-first at 0.015: an edge at 85 degrees still bridges a gap; a 60-degree bound, with
-// or without a smaller proximity for these points, made hand.off worse at 0.03-0.04: see the docs.)
-// Proximity distance of thin-feature points, as a fraction of the refinement's (1: the same rule).
-constexpr double kThinDistance = 1.0;
 
 /// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
 /// removal swaps the last element in. @pre x is not listed (on) or listed (off).
@@ -190,6 +183,7 @@ void Polygonizer::grow_vertex_arrays() {
   fixed_.resize(n, 0);
   tcount_.resize(n, 0);
   lpos_.resize(n, kNotListed);
+  neck_mark_.resize(n, 0);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   grad_.resize(n, Point3{nan, nan, nan});
 }
@@ -357,6 +351,7 @@ void Polygonizer::absorb_renumbering() {
 
 void Polygonizer::classify(TetId t, bool requeue) {
   if (!tri_.is_live(t)) return;
+  if (options_.refine_necks) note_neck_candidates(t);  // its vertices' links changed (necks.cpp)
   const bool was = tpos_[t] != kNotListed;
   const bool now = is_transverse(t);
   if (now && (!was || requeue)) radius_[t] = tri_.circumradius(t);
@@ -516,37 +511,11 @@ void Polygonizer::sample(double radius) {
   }
 }
 
-bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
-  if (!(precision > 0.0) || !std::isfinite(precision))
-    throw InvalidArgument("refine: precision must be positive and finite");
-  const auto t0 = Clock::now();
-  // After edits at the same precision (the Mesher's updates), the queue already holds every active
-  // tetrahedron above the precision (classify() and settle_zeros() queue them as they appear), and only
-  // the tetrahedra created or around changed vertices need the thin-feature test: no pass over the mesh.
-  const bool resume = queue_valid_ && precision == precision_ && !thin_all_;
-  precision_ = precision;
-  const double dmin = options_.min_distance_fraction * precision;
-  if (!resume) {
-    clear_queue();
-    for (const TetId t : tlist_)
-      if (radius_[t] > precision) push(t);
-    for (const VertexId z : lonely_)
-      for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
-  }
-  // Thin features: edges shorter than 2 dmin are not checked (every point of them is within dmin of an
-  // end, so its point would be rejected anyway). A new precision checks every live tetrahedron (the
-  // length floor moved); a resumed one those changed since; from then on only the created ones.
+bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info) {
+  const double precision = precision_;
   const bool thin = options_.refine_thin_features;
   const double thin_dmin = kThinDistance * dmin, thin_min = 2.0 * thin_dmin;
-  thin_.clear();
-  if (thin) check_thin(resume ? thin_recheck_set() : tri_.live_tetrahedra(), thin_min);
-  thin_tets_.clear();
-  thin_vertices_.clear();
-  thin_all_ = false;
-  in_refine_ = true;
   std::vector<TetId> created, retry, fresh;
-  RefineProgress info;
-  bool completed = true;
   while (queued() > 0 || !thin_.empty()) {
     const std::size_t n = std::min(queued(), kRoundSize);
     for (std::size_t i = 0; i < n; ++i) {
@@ -577,14 +546,47 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
       info.vertices = tri_.num_vertices();
       info.queued = queued() + thin_.size();
       if (!progress(info)) {
-        completed = false;
         thin_all_ = true;
         clear_queue();
         thin_.clear();
-        break;
+        return false;
       }
     }
   }
+  return true;
+}
+
+bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
+  if (!(precision > 0.0) || !std::isfinite(precision))
+    throw InvalidArgument("refine: precision must be positive and finite");
+  const auto t0 = Clock::now();
+  // After edits at the same precision (the Mesher's updates), the queue already holds every active
+  // tetrahedron above the precision (classify() and settle_zeros() queue them as they appear), and only
+  // the tetrahedra created or around changed vertices need the thin-feature test: no pass over the mesh.
+  const bool resume = queue_valid_ && precision == precision_ && !thin_all_;
+  precision_ = precision;
+  const double dmin = options_.min_distance_fraction * precision;
+  if (!resume) {
+    clear_queue();
+    for (const TetId t : tlist_)
+      if (radius_[t] > precision) push(t);
+    for (const VertexId z : lonely_)
+      for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
+  }
+  // Thin features: edges shorter than 2 dmin are not checked (every point of them is within dmin of an
+  // end, so its point would be rejected anyway). A new precision checks every live tetrahedron (the
+  // length floor moved); a resumed one those changed since; from then on only the created ones.
+  thin_.clear();
+  if (options_.refine_thin_features)
+    check_thin(resume ? thin_recheck_set() : tri_.live_tetrahedra(), 2.0 * kThinDistance * dmin);
+  thin_tets_.clear();
+  thin_vertices_.clear();
+  thin_all_ = false;
+  in_refine_ = true;
+  RefineProgress info;
+  bool completed = drain_queue(dmin, progress, info);
+  stats_.neck_seconds = 0;
+  if (completed && options_.refine_necks) completed = settle_necks(dmin, progress, info);
   // Status at the box hull: active tetrahedra with a hull face still larger than the precision (their
   // fallback points were rejected). A hull face has three corners, so these are among the corners' stars.
   std::vector<TetId> hull;

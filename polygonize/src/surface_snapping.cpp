@@ -10,7 +10,6 @@
 // when a decision flips, the higher anchored vertices of the flipped vertex's star are re-decided too
 // (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
 // result equals the one-pass result, which the tests check against a fresh tracker.
-#include "link_signs.hpp"
 #include "surface_tracker.hpp"
 #include "vitri/core/threads.hpp"
 
@@ -92,7 +91,6 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
       heap.pop();
       now = can_collapse(in, z);  // leaves the star of a live z in star_
     }
-    if (!now && in.values[z] == 0.0 && in.tri.is_vertex(z)) note_if_pinched(in, z);
     if (now == static_cast<bool>(collapsed_[z])) continue;
     collapsed_[z] = now ? 1 : 0;
     num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
@@ -164,13 +162,6 @@ Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
   const Point3 q = newton_target(p, fz, g);
   snap_target_.emplace(z, q);
   return q;
-}
-
-void SurfaceTracker::note_if_pinched(const TrackerInput& in, VertexId z) {
-  star_vertices_.clear();
-  for (const TetId t : star_) star_vertices_.push_back(in.tri.tet_vertices(t));
-  const auto negative = [&](VertexId u) { return in.values[u] < 0.0; };
-  if (link_sign_groups(z, star_vertices_, negative).pinched()) report_.pinched.push_back(z);
 }
 
 bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {

@@ -58,10 +58,6 @@ struct TrackerReport {
   std::size_t snapped = 0;              ///< vertices whose anchored crossings are collapsed (all of them)
   std::size_t offset = 0;               ///< vertices with anchored crossings left in place (all of them)
   std::size_t placed_edges = 0;         ///< crossings placed by this update
-  /// Zero-valued vertices decided by this update whose collapse was refused and whose link is pinched
-  /// (LinkSignGroups::pinched, link_signs.hpp): the Polygonizer refines their stars (docs/polygonize.md,
-  /// "Pinched zeros"). A vertex not re-decided is not listed again: nothing around it changed.
-  std::vector<VertexId> pinched;
   // Seconds of the update's steps: which tetrahedra and polygons changed, root placement (function
   // evaluations), collapse decisions, the live mesh's edits (triangles and vertices).
   double polygons_seconds = 0, placement_seconds = 0, snapping_seconds = 0, mesh_seconds = 0;
@@ -177,9 +173,6 @@ class SurfaceTracker {
   bool collapse_test(const TrackerInput& in, VertexId z);
   void gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const;
   bool fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count);
-  /// z is zero-valued, live, its collapse refused and its star in star_: lists it in report_.pinched
-  /// when its link is pinched.
-  void note_if_pinched(const TrackerInput& in, VertexId z);
   void remesh_polygons(const TrackerInput& in, Work& w);
   std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);
   void drop_triangle(std::uint32_t t);
@@ -223,7 +216,6 @@ class SurfaceTracker {
   std::vector<TetId> star_;
   std::vector<FanTriangle> fan_;
   std::vector<std::pair<std::uint32_t, std::uint32_t>> link_;
-  std::vector<std::array<VertexId, 4>> star_vertices_;  // note_if_pinched() scratch
   std::vector<std::uint64_t> id_bits_;  // scratch of sort_unique_ids (sorted_ids.hpp), all zero between calls
   // Reported changes since the last update.
   std::vector<TetId> killed_, created_;

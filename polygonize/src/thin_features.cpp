@@ -119,7 +119,7 @@ void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
 
 std::vector<TetId> Polygonizer::thin_recheck_set() {
   // With the history (an interactive session: a recheck per edit) repeated tetrahedra are dropped by
-  // marks, O(set); a batch run rechecks rarely (after the extraction's points for pinched zeros) and
+  // marks, O(set); a batch run rechecks rarely (a new precision checks every tetrahedron instead) and
   // sorts the repeats out instead, so that no mark array over every tetrahedron (4 bytes each, 0.12 GB
   // at 10^6 input points) stays resident for a few thousand ids.
   const bool marks = options_.keep_history;

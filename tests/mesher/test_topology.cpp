@@ -9,15 +9,8 @@
 //   the right hand in the hip), so no closed embedded surface through all its vertices has the Euler
 //   characteristic of its faces (2): the function must pass through the buried vertices and grows
 //   internal sheets (chi -348 and 4 bubbles at 0.01).
-// - turbine.off at its data precision (0.0145 of the diagonal) or 0.01, local: blades thinner than the
-//   precision and long CAD triangles whose interiors carry no constraint (the function bulges out by up
-//   to 6% of the diagonal between their corners): chi -92 and -50 against -20 (-136 and -92 before the
-//   pinched-zero repair; -22 at 0.007, one handle). At 0.006 and 0.005 it is right (in the matrix; a tiny
-//   triangle at 0.005 was fixed in the surface tracker). Global: a subsample that the O(N^3) fit can afford (1000 points) does not carry
-//   its 11 holes (chi -2 to -4).
-// bear.off local at 0.005 and elephant.off global at 0.01 were left out for handles at zero-valued
-// constraints that joined two positive regions of their links; the extraction's pinched-zero repair
-// (docs/polygonize.md) fixed both.
+// - turbine.off global: a subsample that the O(N^3) fit can afford (1000 points) does not carry its 11
+//   holes (chi -2 to -4).
 // - building.ply: an open scan (the ground is sampled with upward normals, no floor, 25% of the points
 //   in no segment): it has no Euler characteristic to compare with.
 #include <catch2/catch.hpp>
@@ -108,7 +101,8 @@ TEST_CASE("topology matrix: local function, every vertex", "[.][slow][topology][
                           TopologyCase{"bear.off", FunctionKind::Local, 0, kDataPrecision},
                           TopologyCase{"bear.off", FunctionKind::Local, 0, 0.01},
                           TopologyCase{"bear.off", FunctionKind::Local, 0, 0.005},
-                          TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.006},
+                          TopologyCase{"turbine.off", FunctionKind::Local, 0, kDataPrecision},
+                          TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.01},
                           TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.005}));
 }
 

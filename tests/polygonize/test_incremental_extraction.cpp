@@ -181,39 +181,40 @@ std::vector<std::array<VertexId, 4>> octahedron_star() {
   return star;
 }
 
-LinkSignGroups groups_with_negative(std::initializer_list<VertexId> negative) {
+// The center counts positive; `negative` lists the link vertices of the other sign.
+LinkGroups groups_with_negative(std::initializer_list<VertexId> negative) {
   const std::vector<VertexId> neg(negative);
   const auto is_negative = [&](VertexId u) { return std::find(neg.begin(), neg.end(), u) != neg.end(); };
-  return link_sign_groups(0, octahedron_star(), is_negative);
+  return link_groups(0, octahedron_star(), is_negative);
 }
 
-TEST_CASE("link_sign_groups: the sign groups of a hand-made link", "[incremental]") {
+TEST_CASE("link_groups: the sign groups of a hand-made link", "[incremental]") {
   // A plane through the center: one group of each sign.
-  LinkSignGroups g = groups_with_negative({6});
-  CHECK((g.negative == 1 && g.positive == 1 && !g.pinched()));
+  LinkGroups g = groups_with_negative({6});
+  CHECK((g.other == 1 && g.own == 1 && !g.neck()));
   g = groups_with_negative({2, 4, 6});
-  CHECK((g.negative == 1 && g.positive == 1 && !g.pinched()));
-  // A negative band between +z and -z (a slab thinner than the star): two positive caps, pinched.
+  CHECK((g.other == 1 && g.own == 1 && !g.neck()));
+  // A negative band between +z and -z (a slab thinner than the star): two positive caps, a neck.
   g = groups_with_negative({1, 2, 3, 4});
-  CHECK((g.negative == 1 && g.positive == 2 && g.pinched()));
-  // The dual: two negative caps in a positive band (a gap between two parts): not pinched under
-  // sign(0) = +, the center keeps the caps apart.
+  CHECK((g.other == 1 && g.own == 2 && g.neck()));
+  // The dual: two negative caps in a positive band (a gap between two parts, the center in it): not
+  // a neck, the center keeps the caps apart.
   g = groups_with_negative({5, 6});
-  CHECK((g.negative == 2 && g.positive == 1 && !g.pinched()));
+  CHECK((g.other == 2 && g.own == 1 && !g.neck()));
   // The band around the x axis: the caps +x and -x share no link edge.
   g = groups_with_negative({3, 4, 5, 6});
-  CHECK((g.negative == 1 && g.positive == 2 && g.pinched()));
+  CHECK((g.other == 1 && g.own == 2 && g.neck()));
   // +x and +z share one: a single positive group.
   g = groups_with_negative({2, 3, 4, 6});
-  CHECK((g.negative == 1 && g.positive == 1 && !g.pinched()));
-  // No negative neighbour: nothing crosses, nothing to pinch.
+  CHECK((g.other == 1 && g.own == 1 && !g.neck()));
+  // No negative neighbour: nothing crosses.
   g = groups_with_negative({});
-  CHECK((g.negative == 0 && g.positive == 1 && !g.pinched()));
+  CHECK((g.other == 0 && g.own == 1 && !g.neck()));
   // Tetrahedra without the center are ignored.
   auto star = octahedron_star();
   star.push_back({1, 3, 5, 7});
   const auto none = [](VertexId) { return false; };
-  CHECK(link_sign_groups(0, star, none).positive == 1);
+  CHECK(link_groups(0, star, none).own == 1);
 }
 
 TEST_CASE("place_crossings: roots of a linear function, zero ends offset, warm starts", "[incremental]") {

@@ -23,11 +23,11 @@ using test::metrics_of;
 /// Euler characteristic of a fresh polygonization of the mesher's RBF, built as vitri::Mesher (and so
 /// `vitri mesh`) builds it: constraint points as seeds with their values, domain = their box x 2.
 long long euler_at(const Mesher& mesher, double relative, QueueOrder order, bool thin = true,
-                   bool pinches = true) {
+                   bool necks = true) {
   PolygonizerOptions o;
   o.order = order;
   o.refine_thin_features = thin;
-  o.refine_pinched_zeros = pinches;
+  o.refine_necks = necks;
   const Constraints& c = mesher.constraints();
   Polygonizer poly(mesher.function(), Polygonizer::domain_for(c.points, 2.0), c.points, c.values, o);
   REQUIRE(poly.refine(relative * mesher.diagonal()));
@@ -63,8 +63,8 @@ TEST_CASE("thin features: hand.off has the hand's topology at 0.02, 0.015 and 0.
 }
 
 // Largest-first at 0.015 used to keep one spurious handle after the rule (chi 0; -2 before it), a gap
-// whose end gradients are 85 degrees apart; the pinched-zero repair of the extraction removes it (the
-// last check above).
+// whose end gradients are 85 degrees apart; the neck rule removes it (the last check above), and the
+// handle of the check without the thin-feature rule too, so that check turns both off.
 
 /// A slab |z| < t (closed by the box into a flat closed pancake), with zero-valued seeds on its top face.
 class SlabFunction final : public ImplicitFunction {
@@ -83,8 +83,8 @@ class SlabFunction final : public ImplicitFunction {
 // The slab is 0.03 thick, half the precision (0.06), so the stars of the seeds on its top face reach
 // below it: where a seed's link has positive vertices above and below with the slab's negative ones
 // between, the seed (f = 0, counted positive) joins them and the piecewise-linear zero set gets a handle
-// through the slab at it. The repair refines those stars below the precision until the slab shows.
-TEST_CASE("pinched zeros: seeds on a slab thinner than the precision give no handle", "[polygonize]") {
+// through the slab at it. The neck rule refines those stars below the precision until the slab shows.
+TEST_CASE("necks: seeds on a slab thinner than the precision give no handle", "[polygonize]") {
   const double t = 0.015;
   const SlabFunction f(t);
   std::vector<Point3> seeds;
@@ -95,30 +95,29 @@ TEST_CASE("pinched zeros: seeds on a slab thinner than the precision give no han
     }
   const std::vector<double> zeros(seeds.size(), 0.0);
   const Box3 box{{-1.0, -1.0, -1.0}, {1.0, 1.0, 1.0}};
-  for (const bool repair : {true, false}) {
+  for (const bool necks : {true, false}) {
     PolygonizerOptions o;
-    o.refine_pinched_zeros = repair;
+    o.refine_necks = necks;
     Polygonizer poly(f, box, seeds, zeros, o);
     REQUIRE(poly.refine(0.06));
     const MeshMetrics mm = metrics_of(poly.extract());
     const PolygonizerStats s = poly.stats();
-    INFO((repair ? "with" : "without") << " the repair: chi " << mm.euler_characteristic << ", "
-                                       << s.pinch_insertions << " points for pinched zeros");
+    INFO((necks ? "with" : "without") << " the rule: chi " << mm.euler_characteristic << ", "
+                                      << s.neck_insertions << " points for necks");
     REQUIRE(mm.closed_manifold());
     REQUIRE(mm.components == 1);
-    if (repair) {
+    if (necks) {
       CHECK(mm.euler_characteristic == 2);
-      CHECK(s.pinch_insertions > 0);
-      CHECK(s.pinched_zeros == 0);
-      // The repair's points are part of the state: a fresh extraction of it is the same mesh, and
-      // extracting again changes nothing.
-      CHECK(metrics_of(poly.extract_fresh()).euler_characteristic == 2);
-      const std::size_t vertices = poly.stats().vertices;
-      CHECK(metrics_of(poly.extract()).euler_characteristic == 2);
-      CHECK(poly.stats().vertices == vertices);
+      CHECK(s.neck_insertions > 0);
+      CHECK(s.necks_left == 0);
+      // Nothing is left to do: refining again at the same precision inserts nothing.
+      REQUIRE(poly.refine(0.06));
+      CHECK(poly.stats().vertices == s.vertices);
+      CHECK(poly.stats().neck_insertions == s.neck_insertions);
     } else {
-      CHECK(mm.euler_characteristic < 2);  // the handles the repair removes
-      CHECK(s.pinch_insertions == 0);
+      CHECK(mm.euler_characteristic < 2);  // the handles the rule removes
+      CHECK(s.neck_insertions == 0);
+      CHECK(s.neck_checks == 0);
     }
   }
 }

@@ -109,15 +109,16 @@ struct PolygonizerOptions {
   /// constraints). false restores the plain rule (only transverse tetrahedra are refined). See
   /// docs/polygonize.md.
   bool refine_lone_zeros = true;
-  /// Pinched zeros: a zero-valued vertex whose crossings cannot be collapsed and whose link has two or
-  /// more groups of non-negative vertices (LinkSignGroups::pinched) joins them through a point where
-  /// f = 0 under sign(0) = +: the piecewise-linear zero set gets a neck there (a spurious handle, e.g.
-  /// where the surface through an on-surface constraint bounds a part thinner than the star). The
-  /// extraction finds them (they are among the collapse tests it runs anyway), inserts the circumcenters
-  /// of their stars' tetrahedra larger than the proximity distance (min_distance_fraction x precision),
-  /// refines the new active tetrahedra to the precision and extracts again, until none is left or nothing
-  /// can be inserted. Only after a completed refine(). See docs/polygonize.md. false: no such points.
-  bool refine_pinched_zeros = true;
+  /// Necks: a vertex whose link (the faces opposite it in its tetrahedra) has two or more groups of
+  /// vertices of its own sign (sign(0) = +), separated by vertices of the other sign, joins those
+  /// regions through itself alone: the piecewise-linear zero set gets a tube around it, i.e. a handle
+  /// that f need not have (a part or a gap thinner than the star; an on-surface constraint, f = 0, on a
+  /// thin part). refine() then inserts the circumcenters of the vertex's tetrahedra larger than the
+  /// proximity distance (min_distance_fraction x precision, so below the precision), refines the new
+  /// active tetrahedra and checks again, until no neck is left or none can be refined further. Only
+  /// vertices whose tetrahedra changed are checked (on `threads`). See docs/polygonize.md, "Necks".
+  /// false: no such points (the paper's rule).
+  bool refine_necks = true;
   /// Mesh f closed by the domain box (BoxClosedFunction, box_closure.hpp): within
   /// `box_band_fraction` (0.1, in (0, 0.5)) x the box's smallest side of its boundary the function is
   /// made positive (keep seeds out of that band: closing_band()), so a
@@ -179,18 +180,18 @@ struct PolygonizerStats {
   std::size_t zero_offset = 0;          ///< last extract(): vertices with anchored crossings left at their offset
   std::size_t lone_zeros = 0;           ///< current zero-valued vertices touched by no transverse tetrahedron
   std::size_t lone_zero_insertions = 0; ///< refinement points inserted for the stars of lone zeros
-  std::size_t pinch_insertions = 0;     ///< points inserted by extractions in the stars of pinched zeros
-  /// Last extraction: pinched zeros left after it (none of their stars' tetrahedra larger than the
-  /// proximity distance), counted among those it decided.
-  std::size_t pinched_zeros = 0;
+  std::size_t neck_insertions = 0;      ///< refine(): points inserted in the stars of necks (refine_necks)
+  std::size_t neck_checks = 0;          ///< refine(): vertices whose link was checked for a neck
+  /// After the last refine(): necks left (none of their tetrahedra larger than the proximity distance).
+  std::size_t necks_left = 0;
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
   double refine_seconds = 0;            ///< last refine() call
   double extract_seconds = 0;           ///< last extract() call
   /// Of the last extraction: finding the changed polygons, placing crossings (evaluations of f),
-  /// deciding collapses, editing the live mesh, and the points and refinement for pinched zeros
-  /// (refine_pinched_zeros; its tracking is in the others); they add up to about extract_seconds.
+  /// deciding collapses, editing the live mesh (they add up to about extract_seconds).
   double extract_polygons_seconds = 0, extract_placement_seconds = 0, extract_snapping_seconds = 0,
-         extract_mesh_seconds = 0, extract_pinch_seconds = 0;
+         extract_mesh_seconds = 0;
+  double neck_seconds = 0;              ///< of the last refine(): the neck checks and their points
   double update_seconds = 0;            ///< last function_changed() call
 };
 
@@ -333,8 +334,19 @@ class Polygonizer {
   const PolygonizerOptions& options() const { return options_; }
 
  private:
-  void track_surface();
-  void repair_pinched_zeros();
+  /// The refinement loop of refine(): pops queued active tetrahedra and flagged thin edges until none is
+  /// left; false when the callback cancelled. `info` accumulates the progress of the whole call.
+  bool drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info);
+  /// Necks (necks.cpp): marks the vertices of a classified tetrahedron for the next check.
+  void note_neck_candidates(TetId t);
+  void note_neck_vertex(VertexId v);
+  /// The marked vertices that are necks, in increasing id (checked on the threads).
+  std::vector<VertexId> find_necks();
+  /// One round of points in the stars of `necks`; returns how many were inserted.
+  std::size_t insert_neck_points(const std::vector<VertexId>& necks, double dmin,
+                                 std::vector<TetId>& created);
+  /// After the queue drained: neck checks and their points until none is left (false: cancelled).
+  bool settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info);
   bool is_negative_value(VertexId v) const { return values_[v] < 0.0; }  // sign(0) = +
   void grow_vertex_arrays();
   void grow_tet_arrays();
@@ -384,6 +396,9 @@ class Polygonizer {
   std::vector<std::uint32_t> lpos_;     // per vertex: index in lonely_, or kNotListed
   std::vector<VertexId> lonely_;        // lone zeros: value 0, tcount_ 0 (their stars are active)
   std::vector<VertexId> zcheck_;        // zero vertices whose loneliness may have changed (settle_zeros)
+  // Necks: vertices of tetrahedra classified since the last check (neck_mark_ 1 while listed).
+  std::vector<VertexId> neck_candidates_;
+  std::vector<std::uint8_t> neck_mark_;
   std::vector<VertexId> pending_;       // vertices waiting for their value (batch)
   std::vector<VertexId> seed_vertices_;
   std::deque<TetId> fifo_;

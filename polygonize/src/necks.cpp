@@ -1,0 +1,138 @@
+// Necks (docs/polygonize.md, "Necks"): vertices through which alone a region of their sign passes.
+//
+// A vertex v counts with its sign (sign(0) = +). When the vertices of its link that share that sign
+// form two or more groups with vertices of the other sign between them (link_signs.hpp), the region of
+// v's sign passes through v alone, and the piecewise-linear zero set of marching tetrahedra has a tube
+// around v: a handle of zero width that f need not have. Typical causes: a part or a gap thinner than
+// the star (both sides of it reach the link), and on-surface constraints (f = 0, counted positive) on
+// such a part, which cannot be collapsed there either.
+//
+// refine() checks the vertices of the tetrahedra classified since the last check (created, or around
+// a vertex whose sign changed: the only events that change a link's signs) once its queue is empty, on
+// the threads. For every neck it inserts the circumcenters of the tetrahedra of its star whose
+// circumradius exceeds the proximity distance d = min_distance_fraction x precision (below the
+// precision: a circumcenter is at distance >= R > d from every vertex, so it always passes), refines the
+// new active tetrahedra to the precision, and checks again the vertices of the tetrahedra this
+// classified. It stops when no neck is found or none of those found has a tetrahedron larger than d
+// (stats().necks_left). Termination: every point is at least d from every vertex, in the box (the
+// packing bound of docs/polygonize.md).
+#include "link_signs.hpp"
+#include "polygonizer_internal.hpp"
+#include "vitri/core/threads.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+
+#include <algorithm>
+#include <thread>
+
+namespace vitri {
+
+using namespace polygonizer_detail;
+
+namespace {
+
+// Checks below this many candidates run on one thread (starting threads would cost more).
+constexpr std::size_t kNeckSliceMin = std::size_t(1) << 12;
+
+}  // namespace
+
+void Polygonizer::note_neck_vertex(VertexId v) {
+  if (neck_mark_[v]) return;
+  neck_mark_[v] = 1;
+  neck_candidates_.push_back(v);
+}
+
+void Polygonizer::note_neck_candidates(TetId t) {
+  for (const VertexId u : tri_.tet_vertices(t)) note_neck_vertex(u);
+}
+
+std::vector<VertexId> Polygonizer::find_necks() {
+  std::vector<VertexId> candidates;
+  candidates.swap(neck_candidates_);
+  std::size_t kept = 0;
+  for (const VertexId v : candidates) {
+    neck_mark_[v] = 0;
+    // A neck has vertices of both signs around it (a transverse tetrahedron); corners have no full link.
+    if (tri_.is_vertex(v) && !tri_.is_corner(v) && tcount_[v] > 0) candidates[kept++] = v;
+  }
+  candidates.resize(kept);
+  std::sort(candidates.begin(), candidates.end());
+  stats_.neck_checks += candidates.size();
+  std::vector<std::uint8_t> neck(candidates.size(), 0);
+  const auto check = [&](std::size_t lo, std::size_t hi) {
+    std::vector<TetId> star;
+    std::vector<std::array<VertexId, 4>> quads;
+    LinkScratch scratch;
+    for (std::size_t i = lo; i < hi; ++i) {
+      const VertexId v = candidates[i];
+      tri_.incident_tetrahedra(v, star);
+      quads.clear();
+      for (const TetId t : star) quads.push_back(tri_.tet_vertices(t));
+      const bool negative = is_negative(values_[v]);
+      const auto differs = [&](VertexId u) { return is_negative(values_[u]) != negative; };
+      neck[i] = link_groups(v, quads.data(), quads.size(), differs, scratch).neck() ? 1 : 0;
+    }
+  };
+  const std::size_t n = candidates.size();
+  const std::size_t slices =
+      std::min<std::size_t>(resolve_thread_count(options_.threads), n / kNeckSliceMin + 1);
+  if (slices <= 1) {
+    check(0, n);
+  } else {
+    std::vector<std::thread> pool;
+    for (std::size_t k = 1; k < slices; ++k) pool.emplace_back(check, k * n / slices, (k + 1) * n / slices);
+    check(0, n / slices);
+    for (std::thread& th : pool) th.join();
+  }
+  std::vector<VertexId> necks;
+  for (std::size_t i = 0; i < n; ++i)
+    if (neck[i]) necks.push_back(candidates[i]);
+  return necks;
+}
+
+std::size_t Polygonizer::insert_neck_points(const std::vector<VertexId>& necks, double dmin,
+                                            std::vector<TetId>& created) {
+  std::size_t inserted = 0;
+  std::vector<TetId> star;
+  for (const VertexId v : necks) {
+    tri_.incident_tetrahedra(v, star);
+    for (const TetId t : star)  // an earlier point of this star may have killed t
+      if (tri_.is_live(t) && tri_.circumradius(t) > dmin &&
+          insert_refinement_point(t, dmin, VertexKind::Refinement, created))
+        ++inserted;
+  }
+  return inserted;
+}
+
+bool Polygonizer::settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info) {
+  const auto t0 = Clock::now();
+  const bool thin = options_.refine_thin_features;
+  const double thin_min = 2.0 * kThinDistance * dmin;
+  std::vector<TetId> created, fresh;
+  bool completed = true;
+  stats_.necks_left = 0;
+  for (;;) {
+    const std::vector<VertexId> necks = find_necks();
+    const std::size_t inserted = insert_neck_points(necks, dmin, created);
+    if (inserted == 0) {
+      // Left as they are (no tetrahedron of theirs above d): checked again by the next refine(), whose
+      // precision, hence d, may be smaller.
+      stats_.necks_left = necks.size();
+      for (const VertexId v : necks) note_neck_vertex(v);
+      break;
+    }
+    stats_.neck_insertions += inserted;
+    info.inserted += inserted;
+    evaluate_pending();
+    if (thin) fresh.assign(created.begin(), created.end());
+    classify_created(created);
+    if (thin) check_thin(fresh, thin_min);
+    if (!drain_queue(dmin, progress, info)) {
+      completed = false;
+      break;
+    }
+  }
+  stats_.neck_seconds = seconds_since(t0);
+  return completed;
+}
+
+}  // namespace vitri

@@ -126,6 +126,15 @@ bool Polygonizer::settle_necks(double dmin, const ProgressCallback& progress, Re
     if (thin) fresh.assign(created.begin(), created.end());
     classify_created(created);
     if (thin) check_thin(fresh, thin_min);
+    if (progress) {  // after a round of checks (seconds at 10^6 points): the state is consistent here
+      info.vertices = tri_.num_vertices();
+      info.queued = queued() + thin_.size();
+      if (!progress(info)) {
+        cancel_refinement();
+        completed = false;
+        break;
+      }
+    }
     if (!drain_queue(dmin, progress, info)) {
       completed = false;
       break;

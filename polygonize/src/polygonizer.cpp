@@ -511,6 +511,12 @@ void Polygonizer::sample(double radius) {
   }
 }
 
+void Polygonizer::cancel_refinement() {
+  thin_all_ = true;  // the next refine() checks every tetrahedron for thin features again
+  clear_queue();
+  thin_.clear();
+}
+
 bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const double precision = precision_;
   const bool thin = options_.refine_thin_features;
@@ -546,9 +552,7 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
       info.vertices = tri_.num_vertices();
       info.queued = queued() + thin_.size();
       if (!progress(info)) {
-        thin_all_ = true;
-        clear_queue();
-        thin_.clear();
+        cancel_refinement();
         return false;
       }
     }

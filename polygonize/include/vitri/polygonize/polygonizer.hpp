@@ -337,6 +337,8 @@ class Polygonizer {
   /// The refinement loop of refine(): pops queued active tetrahedra and flagged thin edges until none is
   /// left; false when the callback cancelled. `info` accumulates the progress of the whole call.
   bool drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info);
+  /// The callback cancelled: the queue and the flagged edges are dropped (the next refine() rebuilds them).
+  void cancel_refinement();
   /// Necks (necks.cpp): marks the vertices of a classified tetrahedron for the next check.
   void note_neck_candidates(TetId t);
   void note_neck_vertex(VertexId v);

@@ -18,11 +18,10 @@
 // packing bound of docs/polygonize.md).
 #include "link_signs.hpp"
 #include "polygonizer_internal.hpp"
-#include "vitri/core/threads.hpp"
+#include "slices.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 
 #include <algorithm>
-#include <thread>
 
 namespace vitri {
 
@@ -58,7 +57,9 @@ std::vector<VertexId> Polygonizer::find_necks() {
   std::sort(candidates.begin(), candidates.end());
   stats_.neck_checks += candidates.size();
   std::vector<std::uint8_t> neck(candidates.size(), 0);
-  const auto check = [&](std::size_t lo, std::size_t hi) {
+  const std::size_t n = candidates.size();
+  const std::size_t slices = slice_count(options_.threads, n, kNeckSliceMin);
+  run_slices(n, slices, [&](std::size_t, std::size_t lo, std::size_t hi) {
     std::vector<TetId> star;
     std::vector<std::array<VertexId, 4>> quads;
     LinkScratch scratch;
@@ -71,18 +72,7 @@ std::vector<VertexId> Polygonizer::find_necks() {
       const auto differs = [&](VertexId u) { return is_negative(values_[u]) != negative; };
       neck[i] = link_groups(v, quads.data(), quads.size(), differs, scratch).neck() ? 1 : 0;
     }
-  };
-  const std::size_t n = candidates.size();
-  const std::size_t slices =
-      std::min<std::size_t>(resolve_thread_count(options_.threads), n / kNeckSliceMin + 1);
-  if (slices <= 1) {
-    check(0, n);
-  } else {
-    std::vector<std::thread> pool;
-    for (std::size_t k = 1; k < slices; ++k) pool.emplace_back(check, k * n / slices, (k + 1) * n / slices);
-    check(0, n / slices);
-    for (std::thread& th : pool) th.join();
-  }
+  });
   std::vector<VertexId> necks;
   for (std::size_t i = 0; i < n; ++i)
     if (neck[i]) necks.push_back(candidates[i]);
@@ -105,9 +95,7 @@ std::size_t Polygonizer::insert_neck_points(const std::vector<VertexId>& necks, 
 
 bool Polygonizer::settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const auto t0 = Clock::now();
-  const bool thin = options_.refine_thin_features;
-  const double thin_min = 2.0 * kThinDistance * dmin;
-  std::vector<TetId> created, fresh;
+  std::vector<TetId> created;
   bool completed = true;
   stats_.necks_left = 0;
   for (;;) {
@@ -122,10 +110,7 @@ bool Polygonizer::settle_necks(double dmin, const ProgressCallback& progress, Re
     }
     stats_.neck_insertions += inserted;
     info.inserted += inserted;
-    evaluate_pending();
-    if (thin) fresh.assign(created.begin(), created.end());
-    classify_created(created);
-    if (thin) check_thin(fresh, thin_min);
+    finish_round(created, dmin);
     if (progress) {  // after a round of checks (seconds at 10^6 points): the state is consistent here
       info.vertices = tri_.num_vertices();
       info.queued = queued() + thin_.size();

@@ -511,6 +511,17 @@ void Polygonizer::sample(double radius) {
   }
 }
 
+void Polygonizer::finish_round(std::vector<TetId>& created, double dmin) {
+  evaluate_pending();
+  if (!options_.refine_thin_features) {
+    classify_created(created);
+    return;
+  }
+  const std::vector<TetId> fresh(created);  // classify_created() empties `created`
+  classify_created(created);
+  check_thin(fresh, thin_min_length(dmin));
+}
+
 void Polygonizer::cancel_refinement() {
   thin_all_ = true;  // the next refine() checks every tetrahedron for thin features again
   clear_queue();
@@ -519,9 +530,8 @@ void Polygonizer::cancel_refinement() {
 
 bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const double precision = precision_;
-  const bool thin = options_.refine_thin_features;
-  const double thin_dmin = kThinDistance * dmin, thin_min = 2.0 * thin_dmin;
-  std::vector<TetId> created, retry, fresh;
+  const double thin_dmin = kThinDistance * dmin;
+  std::vector<TetId> created, retry;
   while (queued() > 0 || !thin_.empty()) {
     const std::size_t n = std::min(queued(), kRoundSize);
     for (std::size_t i = 0; i < n; ++i) {
@@ -541,10 +551,7 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
       while (!thin_.empty()) insert_thin_point(thin_dmin, created);
       info.inserted += stats_.thin_insertions - before;
     }
-    evaluate_pending();
-    if (thin) fresh.assign(created.begin(), created.end());
-    classify_created(created);
-    if (thin) check_thin(fresh, thin_min);
+    finish_round(created, dmin);
     for (const TetId t : retry)
       if (is_active(t)) push(t);
     retry.clear();
@@ -582,7 +589,7 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   // length floor moved); a resumed one those changed since; from then on only the created ones.
   thin_.clear();
   if (options_.refine_thin_features)
-    check_thin(resume ? thin_recheck_set() : tri_.live_tetrahedra(), 2.0 * kThinDistance * dmin);
+    check_thin(resume ? thin_recheck_set() : tri_.live_tetrahedra(), thin_min_length(dmin));
   thin_tets_.clear();
   thin_vertices_.clear();
   thin_all_ = false;

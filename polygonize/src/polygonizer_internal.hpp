@@ -26,6 +26,9 @@ inline double seconds_since(Clock::time_point t0) {
 // largest-first at 0.015: an edge at 85 degrees still bridged a gap; a 60-degree bound, with or without
 // a smaller proximity for these points, made hand.off worse at 0.03-0.04: see the docs.)
 inline constexpr double kThinDistance = 1.0;
+/// Edges shorter than this are not checked for thin features: every point of them is within the
+/// thin-feature proximity distance of an end, so its point would be rejected anyway.
+inline double thin_min_length(double dmin) { return 2.0 * kThinDistance * dmin; }
 
 /// The sign rule of the whole module: exactly 0 counts as positive.
 inline bool is_negative(double v) { return v < 0.0; }

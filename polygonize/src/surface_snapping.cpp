@@ -11,13 +11,12 @@
 // (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
 // result equals the one-pass result, which the tests check against a fresh tracker.
 #include "surface_tracker.hpp"
-#include "vitri/core/threads.hpp"
+#include "slices.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <functional>
 #include <queue>
-#include <thread>
 
 namespace vitri {
 
@@ -112,16 +111,16 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
   const std::size_t n = std::min(kLookaheadChunk, first.size() - from);
   look.begin = from;
   look.end = from + n;
-  const std::size_t slices = std::min<std::size_t>(resolve_thread_count(in.threads), n / kLookaheadSlice + 1);
+  const std::size_t slices = polygonizer_detail::slice_count(in.threads, n, kLookaheadSlice);
   look.slices.resize(slices);
   look.spans.assign(n, SnapLookahead::Span{});
-  const auto work = [&](std::size_t s) {
+  polygonizer_detail::run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
     SnapLookahead::Slice& out = look.slices[s];
     out.stars.clear();
     out.fans.clear();
     out.targets.clear();
     std::vector<TetId> star;
-    for (std::size_t k = s * n / slices; k < (s + 1) * n / slices; ++k) {
+    for (std::size_t k = lo; k < hi; ++k) {
       const VertexId z = first[from + k];
       in.tri.incident_tetrahedra(z, star);
       SnapLookahead::Span& sp = look.spans[k];
@@ -139,11 +138,7 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
       const double fz = in.f.value_gradient(p, g);
       out.targets.emplace_back(z, newton_target(p, fz, g));
     }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t s = 1; s < slices; ++s) pool.emplace_back(work, s);
-  work(0);
-  for (std::thread& th : pool) th.join();
+  });
   for (const SnapLookahead::Slice& slice : look.slices) {
     report_.evaluations += slice.targets.size();
     for (const auto& [z, q] : slice.targets) snap_target_.emplace(z, q);

@@ -1,7 +1,7 @@
 // Incremental marching tetrahedra (surface_tracker.hpp; docs/polygonize.md, "Incremental extraction"):
 // polygons, crossings and the live mesh. The collapse decisions (snapping) are in surface_snapping.cpp.
 #include "surface_tracker.hpp"
-#include "vitri/core/threads.hpp"
+#include "slices.hpp"
 
 #include "sorted_ids.hpp"
 
@@ -189,12 +189,8 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
     }
   };
   constexpr std::size_t kSliceMin = std::size_t(1) << 13;  // smaller batches: one thread
-  const std::size_t slices = std::min<std::size_t>(resolve_thread_count(in.threads), n / kSliceMin + 1);
-  if (slices <= 1) return march(0, n);
-  std::vector<std::thread> pool;
-  for (std::size_t s = 1; s < slices; ++s) pool.emplace_back(march, s * n / slices, (s + 1) * n / slices);
-  march(0, n / slices);
-  for (std::thread& th : pool) th.join();
+  polygonizer_detail::run_slices(n, polygonizer_detail::slice_count(in.threads, n, kSliceMin),
+                                 [&](std::size_t, std::size_t lo, std::size_t hi) { march(lo, hi); });
 }
 
 // New polygons for the tetrahedra of the work list (a polygon with the same crossed edges is kept, and

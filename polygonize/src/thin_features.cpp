@@ -1,13 +1,12 @@
 // Thin features: the Polygonizer's test and refinement of Delaunay edges crossed twice by the surface
 // (docs/polygonize.md, "Thin features"). Split from polygonizer.cpp.
 #include "vitri/polygonize/polygonizer.hpp"
-#include "vitri/core/threads.hpp"
 
 #include "polygonizer_internal.hpp"
+#include "slices.hpp"
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -81,17 +80,13 @@ void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) 
   // The first check of a refinement reads every live tetrahedron: on the threads of options_.threads,
   // each slice of `tets` into its own list, the lists then appended in slice order (the same entries in
   // the same order as one pass, so the same edges survive the deduplication below).
-  const std::size_t slices = std::min<std::size_t>(resolve_thread_count(options_.threads),
-                                                   tets.size() / kThinSliceMin + 1);
+  const std::size_t slices = slice_count(options_.threads, tets.size(), kThinSliceMin);
   if (slices <= 1) {
     check(0, tets.size(), thin_);
   } else {
     std::vector<std::vector<ThinEdge>> found(slices);
-    std::vector<std::thread> pool;
-    for (std::size_t k = 1; k < slices; ++k)
-      pool.emplace_back([&, k] { check(k * tets.size() / slices, (k + 1) * tets.size() / slices, found[k]); });
-    check(0, tets.size() / slices, found[0]);
-    for (std::thread& th : pool) th.join();
+    run_slices(tets.size(), slices,
+               [&](std::size_t k, std::size_t lo, std::size_t hi) { check(lo, hi, found[k]); });
     for (const auto& part : found) thin_.insert(thin_.end(), part.begin(), part.end());
   }
   // An edge is in several of these tetrahedra: keep one entry per edge.

@@ -337,6 +337,10 @@ class Polygonizer {
   /// The refinement loop of refine(): pops queued active tetrahedra and flagged thin edges until none is
   /// left; false when the callback cancelled. `info` accumulates the progress of the whole call.
   bool drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info);
+  /// The end of a round of insertions (proximity distance dmin): the new vertices evaluated (one batch),
+  /// the `created` tetrahedra classified and queued (the list is emptied), their edges checked for thin
+  /// features.
+  void finish_round(std::vector<TetId>& created, double dmin);
   /// The callback cancelled: the queue and the flagged edges are dropped (the next refine() rebuilds them).
   void cancel_refinement();
   /// Necks (necks.cpp): marks the vertices of a classified tetrahedron for the next check.

@@ -166,6 +166,15 @@ void print_neck_split(const PolygonizerStats& s) {
                1e3 * s.neck_seconds, s.neck_checks, s.neck_insertions, s.necks_left);
 }
 
+/// The initial tetrahedralization's own steps (stderr): where the time of a large input goes.
+void print_init_split(const PolygonizerStats& s) {
+  std::fprintf(stderr,
+               "  tetrahedralization: insertion %.0f ms, canonical order %.0f ms, values and gradients %.0f ms, "
+               "classification %.0f ms\n",
+               1e3 * s.init_insert_seconds, 1e3 * s.init_canonical_seconds, 1e3 * s.init_evaluate_seconds,
+               1e3 * s.init_classify_seconds);
+}
+
 /// The local fit's own steps (stderr): where the time of a large fit goes.
 void print_fit_split(const LocalFitReport& r) {
   std::fprintf(stderr,
@@ -375,6 +384,7 @@ int run_mesh(const Args& args) {
   if (announce_fit && !quiet) {
     std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
     if (const LocalRbf* local = mesher.local_function()) print_fit_split(local->report());
+    print_init_split(mesher.stats().polygonizer);
   }
   const double diag = mesher.diagonal();
   const double build_ms = 1e3 * phases.elapsed();

@@ -1,6 +1,8 @@
 // The Delaunay tree, spatial sort of a bulk insertion: BRIO rounds, each sorted along a Hilbert curve.
 #include "scratch.hpp"
 
+#include "vitri/core/bit_spread.hpp"
+
 #include <algorithm>
 #include <exception>
 #include <numeric>
@@ -30,10 +32,8 @@ std::uint64_t hilbert_key(std::uint32_t x, std::uint32_t y, std::uint32_t z) {
   for (std::uint32_t q = m; q > 1; q >>= 1)
     if (X[2] & q) t ^= q - 1;
   for (int i = 0; i < 3; ++i) X[i] ^= t;
-  std::uint64_t key = 0;
-  for (int b = kBits - 1; b >= 0; --b)
-    for (int i = 0; i < 3; ++i) key = (key << 1) | ((X[i] >> b) & 1u);
-  return key;
+  // Bit b of X[i] goes to bit 3 b + 2 - i of the key (X[0] the most significant of each triple).
+  return (spread_bits3(X[0]) << 2) | (spread_bits3(X[1]) << 1) | spread_bits3(X[2]);
 }
 
 std::uint64_t point_key(const Point3& p, const Box3& box) {

@@ -150,7 +150,11 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
   // Without the history the tetrahedra are then renumbered canonically, so that everything after (the
   // refinement order follows tetrahedron ids) is the same whatever the threads of the insertion.
   const std::vector<InsertResult> inserted = tri_.insert_points(seeds, 0.0, nullptr);
+  stats_.init_insert_seconds = seconds_since(t0);
+  const auto t1 = Clock::now();
   if (!options_.keep_history) tri_.canonicalize();
+  stats_.init_canonical_seconds = seconds_since(t1);
+  const auto t2 = Clock::now();
   grow_vertex_arrays();
   for (std::size_t i = 0; i < seeds.size(); ++i) {
     if (inserted[i].status != InsertStatus::Inserted) continue;
@@ -167,9 +171,12 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
   }
   if (options_.sampling_fraction > 0.0) sample(options_.sampling_fraction * domain.diagonal());
   evaluate_pending();
+  stats_.init_evaluate_seconds = seconds_since(t2);
+  const auto t3 = Clock::now();
   grow_tet_arrays();
   tri_.for_each_tetrahedron([this](TetId t) { classify(t, false); });
   settle_zeros({});
+  stats_.init_classify_seconds = seconds_since(t3);
   stats_.init_seconds = seconds_since(t0);
 }
 

@@ -81,7 +81,7 @@ std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, cons
     std::uint64_t code = 0;
     for (int a = 0; a < 3; ++a) {
       const double t = std::min(std::max((points[i][a] - root.lo[a]) * scale, 0.0), double((1 << 21) - 1));
-      code |= rbf_detail::spread_bits3(static_cast<std::uint64_t>(t)) << a;
+      code |= detail::spread_bits3(static_cast<std::uint64_t>(t)) << a;
     }
     keyed[i] = {code, static_cast<std::uint32_t>(i)};
   }

@@ -2,6 +2,7 @@
 // spatial_order: a permutation of points along a Morton (Z-order) curve, so that points near each other
 // in space are near each other in memory. Queries over a PointIndex built in that order, issued in that
 // order, touch a few cache lines per kd-tree leaf instead of one per point.
+#include "vitri/core/bit_spread.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
@@ -17,17 +18,6 @@
 namespace vitri {
 namespace rbf_detail {
 
-/// Spreads the low 21 bits of v to every third bit.
-inline std::uint64_t spread_bits3(std::uint64_t v) {
-  v &= 0x1fffffULL;
-  v = (v | v << 32) & 0x1f00000000ffffULL;
-  v = (v | v << 16) & 0x1f0000ff0000ffULL;
-  v = (v | v << 8) & 0x100f00f00f00f00fULL;
-  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-  v = (v | v << 2) & 0x1249249249249249ULL;
-  return v;
-}
-
 /// Indices of `points` sorted along the Morton curve of their bounding box (ties by index).
 /// @pre every point finite.
 inline std::vector<std::size_t> spatial_order(const std::vector<Point3>& points) {
@@ -40,8 +30,8 @@ inline std::vector<std::size_t> spatial_order(const std::vector<Point3>& points)
   std::vector<std::pair<std::uint64_t, std::size_t>> keyed(points.size());
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Point3& p = points[i];
-    keyed[i] = {spread_bits3(cell(p.x, box.lo.x)) << 2 | spread_bits3(cell(p.y, box.lo.y)) << 1 |
-                    spread_bits3(cell(p.z, box.lo.z)),
+    keyed[i] = {detail::spread_bits3(cell(p.x, box.lo.x)) << 2 | detail::spread_bits3(cell(p.y, box.lo.y)) << 1 |
+                    detail::spread_bits3(cell(p.z, box.lo.z)),
                 i};
   }
   sort_keyed(keyed);

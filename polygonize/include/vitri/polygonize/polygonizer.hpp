@@ -185,6 +185,11 @@ struct PolygonizerStats {
   /// After the last refine(): necks left (none of their tetrahedra larger than the proximity distance).
   std::size_t necks_left = 0;
   double init_seconds = 0;              ///< construction: seeds, sampling, first classification
+  /// Of the construction: inserting the seeds (Delaunay), their canonical renumbering (without the
+  /// history), evaluating f (and gradients) at the vertices with the sampling, classifying every
+  /// tetrahedron (they add up to about init_seconds).
+  double init_insert_seconds = 0, init_canonical_seconds = 0, init_evaluate_seconds = 0,
+         init_classify_seconds = 0;
   double refine_seconds = 0;            ///< last refine() call
   double extract_seconds = 0;           ///< last extract() call
   /// Of the last extraction: finding the changed polygons, placing crossings (evaluations of f),

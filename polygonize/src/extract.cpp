@@ -19,9 +19,11 @@ namespace {
 
 TrackerInput tracker_input(const Triangulation& tri, const std::vector<double>& values,
                            const std::vector<TetId>& transverse, const ImplicitFunction& f,
-                           const PolygonizerOptions& options) {
+                           const std::vector<Point3>& gradients, const PolygonizerOptions& options) {
   TrackerInput in{tri, values, transverse, f, {}, options.snap_zero_vertices, options.snap_fraction,
                   options.warm_start_roots};
+  // The vertices' gradients are kept current only for the thin-feature test (Polygonizer::grad_).
+  if (options.refine_thin_features) in.gradients = &gradients;
   in.roots.root_finding = options.placement == VertexPlacement::RootFinding;
   in.roots.tolerance = options.root_tolerance;
   in.roots.max_iterations = options.max_root_iterations;
@@ -37,7 +39,7 @@ Polygonizer::~Polygonizer() = default;
 MeshDelta Polygonizer::update_surface() {
   const auto t0 = std::chrono::steady_clock::now();
   evaluate_pending();
-  const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, options_);
+  const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, grad_, options_);
   surface_->update(in);
   const TrackerReport& r = surface_->report();
   stats_.function_evaluations += r.evaluations;
@@ -58,7 +60,7 @@ const LiveMesh& Polygonizer::live_surface() const { return surface_->mesh(); }
 
 SurfaceMesh Polygonizer::extract_fresh() {
   evaluate_pending();
-  const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, options_);
+  const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, grad_, options_);
   SurfaceTracker fresh;
   fresh.update(in);
   return fresh.mesh().to_surface_mesh();

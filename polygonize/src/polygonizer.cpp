@@ -228,6 +228,15 @@ void Polygonizer::evaluate_at(const std::vector<VertexId>& ids, std::vector<doub
       throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
 }
 
+// After an edit put v where it is (or gave it a fixed value): its value when it has none of its own,
+// and with refine_thin_features its gradient at the new position in every case (the thin-feature test
+// and the normals of the mesh vertices collapsed onto it read grad_).
+void Polygonizer::refresh_at(VertexId v) {
+  if (!needs_evaluation(v)) return;
+  pending_.push_back(v);
+  evaluate_pending();
+}
+
 void Polygonizer::evaluate_pending() {
   if (pending_.empty()) return;
   std::vector<VertexId> ids;

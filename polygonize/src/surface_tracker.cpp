@@ -493,7 +493,7 @@ void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
   detail::sort_unique_ids(w.normals, id_bits_);
   std::vector<std::uint32_t> ids;
   for (const std::uint32_t v : w.normals)
-    if (mesh_.is_vertex(v)) ids.push_back(v);
+    if (mesh_.is_vertex(v) && !normal_from_vertex(in, v)) ids.push_back(v);
   std::vector<Point3> at(ids.size()), g(ids.size());
   std::vector<double> unused(ids.size());
   for (std::size_t k = 0; k < ids.size(); ++k) at[k] = mesh_.position(ids[k]);
@@ -504,6 +504,20 @@ void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
     const Point3 n = unit_or_zero(g[k]);
     if (!(mesh_.normal(ids[k]) == n)) mesh_.set_normal(ids[k], n);
   }
+}
+
+// A mesh vertex collapsed onto a zero-valued Delaunay vertex z lies at z itself: its normal is f's
+// gradient at z when the Polygonizer knows it (the same evaluation at the same point). False (nothing
+// set) otherwise.
+bool SurfaceTracker::normal_from_vertex(const TrackerInput& in, std::uint32_t v) {
+  if (!in.gradients || v >= owner_.size() || !(owner_[v] & kZeroTag)) return false;
+  const VertexId z = owner_[v] & ~kZeroTag;
+  if (z >= in.gradients->size() || in.values[z] != 0.0 || !(mesh_.position(v) == in.tri.point(z))) return false;
+  const Point3& g = (*in.gradients)[z];
+  if (!is_finite(g)) return false;
+  const Point3 n = unit_or_zero(g);
+  if (!(mesh_.normal(v) == n)) mesh_.set_normal(v, n);
+  return true;
 }
 
 }  // namespace vitri

@@ -48,6 +48,9 @@ struct TrackerInput {
   /// Large updates take the collapse tests' stars and fans from a lookahead on the threads; off, each is
   /// gathered when its vertex is decided (the same decisions: the tests compare both).
   bool snap_lookahead = true;
+  /// Per Delaunay vertex: f's gradient there where the Polygonizer knows it (NaN: unknown), or null.
+  /// The normal of a mesh vertex collapsed onto a zero-valued vertex is read there instead of evaluated.
+  const std::vector<Point3>* gradients = nullptr;
 };
 
 /// Counters of the last update().
@@ -177,6 +180,7 @@ class SurfaceTracker {
   std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);
   void drop_triangle(std::uint32_t t);
   void retire_triangles(Work& w);
+  bool normal_from_vertex(const TrackerInput& in, std::uint32_t v);
   void refresh_vertices(const TrackerInput& in, Work& w);
   void grow_vertex_arrays(std::size_t n);
   std::uint32_t& polygon_of(TetId t);

@@ -38,14 +38,9 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
   kind_[v] = static_cast<std::uint8_t>(kind);
   tcount_[v] = 0;
   if (kind == VertexKind::Refinement) idle_.push_back(v);
-  if (value) {
-    set_value(v, *value);
-    fixed_[v] = 1;
-  } else {
-    fixed_[v] = 0;
-    pending_.push_back(v);
-    evaluate_pending();
-  }
+  fixed_[v] = value ? 1 : 0;
+  if (value) set_value(v, *value);
+  refresh_at(v);
   on_killed(changes_);
   std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
   classify_created(created);
@@ -88,10 +83,8 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
   if (value) {
     set_value(v, *value);
     fixed_[v] = 1;
-  } else if (!fixed_[v]) {
-    pending_.push_back(v);
-    evaluate_pending();
   }
+  refresh_at(v);
   on_killed(changes_);
   std::vector<TetId> created(changes_.created.begin(), changes_.created.end());
   classify_created(created);

@@ -476,3 +476,56 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
   REQUIRE(mesh[0].triangles == mesh[1].triangles);
   REQUIRE(mesh[0].vertices == mesh[1].vertices);
 }
+
+// The normal of a mesh vertex collapsed onto a zero-valued vertex is f's gradient there. With the
+// thin-feature rule the Polygonizer keeps every vertex's gradient current and the extraction reads it
+// instead of evaluating f again; after an edit that moves such a vertex the gradient at its new position
+// must be the one read.
+TEST_CASE("normals at collapsed zero vertices: the vertex's own gradient, kept current by edits", "[polygonizer]") {
+  const Point3 c{0.1, 0.2, -0.05};
+  const SphereFunction f(c, 1.0);
+  std::vector<Point3> seeds;
+  const int n = 300;
+  for (int i = 0; i < n; ++i) {  // a Fibonacci sphere
+    const double z = 1.0 - (2.0 * i + 1.0) / n, r = std::sqrt(1.0 - z * z), a = 2.399963229728653 * i;
+    seeds.push_back(c + Point3{r * std::cos(a), r * std::sin(a), z});
+  }
+  const std::vector<double> zeros(seeds.size(), 0.0);
+  // The mesh vertices exactly at `at`, each with a normal equal to the sphere's (the exact gradient).
+  const auto check_normals_at = [&](const SurfaceMesh& m, const std::vector<Point3>& at) {
+    std::size_t found = 0;
+    for (std::size_t k = 0; k < m.vertices.size(); ++k)
+      if (std::find(at.begin(), at.end(), m.vertices[k]) != at.end()) {
+        ++found;
+        const Point3 want = (m.vertices[k] - c) / norm(m.vertices[k] - c);
+        REQUIRE(norm(m.normals[k] - want) < 1e-12);
+      }
+    return found;
+  };
+  for (const bool thin : {true, false}) {
+    PolygonizerOptions o;
+    o.refine_thin_features = thin;
+    Polygonizer poly(f, kCube, seeds, zeros, o);
+    REQUIRE(poly.refine(0.2));
+    const SurfaceMesh m = poly.extract();
+    require_closed(m, 2, 1);
+    const std::size_t collapsed = check_normals_at(m, seeds);
+    REQUIRE(collapsed > std::size_t(n / 2));
+    // Read, not evaluated: the normals evaluated by the extraction are fewer than those vertices.
+    if (thin) REQUIRE(poly.stats().gradient_evaluations < collapsed);
+    if (!thin) REQUIRE(poly.stats().gradient_evaluations >= collapsed);
+    // Move a collapsed seed along the sphere (value 0 kept): its normal follows.
+    const auto it = std::find_if(seeds.begin(), seeds.end(), [&](const Point3& s) {
+      return std::find(m.vertices.begin(), m.vertices.end(), s) != m.vertices.end();
+    });
+    REQUIRE(it != seeds.end());
+    const VertexId v = poly.seed_vertices()[std::size_t(it - seeds.begin())];
+    const Point3 d = *it - c + Point3{0.03, -0.02, 0.01};
+    const Point3 q = c + d / norm(d);
+    REQUIRE(poly.move_vertex(v, q, 0.0));
+    REQUIRE(poly.refine(0.2));
+    const SurfaceMesh moved = poly.extract();
+    require_closed(moved, 2, 1);
+    REQUIRE(check_normals_at(moved, {q}) == 1);
+  }
+}

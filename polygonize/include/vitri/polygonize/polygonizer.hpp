@@ -362,6 +362,7 @@ class Polygonizer {
   void grow_vertex_arrays();
   void grow_tet_arrays();
   bool needs_evaluation(VertexId v) const;
+  void refresh_at(VertexId v);
   void evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out);
   void evaluate_pending();
   void on_killed(const ChangeSet& cs);

@@ -72,7 +72,7 @@ struct Triangulation::Worker {
   TetId last = kNoTet;                  // its last created tetrahedron (owned while its pass runs)
   std::ptrdiff_t tets_delta = 0;        // live tetrahedra created minus killed in this pass
   std::size_t inserted = 0;             // vertices inserted in this pass
-  std::vector<std::uint32_t> todo;      // ranks of its arc in this pass
+  std::vector<std::uint32_t> assigned;  // ranks of its arc in this pass
   std::vector<std::uint32_t> deferred;  // ranks left to the next pass
   std::vector<std::pair<PointId, PointId>> dups;  // (rejected point, the live vertex it duplicates)
   std::exception_ptr error;
@@ -171,7 +171,7 @@ void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
       bulk_rekey(b, pending, pass);
     }
     bulk_partition(b, pending, pass, T);
-    for (std::size_t k = 0; k < T; ++k) bulk_give_room(b, b.workers[k], b.workers[k].todo.size());
+    for (std::size_t k = 0; k < T; ++k) bulk_give_room(b, b.workers[k], b.workers[k].assigned.size());
     std::vector<std::thread> threads;
     for (std::size_t k = 1; k < T; ++k) threads.emplace_back([&, k] { bulk_work(b, b.workers[k]); });
     bulk_work(b, b.workers[0]);
@@ -285,8 +285,9 @@ void Triangulation::bulk_partition(Bulk& b, const std::vector<std::uint32_t>& pe
     w.owner = {b.part.data(), std::uint8_t(k)};
     if (w.last != kNoTet && (!is_live(w.last) || !w.owner.owns(tets_, w.last))) w.last = kNoTet;
     const std::size_t lo = cut[k], hi = k + 1 < T ? cut[k + 1] : n;
-    w.todo.assign(pending.begin() + std::ptrdiff_t(lo), pending.begin() + std::ptrdiff_t(hi));
-    if (k + 1 == T) w.todo.insert(w.todo.end(), pending.begin(), pending.begin() + std::ptrdiff_t(cut[0]));
+    w.assigned.assign(pending.begin() + std::ptrdiff_t(lo), pending.begin() + std::ptrdiff_t(hi));
+    if (k + 1 == T)
+      w.assigned.insert(w.assigned.end(), pending.begin(), pending.begin() + std::ptrdiff_t(cut[0]));
     w.deferred.clear();
     w.dups.clear();
     w.tets_delta = 0;
@@ -316,7 +317,7 @@ void Triangulation::bulk_give_room(Bulk&, Worker& w, std::size_t points) {
 void Triangulation::bulk_work(const Bulk& b, Worker& w) {
   const double start = thread_cpu_seconds();
   try {
-    for (std::uint32_t r : w.todo)
+    for (std::uint32_t r : w.assigned)
       if (!bulk_insert_one(b, w, r)) w.deferred.push_back(r);
   } catch (...) {
     w.error = std::current_exception();

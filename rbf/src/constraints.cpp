@@ -13,6 +13,7 @@
 
 #include "near_duplicates.hpp"
 #include "parallel.hpp"
+#include "spaced_subset.hpp"
 #include "spatial_order.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
@@ -126,6 +127,37 @@ std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const
   return offsets;
 }
 
+/// Applies ConstraintBuildOptions::off_surface_spacing to `offsets` (see off_surface_offsets): among the
+/// kept points whose every wanted side got the full distance d, a point keeps its off-surface
+/// constraints only if no such point visited before it that kept them lies within spacing x d (a greedy
+/// Poisson-disk subset, the points visited along a Morton curve: spaced_subset.hpp); the others' offsets
+/// become 0. Points on a thin part (a side halved or dropped) keep theirs. Returns the number of
+/// constraints left out.
+std::size_t space_off_surface(std::vector<double>& offsets, const std::vector<Point3>& points,
+                              const std::vector<std::size_t>& keep, double d, double spacing,
+                              const ConstraintBuildOptions& opt) {
+  const bool want_out = opt.sides != OffSurface::Inside, want_in = opt.sides != OffSurface::Outside;
+  std::vector<std::size_t> candidates;  // indices k into keep
+  std::vector<Point3> at;
+  for (std::size_t k = 0; k < keep.size(); ++k) {
+    const bool full_out = !want_out || offsets[2 * k] == d, full_in = !want_in || offsets[2 * k + 1] == -d;
+    if (!full_out || !full_in) continue;
+    candidates.push_back(k);
+    at.push_back(points[keep[k]]);
+  }
+  const std::vector<char> spaced = rbf_detail::spaced_subset(at, rbf_detail::spatial_order(at), spacing * d);
+  std::size_t left_out = 0;
+  for (std::size_t c = 0; c < candidates.size(); ++c) {
+    if (spaced[c]) continue;
+    for (std::size_t s = 0; s < 2; ++s) {
+      double& o = offsets[2 * candidates[c] + s];
+      left_out += o != 0;
+      o = 0;
+    }
+  }
+  return left_out;
+}
+
 /// Appends the off-surface constraints (per kept point, +d then -d) that are not near-duplicates of an
 /// earlier off-surface constraint: two of them closer than tol (neighbouring points with diverging
 /// normals, or offsets halved on a thin part) would make the fit singular, so the later one is dropped
@@ -166,6 +198,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
     throw InvalidArgument("constraint offset must be a positive fraction of the diagonal");
   if (!(opt.offset_spacings >= 0) || !std::isfinite(opt.offset_spacings))
     throw InvalidArgument("constraint offset_spacings must be a finite number >= 0 (0: offset alone)");
+  if (!(opt.off_surface_spacing >= 0) || !std::isfinite(opt.off_surface_spacing))
+    throw InvalidArgument("constraint off_surface_spacing must be a finite number >= 0 (0: every point)");
   if (!(opt.merge_tolerance >= 0) || !std::isfinite(opt.merge_tolerance))
     throw InvalidArgument("constraint merge_tolerance must be a finite fraction >= 0 of the diagonal");
   const std::size_t per = opt.sides == OffSurface::Both ? 3 : 2;
@@ -202,7 +236,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   const double d = spacing > 0 ? std::min(d0, opt.offset_spacings * spacing) : d0;
   rep.offset = d;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
-  const std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);
+  std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);
+  if (opt.off_surface_spacing > 0) rep.spaced_out = space_off_surface(offsets, points, keep, d, opt.off_surface_spacing, opt);
   Constraints c;
   c.points.reserve(keep.size() * per);
   c.values.reserve(keep.size() * per);

@@ -223,6 +223,45 @@ TEST_CASE("vitri mesh --sides: outside/inside/both build 2 or 3 constraints per 
   REQUIRE(e.find("--sides") != std::string::npos);
 }
 
+TEST_CASE("vitri mesh --off-surface-spacing: the local function's normal constraints spaced, never the global's",
+          "[cli][mesh]") {
+  // 2000 points on the unit sphere (spacing about 0.079) with D = 0.05 x the diagonal (0.18; the data's
+  // default D would be capped at 0.036, below the spacing, and leave nothing out): 6000 constraints
+  // without the spacing, so --function auto picks the local function and the default spacing (1 D) applies.
+  const std::string in = write_sphere_points("mesh_spacing.pwn", 2000) + " --offset 0.05",
+                    out = kDir + "/mesh_spacing.obj";
+  std::string o, e;
+  auto constraints = [&]() {
+    const std::size_t at = o.find(" constraints,");
+    REQUIRE(at != std::string::npos);
+    return std::stol(o.substr(o.rfind(' ', at - 1) + 1, at));
+  };
+  REQUIRE(run(in + " -o " + out + " --precision 0.05", o, e) == 0);
+  INFO(o << e);
+  const long spaced = constraints();
+  CHECK(spaced > 2000);
+  CHECK(spaced < 4000);  // most points keep only f = 0
+  REQUIRE(e.find("off-surface constraints left out") != std::string::npos);
+  check_mesh(out);
+  REQUIRE(run(in + " -o " + out + " --precision 0.05 --off-surface-spacing 0", o, e) == 0);
+  CHECK(constraints() == 6000);
+  REQUIRE(e.find("left out") == std::string::npos);
+  REQUIRE(run(in + " -o " + out + " --precision 0.05 --off-surface-spacing 2", o, e) == 0);
+  CHECK(constraints() < spaced);
+  // 1000 points: 3000 constraints without the spacing, so auto picks the global function, which always
+  // has every off-surface constraint (as --function global does).
+  const std::string small = write_sphere_points("mesh_spacing_small.pwn", 1000) + " --offset 0.05";
+  for (const char* f : {"auto", "global"}) {
+    REQUIRE(run(small + " -o " + out + " --precision 0.05 --function " + f, o, e) == 0);
+    CHECK(constraints() == 3000);
+    REQUIRE(e.find("left out") == std::string::npos);
+  }
+  REQUIRE(run(small + " -o " + out + " --precision 0.05 --function local", o, e) == 0);
+  CHECK(constraints() < 3000);
+  REQUIRE(run(in + " -o " + out + " --off-surface-spacing -1", o, e) == 2);
+  REQUIRE(e.find("--off-surface-spacing") != std::string::npos);
+}
+
 TEST_CASE("vitri mesh: unoriented points (.xyz, PLY without faces) get estimated, oriented normals",
           "[cli][mesh][normals]") {
   for (const std::string name : {"mesh_sphere3.xyz", "mesh_sphere3.ply"}) {

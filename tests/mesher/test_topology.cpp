@@ -36,6 +36,7 @@ struct TopologyCase {
   FunctionKind function;
   std::size_t max_constraints;  // 0: every vertex
   double precision;             // relative to the diagonal; kDataPrecision: 2.5 x the median spacing
+  bool cli_constraints = false;  // `vitri mesh`'s constraints: offsets of 2 median spacings, spaced 1 d
 };
 
 const char* name_of(FunctionKind f) {
@@ -70,11 +71,16 @@ void check_topology(const TopologyCase& c) {
   MesherOptions o;
   o.function = c.function;
   o.constraint_build.max_constraints = c.max_constraints;
+  if (c.cli_constraints) {  // apps/input.hpp: kOffsetSpacings, kOffSurfaceSpacing
+    o.constraint_build.offset_spacings = 2.0;
+    o.constraint_build.off_surface_spacing = 1.0;
+  }
   Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
   const double precision = c.precision == kDataPrecision
                                ? kSpacingFactor * median_spacing(mesher.constraints())
                                : c.precision * mesher.diagonal();
-  INFO(c.file << ", " << name_of(c.function) << " function, " << mesher.constraints().size()
+  INFO(c.file << ", " << name_of(c.function) << " function" << (c.cli_constraints ? " (the CLI's constraints)" : "")
+              << ", " << mesher.constraints().size()
               << " constraints, precision " << precision / mesher.diagonal() << " of the diagonal; model chi "
               << model.euler_characteristic << ", " << model.components << " component(s)");
   REQUIRE(mesher.refine(precision));
@@ -104,6 +110,17 @@ TEST_CASE("topology matrix: local function, every vertex", "[.][slow][topology][
                           TopologyCase{"turbine.off", FunctionKind::Local, 0, kDataPrecision},
                           TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.01},
                           TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.005}));
+}
+
+// The constraints `vitri mesh` builds for the local function (off-surface distance from the data's
+// spacing, off-surface constraints one distance apart), at the data's precision and at 0.01.
+TEST_CASE("topology matrix: local function, the CLI's constraints", "[.][slow][topology][local]") {
+  check_topology(GENERATE(TopologyCase{"elephant.off", FunctionKind::Local, 0, kDataPrecision, true},
+                          TopologyCase{"elephant.off", FunctionKind::Local, 0, 0.01, true},
+                          TopologyCase{"bear.off", FunctionKind::Local, 0, kDataPrecision, true},
+                          TopologyCase{"bear.off", FunctionKind::Local, 0, 0.01, true},
+                          TopologyCase{"turbine.off", FunctionKind::Local, 0, kDataPrecision, true},
+                          TopologyCase{"turbine.off", FunctionKind::Local, 0, 0.01, true}));
 }
 
 // The global fit is O(N^3): 3000 constraints (1000 surface points) per model.

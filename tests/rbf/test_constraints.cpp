@@ -9,7 +9,9 @@
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 using namespace vitri;
@@ -236,4 +238,78 @@ TEST_CASE("constraints: offset_spacings follows the data, at most offset x diago
   REQUIRE(report.offset == 0.01 * box.diagonal());
   o.offset_spacings = -1.0;
   REQUIRE_THROWS_AS(constraints_from_oriented_points(points, normals, o), InvalidArgument);
+}
+
+TEST_CASE("constraints: off_surface_spacing keeps normal constraints a spacing apart, all zero constraints",
+          "[rbf][constraints]") {
+  // 3000 points on the unit sphere (a Fibonacci spiral), outward normals: an off-surface constraint q
+  // at p +- d p belongs to the surface point q / |q|.
+  const std::size_t n = 3000;
+  std::vector<Point3> points(n);
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / static_cast<double>(n);
+    const double r = std::sqrt(1.0 - z * z), a = golden * static_cast<double>(i);
+    points[i] = {r * std::cos(a), r * std::sin(a), z};
+  }
+  ConstraintBuildOptions o;
+  o.offset = 0.1;  // not the cap: d = 2 median spacings
+  o.offset_spacings = 2.0;
+  ConstraintBuildReport full_report, report;
+  const Constraints full = constraints_from_oriented_points(points, points, o, &full_report);
+  REQUIRE(full.size() == 3 * n);
+  REQUIRE(full_report.spaced_out == 0);
+  o.off_surface_spacing = 1.5;
+  const Constraints c = constraints_from_oriented_points(points, points, o, &report);
+  const double d = report.offset, radius = 1.5 * d;
+  REQUIRE(d == full_report.offset);
+  // Every surface point keeps f = 0, in the same order; the spacing only leaves out normal constraints.
+  for (std::size_t i = 0; i < n; ++i) REQUIRE((c.points[i] == points[i] && c.values[i] == 0.0));
+  REQUIRE(c.size() + report.spaced_out == full.size());
+  REQUIRE(report.spaced_out > n);  // most points lose theirs on this dense sampling
+  // Both sides of a point stay together, and the points that keep them are pairwise >= radius apart.
+  std::vector<Point3> with;
+  for (std::size_t k = n; k < c.size(); k += 2) {
+    REQUIRE(c.values[k] == d);
+    REQUIRE(c.values[k + 1] == -d);
+    const Point3 p = c.points[k] / norm(c.points[k]);
+    REQUIRE(norm(c.points[k + 1] / norm(c.points[k + 1]) - p) < 1e-12);
+    with.push_back(p);
+  }
+  for (std::size_t a = 0; a < with.size(); ++a)
+    for (std::size_t b = a + 1; b < with.size(); ++b) REQUIRE(norm(with[a] - with[b]) >= radius * (1 - 1e-12));
+  // Maximal: every point without them has one that kept them within the radius.
+  for (const Point3& p : points) {
+    double nearest = std::numeric_limits<double>::infinity();
+    for (const Point3& q : with) nearest = std::min(nearest, norm(p - q));
+    REQUIRE(nearest < radius * (1 + 1e-12));
+  }
+  // Deterministic, and invalid spacings refused.
+  REQUIRE(constraints_from_oriented_points(points, points, o).points == c.points);
+  o.off_surface_spacing = -1.0;
+  REQUIRE_THROWS_AS(constraints_from_oriented_points(points, points, o), InvalidArgument);
+  o.off_surface_spacing = std::numeric_limits<double>::quiet_NaN();
+  REQUIRE_THROWS_AS(constraints_from_oriented_points(points, points, o), InvalidArgument);
+}
+
+TEST_CASE("constraints: off_surface_spacing never thins a thin part", "[rbf][constraints]") {
+  // The slab of the test above, sampled densely: every inside offset is halved, so every point keeps
+  // its constraints; a wide plate beside it (far from the slab) is thinned.
+  std::vector<Point3> p, n;
+  for (int i = 0; i < 20; ++i)
+    for (int j = 0; j < 20; ++j) {
+      p.push_back({i * 0.01, j * 0.01, 0.0}), n.push_back({0, 0, -1});
+      p.push_back({i * 0.01, j * 0.01, 0.02}), n.push_back({0, 0, 1});
+      p.push_back({0.5 + i * 0.01, j * 0.01, 0.5}), n.push_back({0, 0, 1});
+    }
+  ConstraintBuildOptions o;
+  o.offset = 0.03;  // d about 0.025, more than the slab's 0.02
+  o.off_surface_spacing = 2.0;
+  ConstraintBuildReport report;
+  const Constraints c = constraints_from_oriented_points(p, n, o, &report);
+  std::size_t slab_side = 0, plate_side = 0;
+  for (std::size_t k = p.size(); k < c.size(); ++k) (c.points[k].x < 0.3 ? slab_side : plate_side) += 1;
+  CHECK(slab_side == 2 * 800);  // no slab point left out (each has its halved inside and its outside)
+  CHECK(plate_side < 2 * 400 / 4);
+  CHECK(report.spaced_out == 2 * 400 - plate_side);
 }

@@ -38,6 +38,16 @@ struct ConstraintBuildOptions {
   double offset_spacings = 0.0;
   /// Off-surface constraints per point; see OffSurface.
   OffSurface sides = OffSurface::Both;
+  /// When > 0, only some surface points get off-surface constraints, about off_surface_spacing x d
+  /// apart along the surface (d the off-surface distance): a point keeps them unless a point visited
+  /// before it (the points visited along a Morton curve, a deterministic order) that kept its own lies
+  /// closer than that; points whose d was halved or that lost a side on a thin part always keep theirs. Every surface point keeps its f = 0
+  /// constraint. 0 (the library's default): every point gets them. Dense samples need far fewer
+  /// normal constraints than surface points (the zero constraints carry the shape, the off-surface
+  /// ones the sign and scale): the CLI uses 1 with the local function, where at 10^6 points it takes
+  /// 20-40% off the run's CPU time and a quarter off its peak memory for the same distance to the true
+  /// model (docs/benchmarks.md "Off-surface spacing"). Counted in ConstraintBuildReport::spaced_out.
+  double off_surface_spacing = 0.0;
   /// At most this many constraints in total (0: no limit). Surface points are subsampled uniformly at
   /// random (without replacement, input order kept) to floor(max_constraints / per-point count).
   /// A nonzero value below the per-point count (3 for Both, 2 otherwise) is refused (InvalidArgument).
@@ -66,6 +76,8 @@ struct ConstraintBuildReport {
   std::size_t merged_off_surface = 0;
   /// The off-surface distance d used (absolute, before any halving on a thin part).
   double offset = 0.0;
+  /// Off-surface constraints left out by ConstraintBuildOptions::off_surface_spacing.
+  std::size_t spaced_out = 0;
 };
 
 /// The data's resolution: the median distance from a point to its nearest other point, over at most

@@ -47,6 +47,8 @@ struct ConstraintBuildOptions {
   /// ones the sign and scale): the CLI uses 1 with the local function, where at 10^6 points it takes
   /// 20-40% off the run's CPU time and a quarter off its peak memory for the same distance to the true
   /// model (docs/benchmarks.md "Off-surface spacing"). Counted in ConstraintBuildReport::spaced_out.
+  /// It applies to whatever function the constraints are then fitted with; the CLI leaves the global
+  /// function's at every point (and chooses between the two on the count without the spacing).
   double off_surface_spacing = 0.0;
   /// At most this many constraints in total (0: no limit). Surface points are subsampled uniformly at
   /// random (without replacement, input order kept) to floor(max_constraints / per-point count).

@@ -90,8 +90,8 @@ const char* const kUsage =
     "                       apart along the surface (default 1; 0: at every point). Every point keeps\n"
     "                       its f = 0 constraint, and points on a thin part keep theirs. Dense samples\n"
     "                       need fewer normal constraints than points: at 10^6 points the default takes\n"
-    "                       a third off the time and the memory for the same distance to the true\n"
-    "                       surface (docs/guide.md). The global function (and --function auto's choice,\n"
+    "                       20-40% off the time and a quarter off the memory for the same distance to\n"
+    "                       the true surface (docs/guide.md). The global function (and --function auto's choice,\n"
     "                       made on the count without it) always has them at every point.\n"
     "  --neighbours K       neighbours per point for the normals of unoriented points (default 10;\n"
     "                       larger for noisy points, e.g. 50-80 when the noise exceeds the spacing)\n"
@@ -379,7 +379,8 @@ int run_mesh(const Args& args) {
                  options.constraint_build.offset_spacings > 0 ? "the data's spacing, see --offset" : "--offset");
   if (!quiet && merged.spaced_out > 0)
     std::fprintf(stderr, "%zu off-surface constraints left out, the others %g off-surface distances apart or "
-                 "more (see --off-surface-spacing)\n", merged.spaced_out, options.constraint_build.off_surface_spacing);
+                 "more (see --off-surface-spacing)\n",
+                 merged.spaced_out, options.constraint_build.off_surface_spacing);
   if (default_precision) {
     // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
     phases.start("precision", "median spacing");

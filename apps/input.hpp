@@ -6,7 +6,6 @@
 #include "vitri/rbf/constraints.hpp"
 
 #include <cstddef>
-
 #include <string>
 
 namespace vitri::cli {

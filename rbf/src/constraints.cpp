@@ -237,7 +237,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   rep.offset = d;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
   std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);
-  if (opt.off_surface_spacing > 0) rep.spaced_out = space_off_surface(offsets, points, keep, d, opt.off_surface_spacing, opt);
+  if (opt.off_surface_spacing > 0)
+    rep.spaced_out = space_off_surface(offsets, points, keep, d, opt.off_surface_spacing, opt);
   Constraints c;
   c.points.reserve(keep.size() * per);
   c.values.reserve(keep.size() * per);

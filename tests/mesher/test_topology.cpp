@@ -36,7 +36,7 @@ struct TopologyCase {
   FunctionKind function;
   std::size_t max_constraints;  // 0: every vertex
   double precision;             // relative to the diagonal; kDataPrecision: 2.5 x the median spacing
-  bool cli_constraints = false;  // `vitri mesh`'s constraints: offsets of 2 median spacings, spaced 1 d
+  bool cli_constraints = false;  // `vitri mesh`'s: offsets of 2 median spacings, spaced 1 offset apart
 };
 
 const char* name_of(FunctionKind f) {

@@ -41,8 +41,8 @@ struct ConstraintBuildOptions {
   /// When > 0, only some surface points get off-surface constraints, about off_surface_spacing x d
   /// apart along the surface (d the off-surface distance): a point keeps them unless a point visited
   /// before it (the points visited along a Morton curve, a deterministic order) that kept its own lies
-  /// closer than that; points whose d was halved or that lost a side on a thin part always keep theirs. Every surface point keeps its f = 0
-  /// constraint. 0 (the library's default): every point gets them. Dense samples need far fewer
+  /// closer than that; points whose d was halved or that lost a side on a thin part always keep theirs.
+  /// Every surface point keeps its f = 0 constraint. 0 (the library's default): every point gets them. Dense samples need far fewer
   /// normal constraints than surface points (the zero constraints carry the shape, the off-surface
   /// ones the sign and scale): the CLI uses 1 with the local function, where at 10^6 points it takes
   /// 20-40% off the run's CPU time and a quarter off its peak memory for the same distance to the true

@@ -386,7 +386,9 @@ int run_mesh(const Args& args) {
     phases.start("precision", "median spacing");
     Box3 box;
     for (const Point3& p : constraints.points) box.extend(p);
-    precisions.push_back(kSpacingFactor * median_spacing(constraints) / box.diagonal());
+    // Measured already when the builder's off-surface distance followed the data (the same estimate).
+    const double spacing = merged.median_spacing > 0 ? merged.median_spacing : median_spacing(constraints);
+    precisions.push_back(kSpacingFactor * spacing / box.diagonal());
     if (!quiet) std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", precisions[0]);
   }
   const std::size_t levels = std::max(precisions.size(), distances.size());

@@ -235,6 +235,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   const double spacing = opt.offset_spacings > 0 && surf.size() > 1 ? spacing_median(surface, surf) : 0.0;
   const double d = spacing > 0 ? std::min(d0, opt.offset_spacings * spacing) : d0;
   rep.offset = d;
+  rep.median_spacing = spacing;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
   std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);
   if (opt.off_surface_spacing > 0)

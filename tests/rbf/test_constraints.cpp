@@ -224,6 +224,7 @@ TEST_CASE("constraints: offset_spacings follows the data, at most offset x diago
   ConstraintBuildReport report;
   const Constraints c = constraints_from_oriented_points(points, normals, o, &report);
   REQUIRE(report.offset == 2.0 * h);
+  REQUIRE(report.median_spacing == median_spacing(points));  // measured once, reused by the CLI
   // Every off-surface constraint has the value +-2h (its distance along the normal).
   for (std::size_t k = points.size(); k < c.size(); ++k) REQUIRE(std::abs(c.values[k]) == 2.0 * h);
   // Many spacings: the cap, 0.01 x the diagonal of the points' box.
@@ -232,10 +233,11 @@ TEST_CASE("constraints: offset_spacings follows the data, at most offset x diago
   Box3 box;
   for (const Point3& p : points) box.extend(p);
   REQUIRE(report.offset == 0.01 * box.diagonal());
-  // Without it, the library's default.
+  // Without it, the library's default (and no spacing measured).
   o.offset_spacings = 0.0;
   constraints_from_oriented_points(points, normals, o, &report);
   REQUIRE(report.offset == 0.01 * box.diagonal());
+  REQUIRE(report.median_spacing == 0.0);
   o.offset_spacings = -1.0;
   REQUIRE_THROWS_AS(constraints_from_oriented_points(points, normals, o), InvalidArgument);
 }

@@ -378,8 +378,8 @@ int run_mesh(const Args& args) {
     std::fprintf(stderr, "off-surface constraints at distance %.4g (%s)\n", merged.offset,
                  options.constraint_build.offset_spacings > 0 ? "the data's spacing, see --offset" : "--offset");
   if (!quiet && merged.spaced_out > 0)
-    std::fprintf(stderr, "%zu off-surface constraints left out, the others %g off-surface distances apart or "
-                 "more (see --off-surface-spacing)\n",
+    std::fprintf(stderr, "%zu off-surface constraints left out: the points that keep theirs are at least %g x "
+                 "that distance apart (see --off-surface-spacing)\n",
                  merged.spaced_out, options.constraint_build.off_surface_spacing);
   if (default_precision) {
     // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.

@@ -12,7 +12,7 @@ namespace rbf_detail {
 /// Visits points[order[0]], points[order[1]], ... and keeps a point unless a point kept before it lies
 /// strictly closer than `radius`. Returns kept[i] (1 or 0) for every i. Kept points are pairwise >= radius
 /// apart, and every other point of `order` lies closer than radius to a kept one (maximal). Points not
-/// in `order` are not kept. Deterministic; O(n) expected time, 24 bytes per point transient.
+/// in `order` are not kept. Deterministic; O(n) expected time, about 30 bytes per point transient.
 /// @pre every point finite, radius > 0, order a permutation of a subset of the indices.
 /// @throws LimitError for 2^32 points or more.
 std::vector<char> spaced_subset(const std::vector<Point3>& points, const std::vector<std::size_t>& order,

@@ -258,6 +258,20 @@ TEST_CASE("vitri mesh --off-surface-spacing: the local function's normal constra
   }
   REQUIRE(run(small + " -o " + out + " --precision 0.05 --function local", o, e) == 0);
   CHECK(constraints() < 3000);
+  // 5000 lines that merge into 1000 points: too many lines to keep a copy of the input, so auto's global
+  // choice builds the constraints again from the file, without the spacing.
+  {
+    const std::string lines = slurp(small.substr(0, small.find(' ')));
+    const std::string repeated = kDir + "/mesh_spacing_repeated.pwn";
+    std::ofstream r(repeated);
+    for (int k = 0; k < 5; ++k) r << lines;
+    r.close();
+    REQUIRE(run(repeated + " --offset 0.05 -o " + out + " --precision 0.05", o, e) == 0);
+    CHECK(constraints() == 3000);
+    CHECK(o.find("global fit") != std::string::npos);
+    REQUIRE(e.find("merged 4000 near-duplicate points") != std::string::npos);
+    REQUIRE(e.find("left out") == std::string::npos);
+  }
   REQUIRE(run(in + " -o " + out + " --off-surface-spacing -1", o, e) == 2);
   REQUIRE(e.find("--off-surface-spacing") != std::string::npos);
 }

@@ -3,6 +3,8 @@
 // surface constraints) and at a finer one. Every mesh must be a closed, outward 2-manifold with the
 // model's Euler characteristic (computed here from the model's own faces) and component count, every
 // component supported by on-surface constraints, and no triangle with an area below 1e-14 x diagonal^2.
+// The local cases run with the library's default constraints and with those `vitri mesh` builds (the
+// off-surface distance from the data's spacing, off-surface constraints one distance apart).
 //
 // Cases left out, and why (docs/benchmarks.md, "Topology matrix"; tell before adding them back):
 // - man.off: the model self-intersects (514 of its 17,495 vertices lie inside another part: both armpits,
@@ -79,8 +81,8 @@ void check_topology(const TopologyCase& c) {
   const double precision = c.precision == kDataPrecision
                                ? kSpacingFactor * median_spacing(mesher.constraints())
                                : c.precision * mesher.diagonal();
-  INFO(c.file << ", " << name_of(c.function) << " function" << (c.cli_constraints ? " (the CLI's constraints)" : "")
-              << ", " << mesher.constraints().size()
+  INFO(c.file << ", " << name_of(c.function) << " function"
+              << (c.cli_constraints ? " (the CLI's constraints)" : "") << ", " << mesher.constraints().size()
               << " constraints, precision " << precision / mesher.diagonal() << " of the diagonal; model chi "
               << model.euler_characteristic << ", " << model.components << " component(s)");
   REQUIRE(mesher.refine(precision));

@@ -182,11 +182,12 @@ void Mesher::track_zero(VertexId v, const Point3& p, double value) {
 void Mesher::sync_surface() {
   const bool filter = !options_.keep_unsupported_components && !zero_index_.empty() && std::isfinite(precision_);
   const double reach2 = std::pow(2.5 * precision_, 2);
-  std::vector<PointIndex::Id> ids;
-  std::vector<double> d2;
+  // "Is a zero constraint within reach (squared distance <= reach2)?": a ball count that stops at the
+  // first point (the closed ball: strictly below the next double), not a nearest-point search, which
+  // explores far around the vertices of a component that no constraint supports.
+  const double below = std::nextafter(reach2, std::numeric_limits<double>::infinity());
   const SupportFilter::Supported supported = [&](const Point3& p) {
-    zero_index_.nearest(p, 1, ids, &d2);
-    return !d2.empty() && d2[0] <= reach2;
+    return zero_index_.count_ball(p, below, 0) > 0;
   };
   if (quality_) {
     std::size_t dropped = 0;

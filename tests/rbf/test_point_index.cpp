@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <utility>
 #include <vector>
@@ -241,4 +242,29 @@ TEST_CASE("PointIndex rejects bad input with the culprit", "[point_index]") {
   empty.insert(4, {1, 1, 1});
   empty.nearest({0, 0, 0}, 3, out);
   REQUIRE(out == std::vector<Id>{4});
+}
+
+// The Mesher asks "is a point within reach (squared distance <= r2)?" as count_ball(q, next double above
+// r2, 0) > 0: the same answer as the nearest point's squared distance <= r2, ties at exactly r2 included.
+TEST_CASE("PointIndex: a closed-ball count agrees with the nearest distance, ties included", "[point_index]") {
+  std::vector<Point3> grid;  // integer coordinates: every squared distance below is exact
+  for (int x = 0; x < 12; ++x)
+    for (int y = 0; y < 12; ++y)
+      for (int z = 0; z < 3; ++z) grid.push_back({2.0 * x, 2.0 * y, 3.0 * z});
+  const PointIndex index(grid);
+  std::mt19937 rng(5);
+  std::uniform_int_distribution<int> coord(-4, 27);
+  std::vector<Id> ids;
+  std::vector<double> d2;
+  for (int k = 0; k < 2000; ++k) {
+    const double x = coord(rng), y = coord(rng), z = coord(rng) % 9;
+    const Point3 q{x, y, z};
+    index.nearest(q, 1, ids, &d2);
+    REQUIRE(d2.size() == 1);
+    for (const double r2 : {d2[0] - 1.0, d2[0], d2[0] + 0.5}) {
+      const double below = std::nextafter(r2, std::numeric_limits<double>::infinity());
+      REQUIRE((index.count_ball(q, below, 0) > 0) == (d2[0] <= r2));
+    }
+    REQUIRE(index.count_ball(q, d2[0], 0) == 0);  // the open ball at the nearest distance is empty
+  }
 }

@@ -25,7 +25,7 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri studio [INPUT] [--port N] [--host ADDR] [--precision P] [--function F]\n"
-    "                    [--offset D] [--sides both|inside|outside]\n"
+    "                    [--offset D] [--sides both|inside|outside] [--drag-levels K]\n"
     "\n"
     "Starts the interactive modeler: a local web server; open the printed address in a browser. Click\n"
     "the surface to add a constraint, shift+click / alt+click for an outside / inside one, drag a\n"
@@ -42,6 +42,9 @@ const char* const kUsage =
     "  --function F    implicit function: global (the RBF of the paper), local (partition of unity:\n"
     "                  local edits, 10^5+ constraints) or auto (default: global up to 4000\n"
     "                  constraints, local above; docs/local_rbf.md)\n"
+    "  --drag-levels K with the global function, a drag meshes K halvings coarser than the target\n"
+    "                  (default 1; 0: at the current level) above 5000 triangles; the idle\n"
+    "                  refinement brings the target back after the drag\n"
     "  --offset D, --sides S   as vitri mesh, for oriented points and meshes\n"
     "\n"
     "Stops on Ctrl-C. Exit status: 0 stopped, 1 bad input, 2 usage error.\n";
@@ -85,7 +88,7 @@ std::string parse_args(const Args& args, StudioArgs& out) {
     const std::string v = has_value ? args[i + 1] : std::string();
     double d = 0;
     if (a == "--port" || a == "--host" || a == "--precision" || a == "--function" || a == "--offset" ||
-        a == "--sides") {
+        a == "--sides" || a == "--drag-levels") {
       if (!has_value) return a + " needs a value";
       ++i;
     }
@@ -97,6 +100,9 @@ std::string parse_args(const Args& args, StudioArgs& out) {
     } else if (a == "--precision") {
       if (!parse_number(v, d) || !(d > 0) || d > 1) return "--precision needs a number in (0, 1], got " + v;
       out.session.precision = d;
+    } else if (a == "--drag-levels") {
+      if (!parse_number(v, d) || d < 0 || d > 8 || d != std::floor(d)) return "--drag-levels needs 0..8, got " + v;
+      out.session.drag_levels = static_cast<int>(d);
     } else if (a == "--function") {
       if (v == "global") out.session.mesher.function = FunctionKind::Global;
       else if (v == "local") out.session.mesher.function = FunctionKind::Local;

@@ -165,12 +165,32 @@ void Session::move(std::size_t index, const Point3& p, bool merge) {
   e.op = Edit::Op::Move;
   e.id = ids_[checked_index(index)];
   e.position = p;
+  const bool joins = merge && !undo_.empty() && undo_.back().op == Edit::Op::Move && undo_.back().id == e.id;
+  check_position(p);  // before the level changes: a refused move changes nothing
+  const double t0 = now_ms();
+  const bool dropped = joins && drop_to_drag_level();
   const Edit inverse = apply(e);
-  if (merge && !undo_.empty() && undo_.back().op == Edit::Op::Move && undo_.back().id == e.id) {
+  if (dropped) times_.edit_ms = now_ms() - t0;  // the new level's tetrahedralization included
+  if (joins) {
     redo_.clear();  // the first move of the drag holds the position to go back to
     return;
   }
   record(inverse);
+}
+
+// The drag level (SessionOptions::drag_levels): with the global function every move re-places the whole
+// mesh, so a coarser mesh is what keeps a drag interactive. Returns true when the mesh was dropped.
+bool Session::drop_to_drag_level() {
+  if (options_.drag_levels <= 0 || !mesher_->global_function()) return false;
+  const double level = target_ * std::ldexp(1.0, options_.drag_levels);
+  if (current_ >= level || mesher_->live_surface().num_triangles() <= options_.drag_min_triangles) return false;
+  mesher_->restart();
+  current_ = std::numeric_limits<double>::infinity();
+  mesher_->refine(level * unit_);  // no progress callback: the drag waits for its level
+  current_ = level;
+  mesh_timed_ = false;
+  ++revision_;
+  return true;
 }
 
 void Session::remove(std::size_t index) {
@@ -209,9 +229,8 @@ void Session::set_precision(double relative) {
   if (!(relative > 0) || !std::isfinite(relative))
     throw InvalidArgument("precision must be positive and finite, got " + std::to_string(relative));
   if (relative > current_) {
-    // Refinement cannot be undone: a coarser mesh needs a fresh polygonization (and fit).
-    auto mesher = std::make_unique<Mesher>(mesher_->constraints(), options_.mesher);
-    mesher_ = std::move(mesher);
+    // Refinement cannot be undone: a coarser mesh needs a fresh polygonization (the same function).
+    mesher_->restart();
     current_ = std::numeric_limits<double>::infinity();
     target_ = relative;
     ++revision_;

@@ -22,6 +22,12 @@ struct SessionOptions {
   double precision = 0.02;
   /// The first mesh after a load is this many halvings coarser than the target (levels of detail).
   int coarse_levels = 2;
+  /// Drags at a coarser level (the paper's dynamic updates at low resolution): with the global function
+  /// (every edit moves the whole surface), from the second move of a drag on, the mesh is kept this many
+  /// halvings coarser than the target, and the idle refinement brings it back after the drag. Only when
+  /// the mesh holds more than drag_min_triangles; 0 levels: drags stay at the current level.
+  int drag_levels = 1;
+  std::size_t drag_min_triangles = 5000;
   /// Most constraints a session holds with the global function (its fit is O(N^3), an edit O(N^2)).
   /// @throws LimitError beyond.
   std::size_t max_constraints = 20000;
@@ -95,7 +101,8 @@ class Session {
   /// @return the index of the new constraint. @throws InvalidArgument / InvalidPoint, LimitError.
   std::size_t add(const Point3& p, double value);
   /// `merge`: when the last undo step is a move of the same constraint, this move joins it (a drag is
-  /// one undo step: the page merges every move of a drag but the first).
+  /// one undo step: the page merges every move of a drag but the first). A merged move may first drop
+  /// the mesh to the drag level (SessionOptions::drag_levels).
   void move(std::size_t index, const Point3& p, bool merge);
   void remove(std::size_t index);
   void set_value(std::size_t index, double value);
@@ -106,8 +113,8 @@ class Session {
   std::size_t redo_depth() const { return redo_.size(); }
 
   // ---- Precision and progressive refinement
-  /// Sets the target. Finer than the current mesh: refine_step() goes on; coarser: the polygonization is
-  /// rebuilt (RBF refitted) and starts again from the coarse level. @throws InvalidArgument unless > 0.
+  /// Sets the target. Finer than the current mesh: refine_step() goes on; coarser: the polygonization
+  /// starts again (Mesher::restart(), no refit) from the coarse level. @throws InvalidArgument unless > 0.
   void set_precision(double relative);
   double target_precision() const { return target_; }
   /// Relative precision the mesh has reached (infinity before the first level).
@@ -145,6 +152,7 @@ class Session {
   void check_position(const Point3& p) const;
   void start(Constraints constraints);
   void timed_edit(const std::function<void()>& op);
+  bool drop_to_drag_level();
   ConstraintInfo info(std::size_t index) const;
   void log_change(ConstraintChange::Op op, const ConstraintInfo& c);
 

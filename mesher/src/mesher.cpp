@@ -114,6 +114,11 @@ void Mesher::build() {
   if (local_) local_->release_constraints_cache();  // read once here; 32 bytes per constraint freed
 }
 
+void Mesher::restart() {
+  build();
+  precision_ = std::numeric_limits<double>::infinity();
+}
+
 double Mesher::diagonal() const {
   if (local_) return local_->bounding_box().diagonal();
   Box3 b;

@@ -198,6 +198,7 @@ def api_bench(server):
         drag.append(1e3 * (time.perf_counter() - t0))
         server_ms.append(s["edit_ms"] + s["extract_ms"])
     post("/api/undo", {})
+    post("/api/refine", {"all": True})  # back to the target after the drag's level (docs/studio.md)
     version = pull(version, 1)
     add = []
     for k in range(12):

@@ -544,3 +544,82 @@ TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]
   while (session.redo()) REQUIRE(test::metrics_of(session.surface()).watertight());
   CHECK(sorted(session.constraints()) == sorted(edited));
 }
+
+TEST_CASE("studio session: a global drag meshes at the drag level; idle refinement brings the target back",
+          "[studio][session]") {
+  SessionOptions o = fast_options();
+  o.precision = 0.04;
+  o.drag_levels = 1;
+  o.drag_min_triangles = 0;  // the small model's mesh is below the default
+  Session session(small_model(), "small", o);
+  while (session.refine_step()) {
+  }
+  REQUIRE(session.current_precision() == o.precision);
+  const std::size_t i = 1;  // an on-surface constraint
+  const Point3 start = session.mesher().constraints().points[i];
+  std::uint32_t version = session.delta(0, true).version;
+  const std::size_t fine = session.surface().triangles.size();
+
+  // The first move of a drag stays at the target; the second drops the mesh to the drag level.
+  session.move(i, {start.x + 0.02, start.y, start.z}, false);
+  CHECK(session.current_precision() == o.precision);
+  version = session.delta(version, false).version;
+  const Polygonizer* before = &session.mesher().polygonizer();
+  session.move(i, {start.x + 0.04, start.y, start.z}, true);
+  CHECK(session.current_precision() == 2 * o.precision);
+  CHECK(session.mesher().precision() == 2 * o.precision * session.unit());
+  CHECK(&session.mesher().polygonizer() != before);  // a new polygonization at the coarser level
+  const ClientDelta dropped = session.delta(version, false);
+  CHECK(dropped.full);  // the page replaces its mesh
+  const std::size_t coarse = session.surface().triangles.size();
+  CHECK(coarse < fine);
+  CHECK(test::metrics_of(session.surface()).watertight());
+  CHECK(session.mesher().constraints().points[i] == Point3{start.x + 0.04, start.y, start.z});
+
+  // Later moves of the drag edit the coarse mesh in place.
+  const Polygonizer* coarse_poly = &session.mesher().polygonizer();
+  session.move(i, {start.x + 0.05, start.y, start.z}, true);
+  CHECK(&session.mesher().polygonizer() == coarse_poly);
+  CHECK(session.current_precision() == 2 * o.precision);
+  CHECK(session.undo_depth() == 1);  // the drag is one undo step
+
+  // A refused move (not finite) changes nothing, the level included.
+  CHECK_THROWS_AS(session.move(i, {std::nan(""), 0, 0}, true), InvalidArgument);
+  CHECK(session.current_precision() == 2 * o.precision);
+
+  // After the drag: the idle refinement reaches the target again; undo takes the whole drag back.
+  CHECK_FALSE(session.refined());
+  REQUIRE(session.refine_step());
+  CHECK(session.current_precision() == o.precision);
+  CHECK(test::metrics_of(session.surface()).watertight());
+  REQUIRE(session.undo());
+  CHECK(session.mesher().constraints().points[i] == start);
+  CHECK(test::metrics_of(session.surface()).watertight());
+
+  // drag_levels = 0 keeps drags at the current level.
+  o.drag_levels = 0;
+  Session still(small_model(), "small", o);
+  while (still.refine_step()) {
+  }
+  still.move(i, {start.x + 0.02, start.y, start.z}, false);
+  const Polygonizer* kept = &still.mesher().polygonizer();
+  still.move(i, {start.x + 0.04, start.y, start.z}, true);
+  CHECK(still.current_precision() == o.precision);
+  CHECK(&still.mesher().polygonizer() == kept);
+}
+
+TEST_CASE("studio session: a coarser target restarts the polygonization without a refit", "[studio][session]") {
+  Session session(small_model(), "small", fast_options());
+  while (session.refine_step()) {
+  }
+  const Rbf* rbf = session.mesher().global_function();
+  REQUIRE(rbf != nullptr);
+  const std::size_t fine = session.surface().triangles.size();
+  session.set_precision(0.12);
+  CHECK(session.mesher().global_function() == rbf);  // the same fitted function
+  while (session.refine_step()) {
+  }
+  CHECK(session.current_precision() == 0.12);
+  CHECK(session.surface().triangles.size() < fine);
+  CHECK(test::metrics_of(session.surface()).watertight());
+}

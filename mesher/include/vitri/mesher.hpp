@@ -160,6 +160,13 @@ class Mesher {
   ///         LimitError past options().max_vertices.
   bool refine(double precision, const ProgressCallback& progress = {});
 
+  /// Drops the polygonization (Delaunay tree, refinement, mesh) and starts it again from the constraints'
+  /// tetrahedralization with the current function, as after construction, without refitting: precision()
+  /// is infinite until the next refine(), and the next update_surface() returns a full delta. Refinement
+  /// cannot be undone; this is how a coarser level is reached (the studio's drags and coarser targets).
+  /// Cost: the initial tetrahedralization (with f at its vertices), not the fit.
+  void restart();
+
   /// The current mesh (extracted on demand, cached until the next refine or edit), compact.
   const SurfaceMesh& surface();
   /// Brings the live mesh (live_surface()) up to date and returns what changed in it since the previous

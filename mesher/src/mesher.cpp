@@ -184,24 +184,49 @@ void Mesher::track_zero(VertexId v, const Point3& p, double value) {
   if (v != kNoVertex && value == 0) zero_index_.insert(v, p);
 }
 
-void Mesher::sync_surface() {
-  const bool filter = !options_.keep_unsupported_components && !zero_index_.empty() && std::isfinite(precision_);
-  const double reach2 = std::pow(2.5 * precision_, 2);
+bool Mesher::filtering() const {
+  return !options_.keep_unsupported_components && !zero_index_.empty() && std::isfinite(precision_);
+}
+
+std::function<bool(const Point3&)> Mesher::support_query() const {
   // "Is a zero constraint within reach (squared distance <= reach2)?": a ball count that stops at the
   // first point (the closed ball: strictly below the next double), not a nearest-point search, which
   // explores far around the vertices of a component that no constraint supports.
+  const double reach2 = std::pow(2.5 * precision_, 2);
   const double below = std::nextafter(reach2, std::numeric_limits<double>::infinity());
-  const SupportFilter::Supported supported = [&](const Point3& p) {
-    return zero_index_.count_ball(p, below, 0) > 0;
-  };
+  return [this, below](const Point3& p) { return zero_index_.count_ball(p, below, 0) > 0; };
+}
+
+namespace {
+
+/// Every live triangle and vertex of `mesh` as added: what a filter that missed the earlier deltas needs.
+MeshDelta whole_mesh(const LiveMesh& mesh) {
+  MeshDelta d;
+  d.full = true;
+  for (std::uint32_t v = 0; v < mesh.vertex_capacity(); ++v)
+    if (mesh.is_vertex(v)) d.added_vertices.push_back(v);
+  for (std::uint32_t t = 0; t < mesh.triangle_capacity(); ++t)
+    if (mesh.is_triangle(t)) d.added_triangles.push_back(t);
+  return d;
+}
+
+}  // namespace
+
+void Mesher::sync_surface() {
+  const bool filter = filtering();
+  const SupportFilter::Supported supported = support_query();
   if (quality_) {
     std::size_t dropped = 0;
     SurfaceMesh m = quality_->extract();
-    if (filter) m = keep_supported_components(m, supported, &dropped);
+    if (filter) m = keep_supported_components(std::move(m), supported, &dropped);
     filter_->replace(m);
     stats_.dropped_components = dropped;
   } else {
-    const MeshDelta delta = poly_->update_surface();
+    MeshDelta delta = poly_->update_surface();
+    if (filter_behind_) {  // batch extractions skipped the filter: it starts again from the whole mesh
+      delta = whole_mesh(poly_->live_surface());
+      filter_behind_ = false;
+    }
     const bool recheck = filter && filter_precision_ != precision_;
     filter_->update(poly_->live_surface(), delta, filter ? supported : SupportFilter::Supported{}, recheck);
     filter_precision_ = precision_;
@@ -219,7 +244,19 @@ MeshDelta Mesher::update_surface() {
 const LiveMesh& Mesher::live_surface() const { return filter_->view(); }
 
 const SurfaceMesh& Mesher::surface() {
-  if (!mesh_valid_) {
+  if (!mesh_valid_ && !deltas_wanted_ && !quality_) {
+    // Batch (no delta was ever asked for): the polygonizer's mesh, compacted, less its unsupported
+    // components (the filter's rule from scratch); the filter's view, a second live copy of the mesh kept
+    // for deltas, is not built. Its records are dropped (nobody reads them); a later update_surface()
+    // starts the filter from the whole mesh.
+    poly_->update_surface();
+    filter_behind_ = true;
+    std::size_t dropped = 0;
+    mesh_ = poly_->live_surface().to_surface_mesh();
+    if (filtering()) mesh_ = keep_supported_components(std::move(mesh_), support_query(), &dropped);
+    stats_.dropped_components = dropped;
+    mesh_valid_ = true;
+  } else if (!mesh_valid_) {
     sync_surface();
     if (!deltas_wanted_) filter_->view().take_delta();  // nobody reads the record: free the ids
     mesh_ = filter_->view().to_surface_mesh();

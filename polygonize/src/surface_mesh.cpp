@@ -12,43 +12,61 @@
 
 namespace vitri {
 
-SurfaceMesh keep_supported_components(const SurfaceMesh& mesh, const std::function<bool(const Point3&)>& supported,
+SurfaceMesh keep_supported_components(SurfaceMesh mesh, const std::function<bool(const Point3&)>& supported,
                                       std::size_t* dropped) {
+  constexpr std::uint32_t kUnused = 0xffffffffu;
   const std::size_t n = mesh.vertices.size();
-  std::vector<std::uint32_t> parent(n);
-  std::iota(parent.begin(), parent.end(), 0u);
+  // Union-find over the triangles' corners (the smaller id becomes the root), then every used vertex's
+  // root once: `root[v]` (kUnused for a vertex that no triangle uses).
+  std::vector<std::uint32_t> root(n);
+  std::iota(root.begin(), root.end(), 0u);
   auto find = [&](std::uint32_t v) {
-    while (parent[v] != v) v = parent[v] = parent[parent[v]];
+    while (root[v] != v) v = root[v] = root[root[v]];
     return v;
   };
-  for (const auto& t : mesh.triangles)
+  std::vector<std::uint8_t> used(n, 0);
+  for (const auto& t : mesh.triangles) {
+    used[t[0]] = used[t[1]] = used[t[2]] = 1;
     for (int k = 1; k < 3; ++k) {
       const std::uint32_t a = find(t[0]), b = find(t[static_cast<std::size_t>(k)]);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+      if (a != b) root[std::max(a, b)] = std::min(a, b);
     }
-  std::vector<std::uint8_t> keep(n, 0), used(n, 0);
-  for (const auto& t : mesh.triangles)
-    for (std::uint32_t v : t) used[v] = 1;
-  for (std::uint32_t v = 0; v < n; ++v)  // a component is asked about until one vertex supports it
-    if (used[v] && !keep[find(v)] && supported(mesh.vertices[v])) keep[find(v)] = 1;
-  std::size_t components = 0, kept = 0;
-  for (std::uint32_t v = 0; v < n; ++v)
-    if (used[v] && find(v) == v) {
-      ++components;
-      kept += keep[v];
+  }
+  for (std::uint32_t v = 0; v < n; ++v) root[v] = used[v] ? root[root[v]] : kUnused;  // roots precede
+  // A component is asked about until one of its vertices supports it.
+  std::vector<std::uint8_t> keep(n, 0);
+  std::size_t components = 0, kept = 0, unused = 0;
+  for (std::uint32_t v = 0; v < n; ++v) {
+    if (root[v] == kUnused) {
+      ++unused;
+      continue;
     }
+    components += root[v] == v;
+    if (!keep[root[v]] && supported(mesh.vertices[v])) {
+      keep[root[v]] = 1;
+      ++kept;
+    }
+  }
   if (dropped) *dropped = components - kept;
-  SurfaceMesh out;
-  std::vector<std::uint32_t> renumber(n, 0xffffffffu);
+  if (kept == components && unused == 0) return mesh;  // nothing to drop: the mesh as it is
+  std::vector<std::uint32_t> renumber(n, kUnused);
+  std::size_t out = 0;
   for (std::uint32_t v = 0; v < n; ++v)
-    if (used[v] && keep[find(v)]) {
-      renumber[v] = static_cast<std::uint32_t>(out.vertices.size());
-      out.vertices.push_back(mesh.vertices[v]);
-      if (!mesh.normals.empty()) out.normals.push_back(mesh.normals[v]);
+    if (root[v] != kUnused && keep[root[v]]) {
+      renumber[v] = static_cast<std::uint32_t>(out);
+      mesh.vertices[out] = mesh.vertices[v];
+      if (!mesh.normals.empty()) mesh.normals[out] = mesh.normals[v];
+      ++out;
     }
-  for (const auto& t : mesh.triangles)
-    if (keep[find(t[0])]) out.triangles.push_back({renumber[t[0]], renumber[t[1]], renumber[t[2]]});
-  return out;
+  mesh.vertices.resize(out);
+  if (!mesh.normals.empty()) mesh.normals.resize(out);
+  std::size_t f = 0;
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const auto t = mesh.triangles[i];
+    if (keep[root[t[0]]]) mesh.triangles[f++] = {renumber[t[0]], renumber[t[1]], renumber[t[2]]};
+  }
+  mesh.triangles.resize(f);
+  return mesh;
 }
 
 void to_eigen(const SurfaceMesh& mesh, Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd* N) {

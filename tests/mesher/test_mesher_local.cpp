@@ -113,6 +113,15 @@ TEST_CASE("unsupported components are dropped unless the whole zero set is asked
     // What is kept is the supported sphere: every vertex near the unit sphere.
     if (!keep)
       for (const Point3& v : mesher.surface().vertices) REQUIRE(std::abs(norm(v) - 1.0) < 0.1);
+    // Batch surface() calls skip the filter's live view; the first delta asked for starts it from the
+    // whole mesh: a full delta of the same surface, and the same surface from then on.
+    const SurfaceMesh batch = mesher.surface();
+    const MeshDelta d = mesher.update_surface();
+    REQUIRE(d.full);
+    REQUIRE(d.added_triangles.size() == batch.triangles.size());
+    REQUIRE(test::canonical(mesher.live_surface().to_surface_mesh()) == test::canonical(batch));
+    REQUIRE(test::canonical(mesher.surface()) == test::canonical(batch));
+    REQUIRE(mesher.stats().dropped_components == (keep ? 0u : 1u));
   }
 }
 

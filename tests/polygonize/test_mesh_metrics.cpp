@@ -386,4 +386,43 @@ TEST_CASE("keep_supported_components keeps the components with a supported verte
   const SurfaceMesh none = keep_supported_components(m, [](const Point3&) { return false; }, &dropped);
   REQUIRE(dropped == 2);
   REQUIRE(none.triangles.empty());
+  REQUIRE(none.vertices.empty());
+  // Everything supported: only the unused vertex goes, the rest keeps its order.
+  const SurfaceMesh all = keep_supported_components(m, [](const Point3&) { return true; }, &dropped);
+  REQUIRE(dropped == 0);
+  REQUIRE(all.vertices == std::vector<Point3>(m.vertices.begin(), m.vertices.begin() + 8));
+  REQUIRE(all.normals == std::vector<Point3>(m.normals.begin(), m.normals.begin() + 8));
+  REQUIRE(all.triangles == m.triangles);
+  // Nothing to drop: the mesh comes back as it was.
+  m.vertices.pop_back();
+  m.normals.pop_back();
+  const SurfaceMesh same = keep_supported_components(m, [](const Point3& p) { return p.x >= 0; }, &dropped);
+  REQUIRE(dropped == 0);
+  REQUIRE(same.vertices == m.vertices);
+  REQUIRE(same.triangles == m.triangles);
+  REQUIRE(same.normals == m.normals);
+}
+
+TEST_CASE("keep_supported_components: components whose lowest ids come last", "[mesh_metrics]") {
+  using vitri::keep_supported_components;
+  using vitri::Point3;
+  using vitri::SurfaceMesh;
+  // Two strips of triangles with interleaved vertex ids (even: strip A at y = 0, odd: strip B at y = 5),
+  // each listed from its highest ids down, so the unions join roots in every order.
+  SurfaceMesh m;
+  const std::uint32_t n = 40;
+  for (std::uint32_t i = 0; i < n; ++i)
+    m.vertices.push_back({static_cast<double>(i / 2), i % 2 == 0 ? 0.0 : 5.0, static_cast<double>(i % 4 < 2)});
+  for (std::uint32_t i = n - 1; i >= 4; --i) m.triangles.push_back({i, i - 2, i - 4});
+  std::size_t dropped = 9;
+  const SurfaceMesh b = keep_supported_components(m, [](const Point3& p) { return p.y > 1 && p.x > 18; }, &dropped);
+  REQUIRE(dropped == 1);
+  REQUIRE(b.vertices.size() == n / 2);
+  for (std::size_t k = 0; k < b.vertices.size(); ++k) REQUIRE(b.vertices[k] == m.vertices[2 * k + 1]);
+  REQUIRE(b.triangles.size() == (n - 4) / 2);
+  for (const auto& t : b.triangles) {
+    REQUIRE(b.vertices[t[0]].y == 5.0);
+    REQUIRE(t[0] == t[1] + 1);
+    REQUIRE(t[1] == t[2] + 1);
+  }
 }

@@ -167,14 +167,17 @@ class Mesher {
   /// Cost: the initial tetrahedralization (with f at its vertices), not the fit.
   void restart();
 
-  /// The current mesh (extracted on demand, cached until the next refine or edit), compact.
+  /// The current mesh (extracted on demand, cached until the next refine or edit), compact, without the
+  /// components no on-surface constraint supports. Until update_surface() is first called (a batch run),
+  /// it is built from the polygonizer's mesh directly and live_surface() is not kept up to date.
   const SurfaceMesh& surface();
   /// Brings the live mesh (live_surface()) up to date and returns what changed in it since the previous
   /// call: only the changed triangles (polygonizer's incremental extraction, then the support filter kept
   /// incrementally, docs/mesher.md). The first call returns a full delta, so does every call in the
   /// quality mode (its mesh is rebuilt). Until this is first called, surface() drops the records.
   MeshDelta update_surface();
-  /// The current mesh with stable ids, as of the last update_surface(), sync_surface() or surface().
+  /// The current mesh with stable ids, as of the last update_surface() or sync_surface() (or surface()
+  /// once update_surface() was called).
   const LiveMesh& live_surface() const;
   /// Brings live_surface() up to date without taking its delta (the next update_surface() returns the
   /// changes since the previous one, these included). Cost as update_surface().
@@ -224,6 +227,8 @@ class Mesher {
   double value_of(std::size_t i) const;
   Point3 constraints_point(std::size_t i) const;
   void refine_quality();
+  bool filtering() const;
+  std::function<bool(const Point3&)> support_query() const;  // a zero constraint within reach?
   bool inside_domain(const Point3& p) const;
   /// Keeps zero_index_ in step with constraint i's Delaunay vertex, position and value.
   void track_zero(VertexId v, const Point3& p, double value);
@@ -265,6 +270,7 @@ class Mesher {
   bool mesh_valid_ = false;
   std::unique_ptr<SupportFilter> filter_;  // the live mesh without unsupported components
   double filter_precision_ = 0;             // precision of its last support check
+  bool filter_behind_ = false;              // batch surface() calls skipped it (it missed their deltas)
   bool deltas_wanted_ = false;              // update_surface() was called: keep the records
   MesherStats stats_;
 };

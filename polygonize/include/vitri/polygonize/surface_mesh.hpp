@@ -28,8 +28,9 @@ struct SurfaceMesh {
 
 /// The connected components (through shared vertices) of `mesh` that hold at least one vertex v with
 /// supported(v), the others dropped; vertices renumbered in their original order, normals kept. Returns
-/// the number of components dropped through `dropped` when given. O(V + F).
-SurfaceMesh keep_supported_components(const SurfaceMesh& mesh, const std::function<bool(const Point3&)>& supported,
+/// the number of components dropped through `dropped` when given. O(V + F); `mesh` is taken by value, so
+/// a caller that moves it in pays no copy (returned as it is when nothing is dropped).
+SurfaceMesh keep_supported_components(SurfaceMesh mesh, const std::function<bool(const Point3&)>& supported,
                                       std::size_t* dropped = nullptr);
 
 /// Copies the mesh into Eigen arrays: V (#V x 3), F (#F x 3), N (#V x 3, or 0 x 3 without normals).

@@ -31,7 +31,7 @@ const char* const kUsage =
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K]\n"
-    "                  [--function global|local|auto] [--smoothing S] [--threads N] [-q]\n"
+    "                  [--function global|local|auto] [--smoothing S] [--threads N] [--ascii] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -104,6 +104,8 @@ const char* const kUsage =
     "  --threads N          threads of the fit, the seeds' insertion and the extraction (default 0:\n"
     "                       every CPU this process may run on, i.e. its affinity mask, so `taskset`\n"
     "                       works too). The mesh is the same file whatever N.\n"
+    "  --ascii              PLY output as text (default: binary little-endian, about half the size and\n"
+    "                       several times faster to write; OBJ and OFF are always text)\n"
     "  -q, --quiet          no table, no progress\n"
     "\n"
     "Progress goes to stderr: a line as each phase starts (read, constraints, precision, fit,\n"
@@ -193,7 +195,9 @@ void print_fit_split(const LocalFitReport& r) {
                1e3 * r.patches_seconds, r.patches, r.mean_fitted, r.max_fitted);
 }
 
-void write_current(Mesher& mesher, const std::string& path) { write_mesh(path, view_of(mesher.surface())); }
+void write_current(Mesher& mesher, const std::string& path, PlyEncoding ply) {
+  write_mesh(path, view_of(mesher.surface()), ply);
+}
 
 /// From this many constraints on, the fit is announced with its constraint count and its time (every
 /// phase is announced on stderr as it starts, see PhaseTimes).
@@ -244,6 +248,7 @@ int run_mesh(const Args& args) {
   std::vector<double> distances;  // quality mode: --max-distance per level (relative)
   double relative_size = std::numeric_limits<double>::infinity();  // quality mode: --max-size
   bool quiet = false;
+  PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  // --ascii: text
   unsigned threads = 0;  // --threads: 0 = every available CPU
   MesherOptions options;
   options.function = FunctionKind::Auto;
@@ -319,6 +324,8 @@ int run_mesh(const Args& args) {
       threads = unsigned(k);
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
+    } else if (a == "--ascii") {
+      ply = PlyEncoding::Ascii;
     } else if (!a.empty() && a[0] == '-') {
       return usage_error("unknown option '" + a + "'");
     } else if (input.empty()) {
@@ -450,7 +457,7 @@ int run_mesh(const Args& args) {
     total_ms += refine_ms + extract_ms;
     const std::string path = levels == 1 ? output : level_path(output, k);
     phases.start("writing", "writing " + path);
-    write_current(mesher, path);
+    write_current(mesher, path, ply);
     phases.stop();
     if (!quiet)
       std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
@@ -480,7 +487,7 @@ int run_mesh(const Args& args) {
     try {
       if (op == "write") {
         if (tok.size() != 2) throw bad("expected 'write PATH'");
-        write_current(mesher, tok[1]);
+        write_current(mesher, tok[1], ply);
         if (!quiet) std::printf("%5zu %-28s -> %s\n", line, "write", tok[1].c_str());
         continue;
       }

@@ -166,6 +166,25 @@ TEST_CASE("vitri mesh: .ply and .off outputs hold the same mesh as .obj", "[cli]
   }
   REQUIRE(n[0] == n[1]);
   REQUIRE(n[0] == n[2]);
+  // PLY is binary unless --ascii; both hold the same values.
+  const auto header = [](const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    std::string magic, format;
+    std::getline(f, magic);
+    std::getline(f, format);
+    return format;
+  };
+  const std::string text = kDir + "/mesh_fmt_ascii.ply";
+  REQUIRE(run(in + " -o " + text + " --precision 0.06 -q --ascii", o, e) == 0);
+  CHECK(header(kDir + "/mesh_fmt.ply") == "format binary_little_endian 1.0");
+  CHECK(header(text) == "format ascii 1.0");
+  const TriangleMesh a = read_mesh(kDir + "/mesh_fmt.ply"), b = read_mesh(text);
+  REQUIRE(a.V.rows() == b.V.rows());
+  REQUIRE(a.F.rows() == b.F.rows());
+  REQUIRE(a.N.rows() == b.N.rows());
+  CHECK(a.V == b.V);
+  CHECK(a.F == b.F);
+  CHECK(a.N == b.N);
 }
 
 TEST_CASE("vitri mesh: an edit script runs, reports each edit and writes meshes", "[cli][mesh]") {

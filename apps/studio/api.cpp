@@ -90,15 +90,32 @@ std::string param(const ApiRequest& r, const std::string& key, const std::string
   return it == r.params.end() ? fallback : it->second;
 }
 
-/// The version a client holds (query parameter "since", default 0 = none), at most `max`.
-std::uint64_t version_param(const ApiRequest& r, std::uint64_t max) {
-  const std::string s = param(r, "since", "0");
+/// The version a client holds (query parameter `key`, default "since"; absent: 0 = none), at most `max`.
+std::uint64_t version_param(const ApiRequest& r, std::uint64_t max, const char* key = "since") {
+  const std::string s = param(r, key, "0");
   char* end = nullptr;
   errno = 0;
   const unsigned long long v = std::strtoull(s.c_str(), &end, 10);
   if (s.empty() || *end != '\0' || s[0] == '-' || errno == ERANGE || v > max)
-    throw BadRequest("\"since\" must be a version (a non-negative integer), got '" + s + "'");
+    throw BadRequest("\"" + std::string(key) + "\" must be a version (a non-negative integer), got '" + s + "'");
   return v;
+}
+
+bool exact_param(const ApiRequest& r) {
+  const std::string exact = param(r, "exact", "1");
+  if (exact != "0" && exact != "1") throw BadRequest("\"exact\" must be 0 or 1, got '" + exact + "'");
+  return exact == "1";
+}
+
+/// Query parameters "mesh" and "exact" of an edit, undo or redo; read before the edit, so that a bad one
+/// changes nothing.
+MeshWanted mesh_wanted(const ApiRequest& r) {
+  MeshWanted m;
+  if (r.params.find("mesh") == r.params.end()) return m;
+  m.wanted = true;
+  m.since = static_cast<std::uint32_t>(version_param(r, 0xffffffffull, "mesh"));
+  m.exact = exact_param(r);
+  return m;
 }
 
 std::string constraint_json(const ConstraintInfo& c) {
@@ -238,10 +255,27 @@ ApiResponse Api::route(const ApiRequest& r) {
   if (p == "/api/refine") return refine(r);
   if (p == "/api/load") return load(r);
   check_keys(parse_body(r.body), {});
+  const MeshWanted mesh = mesh_wanted(r);
   const std::uint64_t base = session_.constraint_version();
   const bool done = p == "/api/undo" ? session_.undo() : session_.redo();
-  return json_response(
-      stats_json(std::string("\"done\":") + (done ? "true" : "false") + changes_since(base)));
+  return with_mesh(mesh, stats_json(std::string("\"done\":") + (done ? "true" : "false") + changes_since(base)));
+}
+
+// An edit's JSON, and with "mesh=V" the mesh delta from version V in the same body (one round trip
+// instead of two): a little-endian uint32 L, L bytes of JSON (padded with spaces to a multiple of 4, so
+// that the delta's arrays stay aligned), then the delta as GET /api/mesh sends it (docs/studio.md).
+ApiResponse Api::with_mesh(const MeshWanted& mesh, std::string json) {
+  if (!mesh.wanted) return json_response(std::move(json));
+  while (json.size() % 4) json.push_back(' ');
+  const std::string delta = encode_binary(session_.delta(mesh.since, mesh.exact));
+  ApiResponse out;
+  out.content_type = "application/octet-stream";
+  const auto n = static_cast<std::uint32_t>(json.size());
+  out.body.reserve(4 + json.size() + delta.size());
+  for (int k = 0; k < 4; ++k) out.body.push_back(static_cast<char>((n >> (8 * k)) & 0xffu));
+  out.body += json;
+  out.body += delta;
+  return out;
 }
 
 std::string Api::stats_json(const std::string& extra) {
@@ -292,10 +326,9 @@ ApiResponse Api::mesh(const ApiRequest& r) {
   if (format == "indexed") return json_response(indexed_mesh_json(session_.surface()));
   if (format != "binary" && format != "json")
     throw BadRequest("\"format\" must be binary, json or indexed, got '" + format + "'");
-  const std::string exact = param(r, "exact", "1");
-  if (exact != "0" && exact != "1") throw BadRequest("\"exact\" must be 0 or 1, got '" + exact + "'");
+  const bool exact = exact_param(r);
   const auto since = static_cast<std::uint32_t>(version_param(r, 0xffffffffull));
-  const ClientDelta d = session_.delta(since, exact == "1");
+  const ClientDelta d = session_.delta(since, exact);
   if (format == "json") return json_response(encode_json(d));
   ApiResponse out;
   out.content_type = "application/octet-stream";
@@ -306,6 +339,7 @@ ApiResponse Api::mesh(const ApiRequest& r) {
 ApiResponse Api::edit(const ApiRequest& r) {
   const Json body = parse_body(r.body);
   const std::string op = member(body, "op").as_string("\"op\"");
+  const MeshWanted mesh = mesh_wanted(r);
   const std::uint64_t base = session_.constraint_version();
   std::string extra = "\"op\":" + json_quote(op);
   if (op == "add") {
@@ -325,7 +359,7 @@ ApiResponse Api::edit(const ApiRequest& r) {
   } else {
     throw BadRequest("unknown edit \"" + op + "\" (add, move, remove, value)");
   }
-  return json_response(stats_json(extra + changes_since(base)));
+  return with_mesh(mesh, stats_json(extra + changes_since(base)));
 }
 
 ApiResponse Api::refine(const ApiRequest& r) {

@@ -12,6 +12,14 @@
 
 namespace vitri::studio {
 
+/// The mesh delta an edit's answer carries (query parameters "mesh", the client's mesh version, and
+/// "exact", 0 or 1): none unless `wanted`.
+struct MeshWanted {
+  bool wanted = false;
+  std::uint32_t since = 0;
+  bool exact = true;
+};
+
 struct ApiRequest {
   std::string method;                         ///< "GET", "POST", ...
   std::string path;                           ///< e.g. "/api/edit"
@@ -54,6 +62,7 @@ class Api {
   ApiResponse refine(const ApiRequest& request);
   ApiResponse load(const ApiRequest& request);
   ApiResponse export_file(const ApiRequest& request);
+  ApiResponse with_mesh(const MeshWanted& mesh, std::string json);
   std::string stats_json(const std::string& extra = {});
   std::string changes_since(std::uint64_t base) const;
   std::string temp_path(const std::string& ext) const;

@@ -13,6 +13,8 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <cstring>
+#include <map>
 #include <cmath>
 #include <random>
 #include <string>
@@ -253,6 +255,78 @@ TEST_CASE("studio api: refine, precision, export, load", "[studio][api]") {
   CHECK(r.get("/api/mesh?format=json&since=5").find("full")->as_bool(""));
 }
 
+TEST_CASE("studio api: an edit's answer carries the mesh delta when asked (one round trip)", "[studio][api]") {
+  Running r;
+  // A client holding the mesh through binary deltas: triangle id -> 9 floats.
+  std::map<std::uint32_t, std::vector<float>> held;
+  std::uint32_t version = 0;
+  const auto apply = [&](const std::string& bytes) {
+    REQUIRE(bytes.size() >= 24);
+    std::uint32_t h[6];
+    std::memcpy(h, bytes.data(), sizeof h);
+    REQUIRE(h[0] == 0x44525456u);
+    const std::uint32_t removed = h[4], added = h[5];
+    REQUIRE(bytes.size() == 24 + 4 * (removed + added) + 72 * std::size_t{added});
+    if (h[1] & 1) held.clear();
+    const char* at = bytes.data() + 24;
+    for (std::uint32_t k = 0; k < removed; ++k, at += 4) {
+      std::uint32_t id;
+      std::memcpy(&id, at, 4);
+      held.erase(id);
+    }
+    const char* pos = at + 4 * std::size_t{added};
+    for (std::uint32_t k = 0; k < added; ++k, at += 4) {
+      std::uint32_t id;
+      std::memcpy(&id, at, 4);
+      std::vector<float> corners(9);
+      std::memcpy(corners.data(), pos + 36 * std::size_t{k}, 36);
+      held[id] = corners;
+    }
+    version = h[2];
+  };
+  apply(r.client.Get("/api/mesh?since=0")->body);
+  const auto answer = [&](const std::string& path, const std::string& body) {
+    const auto res = r.client.Post(path.c_str(), body, "application/json");
+    REQUIRE(res);
+    REQUIRE(res->status == 200);
+    CHECK(res->get_header_value("Content-Type") == "application/octet-stream");
+    const std::string& b = res->body;
+    REQUIRE(b.size() >= 4);
+    std::uint32_t n = 0;
+    for (int k = 0; k < 4; ++k) n |= std::uint32_t(static_cast<unsigned char>(b[k])) << (8 * k);
+    REQUIRE(n % 4 == 0);  // the delta's arrays stay aligned
+    REQUIRE(b.size() >= 4 + n);
+    const Json j = Json::parse(b.substr(4, n));
+    apply(b.substr(4 + n));
+    return j;
+  };
+  const auto same_as_server = [&] {
+    // An empty delta from the version held: the client is up to date, and holds every server triangle.
+    const Json none = r.get("/api/mesh?format=json&since=" + std::to_string(version));
+    CHECK_FALSE(none.find("full")->as_bool(""));
+    CHECK(none.find("added")->as_array("").empty());
+    CHECK(static_cast<double>(held.size()) == number(r.get("/api/stats"), "triangles"));
+  };
+  Json s = answer("/api/edit?mesh=" + std::to_string(version),
+                  R"({"op": "add", "position": [0, 0, 0.75], "value": 0})");
+  CHECK(number(s, "index") == 25);
+  CHECK(s.find("constraint_delta") != nullptr);
+  same_as_server();
+  s = answer("/api/edit?exact=0&mesh=" + std::to_string(version),
+             R"({"op": "move", "index": 25, "position": [0, 0.1, 0.8]})");
+  CHECK(number(s, "undo") == 2);
+  apply(r.client.Get(("/api/mesh?since=" + std::to_string(version)).c_str())->body);  // the exact mesh after it
+  same_as_server();
+  s = answer("/api/undo?mesh=" + std::to_string(version), "{}");
+  CHECK(s.find("done")->as_bool(""));
+  same_as_server();
+  s = answer("/api/redo?mesh=" + std::to_string(version), "{}");
+  CHECK(s.find("done")->as_bool(""));
+  same_as_server();
+  // Without "mesh" the answer is JSON, as before.
+  CHECK(r.post("/api/undo", "{}").find("done")->as_bool(""));
+}
+
 TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[studio][api]") {
   Running r(4096);
   r.post("/api/edit", R"({"op": "move", "index": 2, "position": [0.1, 0.2, 0.5]})");  // something to undo
@@ -284,6 +358,10 @@ TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[
       {"/api/refine", R"({"precision": -1})", 400, "precision"},
       {"/api/refine", R"({"all": "yes"})", 400, "boolean"},
       {"/api/undo", R"({"steps": 2})", 400, "unknown key"},
+      {"/api/undo?mesh=-1", "{}", 400, "mesh"},
+      {"/api/redo?mesh=x", "{}", 400, "mesh"},
+      {"/api/edit?mesh=99999999999", R"({"op": "move", "index": 1, "position": [0, 0, 0.5]})", 400, "mesh"},
+      {"/api/edit?mesh=0&exact=2", R"({"op": "move", "index": 1, "position": [0, 0, 0.5]})", 400, "exact"},
       {"/api/load?name=x.exe", "data", 400, "cannot open"},
       {"/api/load", "0 0 0 0\n", 400, "name"},
       {"/api/load?name=bad.xyzv", "0 0 zero 0\n", 400, "bad.xyzv"},

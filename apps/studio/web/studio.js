@@ -158,8 +158,13 @@ class Studio {
   async pull(timing, approximate) {
     const r = await api.request('GET', '/api/mesh?since=' + this.slots.version + (approximate ? '&exact=0' : ''));
     const buffer = await r.arrayBuffer();
+    if (timing) timing.server += serverMs(r);
+    this.applyMesh(buffer, timing, approximate);
+  }
+
+  // Applies a binary mesh delta (not drawn yet: present()).
+  applyMesh(buffer, timing, approximate) {
     if (timing) {
-      timing.server += serverMs(r);
       timing.received = performance.now();
       timing.bytes = buffer.byteLength;
     }
@@ -203,10 +208,14 @@ class Studio {
   update(path, body, { event, approximate = true, select } = {}) {
     return this.queue(async () => {
       const timing = { event: event === undefined ? performance.now() : event, sent: performance.now(), server: 0 };
-      const r = await api.request('POST', path, body === undefined ? undefined : JSON.stringify(body));
+      // One round trip: the answer carries the mesh delta from the version held (docs/studio.md).
+      const query = '?mesh=' + this.slots.version + (approximate ? '&exact=0' : '');
+      const r = await api.request('POST', path + query, body === undefined ? undefined : JSON.stringify(body));
       timing.server += serverMs(r);
-      const s = await r.json();
-      await this.pull(timing, approximate);
+      const buffer = await r.arrayBuffer();
+      const n = new DataView(buffer).getUint32(0, true);
+      const s = JSON.parse(new TextDecoder().decode(new Uint8Array(buffer, 4, n)));
+      this.applyMesh(buffer.slice(4 + n), timing, approximate);
       await this.syncConstraints(s.constraint_delta);
       if (select !== undefined) this.select(select(s), false);  // in the same frame
       this.present(timing);

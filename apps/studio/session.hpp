@@ -102,7 +102,8 @@ class Session {
   std::size_t add(const Point3& p, double value);
   /// `merge`: when the last undo step is a move of the same constraint, this move joins it (a drag is
   /// one undo step: the page merges every move of a drag but the first). A merged move may first drop
-  /// the mesh to the drag level (SessionOptions::drag_levels).
+  /// the mesh to the drag level (SessionOptions::drag_levels); a move the Mesher then refuses leaves the
+  /// constraints as they were, the mesh at that level (the idle refinement brings the target back).
   void move(std::size_t index, const Point3& p, bool merge);
   void remove(std::size_t index);
   void set_value(std::size_t index, double value);

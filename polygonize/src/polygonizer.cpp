@@ -29,6 +29,7 @@
 #include "vitri/polygonize/polygonizer.hpp"
 
 #include "polygonizer_internal.hpp"
+#include "slices.hpp"
 #include "surface_tracker.hpp"
 #include "vitri/core/error.hpp"
 
@@ -55,6 +56,7 @@ TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
 }
 
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
+constexpr std::size_t kClassifySliceMin = std::size_t(1) << 16;  // tetrahedra per thread of classify_all
 
 /// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
 /// removal swaps the last element in. @pre x is not listed (on) or listed (off).
@@ -174,7 +176,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
   stats_.init_evaluate_seconds = seconds_since(t2);
   const auto t3 = Clock::now();
   grow_tet_arrays();
-  tri_.for_each_tetrahedron([this](TetId t) { classify(t, false); });
+  classify_all();
   settle_zeros({});
   stats_.init_classify_seconds = seconds_since(t3);
   stats_.init_seconds = seconds_since(t0);
@@ -373,6 +375,27 @@ void Polygonizer::classify(TetId t, bool requeue) {
   if (now && (!was || requeue)) radius_[t] = tri_.circumradius(t);
   set_transverse(t, now);
   if (now && (!was || requeue) && radius_[t] > precision_) push(t);
+}
+
+// The first classification, of every live tetrahedron (construction: nothing listed yet, no precision, so
+// nothing is queued): the transverse flags and the circumradii of the transverse ones on the threads (each
+// slice writes only its own entries), then the list in id order on this thread, as classify() one
+// tetrahedron after the other builds it. Every vertex is a neck candidate (find_necks() sorts them).
+void Polygonizer::classify_all() {
+  const std::size_t n = tri_.tet_capacity();
+  std::vector<std::uint8_t> transverse(n, 0);
+  run_slices(n, slice_count(options_.threads, n, kClassifySliceMin), [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t t = lo; t < hi; ++t) {
+      if (!is_transverse(static_cast<TetId>(t))) continue;  // dead ones are not
+      transverse[t] = 1;
+      radius_[t] = tri_.circumradius(static_cast<TetId>(t));
+    }
+  });
+  for (std::size_t t = 0; t < n; ++t)
+    if (transverse[t]) set_transverse(static_cast<TetId>(t), true);
+  if (options_.refine_necks)
+    for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
+      if (tri_.is_vertex(v)) note_neck_vertex(v);
 }
 
 void Polygonizer::classify_created(std::vector<TetId>& created) {

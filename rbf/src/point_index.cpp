@@ -19,7 +19,8 @@ namespace {
 
 /// Leaves hold at most this many ids after a build; an insertion splits a leaf past twice as many.
 constexpr std::size_t kBucket = 16;
-/// From this many points on, build() with threads puts the root's right half on a second thread.
+/// From this many points on, build() with threads puts a node's right half on another thread (at each of
+/// the top log2(threads) levels).
 constexpr std::size_t kParallelBuildMin = std::size_t(1) << 15;
 
 void grow(Point3& lo, Point3& hi, const Point3& p) {
@@ -144,68 +145,80 @@ void PointIndex::build_entries(std::vector<Entry>& entries, unsigned threads) {
   buckets_.reserve(entries.size());
   Entry* const first = entries.data();
   Entry* const last = first + entries.size();
+  Forest f{std::move(nodes_), std::move(buckets_)};
+  f.nodes.emplace_back();
+  unsigned depth = 0;  // levels whose right subtrees are built on other threads: 2^depth threads at most
+  for (unsigned t = resolve_thread_count(threads); t > 1; t /= 2) ++depth;
+  fill_node_parallel(f, 0, first, last, depth);
+  nodes_ = std::move(f.nodes);
+  buckets_ = std::move(f.buckets);
+}
+
+// fill_node(), with the right subtree of each node of the top `depth` levels built on another thread,
+// into its own forest, while this thread builds the left one in place; the right forest is then
+// spliced in after it: the same nodes, blocks and order as fill_node() on one thread.
+void PointIndex::fill_node_parallel(Forest& f, std::uint32_t index, Entry* first, Entry* last, unsigned depth) {
   Point3 lo, hi;
   std::uint8_t axis = 0;
   double cut = 0;
   Entry* middle = nullptr;
-  Forest f{std::move(nodes_), std::move(buckets_)};
-  f.nodes.emplace_back();
-  if (resolve_thread_count(threads) < 2 || entries.size() < kParallelBuildMin ||
+  // split_entries() reorders nothing when it declines, so fill_node() starts from the same entries.
+  if (depth == 0 || static_cast<std::size_t>(last - first) < kParallelBuildMin ||
       !split_entries(first, last, lo, hi, axis, cut, middle)) {
-    fill_node(f, 0, first, last);
-    nodes_ = std::move(f.nodes);
-    buckets_ = std::move(f.buckets);
+    fill_node(f, index, first, last);
     return;
   }
-  // The root's split here, its left subtree on this thread and its right subtree on another into its own
-  // forest, appended after: the same nodes and blocks in the same order as the one-thread build (the
-  // children pair, then the left subtree, then the right one), the right part's indices shifted by
-  // where it lands.
-  f.nodes[0].lo = lo;
-  f.nodes[0].hi = hi;
-  f.nodes[0].extra = axis;
-  f.nodes[0].split = cut;
-  f.nodes[0].child = 1;
-  f.nodes.resize(3);
+  Node& n = f.nodes[index];
+  n.lo = lo;
+  n.hi = hi;
+  n.extra = axis;
+  n.split = cut;
+  const auto left = static_cast<std::uint32_t>(f.nodes.size());
+  n.child = left;  // n is not used past this point: the resize may move the array
+  f.nodes.resize(f.nodes.size() + 2);
   Forest right;
-  right.nodes.reserve(f.nodes.capacity() / 2);
-  right.buckets.reserve(static_cast<std::size_t>(last - middle));
+  const auto count = static_cast<std::size_t>(last - middle);
+  right.nodes.reserve(2 * (count / (kBucket / 2) + 1));
+  right.buckets.reserve(count);
   right.nodes.emplace_back();
   std::exception_ptr right_error;
   std::thread worker([&] {
     try {
-      fill_node(right, 0, middle, last);
+      fill_node_parallel(right, 0, middle, last, depth - 1);
     } catch (...) {
       right_error = std::current_exception();
     }
   });
   try {
-    fill_node(f, 1, first, middle);
+    fill_node_parallel(f, left, first, middle, depth - 1);
   } catch (...) {
     worker.join();
     throw;
   }
   worker.join();
   if (right_error) std::rethrow_exception(right_error);
-  // right.nodes[0] becomes f.nodes[2]; right.nodes[k], k >= 1, becomes f.nodes[shift + k].
-  const auto shift = static_cast<std::uint32_t>(f.nodes.size() - 1);
+  splice(f, left + 1, right);
+}
+
+// Appends the forest `part` to f: its root becomes f.nodes[at], its other nodes follow f's (children
+// renumbered), its blocks follow f's, and leaf_of_ names the new places of its leaves.
+void PointIndex::splice(Forest& f, std::uint32_t at, const Forest& part) {
+  const auto shift = static_cast<std::uint32_t>(f.nodes.size() - 1);  // part's node k >= 1 lands at shift + k
   const auto bucket_shift = static_cast<std::uint32_t>(f.buckets.size());
-  const auto place = [&](std::uint32_t k) { return k == 0 ? 2u : shift + k; };
-  for (std::uint32_t k = 0; k < right.nodes.size(); ++k) {
-    Node n = right.nodes[k];
+  const auto place = [&](std::uint32_t k) { return k == 0 ? at : shift + k; };
+  for (std::uint32_t k = 0; k < part.nodes.size(); ++k) {
+    Node n = part.nodes[k];
     if (n.leaf()) {
-      const Entry* b = right.buckets.data() + n.bucket.begin;
+      const Entry* b = part.buckets.data() + n.bucket.begin;
       for (std::uint32_t i = 0; i < n.bucket.count; ++i) leaf_of_[b[i].id] = place(k);
       n.bucket.begin += bucket_shift;
     } else {
       n.child = place(n.child);
     }
-    if (k == 0) f.nodes[2] = n;
+    if (k == 0) f.nodes[at] = n;
     else f.nodes.push_back(n);
   }
-  f.buckets.insert(f.buckets.end(), right.buckets.begin(), right.buckets.end());
-  nodes_ = std::move(f.nodes);
-  buckets_ = std::move(f.buckets);
+  f.buckets.insert(f.buckets.end(), part.buckets.begin(), part.buckets.end());
 }
 
 bool PointIndex::split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis_out,

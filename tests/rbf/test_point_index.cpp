@@ -114,14 +114,13 @@ TEST_CASE("PointIndex answers like brute force after build, insertions and remov
   REQUIRE(index.contains(1));
 }
 
-TEST_CASE("PointIndex built on two threads answers like the one-thread build and brute force", "[point_index]") {
-  // Enough points for the threaded build (the root's halves on two threads), with ties and duplicates.
-  std::mt19937 rng(9);
+namespace {
+
+/// `two` (built on threads) answers every query exactly as `one` (built on one thread), in the same
+/// order (the same tree), and as brute force; its leaves are found again by erase().
+void check_same_index(const PointIndex& one, const PointIndex& two, const std::vector<Point3>& pts,
+                      std::mt19937& rng) {
   std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<Point3> pts;
-  for (int i = 0; i < 40000; ++i) pts.push_back({u(rng), u(rng), u(rng)});
-  for (int i = 0; i < 2000; ++i) pts.push_back({std::round(u(rng) * 8) / 8, 0.125, std::round(u(rng) * 8) / 8});
-  const PointIndex one(pts, 1), two(pts, 2);
   Brute brute;
   for (std::size_t i = 0; i < pts.size(); ++i) brute.points.emplace_back(static_cast<Id>(i), pts[i]);
   std::vector<Id> a, b;
@@ -143,8 +142,8 @@ TEST_CASE("PointIndex built on two threads answers like the one-thread build and
   std::sort(pb.begin(), pb.end());
   REQUIRE(pa == pb);
   REQUIRE_FALSE(pa.empty());
-  // The leaves of the half built on the second thread are found again by erase() (leaf_of_ shifted).
-  PointIndex edited(pts, 2);
+  // The leaves of the parts built on other threads are found again by erase() (leaf_of_ shifted).
+  PointIndex edited = two;
   Brute kept;
   for (std::size_t i = 0; i < pts.size(); ++i) {
     if (i % 7 == 0) edited.erase(static_cast<Id>(i));
@@ -154,6 +153,35 @@ TEST_CASE("PointIndex built on two threads answers like the one-thread build and
     const Point3 c{u(rng), u(rng), u(rng)};
     edited.ball(c, 0.01, a);
     REQUIRE(a == kept.ball(c, 0.01));
+  }
+}
+
+}  // namespace
+
+TEST_CASE("PointIndex built on two threads answers like the one-thread build and brute force", "[point_index]") {
+  // Enough points for the threaded build (the root's halves on two threads), with ties and duplicates.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Point3> pts;
+  for (int i = 0; i < 40000; ++i) pts.push_back({u(rng), u(rng), u(rng)});
+  for (int i = 0; i < 2000; ++i) pts.push_back({std::round(u(rng) * 8) / 8, 0.125, std::round(u(rng) * 8) / 8});
+  const PointIndex one(pts, 1), two(pts, 2);
+  check_same_index(one, two, pts, rng);
+}
+
+TEST_CASE("PointIndex built on 3 to 8 threads: the subtrees of several levels spliced as on one thread",
+          "[point_index]") {
+  // 2^17 + points: the top three levels have halves above the threaded build's threshold (2^15).
+  std::mt19937 rng(21);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Point3> pts;
+  for (int i = 0; i < 140000; ++i) pts.push_back({u(rng), 0.5 * u(rng), 0.25 * u(rng)});
+  for (int i = 0; i < 3000; ++i) pts.push_back({std::round(u(rng) * 8) / 8, 0.125, 0.0});
+  const PointIndex one(pts, 1);
+  for (const unsigned threads : {3u, 4u, 8u}) {
+    INFO(threads << " threads");
+    const PointIndex many(pts, threads);
+    check_same_index(one, many, pts, rng);
   }
 }
 

@@ -115,6 +115,10 @@ class PointIndex {
   /// appended to f.nodes (then their subtrees, left first). Writes leaf_of_ with indices into f.nodes
   /// (shifted by the caller when f is a part built on its own).
   void fill_node(Forest& f, std::uint32_t index, Entry* first, Entry* last);
+  /// fill_node() with the right subtrees of the top `depth` levels built on other threads (same result).
+  void fill_node_parallel(Forest& f, std::uint32_t index, Entry* first, Entry* last, unsigned depth);
+  /// Appends a forest built on its own: its root becomes f.nodes[at]; renumbers its nodes, blocks, leaf_of_.
+  void splice(Forest& f, std::uint32_t at, const Forest& part);
   /// The split of entries [first, last) (reordered: left part first): false when they make a leaf
   /// (few, or all at one position). lo / hi: their bounding box.
   static bool split_entries(Entry* first, Entry* last, Point3& lo, Point3& hi, std::uint8_t& axis, double& cut,

@@ -80,42 +80,6 @@ void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rn
   }
 }
 
-}  // namespace
-
-TEST_CASE("PointIndex answers like brute force after build, insertions and removals", "[point_index]") {
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<Point3> pts;
-  for (int i = 0; i < 1500; ++i) pts.push_back({u(rng), u(rng), u(rng)});
-  // Repeated coordinates and exact duplicates: splits must handle ties.
-  for (int i = 0; i < 300; ++i) pts.push_back({std::round(u(rng) * 4) / 4, 0.25, std::round(u(rng) * 4) / 4});
-  for (int i = 0; i < 40; ++i) pts.push_back({0.5, 0.5, 0.5});
-  PointIndex index(pts);
-  Brute brute;
-  for (std::size_t i = 0; i < pts.size(); ++i) brute.points.emplace_back(static_cast<Id>(i), pts[i]);
-  check_queries(index, brute, rng);
-
-  // Insert a dense cluster (forces leaf splits) with sparse ids, then remove every third point.
-  for (Id i = 0; i < 800; ++i) {
-    const Point3 p{0.1 + 0.01 * u(rng), -0.3 + 0.01 * u(rng), 0.2 + 0.01 * u(rng)};
-    const Id id = 5000 + 3 * i;
-    index.insert(id, p);
-    brute.points.emplace_back(id, p);
-  }
-  check_queries(index, brute, rng);
-  std::vector<std::pair<Id, Point3>> kept;
-  for (std::size_t i = 0; i < brute.points.size(); ++i) {
-    if (i % 3 == 0) index.erase(brute.points[i].first);
-    else kept.push_back(brute.points[i]);
-  }
-  brute.points = kept;
-  check_queries(index, brute, rng);
-  REQUIRE_FALSE(index.contains(0));
-  REQUIRE(index.contains(1));
-}
-
-namespace {
-
 /// `two` (built on threads) answers every query exactly as `one` (built on one thread), in the same
 /// order (the same tree), and as brute force; its leaves are found again by erase().
 void check_same_index(const PointIndex& one, const PointIndex& two, const std::vector<Point3>& pts,
@@ -156,15 +120,52 @@ void check_same_index(const PointIndex& one, const PointIndex& two, const std::v
   }
 }
 
+/// n uniform points of [-1, 1]^3, then `ties` points on a grid of step 1 / grid in the plane y = 1 / grid
+/// (repeated coordinates and exact duplicates: the splits must handle ties).
+std::vector<Point3> points_with_ties(std::mt19937& rng, int n, int ties, double grid) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Point3> pts;
+  for (int i = 0; i < n; ++i) pts.push_back({u(rng), u(rng), u(rng)});
+  for (int i = 0; i < ties; ++i)
+    pts.push_back({std::round(u(rng) * grid) / grid, 1.0 / grid, std::round(u(rng) * grid) / grid});
+  return pts;
+}
+
 }  // namespace
+
+TEST_CASE("PointIndex answers like brute force after build, insertions and removals", "[point_index]") {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Point3> pts = points_with_ties(rng, 1500, 300, 4);
+  for (int i = 0; i < 40; ++i) pts.push_back({0.5, 0.5, 0.5});
+  PointIndex index(pts);
+  Brute brute;
+  for (std::size_t i = 0; i < pts.size(); ++i) brute.points.emplace_back(static_cast<Id>(i), pts[i]);
+  check_queries(index, brute, rng);
+
+  // Insert a dense cluster (forces leaf splits) with sparse ids, then remove every third point.
+  for (Id i = 0; i < 800; ++i) {
+    const Point3 p{0.1 + 0.01 * u(rng), -0.3 + 0.01 * u(rng), 0.2 + 0.01 * u(rng)};
+    const Id id = 5000 + 3 * i;
+    index.insert(id, p);
+    brute.points.emplace_back(id, p);
+  }
+  check_queries(index, brute, rng);
+  std::vector<std::pair<Id, Point3>> kept;
+  for (std::size_t i = 0; i < brute.points.size(); ++i) {
+    if (i % 3 == 0) index.erase(brute.points[i].first);
+    else kept.push_back(brute.points[i]);
+  }
+  brute.points = kept;
+  check_queries(index, brute, rng);
+  REQUIRE_FALSE(index.contains(0));
+  REQUIRE(index.contains(1));
+}
 
 TEST_CASE("PointIndex built on two threads answers like the one-thread build and brute force", "[point_index]") {
   // Enough points for the threaded build (the root's halves on two threads), with ties and duplicates.
   std::mt19937 rng(9);
-  std::uniform_real_distribution<double> u(-1, 1);
-  std::vector<Point3> pts;
-  for (int i = 0; i < 40000; ++i) pts.push_back({u(rng), u(rng), u(rng)});
-  for (int i = 0; i < 2000; ++i) pts.push_back({std::round(u(rng) * 8) / 8, 0.125, std::round(u(rng) * 8) / 8});
+  const std::vector<Point3> pts = points_with_ties(rng, 40000, 2000, 8);
   const PointIndex one(pts, 1), two(pts, 2);
   check_same_index(one, two, pts, rng);
 }

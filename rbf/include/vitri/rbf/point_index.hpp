@@ -37,7 +37,8 @@ class PointIndex {
   explicit PointIndex(const std::vector<Point3>& points, unsigned threads = 1) { build(points, threads); }
 
   /// Replaces the content by points[i] with id i. With threads > 1 (0: every available CPU) and enough
-  /// points, the two halves below the root are built on two threads; the tree is the same whatever the
+  /// points, the subtrees of the top log2(threads) levels are built on their own threads (a node of at
+  /// least 2^15 points hands its right half to another thread); the tree is the same whatever the
   /// threads.
   /// @throws InvalidPoint (index i) for a non-finite coordinate; LimitError for more than 2^32 - 2 points.
   void build(const std::vector<Point3>& points, unsigned threads = 1);

@@ -86,7 +86,7 @@ void Session::timed_edit(const std::function<void()>& op) {
   ++revision_;
 }
 
-Edit Session::apply(const Edit& e) {
+Edit Session::apply(const Edit& e, bool dragging) {
   Edit inverse = e;
   switch (e.op) {
     case Edit::Op::Add:
@@ -117,7 +117,10 @@ Edit Session::apply(const Edit& e) {
       check_position(e.position);
       const std::size_t i = index_of(e.id);
       inverse.position = mesher_->constraints().points[i];
-      timed_edit([&] { mesher_->move_constraint(i, e.position); });
+      timed_edit([&] {
+        if (dragging) drop_to_drag_level();  // validated first: a refused move keeps the level
+        mesher_->move_constraint(i, e.position);
+      });
       log_change(ConstraintChange::Op::Update, info(i));
       break;
     }
@@ -166,11 +169,7 @@ void Session::move(std::size_t index, const Point3& p, bool merge) {
   e.id = ids_[checked_index(index)];
   e.position = p;
   const bool joins = merge && !undo_.empty() && undo_.back().op == Edit::Op::Move && undo_.back().id == e.id;
-  check_position(p);  // before the level changes: a refused move changes nothing
-  const double t0 = now_ms();
-  const bool dropped = joins && drop_to_drag_level();
-  const Edit inverse = apply(e);
-  if (dropped) times_.edit_ms = now_ms() - t0;  // the new level's tetrahedralization included
+  const Edit inverse = apply(e, joins);
   if (joins) {
     redo_.clear();  // the first move of the drag holds the position to go back to
     return;
@@ -179,18 +178,15 @@ void Session::move(std::size_t index, const Point3& p, bool merge) {
 }
 
 // The drag level (SessionOptions::drag_levels): with the global function every move re-places the whole
-// mesh, so a coarser mesh is what keeps a drag interactive. Returns true when the mesh was dropped.
-bool Session::drop_to_drag_level() {
-  if (options_.drag_levels <= 0 || !mesher_->global_function()) return false;
+// mesh, so a coarser mesh is what keeps a drag interactive. Called inside the move's timed edit.
+void Session::drop_to_drag_level() {
+  if (options_.drag_levels <= 0 || !mesher_->global_function()) return;
   const double level = target_ * std::ldexp(1.0, options_.drag_levels);
-  if (current_ >= level || mesher_->live_surface().num_triangles() <= options_.drag_min_triangles) return false;
+  if (current_ >= level || mesher_->live_surface().num_triangles() <= options_.drag_min_triangles) return;
   mesher_->restart();
   current_ = std::numeric_limits<double>::infinity();
   mesher_->refine(level * unit_);  // no progress callback: the drag waits for its level
   current_ = level;
-  mesh_timed_ = false;
-  ++revision_;
-  return true;
 }
 
 void Session::remove(std::size_t index) {

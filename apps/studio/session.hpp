@@ -146,14 +146,15 @@ class Session {
   double unit() const { return unit_; }
 
  private:
-  Edit apply(const Edit& e);
+  /// `dragging`: a merged move of a drag, which may first drop the mesh to the drag level.
+  Edit apply(const Edit& e, bool dragging = false);
   void record(Edit inverse);
   std::size_t index_of(std::uint64_t id) const;
   std::size_t checked_index(std::size_t index) const;
   void check_position(const Point3& p) const;
   void start(Constraints constraints);
   void timed_edit(const std::function<void()>& op);
-  bool drop_to_drag_level();
+  void drop_to_drag_level();
   ConstraintInfo info(std::size_t index) const;
   void log_change(ConstraintChange::Op op, const ConstraintInfo& c);
 

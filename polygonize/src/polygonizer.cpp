@@ -384,7 +384,8 @@ void Polygonizer::classify(TetId t, bool requeue) {
 void Polygonizer::classify_all() {
   const std::size_t n = tri_.tet_capacity();
   std::vector<std::uint8_t> transverse(n, 0);
-  run_slices(n, slice_count(options_.threads, n, kClassifySliceMin), [&](std::size_t, std::size_t lo, std::size_t hi) {
+  const std::size_t slices = slice_count(options_.threads, n, kClassifySliceMin);
+  run_slices(n, slices, [&](std::size_t, std::size_t lo, std::size_t hi) {
     for (std::size_t t = lo; t < hi; ++t) {
       if (!is_transverse(static_cast<TetId>(t))) continue;  // dead ones are not
       transverse[t] = 1;

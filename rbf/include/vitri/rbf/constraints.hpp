@@ -42,11 +42,12 @@ struct ConstraintBuildOptions {
   /// apart along the surface (d the off-surface distance): a point keeps them unless a point visited
   /// before it (the points visited along a Morton curve, a deterministic order) that kept its own lies
   /// closer than that; points whose d was halved or that lost a side on a thin part always keep theirs.
-  /// Every surface point keeps its f = 0 constraint. 0 (the library's default): every point gets them. Dense samples need far fewer
-  /// normal constraints than surface points (the zero constraints carry the shape, the off-surface
-  /// ones the sign and scale): the CLI uses 1 with the local function, where at 10^6 points it takes
-  /// 20-40% off the run's CPU time and a quarter off its peak memory for the same distance to the true
-  /// model (docs/benchmarks.md "Off-surface spacing"). Counted in ConstraintBuildReport::spaced_out.
+  /// Every surface point keeps its f = 0 constraint. 0 (the library's default): every point gets them.
+  /// Dense samples need far fewer normal constraints than surface points (the zero constraints carry
+  /// the shape, the off-surface ones the sign and scale): the CLI uses 1 with the local function, where
+  /// at 10^6 points it takes 20-40% off the run's CPU time and a quarter off its peak memory for the same
+  /// distance to the true model (docs/benchmarks.md "Off-surface spacing"). Counted in
+  /// ConstraintBuildReport::spaced_out.
   /// It applies to whatever function the constraints are then fitted with; the CLI leaves the global
   /// function's at every point (and chooses between the two on the count without the spacing).
   double off_surface_spacing = 0.0;

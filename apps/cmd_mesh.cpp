@@ -172,9 +172,10 @@ void print_extraction_split(const PolygonizerStats& s, double extract_ms) {
 /// The neck checks of the refinement (stderr, docs/polygonize.md "Necks"): their share of its time.
 void print_neck_split(const PolygonizerStats& s) {
   std::fprintf(stderr,
-               "  refinement: neck checks and their points %.0f ms (%zu vertices checked, %zu points, "
-               "%zu left)\n",
-               1e3 * s.neck_seconds, s.neck_checks, s.neck_insertions, s.necks_left);
+               "  refinement: %zu points inserted (%zu on edges crossed twice), %zu rejected as too close; "
+               "neck checks and their points %.0f ms (%zu vertices checked, %zu points, %zu left)\n",
+               s.insertions, s.thin_insertions, s.rejected, 1e3 * s.neck_seconds, s.neck_checks,
+               s.neck_insertions, s.necks_left);
 }
 
 /// The initial tetrahedralization's own steps (stderr): where the time of a large input goes.

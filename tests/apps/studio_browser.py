@@ -14,13 +14,14 @@ import argparse
 import json
 import math
 import os
-import re
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
 import urllib.request
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from studio_server import Failure, Server, wait_for  # noqa: E402
 
 SKIP = 77
 
@@ -40,47 +41,10 @@ except ImportError:
     skip("python3-selenium is not installed")
 
 
-class Failure(Exception):
-    pass
-
-
 def check(cond, what):
     if not cond:
         raise Failure(what)
     print("ok: " + what)
-
-
-class Server:
-    """`vitri studio` as a child process on a free port."""
-
-    def __init__(self, vitri, args):
-        self.proc = subprocess.Popen([vitri, "studio", "--port", "0"] + args, stdout=subprocess.PIPE,
-                                     stderr=subprocess.STDOUT, text=True)
-        deadline = time.time() + 120
-        while time.time() < deadline:
-            line = self.proc.stdout.readline()
-            if not line:
-                raise Failure("vitri studio exited before serving")
-            m = re.search(r"http://([0-9.]+):(\d+)/", line)
-            if m:
-                self.url = "http://%s:%s" % (m.group(1), m.group(2))
-                return
-        raise Failure("vitri studio did not print its address")
-
-    def get(self, path):
-        with urllib.request.urlopen(self.url + path, timeout=120) as r:
-            return json.loads(r.read())
-
-    def stop(self):
-        """Stops the server (SIGTERM: a clean shutdown); a sanitizer report or a crash fails the test."""
-        self.proc.terminate()
-        try:
-            rest, _ = self.proc.communicate(timeout=60)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            raise Failure("vitri studio did not stop on SIGTERM")
-        if self.proc.returncode != 0:
-            raise Failure("vitri studio exited with %d:\n%s" % (self.proc.returncode, rest))
 
 
 def edges_closed(mesh):
@@ -142,16 +106,6 @@ def launch_browser(out_dir, window="1280,800"):
     driver = webdriver.Chrome(service=Service(driver_path), options=opts)
     driver.set_script_timeout(600)
     return driver, profile
-
-
-def wait_for(what, fn, timeout=120):
-    deadline = time.time() + timeout
-    while time.time() < deadline:
-        v = fn()
-        if v:
-            return v
-        time.sleep(0.1)
-    raise Failure("timed out waiting for " + what)
 
 
 def page_idle(driver):
@@ -307,6 +261,47 @@ def open_file(driver, server, shot, out_dir):
         check(page_constraints_match(driver, server), "the page's constraint list is the server's")
     check(edges_closed(server.get("/api/mesh?format=indexed")), "the mesh is closed after them")
     shot("studio-5-modifiers.png")
+    pick_rule(driver, server)
+
+
+PICK_RULE = """const done = arguments[arguments.length - 1];
+(async () => {
+  await studio.settled();
+  const hit = studio.surfacePixels(1)[0];
+  const p = studio.pickSurface({ clientX: hit.x, clientY: hit.y }).point, unit = studio.stats.unit;
+  // q: drawn 4 pixels right of p, 0.01 x the diagonal nearer to the camera (an outside constraint in
+  // front of its sample); far: drawn on p, 0.1 x the diagonal behind it (the far side of a model).
+  const ndc = p.clone().project(studio.camera), rect = studio.renderer.domElement.getBoundingClientRect();
+  const side = new THREE.Vector3(ndc.x + 8 / rect.width, ndc.y, ndc.z).unproject(studio.camera);
+  const toCamera = studio.camera.position.clone().sub(side).normalize();
+  const q = side.addScaledVector(toCamera, 0.01 * unit);
+  const far = p.clone().addScaledVector(studio.camera.position.clone().sub(p).normalize(), -0.1 * unit);
+  const n = studio.constraints.count;
+  await studio.edit({ op: 'add', position: [p.x, p.y, p.z], value: 0 });
+  await studio.edit({ op: 'add', position: [q.x, q.y, q.z], value: 0.01 * unit });
+  await studio.edit({ op: 'add', position: [far.x, far.y, far.z], value: 0.1 * unit });
+  await studio.settled();
+  const at = (i) => { const s = studio.screenOf(i); return studio.pickConstraint({ clientX: s.x, clientY: s.y }); };
+  const s = studio.screenOf(n), t = studio.screenOf(n + 1);
+  const out = { count: studio.constraints.count - n, p: at(n), q: at(n + 1), far: at(n + 2), n,
+                gap: Math.hypot(s.x - t.x, s.y - t.y) };
+  for (let k = 0; k < 3; ++k) await studio.command('/api/undo');
+  await studio.settled();
+  return out;
+})().then(done, (e) => done({ error: String(e) }));"""
+
+
+def pick_rule(driver, server):
+    """The pointer picks the constraint drawn nearest to it among those near the front: a sample beside
+    an outside constraint drawn in front of it, not the far side of the model under the near one."""
+    n = server.get("/api/stats")["constraints"]
+    r = driver.execute_async_script(PICK_RULE)
+    check("error" not in r and r["count"] == 3, "three constraints added for the pick test " + json.dumps(r))
+    check(3 < r["gap"] < 8, "the outside constraint is drawn within the pick radius of its sample (%.1f px)" % r["gap"])
+    check(r["p"] == r["n"], "the pointer on the sample picks it, not the outside constraint in front")
+    check(r["q"] == r["n"] + 1, "the pointer on the outside constraint picks it")
+    check(r["far"] in (r["n"], r["n"] + 1), "the pointer does not pick through to the far side")
+    wait_for("the undos", lambda: server.get("/api/stats")["constraints"] == n)
 
 
 def run(args):

@@ -342,27 +342,41 @@ Studio.prototype.screenOf = function (i, rect = this.renderer.domElement.getBoun
   return { x: rect.left + ((p.x + 1) / 2) * rect.width, y: rect.top + ((1 - p.y) / 2) * rect.height, z: p.z };
 };
 
-// The constraint drawn nearest to the pointer (within 8 pixels), the front-most when several are. One
-// projection per constraint (a few ms for 10^5), with the camera's matrix applied by hand.
+// The constraint the pointer picks: of those drawn within 8 pixels of it, the nearest to the pointer
+// among the ones at most kPickDepthBand x the load diagonal behind the front-most of them (ties: the one
+// in front). So a sample stays reachable beside the outside constraint drawn just in front of it (dense
+// oriented points), and the far side of the model is not picked through the near one. One projection
+// per constraint (a few ms for 10^5), with the camera's matrices applied by hand.
+const kPickDepthBand = 0.02;
 Studio.prototype.pickConstraint = function (event) {
   if (!this.constraints.points.visible) return -1;
   const r = this.renderer.domElement.getBoundingClientRect();
   const m = new THREE.Matrix4().multiplyMatrices(this.camera.projectionMatrix, this.camera.matrixWorldInverse).elements;
+  const v = this.camera.matrixWorldInverse.elements;  // view depth: -(row 3 of the view matrix) . p
   const xyz = this.constraints.xyz, px = event.clientX, py = event.clientY;
-  let best = -1, bestDepth = Infinity;
+  const near = [];  // [index, view depth, pixels from the pointer]
+  let front = Infinity;
   for (let i = 0; i < this.constraints.count; ++i) {
     const x = xyz[3 * i], y = xyz[3 * i + 1], z = xyz[3 * i + 2];
     const w = m[3] * x + m[7] * y + m[11] * z + m[15];
     if (!(w > 0)) continue;
-    const nz = (m[2] * x + m[6] * y + m[10] * z + m[14]) / w;
-    if (nz >= 1 || nz >= bestDepth) continue;
+    if ((m[2] * x + m[6] * y + m[10] * z + m[14]) / w >= 1) continue;  // beyond the far plane
     const sx = r.left + (((m[0] * x + m[4] * y + m[8] * z + m[12]) / w + 1) / 2) * r.width;
     const sy = r.top + ((1 - (m[1] * x + m[5] * y + m[9] * z + m[13]) / w) / 2) * r.height;
-    if (Math.hypot(sx - px, sy - py) <= 8) {
-      best = i;
-      bestDepth = nz;
-    }
+    const d = Math.hypot(sx - px, sy - py);
+    if (d > 8) continue;
+    const depth = -(v[2] * x + v[6] * y + v[10] * z + v[14]);
+    near.push([i, depth, d]);
+    front = Math.min(front, depth);
   }
+  const band = kPickDepthBand * (this.stats ? this.stats.unit : 1);
+  let best = -1, bestD = Infinity, bestDepth = Infinity;
+  for (const [i, depth, d] of near)
+    if (depth <= front + band && (d < bestD || (d === bestD && depth < bestDepth))) {
+      best = i;
+      bestD = d;
+      bestDepth = depth;
+    }
   return best;
 };
 

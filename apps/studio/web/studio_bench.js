@@ -79,18 +79,23 @@ Studio.prototype.benchAdd = async function ({ count = 12 } = {}) {
   return { add: breakdown(adds), undo: breakdown(undos), triangles: this.slots.triangles };
 };
 
-// The on-surface constraint drawn nearest to the middle of the view, and where it is on screen.
+// The on-surface constraint nearest to the middle of the view that the pointer picks at its own place on
+// screen (the front-most there: with dense oriented points an outside constraint usually lies in front
+// of its sample, and dragging it barely moves the surface), and where it is on screen.
 Studio.prototype.draggable = function () {
   const r = this.renderer.domElement.getBoundingClientRect(), cx = r.left + r.width / 2, cy = r.top + r.height / 2;
-  let best = null;
+  const near = [];
   for (let i = 0; i < this.constraints.count; ++i) {
     if (this.constraints.value(i) !== 0) continue;
-    const s = this.screenOf(i, r), d = Math.hypot(s.x - cx, s.y - cy);
-    if (s.z < 1 && (!best || d < best.d)) best = { i, x: s.x, y: s.y, d };
+    const s = this.screenOf(i, r);
+    if (s.z < 1) near.push({ i, d: Math.hypot(s.x - cx, s.y - cy) });
   }
-  // The front-most constraint under that point is the one the pointer picks.
-  const picked = best ? this.pickConstraint({ clientX: best.x, clientY: best.y }) : -1;
-  return picked < 0 ? null : Object.assign(this.screenOf(picked, r), { index: picked });
+  near.sort((a, b) => a.d - b.d);
+  for (const { i } of near.slice(0, 200)) {
+    const s = this.screenOf(i, r);
+    if (this.pickConstraint({ clientX: s.x, clientY: s.y }) === i) return Object.assign(s, { index: i });
+  }
+  return null;
 };
 
 // Drags a constraint along a circle of `radius` pixels with synthesized pointer events, then releases
@@ -101,12 +106,12 @@ Studio.prototype.draggable = function () {
 Studio.prototype.benchDrag = async function ({ moves = 60, radius = 12, live = false } = {}) {
   await this.settled();
   const start = this.draggable();
-  if (!start) throw new Error('no constraint to drag in view');
+  if (!start) throw new Error('no on-surface constraint to drag in view');
   this.syncDraw = !live;
   this.holdIdle = true;
   this.timings = [];
   this.pointer('pointerdown', start.x, start.y);
-  if (!this.drag) throw new Error('the pointer did not pick a constraint');
+  if (!this.drag || this.drag.index !== start.index) throw new Error('the pointer did not pick the constraint');
   const t0 = performance.now();
   for (let k = 1; k <= moves; ++k) {
     const a = (2 * Math.PI * k) / moves;

@@ -62,12 +62,6 @@ int quad_split(const Point3& q0, const Point3& q1, const Point3& q2, const Point
   return squared_distance(q0, q2) <= squared_distance(q1, q3) ? 0 : 1;
 }
 
-std::array<int, 3> polygon_triangle(int corners, int split, int k) {
-  if (corners == 3) return {0, 1, 2};
-  if (split == 0) return k == 0 ? std::array<int, 3>{0, 1, 2} : std::array<int, 3>{0, 2, 3};
-  return k == 0 ? std::array<int, 3>{0, 1, 3} : std::array<int, 3>{1, 2, 3};
-}
-
 namespace {
 
 // The Illinois + Newton iteration state of one edge.

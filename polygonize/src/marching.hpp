@@ -29,7 +29,11 @@ int quad_split(const Point3& q0, const Point3& q1, const Point3& q2, const Point
 
 /// The corners (polygon corner indices) of triangle `k` (0 or 1) of a polygon: a triangle polygon has
 /// triangle 0 only; a quad's follow quad_split().
-std::array<int, 3> polygon_triangle(int corners, int split, int k);
+inline std::array<int, 3> polygon_triangle(int corners, int split, int k) {
+  if (corners == 3) return {0, 1, 2};
+  if (split == 0) return k == 0 ? std::array<int, 3>{0, 1, 2} : std::array<int, 3>{0, 2, 3};
+  return k == 0 ? std::array<int, 3>{0, 1, 3} : std::array<int, 3>{1, 2, 3};
+}
 
 /// One crossed edge to place a mesh vertex on.
 struct Crossing {

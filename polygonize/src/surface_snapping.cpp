@@ -69,6 +69,9 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
   const bool ahead = in.snap_lookahead && first.size() >= kLookaheadMin;
   SnapLookahead look;
   std::size_t next = 0;
+  // A full build offered every anchored vertex above (each is a corner of a rebuilt transverse
+  // tetrahedron) and remeshes every polygon: a flip has nothing to re-offer or remesh there.
+  const bool full = w.every_polygon;
   while (next < first.size() || !heap.empty()) {
     VertexId z;
     bool now;
@@ -77,7 +80,7 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
         if (next == look.end) look_ahead(in, first, next, look);
         const SnapLookahead::Span& sp = look.span(next);
         const SnapLookahead::Slice& slice = look.slices[sp.slice];
-        star_.assign(slice.stars.begin() + sp.star_first, slice.stars.begin() + sp.star_last);
+        if (!full) star_.assign(slice.stars.begin() + sp.star_first, slice.stars.begin() + sp.star_last);
         z = first[next++];
         now = in.tri.is_vertex(z) && may_collapse(in, z) &&
               fan_test(in, z, slice.fans.data() + sp.fan_first, sp.fan_last - sp.fan_first);
@@ -93,9 +96,9 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
     if (now == static_cast<bool>(collapsed_[z])) continue;
     collapsed_[z] = now ? 1 : 0;
     num_collapsed_ = now ? num_collapsed_ + 1 : num_collapsed_ - 1;
-    if (!in.tri.is_vertex(z)) continue;  // its polygons died with it
+    if (full || !in.tri.is_vertex(z)) continue;  // (or its polygons died with it)
     for (const TetId t : star_) {
-      if (!w.every_polygon && polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
+      if (polygon_of(t) != kNone) w.remesh.push_back(polygon_of_[t]);
       for (const VertexId u : in.tri.tet_vertices(t))
         if (u > z) offer(u);  // not decided yet (the merge pops in increasing id)
     }

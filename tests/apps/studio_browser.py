@@ -264,6 +264,29 @@ def open_file(driver, server, shot, out_dir):
     pick_rule(driver, server)
 
 
+RAYCAST = """const rect = studio.renderer.domElement.getBoundingClientRect(), unit = studio.stats.unit;
+const out = { hits: 0, disagree: [] };
+for (let k = 0; k < 40; ++k) {
+  const ev = { clientX: rect.left + rect.width * (0.1 + 0.8 * ((k * 0.618034) % 1)),
+               clientY: rect.top + rect.height * (0.1 + 0.8 * ((k * 0.41421) % 1)) };
+  const three = studio.ray(ev).intersectObject(studio.slots.mesh)[0] || null;
+  const ours = studio.slots.raycast(studio.ray(ev).ray);
+  if (!three !== !ours || (three && (three.point.distanceTo(ours.point) > 1e-9 * unit ||
+                                     three.face.normal.distanceTo(ours.face.normal) > 1e-6)))
+    out.disagree.push(k);
+  if (ours) ++out.hits;
+}
+return out;"""
+
+
+def raycast_agrees(driver):
+    """The page's own raycast (the slots' float32 positions) hits what three.js's Mesh.raycast hits."""
+    r = driver.execute_script(RAYCAST)
+    check(r["hits"] > 10 and not r["disagree"],
+          "the page's raycast agrees with three.js's (%d of 40 rays hit the mesh, disagreeing: %s)"
+          % (r["hits"], r["disagree"]))
+
+
 PICK_RULE = """const done = arguments[arguments.length - 1];
 (async () => {
   await studio.settled();
@@ -333,6 +356,7 @@ def run(args):
         if args.bench:
             return bench(driver, server, args.out)
 
+        raycast_agrees(driver)
         click_drag_undo(driver, server, shot, s0, m0)
         open_file(driver, server, shot, args.out)
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]

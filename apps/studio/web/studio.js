@@ -381,8 +381,7 @@ Studio.prototype.pickConstraint = function (event) {
 };
 
 Studio.prototype.pickSurface = function (event) {
-  const hits = this.ray(event).intersectObject(this.slots.mesh);
-  return hits.length ? hits[0] : null;
+  return this.slots.raycast(this.ray(event).ray);
 };
 
 Studio.prototype.onPointerDown = function (event) {

@@ -83,12 +83,46 @@ class MeshSlots {
       }
     }
     this.geometry.setDrawRange(0, 3 * this.used);
-    // No bounding sphere per delta (a pass over the whole mesh): the mesh is never frustum-culled, and a
-    // raycast computes the sphere when it is null.
+    // No bounding sphere per delta (a pass over the whole mesh): the mesh is never frustum-culled, clicks
+    // use raycast() below, and framing the model computes the sphere.
     this.geometry.boundingSphere = null;
     this.version = version;
     this.triangles = this.slotOf.size;
     return nRemoved + nAdded;
+  }
+
+  // The nearest triangle the ray (THREE.Ray) crosses at t > 0, either side: { point, face: { normal },
+  // distance } as three.js's raycast gives it (normal: (b - a) x (c - a), unit), or null. Moller-Trumbore
+  // on the slots' float32 positions, zeroed slots skipped (det 0): several times faster than
+  // Mesh.raycast's per-triangle objects (a click on 10^5 triangles).
+  raycast(ray) {
+    const P = this.geometry.attributes.position.array;
+    const { x: ox, y: oy, z: oz } = ray.origin, { x: dx, y: dy, z: dz } = ray.direction;
+    let best = Infinity, bestSlot = -1;
+    for (let s = 0, o = 0; s < this.used; ++s, o += 9) {
+      const ax = P[o], ay = P[o + 1], az = P[o + 2];
+      const e1x = P[o + 3] - ax, e1y = P[o + 4] - ay, e1z = P[o + 5] - az;
+      const e2x = P[o + 6] - ax, e2y = P[o + 7] - ay, e2z = P[o + 8] - az;
+      const px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
+      const det = e1x * px + e1y * py + e1z * pz;
+      if (det === 0) continue;
+      const inv = 1 / det, tx = ox - ax, ty = oy - ay, tz = oz - az;
+      const u = (tx * px + ty * py + tz * pz) * inv;
+      if (!(u >= 0 && u <= 1)) continue;
+      const qx = ty * e1z - tz * e1y, qy = tz * e1x - tx * e1z, qz = tx * e1y - ty * e1x;
+      const v = (dx * qx + dy * qy + dz * qz) * inv;
+      if (!(v >= 0 && u + v <= 1)) continue;
+      const t = (e2x * qx + e2y * qy + e2z * qz) * inv;
+      if (t > 0 && t < best) {
+        best = t;
+        bestSlot = s;
+      }
+    }
+    if (bestSlot < 0) return null;
+    const o = 9 * bestSlot, a = new THREE.Vector3(P[o], P[o + 1], P[o + 2]);
+    const e1 = new THREE.Vector3(P[o + 3], P[o + 4], P[o + 5]).sub(a);
+    const e2 = new THREE.Vector3(P[o + 6], P[o + 7], P[o + 8]).sub(a);
+    return { point: ray.at(best, new THREE.Vector3()), face: { normal: e1.cross(e2).normalize() }, distance: best };
   }
 
   clear() {

@@ -15,6 +15,7 @@ import json
 import math
 import os
 import shutil
+import struct
 import sys
 import tempfile
 import time
@@ -218,7 +219,8 @@ def click_drag_undo(driver, server, shot, s0, m0):
     check(d <= tol, "the mesh came back (vertex distance %.3g <= %.3g, %d vs %d triangles)"
           % (d, tol, len(m3["triangles"]), len(m0["triangles"])))
     check(driver.execute_script("return studio.slots.triangles") == len(m3["triangles"]),
-          "the page draws the server's mesh after the deltas")
+          "the page draws the server's triangle count after the deltas")
+    check(page_mesh_matches(driver, server), "the page's triangles are the server's, corner for corner (float32)")
     check(page_constraints_match(driver, server), "the page's constraint list is the server's after the edits")
     check(full_constraint_fetches(driver) == 1,
           "the page took the constraint list once (at load), then only the changes of each edit")
@@ -399,6 +401,31 @@ def bench(driver, server, out_dir):
 
 WEBGL_RENDERER = """const gl = studio.renderer.getContext(), e = gl.getExtension('WEBGL_debug_renderer_info');
 return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);"""
+
+
+def page_mesh_matches(driver, server):
+    """The page's triangle slots (kept from the mesh deltas) hold the server's mesh: the same triangles,
+    each corner equal to the server's vertex rounded to float32, the same orientation. Waits for the
+    exact mesh the page asks for when idle (after approximate updates, docs/studio.md)."""
+    wait_for("the target precision", lambda: server.get("/api/stats")["refined"], 300)
+    wait_for("the exact mesh", lambda: driver.execute_script("return !studio.slots.approximate"))
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    page = driver.execute_script(
+        "const P = studio.slots.geometry.attributes.position.array, out = [];"
+        "for (let s = 0; s < studio.slots.used; ++s) {"
+        "  const t = Array.from(P.subarray(9 * s, 9 * s + 9));"
+        "  if (t.some((x) => x !== 0)) out.push(t); }"
+        "return out;")
+    f32 = lambda x: struct.unpack("f", struct.pack("f", x))[0]
+
+    def canonical(corners):  # a triangle as its corners from the smallest, orientation kept
+        k = corners.index(min(corners))
+        return tuple(corners[k:] + corners[:k])
+    mesh = server.get("/api/mesh?format=indexed")
+    vs = [tuple(f32(x) for x in v) for v in mesh["vertices"]]
+    server_tris = sorted(canonical([vs[i] for i in t]) for t in mesh["triangles"])
+    page_tris = sorted(canonical([tuple(t[3 * i:3 * i + 3]) for i in range(3)]) for t in page)
+    return page_tris == server_tris
 
 
 def page_constraints_match(driver, server):

@@ -33,10 +33,12 @@ GL_FLAGS = {
     "default": ["--ignore-gpu-blocklist"],
 }
 
-WEBGL_RENDERER = """(() => { const gl = document.createElement('canvas').getContext('webgl2');
+def webgl_renderer(context):
+    """JavaScript: the renderer string of the WebGL context the expression `context` gives."""
+    return """(() => { const gl = %s;
   if (!gl) return 'no WebGL';
   const e = gl.getExtension('WEBGL_debug_renderer_info');
-  return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER); })()"""
+  return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER); })()""" % context
 
 
 class Browser:
@@ -122,7 +124,7 @@ def probe(args):
         try:
             b = Browser(args.chromium, flags, args.window, args.out)
             try:
-                renderer = b.evaluate(WEBGL_RENDERER)
+                renderer = b.evaluate(webgl_renderer("document.createElement('canvas').getContext('webgl2')"))
             finally:
                 b.close()
         except Failure as e:
@@ -156,8 +158,7 @@ def bench(args):
         load.append(os.getloadavg()[0])
         browser.screenshot(os.path.join(args.out, "studio-bench.png"))
         version = browser.call("Browser.getVersion", browser=True)["product"]
-        renderer = browser.evaluate(WEBGL_RENDERER.replace("document.createElement('canvas').getContext('webgl2')",
-                                                           "studio.renderer.getContext()"))
+        renderer = browser.evaluate(webgl_renderer("studio.renderer.getContext()"))
         print("BENCH " + json.dumps({"model": stats["name"], "load_average": load, "constraints": stats["constraints"],
                                      "triangles": stats["triangles"], "vertices": stats["vertices"],
                                      "browser": version, "webgl": renderer, "flags": flags,

@@ -42,9 +42,9 @@ const char* const kUsage =
     "  --function F    implicit function: global (the RBF of the paper), local (partition of unity:\n"
     "                  local edits, 10^5+ constraints) or auto (default: global up to 4000\n"
     "                  constraints, local above; docs/local_rbf.md)\n"
-    "  --drag-levels K with the global function, a drag meshes K halvings coarser than the target\n"
-    "                  (default 1; 0: at the current level) above 5000 triangles; the idle\n"
-    "                  refinement brings the target back after the drag\n"
+    "  --drag-levels K with the global function, edits are shown first on a preview K halvings\n"
+    "                  coarser than the target (default 1; 0: every edit at the target) above\n"
+    "                  5000 triangles; the target mesh follows in the next idle step\n"
     "  --offset D, --sides S   as vitri mesh, for oriented points and meshes\n"
     "\n"
     "Stops on Ctrl-C. Exit status: 0 stopped, 1 bad input, 2 usage error.\n";

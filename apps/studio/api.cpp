@@ -291,6 +291,7 @@ std::string Api::stats_json(const std::string& extra) {
          ",\"precision\":" + (std::isfinite(current) ? json_number(current) : std::string("null")) +
          ",\"target_precision\":" + json_number(session_.target_precision()) +
          ",\"refined\":" + (session_.refined() ? "true" : "false") +
+         ",\"preview\":" + (session_.showing_preview() ? "true" : "false") +
          ",\"unit\":" + json_number(session_.unit()) +
          ",\"edit_ms\":" + json_number(session_.last_update().edit_ms) +
          ",\"rbf_ms\":" + json_number(s.edit_rbf_seconds * 1e3) +
@@ -399,6 +400,7 @@ ApiResponse Api::export_file(const ApiRequest& r) {
     const Constraints& c = session_.mesher().constraints();
     write_xyzv(path, PointValues{c.points, c.values});
   } else if (format == "obj" || format == "ply" || format == "off") {
+    session_.settle();  // the target mesh, with every edit (not the preview)
     write_mesh(path, cli::view_of(session_.mesher().surface()));
   } else {
     throw BadRequest("\"format\" must be xyzv, obj, ply or off, got '" + format + "'");

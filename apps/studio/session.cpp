@@ -40,6 +40,9 @@ void Session::load(Constraints constraints, std::string name) {
                      (local ? "" : " with the global function (try --function local)"));
   auto mesher = std::make_unique<Mesher>(constraints, options_.mesher);  // throws before anything changes
   mesher_ = std::move(mesher);
+  preview_.reset();
+  behind_.clear();
+  showing_preview_ = switched_ = preview_wanted_ = false;
   name_ = std::move(name);
   ids_.resize(mesher_->size());
   for (auto& id : ids_) id = next_id_++;
@@ -51,7 +54,7 @@ void Session::load(Constraints constraints, std::string name) {
   Box3 box;
   for (const Point3& p : mesher_->constraints().points) box.extend(p);
   center_ = box.center();
-  current_ = std::numeric_limits<double>::infinity();
+  level_ = std::numeric_limits<double>::infinity();
   tracker_.set_cell(options_.drag_tolerance * unit_);
   refine_step();
 }
@@ -88,56 +91,71 @@ void Session::timed_edit(const std::function<void()>& op) {
 
 Edit Session::apply(const Edit& e, bool dragging) {
   Edit inverse = e;
+  Mesher& m = edited();
+  Lag lag{e.op, 0, e.position, e.value};
   switch (e.op) {
     case Edit::Op::Add:
-      if (ids_.size() >=
-          (mesher_->local_function() ? options_.max_local_constraints : options_.max_constraints))
+      if (ids_.size() >= (m.local_function() ? options_.max_local_constraints : options_.max_constraints))
         throw LimitError("the studio holds at most " + std::to_string(ids_.size()) +
                          " constraints with this function");
       check_position(e.position);
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
-      timed_edit([&] { mesher_->add_constraint(e.position, e.value); });
+      timed_edit([&] { m.add_constraint(e.position, e.value); });
+      lag.index = ids_.size();
       ids_.push_back(e.id);
       log_change(ConstraintChange::Op::Add, info(ids_.size() - 1));
       inverse.op = Edit::Op::Remove;
       break;
     case Edit::Op::Remove: {
       if (ids_.size() <= 1) throw InvalidArgument("cannot remove the last constraint");
-      const std::size_t i = index_of(e.id);
+      const std::size_t i = lag.index = index_of(e.id);
       inverse.op = Edit::Op::Add;
-      inverse.position = mesher_->constraints().points[i];
-      inverse.value = mesher_->constraints().values[i];
+      inverse.position = m.constraints().points[i];
+      inverse.value = m.constraints().values[i];
       const ConstraintInfo gone = info(i);
-      timed_edit([&] { mesher_->remove_constraint(i); });
+      timed_edit([&] { m.remove_constraint(i); });
       ids_.erase(ids_.begin() + static_cast<std::ptrdiff_t>(i));
       log_change(ConstraintChange::Op::Remove, gone);
       break;
     }
     case Edit::Op::Move: {
       check_position(e.position);
-      const std::size_t i = index_of(e.id);
-      inverse.position = mesher_->constraints().points[i];
+      const std::size_t i = lag.index = index_of(e.id);
+      inverse.position = m.constraints().points[i];
       timed_edit([&] {
-        if (dragging) drop_to_drag_level();  // validated first: a refused move keeps the level
-        mesher_->move_constraint(i, e.position);
+        if (dragging && !preview_) drop_to_drag_level();  // validated first: a refused move keeps the level
+        m.move_constraint(i, e.position);
       });
       log_change(ConstraintChange::Op::Update, info(i));
       break;
     }
     case Edit::Op::SetValue: {
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
-      const std::size_t i = index_of(e.id);
-      inverse.value = mesher_->constraints().values[i];
-      timed_edit([&] { mesher_->set_value(i, e.value); });
+      const std::size_t i = lag.index = index_of(e.id);
+      inverse.value = m.constraints().values[i];
+      timed_edit([&] { m.set_value(i, e.value); });
       log_change(ConstraintChange::Op::Update, info(i));
       break;
     }
   }
+  if (preview_) landed(lag);
   return inverse;
 }
 
+// An edit landed on the preview: the page is shown the preview, and the target mesh replays the edit in
+// the next refine_step(). Consecutive moves of one constraint (a drag) replay as one.
+void Session::landed(const Lag& lag) {
+  if (lag.op == Edit::Op::Move && !behind_.empty() && behind_.back().op == Edit::Op::Move &&
+      behind_.back().index == lag.index)
+    behind_.back().position = lag.position;
+  else
+    behind_.push_back(lag);
+  if (!showing_preview_) switched_ = true;
+  showing_preview_ = true;
+}
+
 ConstraintInfo Session::info(std::size_t index) const {
-  const Constraints& c = mesher_->constraints();
+  const Constraints& c = (preview_ ? *preview_ : *mesher_).constraints();
   return {index, ids_[index], c.points[index], c.values[index]};
 }
 
@@ -177,16 +195,70 @@ void Session::move(std::size_t index, const Point3& p, bool merge) {
   record(inverse);
 }
 
-// The drag level (SessionOptions::drag_levels): with the global function every move re-places the whole
-// mesh, so a coarser mesh is what keeps a drag interactive. Called inside the move's timed edit.
+// The drag level without a preview (SessionOptions::drag_levels): with the global function every move
+// re-places the whole mesh, so a coarser mesh is what keeps a drag interactive. Called inside the move's
+// timed edit.
 void Session::drop_to_drag_level() {
   if (options_.drag_levels <= 0 || !mesher_->global_function()) return;
   const double level = target_ * std::ldexp(1.0, options_.drag_levels);
-  if (current_ >= level || mesher_->live_surface().num_triangles() <= options_.drag_min_triangles) return;
+  if (level_ >= level || mesher_->live_surface().num_triangles() <= options_.drag_min_triangles) return;
   mesher_->restart();
-  current_ = std::numeric_limits<double>::infinity();
+  preview_wanted_ = false;
+  level_ = std::numeric_limits<double>::infinity();
   mesher_->refine(level * unit_);  // no progress callback: the drag waits for its level
-  current_ = level;
+  level_ = level;
+}
+
+// ------------------------------------------------------------------------------------------- preview
+// The target mesh replays the edits it missed, in order. A replay the Mesher refuses (its own limits at
+// the finer level) starts the target mesh again from a copy of the preview's function, at the preview's
+// level (no preview then: the target is finer than nothing).
+void Session::catch_up() {
+  if (behind_.empty()) return;
+  try {
+    for (const Lag& l : behind_) switch (l.op) {
+        case Edit::Op::Add: mesher_->add_constraint(l.position, l.value); break;
+        case Edit::Op::Remove: mesher_->remove_constraint(l.index); break;
+        case Edit::Op::Move: mesher_->move_constraint(l.index, l.position); break;
+        case Edit::Op::SetValue: mesher_->set_value(l.index, l.value); break;
+      }
+    behind_.clear();
+  } catch (const Error&) {
+    behind_.clear();
+    mesher_ = std::make_unique<Mesher>(preview_->restarted_copy());
+    level_ = std::numeric_limits<double>::infinity();
+    mesher_->refine(preview_level_ * unit_);
+    level_ = preview_level_;
+    drop_preview();
+  }
+}
+
+void Session::settle() {
+  if (!showing_preview_) return;
+  catch_up();
+  showing_preview_ = false;
+  switched_ = true;
+  ++revision_;
+}
+
+// Forgets the preview (the target mesh first replays what it missed).
+void Session::drop_preview() {
+  settle();
+  preview_.reset();
+  preview_wanted_ = false;
+}
+
+void Session::build_preview(const KeepGoing& keep_going) {
+  preview_wanted_ = false;
+  auto preview = std::make_unique<Mesher>(mesher_->restarted_copy());
+  const double level = target_ * std::ldexp(1.0, options_.drag_levels);
+  if (!preview->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); })) {
+    preview_wanted_ = true;  // interrupted: built again by the next step
+    return;
+  }
+  preview->sync_surface();  // its live mesh ready: the first edit's delta is incremental
+  preview_ = std::move(preview);
+  preview_level_ = level;
 }
 
 void Session::remove(std::size_t index) {
@@ -224,10 +296,11 @@ bool Session::redo() {
 void Session::set_precision(double relative) {
   if (!(relative > 0) || !std::isfinite(relative))
     throw InvalidArgument("precision must be positive and finite, got " + std::to_string(relative));
-  if (relative > current_) {
+  drop_preview();  // its level follows the target
+  if (relative > level_) {
     // Refinement cannot be undone: a coarser mesh needs a fresh polygonization (the same function).
     mesher_->restart();
-    current_ = std::numeric_limits<double>::infinity();
+    level_ = std::numeric_limits<double>::infinity();
     target_ = relative;
     ++revision_;
     refine_step();
@@ -237,23 +310,42 @@ void Session::set_precision(double relative) {
 }
 
 bool Session::refine_step(const KeepGoing& keep_going) {
-  if (refined()) return false;
-  const double level = std::isinf(current_) ? target_ * std::ldexp(1.0, options_.coarse_levels)
-                                            : std::max(target_, 0.5 * current_);
   const double t0 = now_ms();
-  const bool done =
-      mesher_->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); });
+  if (showing_preview_) {
+    settle();  // the edits replayed on the target mesh, which is shown again
+  } else if (level_ > target_) {
+    const double level = std::isinf(level_) ? target_ * std::ldexp(1.0, options_.coarse_levels)
+                                            : std::max(target_, 0.5 * level_);
+    const bool done =
+        mesher_->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); });
+    ++revision_;
+    if (!done) {
+      times_.edit_ms = now_ms() - t0;
+      mesh_timed_ = false;
+      return false;
+    }
+    level_ = level;
+    if (level_ <= target_ && options_.drag_levels > 0 && mesher_->global_function() &&
+        mesher_->size() <= options_.preview_max_constraints) {
+      mesher_->sync_surface();
+      preview_wanted_ = mesher_->live_surface().num_triangles() > options_.drag_min_triangles;
+    }
+  } else if (preview_wanted_) {
+    build_preview(keep_going);  // the mesh shown does not change
+    if (preview_wanted_) return false;
+    return true;
+  } else {
+    return false;
+  }
   times_.edit_ms = now_ms() - t0;
   mesh_timed_ = false;
-  ++revision_;
-  if (done) current_ = level;
-  return done;
+  return true;
 }
 
 // -------------------------------------------------------------------------------------------- queries
 const SurfaceMesh& Session::surface() {
   const double t0 = now_ms();
-  const SurfaceMesh& m = mesher_->surface();
+  const SurfaceMesh& m = mesher().surface();
   if (!mesh_timed_) {
     times_.extract_ms = now_ms() - t0;
     mesh_timed_ = true;
@@ -263,16 +355,21 @@ const SurfaceMesh& Session::surface() {
 
 ClientDelta Session::delta(std::uint32_t since, bool exact) {
   const double t0 = now_ms();
-  const MeshDelta change = mesher_->update_surface();
+  Mesher& shown = mesher();
+  MeshDelta change = shown.update_surface();
+  if (switched_) {  // the page holds the other Mesher's mesh: this one's whole mesh replaces it
+    change = shown.live_surface().whole_delta();
+    switched_ = false;
+  }
   if (!mesh_timed_) {
     times_.extract_ms = now_ms() - t0;
     mesh_timed_ = true;
   }
-  return tracker_.update(mesher_->live_surface(), change, since, exact);
+  return tracker_.update(shown.live_surface(), change, since, exact);
 }
 
 std::vector<ConstraintInfo> Session::constraints() const {
-  const Constraints& c = mesher_->constraints();
+  const Constraints& c = (preview_ ? *preview_ : *mesher_).constraints();
   std::vector<ConstraintInfo> out;
   out.reserve(c.size());
   for (std::size_t i = 0; i < c.size(); ++i) out.push_back(info(i));

@@ -22,12 +22,17 @@ struct SessionOptions {
   double precision = 0.02;
   /// The first mesh after a load is this many halvings coarser than the target (levels of detail).
   int coarse_levels = 2;
-  /// Drags at a coarser level (the paper's dynamic updates at low resolution): with the global function
-  /// (every edit moves the whole surface), from the second move of a drag on, the mesh is kept this many
-  /// halvings coarser than the target, and the idle refinement brings it back after the drag. Only when
-  /// the mesh holds more than drag_min_triangles; 0 levels: drags stay at the current level.
+  /// Edits at a coarser level (the paper's dynamic updates at low resolution), with the global function
+  /// (every edit moves the whole surface): once the mesh reaches the target with more than
+  /// drag_min_triangles, the session keeps a preview, a second Mesher of the same function this many
+  /// halvings coarser than the target (Mesher::restarted_copy()). Every edit then lands on the preview
+  /// first and the page is shown the preview; the next refinement step (the page's idle refinement)
+  /// replays the edits on the target mesh and shows it again. Without a preview (more constraints than
+  /// preview_max_constraints: the copy of the RBF's factorization is O(N^2) memory), a drag's moves drop
+  /// the mesh itself to this level from its second move on. 0 levels: every edit at the current level.
   int drag_levels = 1;
   std::size_t drag_min_triangles = 5000;
+  std::size_t preview_max_constraints = 5000;
   /// Most constraints a session holds with the global function (its fit is O(N^3), an edit O(N^2)).
   /// @throws LimitError beyond.
   std::size_t max_constraints = 20000;
@@ -101,9 +106,10 @@ class Session {
   /// @return the index of the new constraint. @throws InvalidArgument / InvalidPoint, LimitError.
   std::size_t add(const Point3& p, double value);
   /// `merge`: when the last undo step is a move of the same constraint, this move joins it (a drag is
-  /// one undo step: the page merges every move of a drag but the first). A merged move may first drop
-  /// the mesh to the drag level (SessionOptions::drag_levels); a move the Mesher then refuses leaves the
-  /// constraints as they were, the mesh at that level (the idle refinement brings the target back).
+  /// one undo step: the page merges every move of a drag but the first). Without a preview, a merged
+  /// move may first drop the mesh to the drag level (SessionOptions::drag_levels); a move the Mesher
+  /// then refuses leaves the constraints as they were, the mesh at that level (the idle refinement brings
+  /// the target back).
   void move(std::size_t index, const Point3& p, bool merge);
   void remove(std::size_t index);
   void set_value(std::size_t index, double value);
@@ -118,12 +124,22 @@ class Session {
   /// starts again (Mesher::restart(), no refit) from the coarse level. @throws InvalidArgument unless > 0.
   void set_precision(double relative);
   double target_precision() const { return target_; }
-  /// Relative precision the mesh has reached (infinity before the first level).
-  double current_precision() const { return current_; }
-  /// One level towards the target (half the current precision, or the target). @return true when a level
-  /// was completed, false when already at the target or interrupted by `keep_going`.
+  /// Relative precision of the mesh shown (infinity before the first level): the preview's after an edit
+  /// that landed there, else the target mesh's.
+  double current_precision() const { return showing_preview_ ? preview_level_ : level_; }
+  /// One step towards the target: with the preview shown, the target mesh replays the edits it missed
+  /// and is shown again; else one level (half the current precision, or the target); at the target, the
+  /// preview is built when it is wanted (SessionOptions::drag_levels). @return true when a step was
+  /// completed, false when there was nothing to do or `keep_going` interrupted it.
   bool refine_step(const KeepGoing& keep_going = {});
-  bool refined() const { return current_ <= target_; }
+  /// The target mesh is shown at the target precision and nothing is left to build.
+  bool refined() const { return !showing_preview_ && level_ <= target_ && !preview_wanted_; }
+  /// The page is shown the preview (an edit landed there; the next refine_step() shows the target).
+  bool showing_preview() const { return showing_preview_; }
+  /// A preview is kept (edits land there first).
+  bool has_preview() const { return preview_ != nullptr; }
+  /// Replays the edits the target mesh missed and shows it (as refine_step() would first). Export does.
+  void settle();
 
   // ---- Queries
   const SurfaceMesh& surface();
@@ -138,7 +154,8 @@ class Session {
   ConstraintDelta constraint_delta(std::uint64_t since) const;
   std::size_t size() const { return ids_.size(); }
   const std::string& name() const { return name_; }
-  Mesher& mesher() { return *mesher_; }
+  /// The Mesher whose mesh is shown; it holds every edit (the target mesh may lag behind the preview).
+  Mesher& mesher() { return showing_preview_ ? *preview_ : *mesher_; }
   const UpdateTimes& last_update() const { return times_; }
   /// Bumped by every change of the model (edit, undo, redo, refinement, load).
   std::uint64_t revision() const { return revision_; }
@@ -155,16 +172,35 @@ class Session {
   void start(Constraints constraints);
   void timed_edit(const std::function<void()>& op);
   void drop_to_drag_level();
+  /// One edit as the target mesh replays it (in the index space of the moment it was made).
+  struct Lag {
+    Edit::Op op = Edit::Op::Add;
+    std::size_t index = 0;
+    Point3 position;
+    double value = 0;
+  };
+  /// The Mesher an edit lands on (the preview when there is one) and what it keeps for the replay.
+  Mesher& edited() { return preview_ ? *preview_ : *mesher_; }
+  void landed(const Lag& lag);
+  void catch_up();
+  void build_preview(const KeepGoing& keep_going);
+  void drop_preview();
   ConstraintInfo info(std::size_t index) const;
   void log_change(ConstraintChange::Op op, const ConstraintInfo& c);
 
   SessionOptions options_;
   std::string name_;
-  std::unique_ptr<Mesher> mesher_;
+  std::unique_ptr<Mesher> mesher_;   // towards the target, level by level
+  std::unique_ptr<Mesher> preview_;  // the same function at preview_level_ (or null); holds every edit
+  std::vector<Lag> behind_;          // edits preview_ has and mesher_ has not, oldest first
+  bool showing_preview_ = false;     // the page is shown preview_ (behind_ may be empty)
+  bool switched_ = false;            // the shown Mesher changed: the next delta is its whole mesh
+  bool preview_wanted_ = false;      // mesher_ is at the target and big enough; preview_ not built yet
+  double preview_level_ = 0;
   std::vector<std::uint64_t> ids_;  // stable id of constraint i
   std::uint64_t next_id_ = 1;
   std::vector<Edit> undo_, redo_;  // inverses to apply
-  double unit_ = 1, target_ = 0.02, current_ = 0;
+  double unit_ = 1, target_ = 0.02, level_ = 0;  // level_: precision mesher_ has reached
   Point3 center_;
   DeltaTracker tracker_;
   UpdateTimes times_;

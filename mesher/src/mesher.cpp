@@ -114,6 +114,16 @@ void Mesher::build() {
   if (local_) local_->release_constraints_cache();  // read once here; 32 bytes per constraint freed
 }
 
+Mesher::Mesher(const Rbf& function, const MesherOptions& options)
+    : options_(options), rbf_(std::make_unique<Rbf>(function)), precision_(std::numeric_limits<double>::infinity()) {
+  build();
+}
+
+Mesher Mesher::restarted_copy() const {
+  if (!rbf_) throw InvalidArgument("Mesher::restarted_copy: the local function is not copied (global only)");
+  return Mesher(*rbf_, options_);
+}
+
 void Mesher::restart() {
   build();
   precision_ = std::numeric_limits<double>::infinity();
@@ -197,21 +207,6 @@ std::function<bool(const Point3&)> Mesher::support_query() const {
   return [this, below](const Point3& p) { return zero_index_.count_ball(p, below, 0) > 0; };
 }
 
-namespace {
-
-/// Every live triangle and vertex of `mesh` as added: what a filter that missed the earlier deltas needs.
-MeshDelta whole_mesh(const LiveMesh& mesh) {
-  MeshDelta d;
-  d.full = true;
-  for (std::uint32_t v = 0; v < mesh.vertex_capacity(); ++v)
-    if (mesh.is_vertex(v)) d.added_vertices.push_back(v);
-  for (std::uint32_t t = 0; t < mesh.triangle_capacity(); ++t)
-    if (mesh.is_triangle(t)) d.added_triangles.push_back(t);
-  return d;
-}
-
-}  // namespace
-
 void Mesher::sync_surface() {
   const bool filter = filtering();
   const SupportFilter::Supported supported = support_query();
@@ -224,7 +219,7 @@ void Mesher::sync_surface() {
   } else {
     MeshDelta delta = poly_->update_surface();
     if (filter_behind_) {  // batch extractions skipped the filter: it starts again from the whole mesh
-      delta = whole_mesh(poly_->live_surface());
+      delta = poly_->live_surface().whole_delta();
       filter_behind_ = false;
     }
     const bool recheck = filter && filter_precision_ != precision_;

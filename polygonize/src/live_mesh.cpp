@@ -104,6 +104,16 @@ void LiveMesh::clear() {
   full_ = true;
 }
 
+MeshDelta LiveMesh::whole_delta() const {
+  MeshDelta d;
+  d.full = true;
+  for (std::uint32_t v = 0; v < vertex_capacity(); ++v)
+    if (is_vertex(v)) d.added_vertices.push_back(v);
+  for (std::uint32_t t = 0; t < triangle_capacity(); ++t)
+    if (is_triangle(t)) d.added_triangles.push_back(t);
+  return d;
+}
+
 MeshDelta LiveMesh::take_delta() {
   MeshDelta d;
   d.full = full_;

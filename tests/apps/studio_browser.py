@@ -155,18 +155,26 @@ def api_bench(server):
     post("/api/undo", {})
     post("/api/refine", {"all": True})  # back to the target after the drag's level (docs/studio.md)
     version = pull(version, 1)
-    add = []
+    add, follow, previews = [], [], 0
     for k in range(12):
         t0 = time.perf_counter()
-        post("/api/edit", {"op": "add", "value": 0, "position": [c[0] + 0.004 * unit * (k - 5.5), c[1], c[2]]})
+        s = post("/api/edit", {"op": "add", "value": 0, "position": [c[0] + 0.004 * unit * (k - 5.5), c[1], c[2]]})
         version = pull(version, 1)
         add.append(1e3 * (time.perf_counter() - t0))
+        previews += s["preview"]
+        t0 = time.perf_counter()
+        while not post("/api/refine", {})["refined"]:  # the target mesh again (after a preview)
+            pass
+        version = pull(version, 1)
+        follow.append(1e3 * (time.perf_counter() - t0))
         post("/api/undo", {})
+        post("/api/refine", {"all": True})
         version = pull(version, 1)
     print("API_BENCH " + json.dumps({"model": state["name"], "load_average": os.getloadavg()[0],
                                      "triangles": state["triangles"], "drag": median(drag),
                                      "drag_server_edit_extract": median(server_ms),
-                                     "drag_updates_per_second": 1e3 * len(drag) / sum(drag), "add": median(add)}))
+                                     "drag_updates_per_second": 1e3 * len(drag) / sum(drag), "add": median(add),
+                                     "adds_on_preview": previews, "target_after_add": median(follow)}))
     return 0
 
 

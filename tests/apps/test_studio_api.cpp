@@ -13,12 +13,15 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cstring>
 #include <map>
 #include <cmath>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
+#include <tuple>
 #include <vector>
 
 using namespace vitri;
@@ -623,16 +626,19 @@ TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]
   CHECK(sorted(session.constraints()) == sorted(edited));
 }
 
-TEST_CASE("studio session: a global drag meshes at the drag level; idle refinement brings the target back",
+TEST_CASE("studio session: without a preview, a global drag meshes at the drag level; idle refinement "
+          "brings the target back",
           "[studio][session]") {
   SessionOptions o = fast_options();
   o.precision = 0.04;
   o.drag_levels = 1;
-  o.drag_min_triangles = 0;  // the small model's mesh is below the default
+  o.drag_min_triangles = 0;       // the small model's mesh is below the default
+  o.preview_max_constraints = 0;  // no preview: the drag drops the mesh itself
   Session session(small_model(), "small", o);
   while (session.refine_step()) {
   }
   REQUIRE(session.current_precision() == o.precision);
+  REQUIRE_FALSE(session.has_preview());
   const std::size_t i = 1;  // an on-surface constraint
   const Point3 start = session.mesher().constraints().points[i];
   std::uint32_t version = session.delta(0, true).version;
@@ -684,6 +690,167 @@ TEST_CASE("studio session: a global drag meshes at the drag level; idle refineme
   still.move(i, {start.x + 0.04, start.y, start.z}, true);
   CHECK(still.current_precision() == o.precision);
   CHECK(&still.mesher().polygonizer() == kept);
+}
+
+namespace {
+
+/// The page's triangle soup, kept from the session's deltas only: id -> 9 corner coordinates (float32).
+struct Soup {
+  std::map<std::uint32_t, std::array<float, 9>> tris;
+  std::uint32_t version = 0;
+  void apply(const ClientDelta& d) {
+    REQUIRE((d.full || d.base == version));
+    if (d.full) tris.clear();
+    for (const std::uint32_t t : d.removed) tris.erase(t);
+    for (std::size_t k = 0; k < d.added.size(); ++k) {
+      std::array<float, 9> c{};
+      std::copy(d.positions.begin() + static_cast<std::ptrdiff_t>(9 * k),
+                d.positions.begin() + static_cast<std::ptrdiff_t>(9 * k + 9), c.begin());
+      tris[d.added[k]] = c;
+    }
+    version = d.version;
+  }
+  /// Equal, triangle for triangle, to the live mesh of the Mesher shown.
+  bool matches(Session& s) const {
+    const LiveMesh& m = s.mesher().live_surface();
+    std::size_t n = 0;
+    for (std::uint32_t t = 0; t < m.triangle_capacity(); ++t) {
+      if (!m.is_triangle(t)) continue;
+      ++n;
+      const auto it = tris.find(t);
+      if (it == tris.end()) return false;
+      for (int j = 0; j < 3; ++j) {
+        const Point3& p = m.position(m.triangle(t)[static_cast<std::size_t>(j)]);
+        for (int k = 0; k < 3; ++k)
+          if (it->second[static_cast<std::size_t>(3 * j + k)] != static_cast<float>(p[static_cast<std::size_t>(k)]))
+            return false;
+      }
+    }
+    return n == tris.size();
+  }
+};
+
+/// The same surface as a set of triangles (corner coordinates, rotated to start at the smallest corner).
+std::set<std::array<double, 9>> triangle_set(const SurfaceMesh& m) {
+  std::set<std::array<double, 9>> out;
+  for (const auto& t : m.triangles) {
+    std::size_t first = 0;
+    for (std::size_t j = 1; j < 3; ++j)
+      if (std::make_tuple(m.vertices[t[j]].x, m.vertices[t[j]].y, m.vertices[t[j]].z) <
+          std::make_tuple(m.vertices[t[first]].x, m.vertices[t[first]].y, m.vertices[t[first]].z))
+        first = j;
+    std::array<double, 9> a{};
+    for (std::size_t j = 0; j < 3; ++j)
+      for (std::size_t k = 0; k < 3; ++k) a[3 * j + k] = m.vertices[t[(first + j) % 3]][k];
+    out.insert(a);
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("studio session: with the global function, edits land on a coarser preview first; the idle step "
+          "replays them on the target mesh",
+          "[studio][session]") {
+  SessionOptions o = fast_options();
+  o.precision = 0.04;
+  o.drag_levels = 1;
+  o.drag_min_triangles = 0;  // the small model's mesh is below the default
+  Session session(small_model(), "small", o);
+  Soup page;
+  page.apply(session.delta(0, true));
+  while (session.refine_step()) page.apply(session.delta(page.version, true));
+  REQUIRE(session.refined());
+  REQUIRE(session.has_preview());  // built by the last step, at the target
+  CHECK_FALSE(session.showing_preview());
+  CHECK(session.current_precision() == o.precision);
+  CHECK(page.matches(session));
+  const std::size_t fine = page.tris.size();
+
+  // The reference: a Mesher that takes the same edits at the target directly, with the same levels
+  // (coarse_levels = 1) and incremental extractions (a crossing's root is sought from its previous one).
+  Mesher direct(small_model(), o.mesher);
+  direct.refine(2 * o.precision * session.unit());
+  direct.update_surface();
+  direct.refine(o.precision * session.unit());
+  direct.update_surface();
+  const auto same_mesh = [&] {
+    direct.update_surface();
+    return triangle_set(session.mesher().live_surface().to_surface_mesh()) ==
+           triangle_set(direct.live_surface().to_surface_mesh());
+  };
+
+  // An add lands on the preview: the page is shown the preview's whole mesh, at the preview level.
+  const Point3 p{0.15, 0.7, 0.1};
+  session.add(p, 0.0);
+  direct.add_constraint(p, 0.0);
+  CHECK(session.showing_preview());
+  CHECK_FALSE(session.refined());
+  CHECK(session.current_precision() == 2 * o.precision);
+  CHECK(session.mesher().precision() == 2 * o.precision * session.unit());
+  CHECK(session.mesher().size() == small_model().size() + 1);
+  const ClientDelta shown = session.delta(page.version, true);
+  CHECK(shown.full);
+  page.apply(shown);
+  CHECK(page.matches(session));
+  CHECK(page.tris.size() < fine);
+  CHECK(test::metrics_of(session.surface()).watertight());
+  REQUIRE(session.constraints().back().position == p);
+
+  // A drag on the preview: its moves are incremental deltas there (no full mesh after the first).
+  const std::size_t i = 1;  // an on-surface constraint
+  const Point3 start = session.constraints()[i].position;
+  for (int k = 1; k <= 4; ++k) {
+    session.move(i, {start.x + 0.01 * k, start.y, start.z}, k > 1);
+    const ClientDelta d = session.delta(page.version, false);
+    CHECK_FALSE(d.full);
+    page.apply(d);
+  }
+  direct.move_constraint(i, {start.x + 0.04, start.y, start.z});  // the drag replays as one move
+  page.apply(session.delta(page.version, true));
+  CHECK(page.matches(session));
+  CHECK(session.undo_depth() == 2);
+
+  // The idle step replays the edits on the target mesh and shows it: the same mesh as the direct edits.
+  REQUIRE(session.refine_step());
+  CHECK_FALSE(session.showing_preview());
+  CHECK(session.refined());
+  CHECK(session.current_precision() == o.precision);
+  const ClientDelta back = session.delta(page.version, true);
+  CHECK(back.full);
+  page.apply(back);
+  CHECK(page.matches(session));
+  CHECK(same_mesh());
+  CHECK(test::metrics_of(session.surface()).watertight());
+
+  // Undo lands on the preview too; settle() (export) brings the target mesh without a step.
+  REQUIRE(session.undo());
+  direct.move_constraint(i, start);
+  CHECK(session.showing_preview());
+  session.settle();
+  CHECK_FALSE(session.showing_preview());
+  CHECK(session.constraints()[i].position == start);
+  page.apply(session.delta(page.version, true));
+  CHECK(page.matches(session));
+  CHECK(same_mesh());
+
+  // A new target drops the preview; it is built again once the target is reached.
+  session.set_precision(0.03);
+  CHECK_FALSE(session.has_preview());
+  while (session.refine_step()) {
+  }
+  CHECK(session.has_preview());
+  CHECK(session.current_precision() == 0.03);
+
+  // drag_levels = 0: no preview, every edit at the target.
+  o.drag_levels = 0;
+  Session plain(small_model(), "small", o);
+  while (plain.refine_step()) {
+  }
+  CHECK_FALSE(plain.has_preview());
+  plain.add(p, 0.0);
+  CHECK_FALSE(plain.showing_preview());
+  CHECK(plain.current_precision() == o.precision);
 }
 
 TEST_CASE("studio session: a coarser target restarts the polygonization without a refit", "[studio][session]") {

@@ -132,6 +132,41 @@ TEST_CASE("levels of detail: more vertices at each level, each watertight", "[me
   }
 }
 
+namespace {
+Point3 in_point(const TriangleMesh& m, int row) { return {m.V(row, 0), m.V(row, 1), m.V(row, 2)}; }
+}  // namespace
+
+TEST_CASE("restarted_copy: the same function and constraints, a fresh polygonization", "[mesher]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.constraint_build.max_constraints = 600;
+  Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+  mesher.refine(0.06 * mesher.diagonal());
+  const SurfaceMesh first = mesher.surface();
+  mesher.refine(0.04 * mesher.diagonal());  // the original goes on; the copy starts from no level
+  Mesher copy = mesher.restarted_copy();
+  CHECK(std::isinf(copy.precision()));
+  REQUIRE(copy.size() == mesher.size());
+  CHECK(copy.constraints().points == mesher.constraints().points);
+  CHECK(copy.constraints().values == mesher.constraints().values);
+  CHECK(copy.global_function() != mesher.global_function());  // its own copy, not refit: equal values
+  for (const Point3& q : {Point3{0.1, 0.2, 0.3}, Point3{0.9, -0.4, 0.2}, in_point(in, 7)})
+    CHECK(copy.function().value(q) == mesher.function().value(q));
+  // The same steps from the same start: the same mesh, vertex for vertex.
+  copy.refine(0.06 * copy.diagonal());
+  CHECK(copy.surface().vertices == first.vertices);
+  CHECK(copy.surface().triangles == first.triangles);
+  // Edits on the copy leave the original alone.
+  const double before = mesher.function().value(in_point(in, 7));
+  copy.move_constraint(0, copy.constraints().points[0] + Point3{0.01, 0, 0});
+  CHECK(mesher.function().value(in_point(in, 7)) == before);
+  // The local function is not copied.
+  MesherOptions local = o;
+  local.function = FunctionKind::Local;
+  const Mesher l = Mesher::from_mesh(in.V, in.F, local);
+  CHECK_THROWS_AS(l.restarted_copy(), InvalidArgument);
+}
+
 TEST_CASE("one-call mesh_points equals the stateful mesher", "[mesher]") {
   const Constraints c = small_model();
   Eigen::MatrixXd V, N;

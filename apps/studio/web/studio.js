@@ -190,7 +190,9 @@ class Studio {
     document.getElementById('precision').value = precisionToSlider(s.target_precision);
     document.getElementById('refine-state').textContent = s.refined
       ? 'refined to the target'
-      : 'refining while idle: at ' + (s.precision === null ? '-' : s.precision.toPrecision(3));
+      : s.preview
+        ? 'preview at ' + s.precision.toPrecision(3) + ': the target follows'
+        : 'refining while idle: at ' + (s.precision === null ? '-' : s.precision.toPrecision(3));
     const lat = this.latency === null ? '-' : this.latency.toFixed(1) + ' ms';
     document.getElementById('stats').textContent =
       'update (edit to screen) ' + lat + '\n' +
@@ -220,7 +222,8 @@ class Studio {
       if (select !== undefined) this.select(select(s), false);  // in the same frame
       this.present(timing);
       this.showStats(s);
-      this.scheduleRefine();
+      // An edit shown on the server's coarser preview (docs/studio.md): the target mesh follows at once.
+      this.scheduleRefine(s.preview ? 30 : 300);
       return s;
     });
   }

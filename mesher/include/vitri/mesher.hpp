@@ -166,6 +166,12 @@ class Mesher {
   /// cannot be undone; this is how a coarser level is reached (the studio's drags and coarser targets).
   /// Cost: the initial tetrahedralization (with f at its vertices), not the fit.
   void restart();
+  /// A second Mesher of the same surface: this one's options, constraints and global function (copied,
+  /// not refit), its polygonization started as restart() leaves it (no level yet). Edits applied to both
+  /// keep them the same function (the studio edits a coarse copy first, docs/studio.md). Cost: a copy of
+  /// the RBF's factorization (O(N^2) memory) and the initial tetrahedralization.
+  /// @throws InvalidArgument with the local function (it is not copied).
+  Mesher restarted_copy() const;
 
   /// The current mesh (extracted on demand, cached until the next refine or edit), compact, without the
   /// components no on-surface constraint supports. Until update_surface() is first called (a batch run),
@@ -221,6 +227,7 @@ class Mesher {
   const MesherOptions& options() const { return options_; }
 
  private:
+  Mesher(const Rbf& function, const MesherOptions& options);  // restarted_copy()
   void build();
   void after_edit(double rbf_seconds, double t_start, const ChangedRegion* region = nullptr);
   bool rebuild_if_outside(const Point3& p, double t_start, double t_rbf);

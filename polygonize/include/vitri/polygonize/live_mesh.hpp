@@ -88,6 +88,9 @@ class LiveMesh {
   /// The changes since the previous call (or construction), then starts a new record and frees the ids
   /// removed in it.
   MeshDelta take_delta();
+  /// Every live vertex and triangle as added, `full` set: what a reader that holds nothing of this mesh
+  /// needs (the record is left alone). O(capacity).
+  MeshDelta whole_delta() const;
 
  private:
   static constexpr std::uint32_t kDead = 0xffffffffu;  // vrefs_ of a free vertex slot

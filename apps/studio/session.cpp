@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <new>
 
 namespace vitri::studio {
 namespace {
@@ -210,9 +211,9 @@ void Session::drop_to_drag_level() {
 }
 
 // ------------------------------------------------------------------------------------------- preview
-// The target mesh replays the edits it missed, in order. A replay the Mesher refuses (its own limits at
-// the finer level) starts the target mesh again from a copy of the preview's function, at the preview's
-// level (no preview then: the target is finer than nothing).
+// The target mesh replays the edits it missed, in order. A replay that fails (the Mesher's own limits at
+// the finer level, memory) starts the target mesh again from a copy of the preview's function, refined to
+// the preview's level, and drops the preview (the target is then no finer than it).
 void Session::catch_up() {
   if (behind_.empty()) return;
   try {
@@ -223,14 +224,16 @@ void Session::catch_up() {
         case Edit::Op::SetValue: mesher_->set_value(l.index, l.value); break;
       }
     behind_.clear();
-  } catch (const Error&) {
-    behind_.clear();
-    mesher_ = std::make_unique<Mesher>(preview_->restarted_copy());
-    level_ = std::numeric_limits<double>::infinity();
-    mesher_->refine(preview_level_ * unit_);
-    level_ = preview_level_;
-    drop_preview();
+    return;
+  } catch (...) {
+    behind_.clear();  // mesher_ may hold part of them: it is replaced below
   }
+  mesher_ = std::make_unique<Mesher>(preview_->restarted_copy());
+  level_ = std::numeric_limits<double>::infinity();
+  mesher_->refine(preview_level_ * unit_);  // throws on: the next step shows mesher_ and refines it
+  level_ = preview_level_;
+  preview_.reset();
+  preview_wanted_ = false;
 }
 
 void Session::settle() {
@@ -248,17 +251,23 @@ void Session::drop_preview() {
   preview_wanted_ = false;
 }
 
+// A preview that does not fit in memory is not built (the session goes on without one: drags drop the
+// target mesh itself, adds stay at the target).
 void Session::build_preview(const KeepGoing& keep_going) {
   preview_wanted_ = false;
-  auto preview = std::make_unique<Mesher>(mesher_->restarted_copy());
   const double level = target_ * std::ldexp(1.0, options_.drag_levels);
-  if (!preview->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); })) {
-    preview_wanted_ = true;  // interrupted: built again by the next step
-    return;
+  try {
+    auto preview = std::make_unique<Mesher>(mesher_->restarted_copy());
+    if (!preview->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); })) {
+      preview_wanted_ = true;  // interrupted: built again by the next step
+      return;
+    }
+    preview->sync_surface();  // its live mesh ready: the first edit's delta is incremental
+    preview_ = std::move(preview);
+    preview_level_ = level;
+  } catch (const std::bad_alloc&) {
+  } catch (const LimitError&) {
   }
-  preview->sync_surface();  // its live mesh ready: the first edit's delta is incremental
-  preview_ = std::move(preview);
-  preview_level_ = level;
 }
 
 void Session::remove(std::size_t index) {

@@ -403,7 +403,8 @@ def bench(driver, server, out_dir):
                                  "webgl": driver.execute_script(WEBGL_RENDERER),
                                  "antialias": driver.execute_script("return studio.renderer.getContextAttributes().antialias"),
                                  "low_res_interaction": driver.execute_script("return studio.lowResInteraction"),
-                                 "add": adds["add"], "undo": adds["undo"], "drag": drag, "live_drag": live}, indent=1))
+                                 "add": adds["add"], "undo": adds["undo"], "target_after_add": adds["target_after_add"],
+                                 "drag": drag, "live_drag": live}, indent=1))
     return 0
 
 

@@ -164,7 +164,8 @@ def bench(args):
                                      "browser": version, "webgl": renderer, "flags": flags,
                                      "antialias": browser.evaluate("studio.renderer.getContextAttributes().antialias"),
                                      "low_res_interaction": browser.evaluate("studio.lowResInteraction"),
-                                     "add": adds["add"], "undo": adds["undo"], "drag": drag, "live_drag": live},
+                                     "add": adds["add"], "undo": adds["undo"],
+                                     "target_after_add": adds["target_after_add"], "drag": drag, "live_drag": live},
                                     indent=1), flush=True)
         return 0
     finally:

@@ -853,6 +853,68 @@ TEST_CASE("studio session: with the global function, edits land on a coarser pre
   CHECK(plain.current_precision() == o.precision);
 }
 
+TEST_CASE("studio session with a preview: random edits, undos, steps and targets; the page follows every "
+          "delta and the target mesh catches up",
+          "[studio][session]") {
+  SessionOptions o = fast_options();
+  o.precision = 0.045;
+  o.drag_min_triangles = 0;
+  Session session(small_model(), "small", o);
+  Soup page;
+  page.apply(session.delta(0, true));
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  const auto surface_index = [&] {
+    for (;;) {
+      const std::size_t i = rng() % session.size();
+      if (std::abs(session.constraints()[i].value) < 0.2) return i;
+    }
+  };
+  int previews = 0, catch_ups = 0;
+  for (int step = 0; step < 60; ++step) {
+    const bool was_preview = session.showing_preview();
+    try {
+      const std::size_t i = surface_index();
+      const Point3 p = session.constraints()[i].position;
+      switch (rng() % 9) {
+        case 0: session.add({0.9 * u(rng), 0.7 * u(rng), 0.5 * u(rng)}, 0.0); break;
+        case 1: session.move(i, {p.x + 0.05 * u(rng), p.y + 0.05 * u(rng), p.z + 0.05 * u(rng)}, rng() % 2 == 0); break;
+        case 2: session.remove(i); break;
+        case 3: session.set_value(i, 0.05 * u(rng)); break;
+        case 4: session.undo(); break;
+        case 5: session.redo(); break;
+        case 6: session.set_precision(rng() % 2 ? 0.045 : 0.04); break;
+        default: session.refine_step(); break;
+      }
+    } catch (const Error&) {
+      // A refused edit changes nothing; the checks below still hold.
+    }
+    previews += session.showing_preview() && !was_preview;
+    const bool exact = rng() % 3 != 0;
+    page.apply(session.delta(page.version, exact));
+    if (exact) REQUIRE(page.matches(session));
+    INFO("step " << step);
+    REQUIRE(test::metrics_of(session.surface()).watertight());
+    if (was_preview && !session.showing_preview()) {  // the target mesh is shown again: it holds every edit
+      ++catch_ups;
+      std::vector<std::tuple<double, double, double, double>> shown, listed;
+      const Constraints& c = session.mesher().constraints();
+      for (std::size_t k = 0; k < c.size(); ++k)
+        shown.emplace_back(c.points[k].x, c.points[k].y, c.points[k].z, c.values[k]);
+      for (const ConstraintInfo& x : session.constraints())
+        listed.emplace_back(x.position.x, x.position.y, x.position.z, x.value);
+      REQUIRE(shown == listed);
+    }
+  }
+  while (session.refine_step()) {
+  }
+  page.apply(session.delta(page.version, true));
+  CHECK(page.matches(session));
+  CHECK(session.refined());
+  CHECK(previews > 5);  // the sequence exercised the preview and its replays
+  CHECK(catch_ups > 2);
+}
+
 TEST_CASE("studio session: a coarser target restarts the polygonization without a refit", "[studio][session]") {
   Session session(small_model(), "small", fast_options());
   while (session.refine_step()) {

@@ -42,6 +42,7 @@ void Session::load(Constraints constraints, std::string name) {
   auto mesher = std::make_unique<Mesher>(constraints, options_.mesher);  // throws before anything changes
   mesher_ = std::move(mesher);
   preview_.reset();
+  building_.reset();
   behind_.clear();
   showing_preview_ = switched_ = preview_wanted_ = false;
   name_ = std::move(name);
@@ -93,6 +94,7 @@ void Session::timed_edit(const std::function<void()>& op) {
 Edit Session::apply(const Edit& e, bool dragging) {
   Edit inverse = e;
   Mesher& m = edited();
+  if (!preview_) building_.reset();  // its function would differ from the target's after this edit
   Lag lag{e.op, 0, e.position, e.value};
   switch (e.op) {
     case Edit::Op::Add:
@@ -205,6 +207,7 @@ void Session::drop_to_drag_level() {
   if (level_ >= level || mesher_->live_surface().num_triangles() <= options_.drag_min_triangles) return;
   mesher_->restart();
   preview_wanted_ = false;
+  building_.reset();
   level_ = std::numeric_limits<double>::infinity();
   mesher_->refine(level * unit_);  // no progress callback: the drag waits for its level
   level_ = level;
@@ -248,25 +251,30 @@ void Session::settle() {
 void Session::drop_preview() {
   settle();
   preview_.reset();
+  building_.reset();
   preview_wanted_ = false;
 }
 
 // A preview that does not fit in memory is not built (the session goes on without one: drags drop the
-// target mesh itself, adds stay at the target).
+// target mesh itself, adds stay at the target). An interrupted build is kept in building_ and resumed by
+// the next step (starting again each time, a page or a script polling the server could starve it); an
+// edit of the target mesh forgets it.
 void Session::build_preview(const KeepGoing& keep_going) {
   preview_wanted_ = false;
   const double level = target_ * std::ldexp(1.0, options_.drag_levels);
   try {
-    auto preview = std::make_unique<Mesher>(mesher_->restarted_copy());
-    if (!preview->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); })) {
-      preview_wanted_ = true;  // interrupted: built again by the next step
+    if (!building_) building_ = std::make_unique<Mesher>(mesher_->restarted_copy());
+    if (!building_->refine(level * unit_, [&](const RefineProgress&) { return !keep_going || keep_going(); })) {
+      preview_wanted_ = true;  // interrupted: resumed by the next step
       return;
     }
-    preview->sync_surface();  // its live mesh ready: the first edit's delta is incremental
-    preview_ = std::move(preview);
+    building_->sync_surface();  // its live mesh ready: the first edit's delta is incremental
+    preview_ = std::move(building_);
     preview_level_ = level;
   } catch (const std::bad_alloc&) {
+    building_.reset();
   } catch (const LimitError&) {
+    building_.reset();
   }
 }
 

@@ -192,6 +192,7 @@ class Session {
   std::string name_;
   std::unique_ptr<Mesher> mesher_;   // towards the target, level by level
   std::unique_ptr<Mesher> preview_;  // the same function at preview_level_ (or null); holds every edit
+  std::unique_ptr<Mesher> building_;  // a preview whose build an edit request interrupted (resumed next)
   std::vector<Lag> behind_;          // edits preview_ has and mesher_ has not, oldest first
   bool showing_preview_ = false;     // the page is shown preview_ (behind_ may be empty)
   bool switched_ = false;            // the shown Mesher changed: the next delta is its whole mesh

@@ -853,6 +853,28 @@ TEST_CASE("studio session: with the global function, edits land on a coarser pre
   CHECK(plain.current_precision() == o.precision);
 }
 
+TEST_CASE("studio session: an interrupted preview build resumes where it stopped", "[studio][session]") {
+  SessionOptions o = fast_options();
+  o.precision = 0.03;
+  o.drag_min_triangles = 0;
+  Session session(small_model(), "small", o);
+  // A request waits at every progress report (a page or a script polling the server): each step does one
+  // round of refinement. Were the build started again at each step, the preview would never be done.
+  const auto always_interrupted = [] { return false; };
+  int steps = 0;
+  while (!session.refined() && steps < 400) {
+    session.refine_step(always_interrupted);
+    ++steps;
+  }
+  REQUIRE(session.refined());
+  CHECK(session.has_preview());
+  CHECK(session.current_precision() == o.precision);
+  session.add({0.15, 0.7, 0.1}, 0.0);
+  CHECK(session.showing_preview());
+  CHECK(session.mesher().precision() == 2 * o.precision * session.unit());
+  CHECK(test::metrics_of(session.surface()).watertight());
+}
+
 TEST_CASE("studio session with a preview: random edits, undos, steps and targets; the page follows every "
           "delta and the target mesh catches up",
           "[studio][session]") {

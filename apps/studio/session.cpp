@@ -158,7 +158,7 @@ void Session::landed(const Lag& lag) {
 }
 
 ConstraintInfo Session::info(std::size_t index) const {
-  const Constraints& c = (preview_ ? *preview_ : *mesher_).constraints();
+  const Constraints& c = latest_constraints();
   return {index, ids_[index], c.points[index], c.values[index]};
 }
 
@@ -386,7 +386,7 @@ ClientDelta Session::delta(std::uint32_t since, bool exact) {
 }
 
 std::vector<ConstraintInfo> Session::constraints() const {
-  const Constraints& c = (preview_ ? *preview_ : *mesher_).constraints();
+  const Constraints& c = latest_constraints();
   std::vector<ConstraintInfo> out;
   out.reserve(c.size());
   for (std::size_t i = 0; i < c.size(); ++i) out.push_back(info(i));

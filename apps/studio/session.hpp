@@ -181,6 +181,7 @@ class Session {
   };
   /// The Mesher an edit lands on (the preview when there is one) and what it keeps for the replay.
   Mesher& edited() { return preview_ ? *preview_ : *mesher_; }
+  const Constraints& latest_constraints() const { return (preview_ ? *preview_ : *mesher_).constraints(); }
   void landed(const Lag& lag);
   void catch_up();
   void build_preview(const KeepGoing& keep_going);

@@ -50,6 +50,16 @@ SessionOptions fast_options() {
   return o;
 }
 
+/// fast_options() at `precision` with the global function's edits on a preview one level coarser, also
+/// for the small model (whose mesh is below the default drag_min_triangles).
+SessionOptions preview_options(double precision) {
+  SessionOptions o = fast_options();
+  o.precision = precision;
+  o.drag_levels = 1;
+  o.drag_min_triangles = 0;
+  return o;
+}
+
 /// The server of one test, serving on its own thread until destroyed.
 struct Running {
   Session session;
@@ -629,10 +639,7 @@ TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]
 TEST_CASE("studio session: without a preview, a global drag meshes at the drag level; idle refinement "
           "brings the target back",
           "[studio][session]") {
-  SessionOptions o = fast_options();
-  o.precision = 0.04;
-  o.drag_levels = 1;
-  o.drag_min_triangles = 0;       // the small model's mesh is below the default
+  SessionOptions o = preview_options(0.04);
   o.preview_max_constraints = 0;  // no preview: the drag drops the mesh itself
   Session session(small_model(), "small", o);
   while (session.refine_step()) {
@@ -752,10 +759,7 @@ std::set<std::array<double, 9>> triangle_set(const SurfaceMesh& m) {
 TEST_CASE("studio session: with the global function, edits land on a coarser preview first; the idle step "
           "replays them on the target mesh",
           "[studio][session]") {
-  SessionOptions o = fast_options();
-  o.precision = 0.04;
-  o.drag_levels = 1;
-  o.drag_min_triangles = 0;  // the small model's mesh is below the default
+  SessionOptions o = preview_options(0.04);
   Session session(small_model(), "small", o);
   Soup page;
   page.apply(session.delta(0, true));
@@ -854,9 +858,7 @@ TEST_CASE("studio session: with the global function, edits land on a coarser pre
 }
 
 TEST_CASE("studio session: an interrupted preview build resumes where it stopped", "[studio][session]") {
-  SessionOptions o = fast_options();
-  o.precision = 0.03;
-  o.drag_min_triangles = 0;
+  const SessionOptions o = preview_options(0.03);
   Session session(small_model(), "small", o);
   // A request waits at every progress report (a page or a script polling the server): each step does one
   // round of refinement. Were the build started again at each step, the preview would never be done.
@@ -878,9 +880,7 @@ TEST_CASE("studio session: an interrupted preview build resumes where it stopped
 TEST_CASE("studio session with a preview: random edits, undos, steps and targets; the page follows every "
           "delta and the target mesh catches up",
           "[studio][session]") {
-  SessionOptions o = fast_options();
-  o.precision = 0.045;
-  o.drag_min_triangles = 0;
+  const SessionOptions o = preview_options(0.045);
   Session session(small_model(), "small", o);
   Soup page;
   page.apply(session.delta(0, true));

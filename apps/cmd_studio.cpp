@@ -25,7 +25,7 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri studio [INPUT] [--port N] [--host ADDR] [--precision P] [--function F]\n"
-    "                    [--offset D] [--sides both|inside|outside] [--drag-levels K]\n"
+    "                    [--offset D] [--sides both|inside|outside] [--drag-levels K] [--no-socket]\n"
     "\n"
     "Starts the interactive modeler: a local web server; open the printed address in a browser. Click\n"
     "the surface to add a constraint, shift+click / alt+click for an outside / inside one, drag a\n"
@@ -46,6 +46,8 @@ const char* const kUsage =
     "                  coarser than the target (default 1; 0: every edit at the target) above\n"
     "                  5000 triangles; the target mesh follows in the next idle step\n"
     "  --offset D, --sides S   as vitri mesh, for oriented points and meshes\n"
+    "  --no-socket     HTTP only: no WebSocket beside it (by default the page sends its requests\n"
+    "                  over a WebSocket on a second, free port of the same host: faster updates)\n"
     "\n"
     "Stops on Ctrl-C. Exit status: 0 stopped, 1 bad input, 2 usage error.\n";
 
@@ -121,6 +123,8 @@ std::string parse_args(const Args& args, StudioArgs& out) {
         out.session.mesher.constraint_build.sides = OffSurface::Outside;
       else
         return "--sides must be both, inside or outside, got '" + v + "'";
+    } else if (a == "--no-socket") {
+      out.server.socket = false;
     } else if (!a.empty() && a[0] == '-') {
       return "unknown option '" + a + "'";
     } else if (out.input.empty()) {

@@ -301,7 +301,8 @@ std::string Api::stats_json(const std::string& extra) {
          ",\"undo\":" + std::to_string(session_.undo_depth()) +
          ",\"redo\":" + std::to_string(session_.redo_depth()) +
          ",\"revision\":" + std::to_string(session_.revision()) +
-         ",\"constraint_version\":" + std::to_string(session_.constraint_version()) + "}";
+         ",\"constraint_version\":" + std::to_string(session_.constraint_version()) +
+         ",\"socket_port\":" + (socket_port_ > 0 ? std::to_string(socket_port_) : std::string("null")) + "}";
   return out;
 }
 

@@ -52,6 +52,8 @@ class Api {
   ApiResponse handle(const ApiRequest& request);
   /// True when the path is an API route (the server serves the page's files for the others).
   static bool is_api_path(const std::string& path);
+  /// The WebSocket transport's port, shown in the stats as `socket_port` (0: none, `null`).
+  void set_socket_port(int port) { socket_port_ = port; }
 
  private:
   ApiResponse route(const ApiRequest& request);
@@ -70,7 +72,8 @@ class Api {
   Session& session_;
   ConstraintBuildOptions build_;
   std::mutex mutex_;
-  std::atomic<int> waiting_{0};  // requests waiting for the mutex (a refinement step yields to them)
+  std::atomic<int> waiting_{0};
+  std::atomic<int> socket_port_{0};  // requests waiting for the mutex (a refinement step yields to them)
   std::string temp_dir_;         // private (0700) directory for exports, removed by the destructor
 };
 

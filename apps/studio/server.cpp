@@ -2,6 +2,8 @@
 // never throws); transport errors (bad HTTP, payload over the limit) get a JSON body too.
 #include "server.hpp"
 
+#include "socket.hpp"
+
 #include "vitri/core/error.hpp"
 
 #include <httplib.h>
@@ -53,9 +55,11 @@ std::vector<StaticFile> static_files(const ServerOptions& o) {
 
 struct Server::Impl {
   httplib::Server http;
+  std::unique_ptr<SocketServer> socket;
 };
 
-Server::Server(Api& api, const ServerOptions& options) : impl_(std::make_unique<Impl>()), options_(options) {
+Server::Server(Api& api, const ServerOptions& options)
+    : api_(api), impl_(std::make_unique<Impl>()), options_(options) {
   httplib::Server& http = impl_->http;
   http.set_payload_max_length(options.max_body);
   // SO_REUSEADDR only: cpp-httplib's default also sets SO_REUSEPORT, with which a second studio on the
@@ -65,7 +69,11 @@ Server::Server(Api& api, const ServerOptions& options) : impl_(std::make_unique<
     setsockopt(sock, SOL_SOCKET, SO_REUSEADDR, &yes, sizeof yes);
   });
   http.set_tcp_nodelay(true);  // small responses go out at once (Nagle + delayed ACK cost ~40 ms each)
-  const auto to_api = [&api](const httplib::Request& req, httplib::Response& res) {
+  const auto to_api = [this, &api](const httplib::Request& req, httplib::Response& res) {
+    // A page of another site (a cross-site form or fetch, DNS rebinding) may not edit or read the model.
+    if (!origin_allowed(req.get_header_value("Origin"), options_.host, port_, req.get_header_value("Host")))
+      return answer(res, error_response(403, "a page of another origin may not use the studio: " +
+                                                 req.get_header_value("Origin")));
     ApiRequest r;
     r.method = req.method;
     r.path = req.path;
@@ -112,15 +120,31 @@ int Server::bind() {
                   " (in use? try --port 0 for any free port)");
     port_ = options_.port;
   }
+  if (options_.socket) {
+    SocketOptions so;
+    so.host = options_.host;
+    so.port = options_.socket_port;
+    so.http_port = port_;
+    so.max_message = options_.max_body + 4096;  // the request line besides the body
+    impl_->socket = std::make_unique<SocketServer>(api_, so);
+    api_.set_socket_port(impl_->socket->bind());
+  }
   return port_;
 }
 
+int Server::socket_port() const {
+  return impl_->socket ? impl_->socket->port() : 0;
+}
+
 void Server::run() {
+  if (impl_->socket) impl_->socket->start();
   impl_->http.listen_after_bind();
 }
 
 void Server::stop() {
-  if (impl_) impl_->http.stop();
+  if (!impl_) return;
+  impl_->http.stop();
+  if (impl_->socket) impl_->socket->stop();
 }
 
 }  // namespace vitri::studio

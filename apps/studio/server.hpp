@@ -15,6 +15,10 @@ struct ServerOptions {
   std::string web_dir;               ///< folder with index.html, studio.js, studio.css
   std::string three_dir;             ///< three.js installation (build/three.min.js, examples/js/controls/)
   std::size_t max_body = 64u << 20;  ///< largest request body (an uploaded file); larger gets 413
+  /// The WebSocket transport (socket.hpp) on a second port of the same host, which the page uses for
+  /// its requests when it can (`socket_port` in the stats); false: HTTP only.
+  bool socket = true;
+  int socket_port = 0;  ///< 0: any free port
 };
 
 /// The files the server serves besides the API: URL path -> file on disk (never a client-given path).
@@ -25,21 +29,27 @@ struct StaticFile {
 };
 std::vector<StaticFile> static_files(const ServerOptions& options);
 
+class SocketServer;
+
 class Server {
  public:
   Server(Api& api, const ServerOptions& options);
   ~Server();
   Server(const Server&) = delete;
   Server& operator=(const Server&) = delete;
-  /// Binds the address. @return the port. @throws vitri::Error when it cannot bind.
+  /// Binds the address (and the socket's, see ServerOptions::socket). @return the HTTP port.
+  /// @throws vitri::Error when it cannot bind.
   int bind();
   /// Serves until stop() (from another thread or a signal-waiting thread). @pre bind() succeeded.
   void run();
   void stop();
   int port() const { return port_; }
+  /// The WebSocket's port (0 without it).
+  int socket_port() const;
 
  private:
   struct Impl;
+  Api& api_;
   std::unique_ptr<Impl> impl_;
   ServerOptions options_;
   int port_ = 0;

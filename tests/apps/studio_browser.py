@@ -232,6 +232,9 @@ def click_drag_undo(driver, server, shot, s0, m0):
     check(page_constraints_match(driver, server), "the page's constraint list is the server's after the edits")
     check(full_constraint_fetches(driver) == 1,
           "the page took the constraint list once (at load), then only the changes of each edit")
+    check(requests_sent(driver, "socket", "/api/edit") >= 2 and requests_sent(driver, "http", "/api/edit") == 0,
+          "the page sent its edits over the WebSocket (%d), none over HTTP"
+          % requests_sent(driver, "socket", "/api/edit"))
 
 
 def open_file(driver, server, shot, out_dir):
@@ -337,6 +340,24 @@ def pick_rule(driver, server):
     wait_for("the undos", lambda: server.get("/api/stats")["constraints"] == n)
 
 
+def http_only(driver, server):
+    """The page without its WebSocket (?socket=0, as when the socket cannot open): edits over HTTP."""
+    driver.get(server.url + "/?socket=0")
+    wait_for("the page to start", lambda: driver.execute_script("return !!(window.studio && studio.ready)"))
+    wait_for("the page to be idle", lambda: page_idle(driver))
+    check(driver.execute_script("return api.socket === null"), "?socket=0: the page has no socket")
+    n = server.get("/api/stats")["constraints"]
+    p = server.get("/api/mesh?format=indexed")["vertices"][0]  # on the surface
+    driver.execute_async_script("const done = arguments[arguments.length - 1];"
+                                "studio.edit({op: 'add', position: arguments[0], value: 0}).then(done, done);", p)
+    check(server.get("/api/stats")["constraints"] == n + 1, "?socket=0: the page's add reached the server")
+    driver.find_element("id", "undo").click()
+    wait_for("its undo", lambda: server.get("/api/stats")["constraints"] == n)
+    check(requests_sent(driver, "http", "/api/edit") == 1 and requests_sent(driver, "socket", "/api/edit") == 0,
+          "?socket=0: the edit went over HTTP")
+    check(page_mesh_matches(driver, server), "?socket=0: the page's triangles are the server's after an add and its undo")
+
+
 def run(args):
     server = Server(args.vitri, ([args.model] if args.model else []) + ["--precision", str(args.precision)] +
                     args.studio_args.split())
@@ -369,6 +390,7 @@ def run(args):
         raycast_agrees(driver)
         click_drag_undo(driver, server, shot, s0, m0)
         open_file(driver, server, shot, args.out)
+        http_only(driver, server)
         errors = [e for e in driver.get_log("browser") if e["level"] == "SEVERE"]
         check(not errors, "no error in the browser console " + (json.dumps(errors) if errors else ""))
         check(driver.execute_script("return document.getElementById('error').hidden"), "no error shown")
@@ -450,7 +472,12 @@ def page_constraints_match(driver, server):
 def full_constraint_fetches(driver):
     """How many times the page asked for the constraint list with /api/constraints (a load, or out of step)."""
     return driver.execute_script(
-        "return performance.getEntriesByType('resource').filter((e) => e.name.includes('/api/constraints')).length")
+        "return (api.counts.socket['/api/constraints'] || 0) + (api.counts.http['/api/constraints'] || 0)")
+
+
+def requests_sent(driver, transport, route):
+    """Requests of the page to `route` over `transport` ('socket' or 'http')."""
+    return driver.execute_script("return api.counts[arguments[0]][arguments[1]] || 0", transport, route)
 
 
 def main():

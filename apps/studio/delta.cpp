@@ -65,21 +65,20 @@ void DeltaTracker::track(const LiveMesh& mesh, const MeshDelta& change, std::vec
                          std::vector<std::uint32_t>& removed) {
   if (change.full) {
     corners_.clear();
-    incident_.clear();
     held_.clear();
     stale_.clear();
     sent_any_ = false;
+    incident_valid_ = false;  // built again when a moved vertex needs it (a whole mesh resends everything)
   }
   if (corners_.size() < mesh.triangle_capacity()) corners_.resize(mesh.triangle_capacity());
-  if (incident_.size() < mesh.vertex_capacity()) {
-    incident_.resize(mesh.vertex_capacity());
-    held_.resize(mesh.vertex_capacity());
-  }
+  if (held_.size() < mesh.vertex_capacity()) held_.resize(mesh.vertex_capacity());
+  if (incident_valid_ && incident_.size() < mesh.vertex_capacity()) incident_.resize(mesh.vertex_capacity());
   for (const std::uint32_t t : change.removed_triangles) {
-    for (const std::uint32_t v : corners_[t]) {
-      auto& inc = incident_[v];
-      inc.erase(std::find(inc.begin(), inc.end(), t));
-    }
+    if (incident_valid_)
+      for (const std::uint32_t v : corners_[t]) {
+        auto& inc = incident_[v];
+        inc.erase(std::find(inc.begin(), inc.end(), t));
+      }
     removed.push_back(t);
   }
   for (const std::uint32_t v : change.added_vertices) {
@@ -88,10 +87,20 @@ void DeltaTracker::track(const LiveMesh& mesh, const MeshDelta& change, std::vec
   }
   for (const std::uint32_t t : change.added_triangles) {
     corners_[t] = mesh.triangle(t);
-    for (const std::uint32_t v : corners_[t]) incident_[v].push_back(t);
+    if (incident_valid_)
+      for (const std::uint32_t v : corners_[t]) incident_[v].push_back(t);
     resend.push_back(t);
   }
   stale_.insert(stale_.end(), change.moved_vertices.begin(), change.moved_vertices.end());
+}
+
+void DeltaTracker::build_incidence(const LiveMesh& mesh) {
+  for (auto& inc : incident_) inc.clear();
+  incident_.resize(mesh.vertex_capacity());
+  for (std::uint32_t t = 0; t < mesh.triangle_capacity(); ++t)
+    if (mesh.is_triangle(t))
+      for (const std::uint32_t v : mesh.triangle(t)) incident_[v].push_back(t);
+  incident_valid_ = true;
 }
 
 void DeltaTracker::append_triangle(const LiveMesh& mesh, std::uint32_t t, ClientDelta& d) {
@@ -110,6 +119,7 @@ ClientDelta DeltaTracker::update(const LiveMesh& mesh, const MeshDelta& change, 
   d.base = d.full ? 0 : since;
   // Moved vertices: resent (their triangles) when exact, or when they left the cell the page holds.
   std::vector<std::uint32_t> still_stale;
+  if (!d.full && !stale_.empty() && !incident_valid_) build_incidence(mesh);
   std::sort(stale_.begin(), stale_.end());
   stale_.erase(std::unique(stale_.begin(), stale_.end()), stale_.end());
   for (const std::uint32_t v : stale_) {
@@ -120,10 +130,13 @@ ClientDelta DeltaTracker::update(const LiveMesh& mesh, const MeshDelta& change, 
       continue;
     }
     held_[v] = {static_cast<float>(p.x), static_cast<float>(p.y), static_cast<float>(p.z)};
-    resend.insert(resend.end(), incident_[v].begin(), incident_[v].end());
+    if (!d.full) resend.insert(resend.end(), incident_[v].begin(), incident_[v].end());
   }
   stale_ = std::move(still_stale);
   if (d.full) {
+    d.added.reserve(mesh.num_triangles());
+    d.positions.reserve(9 * std::size_t(mesh.num_triangles()));
+    d.normals.reserve(9 * std::size_t(mesh.num_triangles()));
     for (std::uint32_t v = 0; v < mesh.vertex_capacity(); ++v)
       if (mesh.is_vertex(v)) {
         const Point3& p = mesh.position(v);

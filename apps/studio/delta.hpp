@@ -52,12 +52,16 @@ class DeltaTracker {
   void track(const LiveMesh& mesh, const MeshDelta& change, std::vector<std::uint32_t>& resend,
              std::vector<std::uint32_t>& removed);
   void append_triangle(const LiveMesh& mesh, std::uint32_t t, ClientDelta& d);
+  void build_incidence(const LiveMesh& mesh);
   bool moved_beyond_cell(const Held& held, const Point3& p) const;
 
   // Per live-mesh triangle: its corners (to know those of removed ones). Per vertex: its triangles, the
-  // position the page holds, stale (moved, not resent).
+  // position the page holds, stale (moved, not resent). The vertices' triangles are kept only once a
+  // partial delta needs them (incident_valid_): a whole mesh (a load, the preview's switch) resends every
+  // triangle without them.
   std::vector<std::array<std::uint32_t, 3>> corners_;
   std::vector<std::vector<std::uint32_t>> incident_;
+  bool incident_valid_ = false;
   std::vector<Held> held_;
   std::vector<std::uint32_t> stale_;
   double cell_ = 1e-6;

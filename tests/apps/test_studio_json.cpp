@@ -220,6 +220,24 @@ TEST_CASE("delta: a client applying every delta holds the server's mesh", "[stud
   CHECK(flip.added.size() == 2);
   client.apply(flip);
   CHECK(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
+
+  // After a whole-mesh change (the studio's switch between its meshes), the tracker knows every vertex's
+  // triangles again when one moves: exactly its triangles are resent, then a removal is followed.
+  client = Client{};
+  live.take_delta();
+  client.apply(tracker.update(live, live.whole_delta(), 0));
+  displace(live, 3, -1.25);  // vertex 3 is in 4 triangles
+  const ClientDelta after = tracker.update(live, live.take_delta(), client.version);
+  CHECK_FALSE(after.full);
+  CHECK(after.added.size() == 4);
+  CHECK(after.removed == after.added);
+  client.apply(after);
+  live.remove_triangle(2);
+  live.add_triangle({1, 3, 4});
+  displace(live, 3, -1.5);
+  const ClientDelta again = tracker.update(live, live.take_delta(), client.version);
+  client.apply(again);
+  CHECK(canonical(triangles_of(client)) == canonical(triangles_of(live.to_surface_mesh())));
 }
 
 TEST_CASE("delta: approximate mode keeps vertices that moved less than a cell", "[studio][delta]") {

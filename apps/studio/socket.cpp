@@ -359,6 +359,8 @@ int SocketServer::bind() {
 }
 
 void SocketServer::start() {
+  const std::lock_guard<std::mutex> lock(mutex_);  // stop() may run on another thread (a signal)
+  if (stopping_.load()) return;  // stopped before it started (a signal right after the bind)
   if (listen_fd_ < 0) throw Error("studio socket: start() before bind()");
   acceptor_ = std::thread([this] { accept_loop(); });
 }
@@ -366,7 +368,12 @@ void SocketServer::start() {
 void SocketServer::stop() {
   if (stopping_.exchange(true)) return;
   if (listen_fd_ >= 0) ::shutdown(listen_fd_, SHUT_RDWR);  // accept() returns
-  if (acceptor_.joinable()) acceptor_.join();
+  std::thread acceptor;
+  {
+    const std::lock_guard<std::mutex> lock(mutex_);
+    acceptor.swap(acceptor_);
+  }
+  if (acceptor.joinable()) acceptor.join();
   if (listen_fd_ >= 0) ::close(listen_fd_);
   listen_fd_ = -1;
   std::list<std::unique_ptr<Connection>> all;
@@ -589,9 +596,12 @@ void SocketServer::handle_message(Connection& c, std::string message) {
   // On a thread of its own, as an HTTP request: an edit arriving while a refinement step runs makes it
   // yield (Api::handle), which a reader busy with the step could not.
   auto done = std::make_shared<std::atomic<bool>>(false);
+  // A request counts as done before its answer leaves: a client that sends the next one on receiving it
+  // never finds the previous one still in flight (joining its thread then waits for the send at most).
   c.workers.push_back({std::thread([this, &c, id, r = std::move(r), done] {
-                         answer(c, id, api_.handle(r));
+                         const ApiResponse response = api_.handle(r);
                          *done = true;
+                         answer(c, id, response);
                        }),
                        done});
 }

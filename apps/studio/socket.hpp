@@ -64,7 +64,8 @@ class SocketServer {
   SocketServer& operator=(const SocketServer&) = delete;
   /// Binds and listens. @return the port. @throws vitri::Error when it cannot bind.
   int bind();
-  /// Accepts connections on a thread of its own until stop(). @pre bind() succeeded.
+  /// Accepts connections on a thread of its own until stop() (nothing after a stop()).
+  /// @pre bind() succeeded.
   void start();
   /// Closes the listening socket and every connection; waits for their threads.
   void stop();

@@ -182,13 +182,13 @@ class Studio {
       this.waiting.push(timing);
     }
     if (!this.frame) {
-      this.frame = new Promise((resolve) => requestAnimationFrame(() => {
+      this.frame = new Promise((resolve) => requestAnimationFrame((vsync) => {
         const t = performance.now();
         this.render(this.waiting.length > 0 || this.drag !== null);
         if (this.syncDraw) this.waitForDraw();
         const drawn = performance.now();
         for (const w of this.waiting) {
-          Object.assign(w, { frame: t, drawn });
+          Object.assign(w, { frame: t, drawn, vsync });  // vsync: the frame's begin time (rAF's argument)
           this.latency = drawn - w.event;
           this.timings.push(w);
         }

@@ -13,13 +13,38 @@ function summary(values) {
   return { count: v.length, p50: r(at(0.5)), p90: r(at(0.9)), max: r(v[v.length - 1]) };
 }
 
+// The begin times of every animation frame while a benchmark runs (a loop of empty rAF callbacks), so
+// that an update can be checked against the frames that began between its event and the frame that drew
+// it: none means it was drawn in the first frame after the event, the soonest a display shows it.
+// Only with hardware WebGL: with a software rasterizer every extra frame costs CPU time that the server
+// and the page share (frames_missed then has count 0).
+function frameClock(studio) {
+  return studio.software ? null : new FrameClock();
+}
+
+class FrameClock {
+  constructor() {
+    this.begins = [];
+    this.running = true;
+    const tick = (t) => {
+      this.begins.push(t);
+      if (this.running) requestAnimationFrame(tick);
+    };
+    requestAnimationFrame(tick);
+  }
+  stop() { this.running = false; }
+  missed(t) { return this.begins.filter((b) => b > t.event && b < t.vsync).length; }
+}
+
 // Where the time of updates went: input (event to request sent: handlers, raycast, queue), server (its
-// Server-Timing: edit + delta), transfer (request to delta received, less the server: HTTP, JSON parse),
-// apply (mesh delta and constraint changes into the buffers), wait (to the animation frame), draw
-// (render + read back), total (event to drawn).
-function breakdown(timings) {
+// Server-Timing: edit + delta), transfer (request to delta received, less the server: HTTP or socket,
+// JSON parse), apply (mesh delta and constraint changes into the buffers), wait (to the animation frame),
+// draw (render + read back), total (event to drawn); frames_missed (with a FrameClock: frames that began
+// after the event, before the one that drew the update).
+function breakdown(timings, clock) {
   const of = (f) => summary(timings.map(f));
   return {
+    frames_missed: clock ? of((t) => clock.missed(t)) : { count: 0 },
     total: of((t) => t.drawn - t.event), input: of((t) => t.sent - t.event), server: of((t) => t.server),
     transfer: of((t) => t.received - t.sent - t.server), apply: of((t) => t.applied - t.received),
     wait: of((t) => t.frame - t.applied), draw: of((t) => t.drawn - t.frame),
@@ -60,7 +85,7 @@ Studio.prototype.benchAdd = async function ({ count = 12 } = {}) {
   const shown = this.constraints.points.visible;
   this.constraints.points.visible = false;
   this.syncDraw = this.holdIdle = true;
-  const adds = [], undos = [], target = [];
+  const adds = [], undos = [], target = [], clock = frameClock(this);
   for (const p of this.surfacePixels(count)) {
     this.timings = [];
     const before = this.constraints.count;
@@ -82,9 +107,10 @@ Studio.prototype.benchAdd = async function ({ count = 12 } = {}) {
     undos.push(...this.timings);
     if (this.stats.preview) await this.benchTarget();  // the next click starts from the target mesh
   }
+  if (clock) clock.stop();
   this.syncDraw = this.holdIdle = false;
   this.constraints.points.visible = shown;
-  return { add: breakdown(adds), undo: breakdown(undos), target_after_add: summary(target),
+  return { add: breakdown(adds, clock), undo: breakdown(undos, clock), target_after_add: summary(target),
            triangles: this.slots.triangles };
 };
 
@@ -131,6 +157,7 @@ Studio.prototype.benchDrag = async function ({ moves = 60, radius = 12, live = f
   this.syncDraw = !live;
   this.holdIdle = true;
   this.timings = [];
+  const clock = frameClock(this);
   this.pointer('pointerdown', start.x, start.y);
   if (!this.drag || this.drag.index !== start.index) throw new Error('the pointer did not pick the constraint');
   const t0 = performance.now();
@@ -144,10 +171,11 @@ Studio.prototype.benchDrag = async function ({ moves = 60, radius = 12, live = f
   this.pointer('pointerup', start.x, start.y);
   await this.settled();
   const timings = this.timings.filter((t) => !live || t.drawn <= end);  // live: those drawn while moving
+  if (clock) clock.stop();
   this.syncDraw = this.holdIdle = false;
   await this.command('/api/undo');
   await this.settled();
-  return Object.assign(breakdown(timings), { index: start.index, moves, updates: timings.length,
+  return Object.assign(breakdown(timings, clock), { index: start.index, moves, updates: timings.length,
                                              updates_per_second: timings.length / seconds,
                                              triangles: this.slots.triangles });
 };

@@ -1,7 +1,7 @@
 #pragma once
 // The studio's WebSocket transport (RFC 6455), beside the HTTP server: the page sends its API requests
 // over one socket and gets each answer as one binary message, without a fetch per update (a fetch costs
-// the page 2-4 ms on localhost, a socket message 0.3-0.5 ms: docs/benchmarks.md). The same Api serves
+// the page 2.7-4.6 ms on localhost, a socket message 0.3-0.4 ms: docs/studio.md). The same Api serves
 // both; the messages carry the HTTP API's requests and answers unchanged (docs/studio.md, "Socket").
 //
 // Request: one text (or binary) message "ID METHOD TARGET\n" then the body, with ID a decimal in

@@ -1,5 +1,5 @@
 // vitri studio: the page. Draws the mesh and the constraints with three.js, sends edits to the server's
-// HTTP/JSON API and applies the mesh deltas it answers with (docs/studio.md). No build step, no modules:
+// API (over its WebSocket, else HTTP) and applies the mesh deltas it answers with (docs/studio.md). No build step, no modules:
 // three.min.js and OrbitControls.js (Debian libjs-three), then studio_buffers.js (the mesh and the
 // constraints held in WebGL buffers) are loaded before this file.
 'use strict';

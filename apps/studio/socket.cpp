@@ -169,6 +169,7 @@ std::string http_error(int status, const char* reason, const std::string& what, 
 // Frame opcodes and close codes (RFC 6455 5.2, 7.4.1).
 constexpr int kContinuation = 0x0, kText = 0x1, kBinary = 0x2, kClose = 0x8, kPing = 0x9, kPong = 0xA;
 constexpr int kProtocolError = 1002, kTooBig = 1009;
+constexpr int kEnd = -1;  // read_frame(): the stream ended (or failed) before a whole frame
 
 // The header of an unmasked server frame with FIN set.
 std::string frame_header(int opcode, std::size_t n) {
@@ -495,6 +496,39 @@ bool SocketServer::handshake(Connection& c) {
                                         websocket_accept(key) + "\r\n\r\n");
 }
 
+// One client frame, unmasked. Returns 0, kEnd (the stream ended) or the close code of a frame no browser
+// sends: masked frames only; no RSV bit (no extension was negotiated); control frames whole and short; a
+// continuation continues a message, a text or binary frame starts one (`in_message`); a data frame over
+// `room` bytes is refused from its header, before its payload is read.
+int SocketServer::read_frame(Connection& c, bool in_message, std::size_t room, Frame& f) {
+  unsigned char h[2];
+  if (!c.read_exact(h, 2)) return kEnd;
+  f.fin = (h[0] & 0x80) != 0;
+  f.opcode = h[0] & 0x0f;
+  const bool masked = (h[1] & 0x80) != 0;
+  std::uint64_t len = h[1] & 0x7f;
+  if (len >= 126) {
+    unsigned char e[8];
+    const std::size_t k = len == 126 ? 2 : 8;
+    if (!c.read_exact(e, k)) return kEnd;
+    len = 0;
+    for (std::size_t i = 0; i < k; ++i) len = (len << 8) | e[i];
+  }
+  const bool control = (f.opcode & 0x8) != 0;
+  const bool known = f.opcode == kContinuation || f.opcode == kText || f.opcode == kBinary ||
+                     f.opcode == kClose || f.opcode == kPing || f.opcode == kPong;
+  if ((h[0] & 0x70) != 0 || !masked || !known || (control && (!f.fin || len > 125)) ||
+      (f.opcode == kContinuation && !in_message) || ((f.opcode == kText || f.opcode == kBinary) && in_message))
+    return kProtocolError;
+  if (!control && len > room) return kTooBig;
+  unsigned char mask[4];
+  if (!c.read_exact(mask, 4)) return kEnd;
+  f.payload.assign(static_cast<std::size_t>(len), '\0');
+  if (len > 0 && !c.read_exact(&f.payload[0], f.payload.size())) return kEnd;
+  for (std::size_t i = 0; i < f.payload.size(); ++i) f.payload[i] = static_cast<char>(f.payload[i] ^ mask[i % 4]);
+  return 0;
+}
+
 void SocketServer::serve(Connection& c) {
   set_receive_timeout(c.fd, 10);  // a client that opens a connection and says nothing
   const bool open = handshake(c);
@@ -506,52 +540,25 @@ void SocketServer::serve(Connection& c) {
   std::string message;
   bool in_message = false;
   for (;;) {
-    unsigned char h[2];
-    if (!c.read_exact(h, 2)) break;
-    const bool fin = (h[0] & 0x80) != 0, masked = (h[1] & 0x80) != 0;
-    const int rsv = h[0] & 0x70, opcode = h[0] & 0x0f;
-    std::uint64_t len = h[1] & 0x7f;
-    if (len == 126) {
-      unsigned char e[2];
-      if (!c.read_exact(e, 2)) break;
-      len = (std::uint64_t(e[0]) << 8) | e[1];
-    } else if (len == 127) {
-      unsigned char e[8];
-      if (!c.read_exact(e, 8)) break;
-      len = 0;
-      for (const unsigned char b : e) len = (len << 8) | b;
-    }
-    const bool control = (opcode & 0x8) != 0;
-    const bool known = opcode == kContinuation || opcode == kText || opcode == kBinary || opcode == kClose ||
-                       opcode == kPing || opcode == kPong;
-    // Client frames are masked; no extension was negotiated (no RSV bit); control frames are whole and
-    // short; a continuation continues a message, a text or binary frame starts one.
-    if (rsv != 0 || !masked || !known || (control && (!fin || len > 125)) ||
-        (opcode == kContinuation && !in_message) || ((opcode == kText || opcode == kBinary) && in_message)) {
-      c.close_with(kProtocolError);
+    Frame f;
+    const int status = read_frame(c, in_message, options_.max_message - message.size(), f);
+    if (status == kEnd) break;
+    if (status != 0) {
+      c.close_with(status);
       break;
     }
-    if (!control && len > options_.max_message - message.size()) {
-      c.close_with(kTooBig);
+    if (f.opcode == kClose) {  // echo the code (RFC 6455 5.5.1), then the connection ends
+      c.send_frame(kClose, f.payload.substr(0, std::min<std::size_t>(f.payload.size(), 2)));
       break;
     }
-    unsigned char mask[4];
-    if (!c.read_exact(mask, 4)) break;
-    std::string payload(static_cast<std::size_t>(len), '\0');
-    if (len > 0 && !c.read_exact(&payload[0], payload.size())) break;
-    for (std::size_t i = 0; i < payload.size(); ++i) payload[i] = static_cast<char>(payload[i] ^ mask[i % 4]);
-    if (opcode == kClose) {  // echo the code (RFC 6455 5.5.1), then the connection ends
-      c.send_frame(kClose, payload.substr(0, std::min<std::size_t>(payload.size(), 2)));
-      break;
-    }
-    if (opcode == kPing) {
-      c.send_frame(kPong, payload);
+    if (f.opcode == kPing) {
+      c.send_frame(kPong, f.payload);
       continue;
     }
-    if (opcode == kPong) continue;
-    message += payload;
-    in_message = !fin;
-    if (fin) {
+    if (f.opcode == kPong) continue;
+    message += f.payload;
+    in_message = !f.fin;
+    if (f.fin) {
       handle_message(c, std::move(message));
       message.clear();
     }

@@ -73,7 +73,13 @@ class SocketServer {
 
  private:
   struct Connection;
+  struct Frame {
+    bool fin = false;
+    int opcode = 0;
+    std::string payload;
+  };
   void accept_loop();
+  static int read_frame(Connection& c, bool in_message, std::size_t room, Frame& f);
   void serve(Connection& c);
   bool handshake(Connection& c);
   void answer(Connection& c, std::uint32_t id, const ApiResponse& r);

@@ -341,7 +341,16 @@ def pick_rule(driver, server):
 
 
 def http_only(driver, server):
-    """The page without its WebSocket (?socket=0, as when the socket cannot open): edits over HTTP."""
+    """The page without its WebSocket: closed during a session (later requests over HTTP), then
+    ?socket=0 (as when the socket cannot open): edits over HTTP."""
+    driver.execute_script("api.socket.close()")
+    wait_for("the socket to close", lambda: driver.execute_script("return api.socket === null"))
+    before = requests_sent(driver, "http", "/api/undo")
+    n = server.get("/api/stats")["undo"]
+    driver.find_element("id", "undo").click()
+    wait_for("the undo after the socket closed", lambda: server.get("/api/stats")["undo"] == n - 1)
+    check(requests_sent(driver, "http", "/api/undo") == before + 1,
+          "after the socket closed, the page's undo went over HTTP")
     driver.get(server.url + "/?socket=0")
     wait_for("the page to start", lambda: driver.execute_script("return !!(window.studio && studio.ready)"))
     wait_for("the page to be idle", lambda: page_idle(driver))

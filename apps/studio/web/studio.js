@@ -28,13 +28,15 @@ const api = {
   nextId: 1,
   counts: { socket: {}, http: {} },  // requests sent per transport and API path (the tests read them)
 
-  // Opens the socket on `port` of this host (null or ?socket=0: HTTP only). Resolves either way.
+  // Opens the socket on `port` of this host (null or ?socket=0: HTTP only). Resolves either way, within
+  // 2 s (a port that a firewall drops would otherwise hold the page's start for the TCP timeout).
   connect(port) {
     if (!port || /[?&]socket=0/.test(location.search)) return Promise.resolve(false);
     return new Promise((resolve) => {
       const ws = new WebSocket('ws://' + location.hostname + ':' + port + '/api/socket');
       ws.binaryType = 'arraybuffer';
-      ws.onopen = () => { this.socket = ws; resolve(true); };
+      const timer = setTimeout(() => { if (this.socket !== ws) { ws.close(); resolve(false); } }, 2000);
+      ws.onopen = () => { clearTimeout(timer); this.socket = ws; resolve(true); };
       ws.onmessage = (e) => this.receive(e.data);
       ws.onclose = () => {
         if (this.socket === ws) this.socket = null;  // later requests over HTTP

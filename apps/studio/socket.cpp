@@ -129,9 +129,16 @@ bool split_host_port(const std::string& s, std::string& host, int& port) {
   return true;
 }
 
+// localhost, ::1 or an IPv4 address 127.x.y.z written in digits (a name such as "127.example.com" is
+// not: it could resolve anywhere).
 bool is_loopback_name(const std::string& host) {
-  return host == "127.0.0.1" || host == "localhost" || host == "[::1]" || host == "::1" ||
-         host.rfind("127.", 0) == 0;
+  if (host == "localhost" || host == "[::1]" || host == "::1") return true;
+  int dots = 0;
+  for (const char ch : host) {
+    if (ch == '.') ++dots;
+    else if (ch < '0' || ch > '9') return false;
+  }
+  return dots == 3 && host.rfind("127.", 0) == 0;
 }
 
 int hex_digit(char ch) {

@@ -199,6 +199,8 @@ TEST_CASE("studio socket: a page must come from the studio itself (Origin)", "[s
   CHECK(origin_allowed("HTTP://LocalHost:8080", "127.0.0.1", 8080, ""));
   CHECK_FALSE(origin_allowed("http://127.0.0.1:8081", "127.0.0.1", 8080, "127.0.0.1:8080"));
   CHECK_FALSE(origin_allowed("http://evil.example:8080", "127.0.0.1", 8080, "evil.example:8080"));  // rebinding
+  CHECK_FALSE(origin_allowed("http://127.evil.example:8080", "127.0.0.1", 8080, "127.evil.example:8080"));
+  CHECK(origin_allowed("http://127.0.0.2:8080", "127.0.0.1", 8080, "127.0.0.2:8080"));
   CHECK_FALSE(origin_allowed("https://127.0.0.1:8080", "127.0.0.1", 8080, "127.0.0.1:8080"));
   CHECK_FALSE(origin_allowed("null", "127.0.0.1", 8080, "127.0.0.1:8080"));
   CHECK_FALSE(origin_allowed("http://127.0.0.1:8080/x", "127.0.0.1", 8080, "127.0.0.1:8080"));

@@ -279,6 +279,7 @@ struct SocketServer::Connection {
   std::string inbuf;  // bytes read past the handshake
   std::size_t inpos = 0;
   std::mutex write_mutex;  // one message at a time on the socket
+  bool closed = false;     // a close frame went out: no data frame may follow (guarded by write_mutex)
   struct Worker {
     std::thread thread;
     std::shared_ptr<std::atomic<bool>> done;
@@ -303,6 +304,8 @@ struct SocketServer::Connection {
   }
   bool send_frame(int opcode, const std::string& payload) {
     const std::lock_guard<std::mutex> lock(write_mutex);
+    if (closed) return false;
+    if (opcode == kClose) closed = true;
     return send_text(fd, frame_header(opcode, payload.size()) + payload);
   }
   static bool send_text(int fd, const std::string& s) { return studio::send_all(fd, s.data(), s.size()); }
@@ -633,6 +636,7 @@ void SocketServer::answer(Connection& c, std::uint32_t id, const ApiResponse& r)
   append_u32(head, static_cast<std::uint32_t>(type.size()));
   head += type;
   const std::lock_guard<std::mutex> lock(c.write_mutex);
+  if (c.closed) return;  // the client closed (or was closed on) while the request ran: nobody to answer
   const std::string frame = frame_header(kBinary, head.size() + r.body.size()) + head;
   // MSG_MORE: the header and the body leave in the same packets.
   if (studio::send_all(c.fd, frame.data(), frame.size(), MSG_MORE))

@@ -417,6 +417,19 @@ TEST_CASE("studio socket: frames a browser may not send close the connection wit
   CHECK(c.request("2 GET /api/stats\n").status == 200);
 }
 
+TEST_CASE("studio socket: no answer follows the close handshake", "[studio][socket]") {
+  Running r;
+  Client c(socket_port(r));
+  c.open();
+  // A refinement (about 0.5 s here) still runs when the client closes: its answer is dropped, as the
+  // RFC allows no data frame after a close frame (a browser reports one as an error).
+  c.frame(1, "1 POST /api/refine\n{\"precision\": 0.01, \"all\": true}");
+  c.frame(8, std::string("\x03\xe8", 2));
+  CHECK(c.close_code() == 1000);
+  CHECK(c.next().first == -1);
+  CHECK(r.get("/api/stats").find("target_precision")->as_number("") == 0.01);  // the request itself ran
+}
+
 TEST_CASE("studio socket: connection and in-flight limits answer 503", "[studio][socket]") {
   Running r;
   SocketOptions o;

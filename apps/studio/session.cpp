@@ -349,8 +349,7 @@ bool Session::refine_step(const KeepGoing& keep_going) {
     }
   } else if (preview_wanted_) {
     build_preview(keep_going);  // the mesh shown does not change
-    if (preview_wanted_) return false;
-    return true;
+    return !preview_wanted_;     // false: interrupted, resumed by the next step
   } else {
     return false;
   }

@@ -586,10 +586,11 @@ void SocketServer::handle_message(Connection& c, std::string message) {
   std::string error;
   const std::size_t s1 = line.find(' '), s2 = s1 == std::string::npos ? s1 : line.find(' ', s1 + 1);
   const std::string id_text = line.substr(0, s1);
-  const bool id_ok = !id_text.empty() && id_text.size() <= 10 &&
-                     std::all_of(id_text.begin(), id_text.end(), [](char ch) { return ch >= '0' && ch <= '9'; }) &&
-                     std::stoull(id_text) >= 1 && std::stoull(id_text) <= 0xffffffffull;
-  if (id_ok) id = static_cast<std::uint32_t>(std::stoull(id_text));
+  const bool digits = !id_text.empty() && id_text.size() <= 10 &&
+                      std::all_of(id_text.begin(), id_text.end(), [](char ch) { return ch >= '0' && ch <= '9'; });
+  const unsigned long long id_value = digits ? std::stoull(id_text) : 0;
+  const bool id_ok = id_value >= 1 && id_value <= 0xffffffffull;
+  if (id_ok) id = static_cast<std::uint32_t>(id_value);
   if (nl == std::string::npos || !id_ok || s2 == std::string::npos || line.find(' ', s2 + 1) != std::string::npos) {
     error = "socket request: the first line must be 'ID METHOD TARGET' (ID in 1..4294967295), then the body";
   } else {

@@ -57,6 +57,7 @@ TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
 
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
 constexpr std::size_t kClassifySliceMin = std::size_t(1) << 16;  // tetrahedra per thread of classify_all
+constexpr std::size_t kCreatedSliceMin = std::size_t(1) << 12;   // of classify_created (a round's tetrahedra)
 
 /// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
 /// removal swaps the last element in. @pre x is not listed (on) or listed (off).
@@ -369,10 +370,17 @@ void Polygonizer::absorb_renumbering() {
 
 void Polygonizer::classify(TetId t, bool requeue) {
   if (!tri_.is_live(t)) return;
+  const bool now = is_transverse(t);
+  const bool was = tpos_[t] != kNotListed;
+  classify_as(t, requeue, now, now && (!was || requeue) ? tri_.circumradius(t) : 0.0);
+}
+
+// classify() of the live tetrahedron t, whose transverse flag `now` (and circumradius, read when it is
+// transverse and newly listed or requeued) were computed by the caller.
+void Polygonizer::classify_as(TetId t, bool requeue, bool now, double radius) {
   if (options_.refine_necks) note_neck_candidates(t);  // its vertices' links changed (necks.cpp)
   const bool was = tpos_[t] != kNotListed;
-  const bool now = is_transverse(t);
-  if (now && (!was || requeue)) radius_[t] = tri_.circumradius(t);
+  if (now && (!was || requeue)) radius_[t] = radius;
   set_transverse(t, now);
   if (now && (!was || requeue) && radius_[t] > precision_) push(t);
 }
@@ -399,11 +407,32 @@ void Polygonizer::classify_all() {
       if (tri_.is_vertex(v)) note_neck_vertex(v);
 }
 
+// The tetrahedra created by a round of insertions (thousands during a refinement): their liveness,
+// transverse flags and circumradii on the threads, each slice into its own entries (they read only the
+// triangulation and the values, which the serial pass does not change), then classify_as() in order on
+// this thread, as classify() one tetrahedron after the other would. An id may appear twice (created,
+// killed and reused within the round): both entries see its final tetrahedron, as before.
 void Polygonizer::classify_created(std::vector<TetId>& created) {
   grow_tet_arrays();
-  for (const TetId t : created) {
-    surface_->note_created(t);
-    classify(t, false);
+  struct Ahead {
+    double radius = 0;  // when transverse
+    bool live = false, transverse = false;
+  };
+  const std::size_t n = created.size();
+  std::vector<Ahead> ahead(n);
+  const std::size_t slices = slice_count(options_.threads, n, kCreatedSliceMin);
+  run_slices(n, slices, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t k = lo; k < hi; ++k) {
+      const TetId t = created[k];
+      Ahead& a = ahead[k];
+      a.live = tri_.is_live(t);
+      a.transverse = a.live && is_transverse(t);
+      if (a.transverse) a.radius = tri_.circumradius(t);
+    }
+  });
+  for (std::size_t k = 0; k < n; ++k) {
+    surface_->note_created(created[k]);
+    if (ahead[k].live) classify_as(created[k], false, ahead[k].transverse, ahead[k].radius);
   }
   note_thin_tets(created);
   settle_zeros(created);

@@ -17,7 +17,7 @@ using namespace polygonizer_detail;
 namespace {
 constexpr double kThinCosine = 0.0;  // the gradients at the two ends must point at each other (below)
 static_assert(kThinCosine <= 0.0, "crossed_twice rejects a non-negative dot product before the bound");
-constexpr std::size_t kThinSliceMin = std::size_t(1) << 16;  // tetrahedra per thread of check_thin, at least
+constexpr std::size_t kThinSliceMin = std::size_t(1) << 12;  // tetrahedra per thread of check_thin, at least
 }  // namespace
 
 // ---- Thin features -------------------------------------------------------------------------------------

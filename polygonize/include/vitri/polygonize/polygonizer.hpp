@@ -368,6 +368,7 @@ class Polygonizer {
   void on_killed(const ChangeSet& cs);
   void absorb_renumbering();
   void classify(TetId t, bool requeue);
+  void classify_as(TetId t, bool requeue, bool now, double radius);
   void classify_all();
   void set_transverse(TetId t, bool on);
   void push(TetId t);

@@ -22,6 +22,15 @@ std::vector<std::uint32_t> minus(const std::vector<std::uint32_t>& a, const std:
 
 }  // namespace
 
+void LiveMesh::reserve(std::size_t vertices, std::size_t triangles) {
+  vpos_.reserve(vertices);
+  vnormal_.reserve(vertices);
+  vrefs_.reserve(vertices);
+  added_v_.reserve(vertices);
+  tris_.reserve(triangles);
+  added_t_.reserve(triangles);
+}
+
 std::uint32_t LiveMesh::add_vertex(const Point3& p, const Point3& normal) {
   std::uint32_t v;
   if (!free_vertices_.empty()) {

@@ -84,6 +84,9 @@ class LiveMesh {
   void remove_triangle(std::uint32_t t);
   /// Removes everything; the next delta is `full`.
   void clear();
+  /// Room for this many vertex and triangle slots in all, and as many records in the current delta,
+  /// without reallocation (a large build that knows its sizes: the slots are not touched).
+  void reserve(std::size_t vertices, std::size_t triangles);
 
   /// The changes since the previous call (or construction), then starts a new record and frees the ids
   /// removed in it.

@@ -111,55 +111,82 @@ double box_band(const Box3& domain, const PolygonizerOptions& options) {
   return options.box_band_fraction * smallest;
 }
 
+// The options' own checks (the constructor's and tetrahedralize_seeds'), the closing band's first.
+void check_options(const Box3& domain, const PolygonizerOptions& options) {
+  if (options.close_at_box) box_band(domain, options);
+  if (!(options.sampling_fraction >= 0.0) || !std::isfinite(options.sampling_fraction))
+    throw InvalidArgument("PolygonizerOptions::sampling_fraction must be >= 0");
+  if (!(options.min_distance_fraction > 0.0 && options.min_distance_fraction < 1.0))
+    throw InvalidArgument("PolygonizerOptions::min_distance_fraction must be in (0, 1)");
+  if (!(options.root_tolerance > 0.0 && options.root_tolerance < 1.0))
+    throw InvalidArgument("PolygonizerOptions::root_tolerance must be in (0, 1)");
+  if (!(options.zero_offset > 0.0 && options.zero_offset < 0.5))
+    throw InvalidArgument("PolygonizerOptions::zero_offset must be in (0, 0.5)");
+  if (!(options.snap_fraction > 0.0 && options.snap_fraction < 0.5))
+    throw InvalidArgument("PolygonizerOptions::snap_fraction must be in (0, 0.5)");
+  if (options.max_root_iterations < 1)
+    throw InvalidArgument("PolygonizerOptions::max_root_iterations must be >= 1");
+}
+
 }  // namespace
+
+// Batch insertion (randomized spatial order inside the Delaunay tree); exact duplicates are skipped.
+// Without the history the tetrahedra are then renumbered canonically, so that everything after (the
+// refinement order follows tetrahedron ids) is the same whatever the threads of the insertion.
+SeedTetrahedralization Polygonizer::tetrahedralize_seeds(const Box3& domain, const std::vector<Point3>& seeds,
+                                                         const PolygonizerOptions& options) {
+  // The checks in the first constructor's order: the closing band, the domain (by the Triangulation), the
+  // other options, the seeds.
+  if (options.close_at_box) box_band(domain, options);
+  SeedTetrahedralization s{domain, Triangulation(domain, triangulation_options(options)), {}, 0, 0};
+  check_options(domain, options);
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed coordinates are not finite");
+    if (!strictly_inside(domain, seeds[i]))
+      throw InvalidPoint(i, "seed " + describe(seeds[i]) + " is not strictly inside the domain box");
+  }
+  const auto t0 = Clock::now();
+  s.inserted = s.tri.insert_points(seeds, 0.0, nullptr);
+  s.insert_seconds = seconds_since(t0);
+  const auto t1 = Clock::now();
+  if (!options.keep_history) s.tri.canonicalize();
+  s.canonical_seconds = seconds_since(t1);
+  return s;
+}
 
 Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                          const std::vector<double>& seed_values, const PolygonizerOptions& options)
-    : closed_(options.close_at_box ? std::make_unique<BoxClosedFunction>(f, domain, box_band(domain, options))
-                                   : nullptr),
+    : Polygonizer(f, tetrahedralize_seeds(domain, seeds, options), seed_values, options) {}
+
+Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& seeds,
+                         const std::vector<double>& seed_values, const PolygonizerOptions& options)
+    : closed_(options.close_at_box
+                  ? std::make_unique<BoxClosedFunction>(f, seeds.domain, box_band(seeds.domain, options))
+                  : nullptr),
       f_(closed_ ? *closed_ : f),
       options_(options),
-      tri_(domain, triangulation_options(options)),
+      tri_(std::move(seeds.tri)),
       precision_(std::numeric_limits<double>::infinity()),
       surface_(std::make_unique<SurfaceTracker>()) {
   const auto t0 = Clock::now();
-  if (!(options_.sampling_fraction >= 0.0) || !std::isfinite(options_.sampling_fraction))
-    throw InvalidArgument("PolygonizerOptions::sampling_fraction must be >= 0");
-  if (!(options_.min_distance_fraction > 0.0 && options_.min_distance_fraction < 1.0))
-    throw InvalidArgument("PolygonizerOptions::min_distance_fraction must be in (0, 1)");
-  if (!(options_.root_tolerance > 0.0 && options_.root_tolerance < 1.0))
-    throw InvalidArgument("PolygonizerOptions::root_tolerance must be in (0, 1)");
-  if (!(options_.zero_offset > 0.0 && options_.zero_offset < 0.5))
-    throw InvalidArgument("PolygonizerOptions::zero_offset must be in (0, 0.5)");
-  if (!(options_.snap_fraction > 0.0 && options_.snap_fraction < 0.5))
-    throw InvalidArgument("PolygonizerOptions::snap_fraction must be in (0, 0.5)");
-  if (options_.max_root_iterations < 1) throw InvalidArgument("PolygonizerOptions::max_root_iterations must be >= 1");
-  if (!seed_values.empty() && seed_values.size() != seeds.size())
+  check_options(seeds.domain, options_);
+  if (tri_.keeps_history() != options_.keep_history)
+    throw InvalidArgument("Polygonizer: the seeds were tetrahedralized with another keep_history option");
+  const std::vector<InsertResult>& inserted = seeds.inserted;
+  if (!seed_values.empty() && seed_values.size() != inserted.size())
     throw InvalidArgument("Polygonizer: seed_values must be empty or have one value per seed");
-
+  for (std::size_t i = 0; i < seed_values.size(); ++i)
+    if (std::isinf(seed_values[i])) throw InvalidPoint(i, "seed value is infinite");
+  stats_.init_insert_seconds = seeds.insert_seconds;
+  stats_.init_canonical_seconds = seeds.canonical_seconds;
+  const auto t2 = Clock::now();
   grow_vertex_arrays();
   for (VertexId v = 0; v < 8; ++v) {
     kind_[v] = static_cast<std::uint8_t>(VertexKind::Corner);
     pending_.push_back(v);
   }
-  seed_vertices_.assign(seeds.size(), kNoVertex);
-  for (std::size_t i = 0; i < seeds.size(); ++i) {
-    if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed coordinates are not finite");
-    if (!strictly_inside(domain, seeds[i]))
-      throw InvalidPoint(i, "seed " + describe(seeds[i]) + " is not strictly inside the domain box");
-    if (!seed_values.empty() && std::isinf(seed_values[i])) throw InvalidPoint(i, "seed value is infinite");
-  }
-  // Batch insertion (randomized spatial order inside the Delaunay tree); exact duplicates are skipped.
-  // Without the history the tetrahedra are then renumbered canonically, so that everything after (the
-  // refinement order follows tetrahedron ids) is the same whatever the threads of the insertion.
-  const std::vector<InsertResult> inserted = tri_.insert_points(seeds, 0.0, nullptr);
-  stats_.init_insert_seconds = seconds_since(t0);
-  const auto t1 = Clock::now();
-  if (!options_.keep_history) tri_.canonicalize();
-  stats_.init_canonical_seconds = seconds_since(t1);
-  const auto t2 = Clock::now();
-  grow_vertex_arrays();
-  for (std::size_t i = 0; i < seeds.size(); ++i) {
+  seed_vertices_.assign(inserted.size(), kNoVertex);
+  for (std::size_t i = 0; i < inserted.size(); ++i) {
     if (inserted[i].status != InsertStatus::Inserted) continue;
     const VertexId v = inserted[i].vertex;
     kind_[v] = static_cast<std::uint8_t>(VertexKind::Seed);
@@ -172,7 +199,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
       pending_.push_back(v);
     }
   }
-  if (options_.sampling_fraction > 0.0) sample(options_.sampling_fraction * domain.diagonal());
+  if (options_.sampling_fraction > 0.0) sample(options_.sampling_fraction * seeds.domain.diagonal());
   evaluate_pending();
   stats_.init_evaluate_seconds = seconds_since(t2);
   const auto t3 = Clock::now();
@@ -180,7 +207,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
   classify_all();
   settle_zeros({});
   stats_.init_classify_seconds = seconds_since(t3);
-  stats_.init_seconds = seconds_since(t0);
+  stats_.init_seconds = seeds.insert_seconds + seeds.canonical_seconds + seconds_since(t0);
 }
 
 void Polygonizer::grow_vertex_arrays() {

@@ -10,11 +10,13 @@
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
 #include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/rbf/point_index.hpp"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <random>
 #include <string>
@@ -202,6 +204,58 @@ TEST_CASE("batch option with bulk threads: the serial tetrahedralization, the sa
   // Canonical tetrahedron ids after the seeds (Triangulation::canonicalize): bit for bit the same.
   REQUIRE(a.surface().triangles == b.surface().triangles);
   REQUIRE(a.surface().vertices == b.surface().vertices);
+}
+
+// The local function is fitted on a thread of its own while the constraints are tetrahedralized: the
+// result is the Polygonizer built from the fitted function afterwards (same counts before and after a
+// refinement), the phases are announced in order, and the fit's errors come first, as in turn.
+TEST_CASE("local fit beside the seeds' tetrahedralization: the same structure, the fit's errors first",
+          "[mesher][local]") {
+  const TriangleMesh in = read_mesh(kData + "/knot1.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  o.polygonizer.keep_history = false;
+  o.polygonizer.threads = 2;
+  std::vector<std::string> phases;
+  o.on_phase = [&](const char* phase) { phases.emplace_back(phase); };
+  Mesher m = Mesher::from_mesh(in.V, in.F, o);
+  REQUIRE(phases == std::vector<std::string>{"fit+seeds", "tetrahedralization"});
+  REQUIRE(m.stats().fit_seconds > 0);
+  const Constraints& c = m.constraints();
+  Polygonizer ref(*m.local_function(), Polygonizer::domain_for(c.points, o.box_factor), c.points, c.values,
+                  o.polygonizer);
+  const auto same_counts = [&] {
+    const PolygonizerStats a = m.polygonizer().stats(), b = ref.stats();
+    REQUIRE(a.vertices == b.vertices);
+    REQUIRE(a.tetrahedra == b.tetrahedra);
+    REQUIRE(a.transverse == b.transverse);
+  };
+  same_counts();
+  REQUIRE(m.polygonizer().seed_vertices() == ref.seed_vertices());
+  const double p = 0.02 * m.diagonal();
+  m.refine(p);
+  ref.refine(p);
+  same_counts();
+  require_closed(m.surface(), 0);
+  REQUIRE(m.surface().triangles.size() == ref.extract().triangles.size());
+
+  Constraints bad = c;
+  bad.add(c.points[3], 0.0);  // a duplicate: the fit refuses it, the tetrahedralization alone would not
+  try {
+    Mesher dup(bad, o);
+    FAIL("no exception");
+  } catch (const InvalidPoint& e) {
+    REQUIRE(std::string(e.what()).find("duplicates constraint") != std::string::npos);
+  }
+  bad = c;
+  bad.points[5].y = std::numeric_limits<double>::quiet_NaN();  // both refuse it: the fit's message
+  try {
+    Mesher nan(bad, o);
+    FAIL("no exception");
+  } catch (const InvalidPoint& e) {
+    REQUIRE(e.index() == 5);
+    REQUIRE(std::string(e.what()).find("non-finite constraint position") != std::string::npos);
+  }
 }
 
 TEST_CASE("max_vertices: a refinement past the limit is a LimitError naming the count", "[mesher][local]") {

@@ -477,6 +477,63 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
   REQUIRE(mesh[0].vertices == mesh[1].vertices);
 }
 
+// The constructor's first step on its own (what the Mesher runs while it fits the local function): the
+// Polygonizer built from seeds tetrahedralized ahead is the one the constructor builds, bit for bit, with
+// and without the history; mismatched options and bad seeds are refused.
+TEST_CASE("seeds tetrahedralized ahead: the same Polygonizer as the constructor's", "[polygonizer]") {
+  const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
+  std::mt19937_64 rng(22);
+  std::uniform_real_distribution<double> u(-1.9, 1.9);
+  std::vector<Point3> seeds(20000);
+  std::vector<double> values(seeds.size());
+  for (std::size_t i = 0; i < seeds.size(); ++i) {
+    seeds[i] = {u(rng), u(rng), u(rng)};
+    values[i] = i % 3 == 0 ? std::numeric_limits<double>::quiet_NaN() : f.value(seeds[i]);  // NaN: evaluated
+  }
+  seeds.push_back(seeds[7]);  // an exact duplicate: skipped by both
+  values.push_back(values[7]);
+  for (const bool history : {true, false}) {
+    PolygonizerOptions o;
+    o.keep_history = history;
+    o.threads = 2;
+    Polygonizer direct(f, kCube, seeds, values, o);
+    SeedTetrahedralization ahead = Polygonizer::tetrahedralize_seeds(kCube, seeds, o);
+    REQUIRE(ahead.inserted.size() == seeds.size());
+    REQUIRE(ahead.inserted.back().status == InsertStatus::TooClose);
+    Polygonizer built(f, std::move(ahead), values, o);
+    REQUIRE(built.seed_vertices() == direct.seed_vertices());
+    const PolygonizerStats a = direct.stats(), b = built.stats();
+    REQUIRE(b.vertices == a.vertices);
+    REQUIRE(b.tetrahedra == a.tetrahedra);
+    REQUIRE(b.transverse == a.transverse);
+    REQUIRE(b.init_seconds >= b.init_insert_seconds + b.init_canonical_seconds);
+    REQUIRE(direct.refine(0.15));
+    REQUIRE(built.refine(0.15));
+    const SurfaceMesh ma = direct.extract(), mb = built.extract();
+    require_closed(mb, 0, 1);
+    REQUIRE(ma.triangles == mb.triangles);
+    REQUIRE(ma.vertices == mb.vertices);
+  }
+  SECTION("refused") {
+    PolygonizerOptions with, without;
+    without.keep_history = false;
+    REQUIRE_THROWS_AS(Polygonizer(f, Polygonizer::tetrahedralize_seeds(kCube, seeds, without), {}, with),
+                      InvalidArgument);
+    REQUIRE_THROWS_AS(Polygonizer(f, Polygonizer::tetrahedralize_seeds(kCube, seeds, with), {1.0, 2.0}, with),
+                      InvalidArgument);
+    const std::vector<Point3> outside = {{0, 0, 0}, {3.0, 0, 0}};
+    try {
+      Polygonizer::tetrahedralize_seeds(kCube, outside, with);
+      FAIL("no exception");
+    } catch (const InvalidPoint& e) {
+      REQUIRE(e.index() == 1);
+    }
+    PolygonizerOptions bad;
+    bad.root_tolerance = 2.0;
+    REQUIRE_THROWS_AS(Polygonizer::tetrahedralize_seeds(kCube, outside, bad), InvalidArgument);
+  }
+}
+
 // The normal of a mesh vertex collapsed onto a zero-valued vertex is f's gradient there. With the
 // thin-feature rule the Polygonizer keeps every vertex's gradient current and the extraction reads it
 // instead of evaluating f again; after an edit that moves such a vertex the gradient at its new position

@@ -106,7 +106,11 @@ struct MesherOptions {
   std::size_t max_vertices = 0;
   /// Called by the constructor when a long phase starts: "fit" (the implicit function) and then
   /// "tetrahedralization" (Delaunay insertion of the constraints, evaluation and classification), so
-  /// that a caller can report progress (the CLI does). Empty: nothing is called.
+  /// that a caller can report progress (the CLI does). With the local function the Delaunay insertion
+  /// of the constraints (which does not read the function) runs while the function is fitted on a
+  /// thread of its own, so the phases are "fit+seeds" and then "tetrahedralization" (evaluation and
+  /// classification); each step's own time is in stats() (fit_seconds, polygonizer.init_*_seconds).
+  /// Empty: nothing is called.
   std::function<void(const char* phase)> on_phase;
 };
 
@@ -228,7 +232,10 @@ class Mesher {
 
  private:
   Mesher(const Rbf& function, const MesherOptions& options);  // restarted_copy()
+  void fit_local_beside_seeds(const Constraints& constraints);
   void build();
+  /// build() from the constraints' tetrahedralization made ahead (beside the fit).
+  void build(SeedTetrahedralization&& seeds);
   void after_edit(double rbf_seconds, double t_start, const ChangedRegion* region = nullptr);
   bool rebuild_if_outside(const Point3& p, double t_start, double t_rbf);
   double value_of(std::size_t i) const;

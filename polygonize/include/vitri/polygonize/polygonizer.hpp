@@ -212,6 +212,16 @@ struct RefineProgress {
 using ProgressCallback = std::function<bool(const RefineProgress&)>;
 
 /// Stateful refinement + extraction over one implicit function. Not thread-safe.
+/// The seeds of a Polygonizer tetrahedralized ahead of it (Polygonizer::tetrahedralize_seeds): the
+/// Delaunay insertion does not read the function, so a caller may run it while the function is still
+/// being fitted, then hand it over to the constructor.
+struct SeedTetrahedralization {
+  Box3 domain;
+  Triangulation tri;                   ///< the box corners and the seeds (canonical ids without history)
+  std::vector<InsertResult> inserted;  ///< per seed: its vertex, or the seed it duplicates
+  double insert_seconds = 0, canonical_seconds = 0;
+};
+
 class Polygonizer {
  public:
   /// Tetrahedralizes the domain box and the seed points (inserted in a shuffled order), evaluates f at
@@ -226,6 +236,16 @@ class Polygonizer {
   ///         InvalidPoint(i) when seed i is not finite or not strictly inside the domain.
   Polygonizer(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds = {},
               const std::vector<double>& seed_values = {}, const PolygonizerOptions& options = {});
+  /// The same from seeds tetrahedralized ahead by tetrahedralize_seeds() with the same options (the
+  /// same Polygonizer as the constructor above given their domain and points).
+  /// @throws InvalidArgument for bad options or seed values of the wrong count.
+  Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& seeds,
+              const std::vector<double>& seed_values, const PolygonizerOptions& options);
+  /// The first step of the constructor, which does not read the function: the domain box and the seeds
+  /// in a Delaunay tetrahedralization, renumbered canonically without the history.
+  /// @throws as the constructor for the domain, the options and the seed points.
+  static SeedTetrahedralization tetrahedralize_seeds(const Box3& domain, const std::vector<Point3>& seeds,
+                                                     const PolygonizerOptions& options);
   ~Polygonizer();
   Polygonizer(const Polygonizer&) = delete;
   Polygonizer& operator=(const Polygonizer&) = delete;

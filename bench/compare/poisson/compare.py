@@ -277,6 +277,9 @@ def phase_table(rows):
     if not sel:
         return []
     lines = ["#### vitri phases (s; total = from reading the input to the extracted mesh)", "",
+             "Each step's own wall time. With the local function the fit and the initial tetrahedralization's "
+             "Delaunay insertion run at the same time (the Mesher overlaps them), so they add up to more "
+             "than the time they took together.", "",
              "| model | points | method | fit | initial tetrahedralization | refine | extract | total |",
              "|---|---|---|---|---|---|---|---|"]
     for r in sel:

@@ -211,17 +211,17 @@ struct RefineProgress {
 /// be called again to continue).
 using ProgressCallback = std::function<bool(const RefineProgress&)>;
 
-/// Stateful refinement + extraction over one implicit function. Not thread-safe.
 /// The seeds of a Polygonizer tetrahedralized ahead of it (Polygonizer::tetrahedralize_seeds): the
 /// Delaunay insertion does not read the function, so a caller may run it while the function is still
 /// being fitted, then hand it over to the constructor.
 struct SeedTetrahedralization {
   Box3 domain;
   Triangulation tri;                   ///< the box corners and the seeds (canonical ids without history)
-  std::vector<InsertResult> inserted;  ///< per seed: its vertex, or the seed it duplicates
+  std::vector<InsertResult> inserted;  ///< per seed: its vertex, or (TooClose) the vertex it duplicates
   double insert_seconds = 0, canonical_seconds = 0;
 };
 
+/// Stateful refinement + extraction over one implicit function. Not thread-safe.
 class Polygonizer {
  public:
   /// Tetrahedralizes the domain box and the seed points (inserted in a shuffled order), evaluates f at

@@ -111,9 +111,8 @@ double box_band(const Box3& domain, const PolygonizerOptions& options) {
   return options.box_band_fraction * smallest;
 }
 
-// The options' own checks (the constructor's and tetrahedralize_seeds'), the closing band's first.
-void check_options(const Box3& domain, const PolygonizerOptions& options) {
-  if (options.close_at_box) box_band(domain, options);
+// The options' own checks (the constructor's and tetrahedralize_seeds'; the closing band's is box_band's).
+void check_options(const PolygonizerOptions& options) {
   if (!(options.sampling_fraction >= 0.0) || !std::isfinite(options.sampling_fraction))
     throw InvalidArgument("PolygonizerOptions::sampling_fraction must be >= 0");
   if (!(options.min_distance_fraction > 0.0 && options.min_distance_fraction < 1.0))
@@ -139,7 +138,7 @@ SeedTetrahedralization Polygonizer::tetrahedralize_seeds(const Box3& domain, con
   // other options, the seeds.
   if (options.close_at_box) box_band(domain, options);
   SeedTetrahedralization s{domain, Triangulation(domain, triangulation_options(options)), {}, 0, 0};
-  check_options(domain, options);
+  check_options(options);
   for (std::size_t i = 0; i < seeds.size(); ++i) {
     if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed coordinates are not finite");
     if (!strictly_inside(domain, seeds[i]))
@@ -169,7 +168,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
       precision_(std::numeric_limits<double>::infinity()),
       surface_(std::make_unique<SurfaceTracker>()) {
   const auto t0 = Clock::now();
-  check_options(seeds.domain, options_);
+  check_options(options_);  // (the closing band was checked by closed_'s initializer)
   if (tri_.keeps_history() != options_.keep_history)
     throw InvalidArgument("Polygonizer: the seeds were tetrahedralized with another keep_history option");
   const std::vector<InsertResult>& inserted = seeds.inserted;

@@ -257,6 +257,91 @@ void Triangulation::incident_tetrahedra(VertexId v, std::vector<TetId>& out) con
   }
 }
 
+namespace {
+
+// One star of the interleaved walk of incident_tetrahedra(vs, n, ...): the same breadth-first order as
+// the single walk, its visited set an open-addressing table; a star larger than kMax is left to the
+// single walk (rare: a star has ~27 tetrahedra).
+struct StarLane {
+  static constexpr std::size_t kSlots = 256;  // a power of two, at least twice kMax
+  static constexpr std::size_t kMax = kSlots / 2;
+  std::array<TetId, kSlots> slots;
+  std::array<TetId, kMax> list;
+  std::size_t head = 0, size = 0;
+  std::uint32_t center = 0;  // the point id of the star's vertex
+  bool overflow = false;
+
+  void start(std::uint32_t pv, TetId first) {
+    slots.fill(kNoTet);
+    head = size = 0;
+    center = pv;
+    overflow = false;
+    if (first != kNoTet) visit(first);
+  }
+  bool busy() const { return head < size && !overflow; }
+  void visit(TetId t) {
+    std::size_t h = (static_cast<std::size_t>(t) * 0x9E3779B1u) & (kSlots - 1);
+    while (slots[h] != kNoTet) {
+      if (slots[h] == t) return;
+      h = (h + 1) & (kSlots - 1);
+    }
+    if (size == kMax) {
+      overflow = true;
+      return;
+    }
+    slots[h] = t;
+    list[size++] = t;
+  }
+};
+
+}  // namespace
+
+void Triangulation::incident_tetrahedra(const VertexId* vs, std::size_t n, std::vector<TetId>& out,
+                                        std::vector<std::size_t>& ends) const {
+  out.clear();
+  ends.clear();
+  ends.reserve(n);
+  constexpr std::size_t kLanes = 8;  // stars walked at once
+  std::array<StarLane, kLanes> lanes;
+  for (std::size_t b = 0; b < n; b += kLanes) {
+    const std::size_t m = std::min(kLanes, n - b);
+    for (std::size_t k = 0; k < m; ++k) {
+      const VertexId v = vs[b + k];
+      const TetId first = is_vertex(v) ? vtet_[pid(v)] : kNoTet;
+      if (first != kNoTet) tets_.prefetch_record(first);
+      lanes[k].start(first != kNoTet ? pid(v) : 0, first);
+    }
+    // One record per busy lane per turn: the lanes' next records are fetched while the others work.
+    for (bool busy = true; busy;) {
+      busy = false;
+      for (std::size_t k = 0; k < m; ++k) {
+        StarLane& lane = lanes[k];
+        if (!lane.busy()) continue;
+        busy = true;
+        const TetId t = lane.list[lane.head++];
+        for (int i = 0; i < 4; ++i) {
+          if (tets_.vertex(t, i) == lane.center) continue;
+          const TetId nb = tets_.neighbor(t, i);
+          if (nb == kNoTet) continue;
+          const std::size_t before = lane.size;
+          lane.visit(nb);
+          if (lane.size != before) tets_.prefetch_record(nb);
+        }
+      }
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+      if (lanes[k].overflow) {
+        std::vector<TetId> star;
+        incident_tetrahedra(vs[b + k], star);
+        out.insert(out.end(), star.begin(), star.end());
+      } else {
+        out.insert(out.end(), lanes[k].list.begin(), lanes[k].list.begin() + lanes[k].size);
+      }
+      ends.push_back(out.size());
+    }
+  }
+}
+
 Point3 Triangulation::circumcenter(TetId t) const {
   const Point3& a = tet_point(t, 0);
   const Point3 ba = tet_point(t, 1) - a, ca = tet_point(t, 2) - a, da = tet_point(t, 3) - a;

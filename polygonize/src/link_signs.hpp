@@ -96,11 +96,79 @@ LinkGroups link_groups(VertexId center, const std::array<VertexId, 4>* star, std
   return g;
 }
 
+/// link_groups(center, star, n, differs, s).neck() for the link of an interior vertex (a triangulated
+/// sphere: every link edge lies in exactly two link triangles), from the vertices of the other sign
+/// alone, which are usually a few. Let D be the part of the link spanned by them (those vertices, the
+/// link edges and triangles with every end among them): V vertices, E edges, F triangles, C components.
+/// The own groups are the components of the sphere minus D (the complement of a full subcomplex retracts
+/// onto the full subcomplex of the other vertices), and by Alexander duality there are 1 + b1(D) of them
+/// when some link vertex has the center's sign, with b1(D) = E - V + C - F (D is a proper part of the
+/// sphere: no 2-cycle). So it is a neck when V >= 1, an own vertex exists and E - V + C - F >= 1. E is
+/// counted as half the link triangles' edges between two other vertices; D's vertices are found by a
+/// linear search, and a link with more than kMaxOther of them goes to link_groups().
+template <class Differs>
+bool link_is_neck(VertexId center, const std::array<VertexId, 4>* star, std::size_t n, Differs&& differs,
+                  LinkScratch& s) {
+  constexpr int kMaxOther = 32;
+  std::array<VertexId, kMaxOther> id;
+  std::array<std::uint8_t, kMaxOther> parent;
+  int vertices = 0;
+  long half_edges = 0, triangles = 0;  // half_edges: each link edge of D is counted in both its triangles
+  bool own = false;
+  const auto root = [&](int a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::array<VertexId, 4>& t = star[i];
+    if (t[0] != center && t[1] != center && t[2] != center && t[3] != center) continue;  // not in the star
+    std::array<VertexId, 3> face{};
+    int j = 0;
+    for (const VertexId u : t)
+      if (u != center) face[j++] = u;
+    const int mask = (differs(face[0]) ? 1 : 0) | (differs(face[1]) ? 2 : 0) | (differs(face[2]) ? 4 : 0);
+    if (mask != 7) own = true;
+    if (mask == 0) continue;  // the usual triangle: nothing of D
+    std::array<int, 3> local{-1, -1, -1};
+    for (int a = 0; a < 3; ++a) {
+      if (!(mask & (1 << a))) continue;
+      const VertexId u = face[a];
+      int k = 0;
+      while (k < vertices && id[k] != u) ++k;
+      if (k == vertices) {
+        if (vertices == kMaxOther) return link_groups(center, star, n, differs, s).neck();
+        id[k] = u;
+        parent[k] = static_cast<std::uint8_t>(k);
+        ++vertices;
+      }
+      local[a] = k;
+    }
+    if (mask == 1 || mask == 2 || mask == 4) continue;  // one vertex of D: no edge of it
+    for (int a = 0; a < 3; ++a) {
+      const int x = local[a], y = local[(a + 1) % 3];
+      if (x < 0 || y < 0) continue;
+      ++half_edges;
+      parent[root(x)] = static_cast<std::uint8_t>(root(y));
+    }
+    if (mask == 7) ++triangles;
+  }
+  if (vertices == 0 || !own) return false;
+  long components = 0;
+  for (int k = 0; k < vertices; ++k)
+    if (root(k) == k) ++components;
+  return half_edges / 2 - vertices + components - triangles >= 1;
+}
+
 /// The same with a star as a vector and fresh buffers.
 template <class Differs>
 LinkGroups link_groups(VertexId center, const std::vector<std::array<VertexId, 4>>& star, Differs&& differs) {
   LinkScratch s;
   return link_groups(center, star.data(), star.size(), differs, s);
+}
+template <class Differs>
+bool link_is_neck(VertexId center, const std::vector<std::array<VertexId, 4>>& star, Differs&& differs) {
+  LinkScratch s;
+  return link_is_neck(center, star.data(), star.size(), differs, s);
 }
 
 }  // namespace vitri

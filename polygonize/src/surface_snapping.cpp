@@ -122,10 +122,15 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
     out.stars.clear();
     out.fans.clear();
     out.targets.clear();
-    std::vector<TetId> star;
+    std::vector<TetId> star, stars;
+    std::vector<std::size_t> ends;
     for (std::size_t k = lo; k < hi; ++k) {
       const VertexId z = first[from + k];
-      in.tri.incident_tetrahedra(z, star);
+      if ((k - lo) % kStarChunk == 0)  // the next stars walked together: their cache misses overlap
+        in.tri.incident_tetrahedra(first.data() + from + k, std::min(kStarChunk, hi - k), stars, ends);
+      const std::size_t j = (k - lo) % kStarChunk;
+      star.assign(stars.begin() + static_cast<std::ptrdiff_t>(j == 0 ? 0 : ends[j - 1]),
+                  stars.begin() + static_cast<std::ptrdiff_t>(ends[j]));
       SnapLookahead::Span& sp = look.spans[k];
       sp.slice = static_cast<std::uint32_t>(s);
       sp.star_first = static_cast<std::uint32_t>(out.stars.size());

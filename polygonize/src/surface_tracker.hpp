@@ -74,6 +74,8 @@ class SurfaceTracker {
   static constexpr std::size_t kLookaheadMin = std::size_t(1) << 12;
   static constexpr std::size_t kLookaheadChunk = std::size_t(1) << 15;
   static constexpr std::size_t kLookaheadSlice = std::size_t(1) << 11;
+  /// Stars the lookahead walks together (Triangulation::incident_tetrahedra of several vertices).
+  static constexpr std::size_t kStarChunk = 64;
 
   // ---- What changed (called by the Polygonizer as it edits) -----------------------------------------
   // Tetrahedra are listed until the lists outgrow the mesh (a refinement), then the next update sweeps

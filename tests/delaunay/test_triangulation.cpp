@@ -750,6 +750,48 @@ TEST_CASE("delaunay: location and incident tetrahedra") {
   CHECK(tr.memory_live_bytes() > tr.num_tetrahedra() * 32);
 }
 
+TEST_CASE("delaunay: stars of many vertices walked together equal the single walks") {
+  for (const bool history : {true, false}) {
+    // A vertex whose star outgrows the interleaved walk's lanes (about 2 x 300 tetrahedra around the
+    // centre of points on a sphere), uniform points, and removed vertices.
+    std::vector<Point3> pts{{0.5, 0.5, 0.5}};
+    std::mt19937_64 rng(7);
+    std::normal_distribution<double> g;
+    for (int i = 0; i < 300; ++i) {
+      Point3 d{g(rng), g(rng), g(rng)};
+      pts.push_back(Point3{0.5, 0.5, 0.5} + (0.3 / std::sqrt(dot(d, d))) * d);
+    }
+    for (const Point3& p : uniform_points(300, 73))
+      if (norm(p - Point3{0.5, 0.5, 0.5}) > 0.35) pts.push_back(p);  // none inside the sphere
+    TriangulationOptions opt;
+    opt.keep_history = history;
+    auto b = build(kUnitBox, pts, iota_order(pts.size()), false, opt);
+    Triangulation& tr = b.tr;
+    std::vector<VertexId> vs;
+    for (const auto& [v, lab] : b.label) vs.push_back(v);
+    for (std::size_t k = 1; k < vs.size(); k += 7) tr.remove(vs[k]);  // their ids come back with no star
+    std::shuffle(vs.begin(), vs.end(), rng);
+    for (VertexId c = 0; c < 8; ++c) vs.push_back(c);
+    vs.push_back(static_cast<VertexId>(tr.vertex_capacity() + 3));  // never a vertex
+    std::vector<TetId> stars, single;
+    std::vector<std::size_t> ends;
+    for (const std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{5}, vs.size()}) {
+      tr.incident_tetrahedra(vs.data(), n, stars, ends);
+      REQUIRE(ends.size() == n);
+      std::size_t begin = 0, largest = 0;
+      for (std::size_t k = 0; k < n; ++k) {
+        tr.incident_tetrahedra(vs[k], single);
+        REQUIRE(ends[k] - begin == single.size());
+        CHECK(std::equal(single.begin(), single.end(), stars.begin() + static_cast<std::ptrdiff_t>(begin)));
+        largest = std::max(largest, single.size());
+        begin = ends[k];
+      }
+      CHECK(begin == stars.size());
+      if (n == vs.size()) CHECK(largest > 256);  // the large star was among them
+    }
+  }
+}
+
 TEST_CASE("delaunay: bad input is rejected with clear errors") {
   CHECK_THROWS_AS(Triangulation(Box3{}), InvalidArgument);
   CHECK_THROWS_AS(Triangulation(Box3{{0, 0, 0}, {1, 0, 1}}), InvalidArgument);

@@ -217,6 +217,68 @@ TEST_CASE("link_groups: the sign groups of a hand-made link", "[incremental]") {
   CHECK(link_groups(0, star, none).own == 1);
 }
 
+TEST_CASE("link_is_neck: the groups' decision from the other sign alone", "[incremental]") {
+  // The hand-made links above: the same decisions.
+  for (const auto& negative : std::vector<std::vector<VertexId>>{
+           {6}, {2, 4, 6}, {1, 2, 3, 4}, {5, 6}, {3, 4, 5, 6}, {2, 3, 4, 6}, {}, {1, 2, 3, 4, 5, 6}}) {
+    const auto is_negative = [&](VertexId u) {
+      return std::find(negative.begin(), negative.end(), u) != negative.end();
+    };
+    CHECK(link_is_neck(0, octahedron_star(), is_negative) == link_groups(0, octahedron_star(), is_negative).neck());
+  }
+  // Real links (a Delaunay tetrahedralization of random points) under sign patterns that make necks:
+  // random signs, and slabs and shells through the stars (a band of the other sign around a vertex).
+  // The first vertex has a large link: 60 points on a sphere around it (more vertices of the other sign
+  // than link_is_neck's linear search takes: its fallback).
+  Triangulation tr(kCube);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> u(-1.5, 1.5);
+  std::normal_distribution<double> g;
+  tr.insert({0.0, 0.0, 0.0});
+  for (int i = 0; i < 60; ++i) {
+    const Point3 d{g(rng), g(rng), g(rng)};
+    tr.insert((0.3 / norm(d)) * d);
+  }
+  for (int i = 0; i < 400;) {
+    const Point3 p{u(rng), u(rng), u(rng)};
+    if (norm(p) > 0.5 && tr.insert(p).status == InsertStatus::Inserted) ++i;
+  }
+  std::size_t necks = 0, checked = 0, large = 0;
+  std::vector<TetId> star;
+  for (VertexId v = 8; v < tr.vertex_capacity(); ++v) {
+    if (!tr.is_vertex(v)) continue;
+    tr.incident_tetrahedra(v, star);
+    std::vector<std::array<VertexId, 4>> quads;
+    for (const TetId t : star) quads.push_back(tr.tet_vertices(t));
+    const Point3 c = tr.point(v);
+    for (int pattern = 0; pattern < 40; ++pattern) {
+      std::vector<char> other(tr.vertex_capacity(), 0);
+      const Point3 n{u(rng), u(rng), u(rng)};
+      const double width = 0.05 + 0.1 * (pattern % 4);
+      for (VertexId w = 0; w < tr.vertex_capacity(); ++w) {
+        const Point3 d = tr.point(w) - c;
+        if (pattern < 10) other[w] = rng() % 2;                                   // random signs
+        else if (pattern < 25) other[w] = std::abs(dot(d, n)) > width ? 1 : 0;    // a slab of own sign
+        else other[w] = std::abs(dot(d, n)) < width * norm(n) ? 1 : 0;          // a slab of the other
+      }
+      other[v] = 0;
+      const auto differs = [&](VertexId w) { return other[w] != 0; };
+      const bool expect = link_groups(v, quads, differs).neck();
+      REQUIRE(link_is_neck(v, quads, differs) == expect);
+      necks += expect ? 1 : 0;
+      ++checked;
+    }
+    // Every link vertex of the other sign: more than the linear search's 32 on the larger links (the
+    // fallback), never a neck (no own vertex).
+    const auto all = [&](VertexId w) { return w != v; };
+    REQUIRE(link_is_neck(v, quads, all) == link_groups(v, quads, all).neck());
+    large += quads.size() > 100 ? 1 : 0;
+  }
+  CHECK(checked > 10000);
+  CHECK(necks > checked / 20);  // the patterns made necks, not only the easy answer
+  CHECK(large > 0);
+}
+
 TEST_CASE("place_crossings: roots of a linear function, zero ends offset, warm starts", "[incremental]") {
   const SphereFunction f({0.0, 0.0, 0.0}, 1.0);
   marching::RootSettings s;

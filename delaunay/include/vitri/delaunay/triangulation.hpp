@@ -240,6 +240,12 @@ class Triangulation {
   std::vector<TetId> incident_tetrahedra(VertexId v) const;
   /// The same into `out` (cleared first; its capacity is reused: no allocation in a loop).
   void incident_tetrahedra(VertexId v, std::vector<TetId>& out) const;
+  /// The stars of vs[0, n) one after the other: vertex k's are out[ends[k-1] .. ends[k]) (ends[-1] = 0),
+  /// each in the order of incident_tetrahedra(vs[k]). Several stars are walked at once, interleaved, so
+  /// that their records' cache misses overlap (a star's records lie far apart in memory): for passes
+  /// over many vertices. Both vectors are cleared first.
+  void incident_tetrahedra(const VertexId* vs, std::size_t n, std::vector<TetId>& out,
+                           std::vector<std::size_t>& ends) const;
 
   /// Circumcenter of a live or dead tetrahedron (double arithmetic, robust formula).
   Point3 circumcenter(TetId t) const;

@@ -31,6 +31,7 @@
 #include "polygonizer_internal.hpp"
 #include "slices.hpp"
 #include "surface_tracker.hpp"
+#include "values_ahead.hpp"
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
@@ -39,6 +40,7 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <optional>
 #include <string>
 
 namespace vitri {
@@ -56,6 +58,8 @@ TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
 }
 
 constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of evaluations, progress)
+// Rounds with fewer possible points evaluate them in the batch only (a helper thread costs more).
+constexpr std::size_t kAheadRoundMin = 256;
 constexpr std::size_t kClassifySliceMin = std::size_t(1) << 16;  // tetrahedra per thread of classify_all
 constexpr std::size_t kCreatedSliceMin = std::size_t(1) << 12;   // of classify_created (a round's tetrahedra)
 
@@ -240,6 +244,11 @@ bool Polygonizer::needs_evaluation(VertexId v) const {
 // f at the vertices `ids` into `out`, in one batch call; with refine_thin_features the gradients come
 // with the values (about the cost of the values alone for the RBF) and are stored in grad_.
 void Polygonizer::evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
+  compute_at(ids, out);
+  check_values(ids, out);
+}
+
+void Polygonizer::compute_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
   std::vector<Point3> pts(ids.size());
   for (std::size_t i = 0; i < ids.size(); ++i) pts[i] = tri_.point(ids[i]);
   out.resize(ids.size());
@@ -252,9 +261,42 @@ void Polygonizer::evaluate_at(const std::vector<VertexId>& ids, std::vector<doub
   }
   stats_.function_evaluations += ids.size();
   stats_.vertex_evaluations += ids.size();
+}
+
+void Polygonizer::check_values(const std::vector<VertexId>& ids, const std::vector<double>& out) const {
   for (std::size_t i = 0; i < ids.size(); ++i)
     if (!fixed_[ids[i]] && std::isnan(out[i]))
-      throw NumericalError("implicit function returned NaN at " + describe(pts[i]));
+      throw NumericalError("implicit function returned NaN at " + describe(tri_.point(ids[i])));
+}
+
+// evaluate_at() when a helper evaluated a round's new vertices (values_ahead.hpp): its results for the
+// vertices it was given (in the order of `ids`, at the points they still have), the others in one batch,
+// the same checks after. The same values, gradients and counts as evaluate_at(ids).
+void Polygonizer::values_from_ahead(const std::vector<VertexId>& ids, std::vector<double>& out) {
+  polygonizer_detail::ValuesAhead& ahead = *ahead_;
+  ahead.finish();
+  out.resize(ids.size());
+  std::vector<VertexId> rest;
+  std::vector<std::size_t> rest_at;
+  std::size_t j = 0;  // the helper's next result
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    const VertexId v = ids[i];
+    if (j < ahead.size() && ahead.vertex(j) == v && ahead.point(j) == tri_.point(v)) {
+      out[i] = ahead.value(j);
+      if (options_.refine_thin_features) grad_[v] = ahead.gradient(j);
+      ++j;
+    } else {
+      rest.push_back(v);
+      rest_at.push_back(i);
+    }
+  }
+  stats_.function_evaluations += ids.size() - rest.size();
+  stats_.vertex_evaluations += ids.size() - rest.size();
+  stats_.ahead_evaluations += ids.size() - rest.size();
+  std::vector<double> rest_out;
+  compute_at(rest, rest_out);
+  for (std::size_t k = 0; k < rest.size(); ++k) out[rest_at[k]] = rest_out[k];
+  check_values(ids, out);
 }
 
 // After an edit put v where it is (or gave it a fixed value): its value when it has none of its own,
@@ -274,7 +316,10 @@ void Polygonizer::evaluate_pending() {
     if (needs_evaluation(v)) ids.push_back(v);
   pending_.clear();
   std::vector<double> out;
-  evaluate_at(ids, out);
+  if (ahead_)
+    values_from_ahead(ids, out);
+  else
+    evaluate_at(ids, out);
   for (std::size_t i = 0; i < ids.size(); ++i)
     if (!fixed_[ids[i]]) set_value(ids[i], out[i]);
 }
@@ -522,6 +567,7 @@ bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, Ve
   fixed_[r.vertex] = 0;
   tcount_[r.vertex] = 0;
   pending_.push_back(r.vertex);
+  if (ahead_) ahead_->offer(r.vertex, tri_.point(r.vertex));  // refused when full: the batch has it
   ++stats_.insertions;
   on_killed(changes_);
   created.insert(created.end(), changes_.created.begin(), changes_.created.end());
@@ -629,6 +675,17 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
   std::vector<TetId> created, retry;
   while (queued() > 0 || !thin_.empty()) {
     const std::size_t n = std::min(queued(), kRoundSize);
+    // With threads, f at the round's new vertices on a helper while the insertions go on (they are
+    // serial; values_ahead.hpp): the batch below then takes its results. At most one point per entry.
+    std::optional<polygonizer_detail::ValuesAhead> ahead;
+    const std::size_t most = n + thin_.size();
+    if (resolve_thread_count(options_.threads) > 1 && most >= kAheadRoundMin)
+      ahead.emplace(f_, options_.refine_thin_features, most);
+    struct Detach {  // ahead_ never outlives the helper, even when an insertion throws
+      polygonizer_detail::ValuesAhead*& p;
+      ~Detach() { p = nullptr; }
+    } detach{ahead_};
+    ahead_ = ahead ? &*ahead : nullptr;
     for (std::size_t i = 0; i < n; ++i) {
       TetId t;
       if (!pop(t)) break;
@@ -647,6 +704,7 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
       info.inserted += stats_.thin_insertions - before;
     }
     finish_round(created, dmin);
+    ahead_ = nullptr;
     for (const TetId t : retry)
       if (is_active(t)) push(t);
     retry.clear();

@@ -106,6 +106,28 @@ TEST_CASE("real models: watertight 2-manifold with the model's Euler characteris
                        ModelCase{"knot1.off", 1500, 0.03, 0}));
 }
 
+// The global function's batch kernels on a round's new vertices, one helper batch at a time
+// (values_ahead.hpp) or in the round's batch: the same values, so the same mesh bit for bit.
+TEST_CASE("global function: the refinement's helper thread does not change the mesh", "[mesher]") {
+  const TriangleMesh in = read_mesh(kData + "/hand.off");
+  SurfaceMesh mesh[2];
+  std::size_t ahead[2];
+  for (int k = 0; k < 2; ++k) {
+    MesherOptions o;
+    o.constraint_build.max_constraints = 1500;
+    o.polygonizer.threads = k == 0 ? 1 : 2;
+    Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
+    REQUIRE(mesher.refine(0.02 * mesher.diagonal()));
+    mesh[k] = mesher.surface();
+    ahead[k] = mesher.stats().polygonizer.ahead_evaluations;
+  }
+  CHECK(ahead[0] == 0);
+  CHECK(ahead[1] > 0);
+  require_closed(mesh[1]);
+  REQUIRE(mesh[0].triangles == mesh[1].triangles);
+  REQUIRE(mesh[0].vertices == mesh[1].vertices);
+}
+
 // Elephant (genus 3) needs ~1500 surface points (4500 constraints): with fewer, the fitted surface itself
 // grows extra handles, so a cheaper model would no longer test genus 3 (only whether subsampling broke
 // it). The O(N^3) fit takes ~100 s under the sanitizers (about 5 s in Release), so the case is hidden from

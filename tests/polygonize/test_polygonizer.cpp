@@ -14,7 +14,10 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <atomic>
 #include <set>
+#include <string>
+#include <thread>
 
 using namespace vitri;
 
@@ -475,6 +478,77 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
   require_closed(mesh[1], 0, 1);
   REQUIRE(mesh[0].triangles == mesh[1].triangles);
   REQUIRE(mesh[0].vertices == mesh[1].vertices);
+}
+
+// With threads, a refinement round's new vertices are evaluated on a helper while the round inserts
+// (values_ahead.hpp): the same refinement, counts and mesh as on one thread, and an error of f raised on
+// the helper reaches the caller as the one-thread run raises it.
+TEST_CASE("f at a round's new vertices on a helper thread: the same refinement", "[polygonizer]") {
+  const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u(-1.9, 1.9);
+  std::vector<Point3> seeds(3000);
+  for (Point3& p : seeds) p = {u(rng), u(rng), u(rng)};
+  for (const bool thin : {true, false}) {
+    PolygonizerStats stats[2];
+    SurfaceMesh mesh[2];
+    for (int k = 0; k < 2; ++k) {
+      PolygonizerOptions o;
+      o.threads = k == 0 ? 1 : 2;
+      o.refine_thin_features = thin;
+      Polygonizer poly(f, kCube, seeds, {}, o);
+      REQUIRE(poly.refine(0.1));
+      REQUIRE(poly.refine(0.05));  // a second level: rounds after a first refinement
+      stats[k] = poly.stats();
+      mesh[k] = poly.extract();
+    }
+    CHECK(stats[0].ahead_evaluations == 0);
+    CHECK(stats[1].ahead_evaluations > stats[1].insertions / 2);  // most rounds had the helper
+    CHECK(stats[1].insertions == stats[0].insertions);
+    CHECK(stats[1].function_evaluations == stats[0].function_evaluations);
+    CHECK(stats[1].vertex_evaluations == stats[0].vertex_evaluations);
+    require_closed(mesh[1], 0, 1);
+    REQUIRE(mesh[0].triangles == mesh[1].triangles);
+    REQUIRE(mesh[0].vertices == mesh[1].vertices);
+  }
+  SECTION("an error of f on the helper") {
+    // f refuses points off the seeds' lattice with x > 1: the refinement's first such point.
+    struct Refusing : ImplicitFunction {
+      const TorusFunction torus{{0.0, 0.0, 0.1}, 1.0, 0.35};
+      const std::thread::id caller = std::this_thread::get_id();
+      mutable std::atomic<bool> refused_elsewhere{false};  // refused on another thread than the test's
+      double value(const Point3& p) const override {
+        if (p.x > 1.0 && p.x != std::round(p.x * 8.0) / 8.0) {
+          if (std::this_thread::get_id() != caller) refused_elsewhere = true;
+          throw NumericalError("refused at x " + std::to_string(p.x));
+        }
+        return torus.value(p);
+      }
+      double value_gradient(const Point3& p, Point3& g) const override {
+        (void)value(p);
+        return torus.value_gradient(p, g);
+      }
+    } refusing;
+    std::vector<Point3> lattice;
+    for (int i = -15; i <= 15; ++i)
+      for (int j = -15; j <= 15; ++j)
+        for (int l = -15; l <= 15; l += 3) lattice.push_back({i / 8.0, j / 8.0, l / 8.0});
+    std::string message[2];
+    for (int k = 0; k < 2; ++k) {
+      PolygonizerOptions o;
+      o.threads = k == 0 ? 1 : 2;
+      o.sampling_fraction = 0.0;
+      Polygonizer poly(refusing, kCube, lattice, {}, o);
+      try {
+        poly.refine(0.05);
+      } catch (const NumericalError& e) {
+        message[k] = e.what();
+      }
+    }
+    REQUIRE(message[0].rfind("refused at x", 0) == 0);
+    REQUIRE(message[1] == message[0]);
+    REQUIRE(refusing.refused_elsewhere);  // the two-thread run's error came from the helper
+  }
 }
 
 // The constructor's first step on its own (what the Mesher runs while it fits the local function): the

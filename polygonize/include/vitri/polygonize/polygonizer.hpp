@@ -44,6 +44,9 @@
 namespace vitri {
 
 class SurfaceTracker;
+namespace polygonizer_detail {
+class ValuesAhead;
+}
 
 /// Order in which transverse tetrahedra are refined.
 enum class QueueOrder {
@@ -162,6 +165,9 @@ struct PolygonizerStats {
   std::size_t transverse = 0;           ///< live transverse tetrahedra
   std::size_t function_evaluations = 0; ///< calls of f (value or gradient), all phases
   std::size_t vertex_evaluations = 0;   ///< of which at Delaunay vertices
+  /// Of those, computed on a helper thread while a refinement round was inserting (threads > 1): the same
+  /// values as the round's batch would compute.
+  std::size_t ahead_evaluations = 0;
   std::size_t root_evaluations = 0;     ///< of which by the root finder (value + gradient: the normal)
   std::size_t gradient_evaluations = 0; ///< of which for normals not given by the root finder
   std::size_t insertions = 0;           ///< Delaunay insertions by refinement and sampling
@@ -384,6 +390,9 @@ class Polygonizer {
   bool needs_evaluation(VertexId v) const;
   void refresh_at(VertexId v);
   void evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out);
+  void compute_at(const std::vector<VertexId>& ids, std::vector<double>& out);
+  void check_values(const std::vector<VertexId>& ids, const std::vector<double>& out) const;
+  void values_from_ahead(const std::vector<VertexId>& ids, std::vector<double>& out);
   void evaluate_pending();
   void on_killed(const ChangeSet& cs);
   void absorb_renumbering();
@@ -434,6 +443,9 @@ class Polygonizer {
   std::vector<VertexId> neck_candidates_;
   std::vector<std::uint8_t> neck_mark_;
   std::vector<VertexId> pending_;       // vertices waiting for their value (batch)
+  // During a refinement round with threads: the helper evaluating f at the round's new vertices
+  // (values_ahead.hpp), owned by run_round(); null otherwise.
+  polygonizer_detail::ValuesAhead* ahead_ = nullptr;
   std::vector<VertexId> seed_vertices_;
   std::deque<TetId> fifo_;
   std::priority_queue<std::pair<double, TetId>> heap_;

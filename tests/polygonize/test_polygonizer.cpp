@@ -39,6 +39,15 @@ double max_distance(const SurfaceMesh& m, const Fn& dist, bool centroids) {
 
 const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
 
+// n seeds uniform in [-1.9, 1.9]^3 (fixed seed).
+std::vector<Point3> uniform_seeds(std::size_t n, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u(-1.9, 1.9);
+  std::vector<Point3> seeds(n);
+  for (Point3& p : seeds) p = {u(rng), u(rng), u(rng)};
+  return seeds;
+}
+
 }  // namespace
 
 TEST_CASE("sphere: closed genus-0 manifold, on the surface, within the precision", "[polygonizer]") {
@@ -460,10 +469,7 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
   // The refinement order follows tetrahedron ids; a parallel insertion numbers them by the threads'
   // timing, so the Polygonizer renumbers them canonically after the seeds. Bit for bit the same mesh.
   const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
-  std::mt19937_64 rng(21);
-  std::uniform_real_distribution<double> u(-1.9, 1.9);
-  std::vector<Point3> seeds(40000);
-  for (Point3& p : seeds) p = {u(rng), u(rng), u(rng)};
+  const std::vector<Point3> seeds = uniform_seeds(40000, 21);
   SurfaceMesh mesh[2];
   for (int k = 0; k < 2; ++k) {
     PolygonizerOptions o;
@@ -485,10 +491,7 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
 // the helper reaches the caller as the one-thread run raises it.
 TEST_CASE("f at a round's new vertices on a helper thread: the same refinement", "[polygonizer]") {
   const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
-  std::mt19937_64 rng(23);
-  std::uniform_real_distribution<double> u(-1.9, 1.9);
-  std::vector<Point3> seeds(3000);
-  for (Point3& p : seeds) p = {u(rng), u(rng), u(rng)};
+  const std::vector<Point3> seeds = uniform_seeds(3000, 23);
   for (const bool thin : {true, false}) {
     PolygonizerStats stats[2];
     SurfaceMesh mesh[2];

@@ -154,7 +154,9 @@ struct PolygonizerOptions {
   /// are renumbered canonically after the seeds (Triangulation::canonicalize()), so the result is the same,
   /// bit for bit, for any number of threads. The first thin-feature check of a refinement (every live
   /// tetrahedron) and the marching pass of a large extraction run on them too, with any history setting (same
-  /// result; docs/polygonize.md "Threads").
+  /// result; docs/polygonize.md "Threads"), as do the neck checks and the classification of a round's new
+  /// tetrahedra; with more than one, a helper thread evaluates f at a round's new vertices while the round
+  /// inserts (docs/polygonize.md "Pipeline"; f must allow concurrent evaluations, as ImplicitFunction says).
   unsigned threads = 1;
 };
 

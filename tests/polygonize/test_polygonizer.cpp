@@ -10,11 +10,13 @@
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
+#include "values_ahead.hpp"  // internal: polygonize/src
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 #include <random>
-#include <atomic>
 #include <set>
 #include <string>
 #include <thread>
@@ -484,6 +486,44 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
   require_closed(mesh[1], 0, 1);
   REQUIRE(mesh[0].triangles == mesh[1].triangles);
   REQUIRE(mesh[0].vertices == mesh[1].vertices);
+}
+
+// The helper on its own: the values (and gradients) of f at the points offered, in order; offers past
+// the capacity refused; an error of f rethrown by finish(); a helper given nothing stops cleanly.
+TEST_CASE("ValuesAhead: f at the points offered, on a helper thread", "[polygonizer]") {
+  const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
+  const std::vector<Point3> pts = uniform_seeds(100, 24);
+  for (const bool gradients : {false, true}) {
+    polygonizer_detail::ValuesAhead ahead(f, gradients, 70);
+    std::size_t accepted = 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) accepted += ahead.offer(static_cast<VertexId>(i + 8), pts[i]) ? 1 : 0;
+    ahead.finish();
+    REQUIRE(accepted == 70);
+    REQUIRE(ahead.size() == 70);
+    for (std::size_t i = 0; i < 70; ++i) {
+      REQUIRE(ahead.vertex(i) == i + 8);
+      REQUIRE(ahead.point(i) == pts[i]);
+      Point3 g;
+      REQUIRE(ahead.value(i) == f.value_gradient(pts[i], g));
+      if (gradients) REQUIRE(ahead.gradient(i) == g);
+    }
+    REQUIRE_FALSE(ahead.offer(0, pts[0]));  // finished: nothing more
+  }
+  struct Failing : ImplicitFunction {
+    double value(const Point3& p) const override {
+      if (p.x > 0.5) throw NumericalError("refused at " + std::to_string(p.x));
+      return p.x;
+    }
+    double value_gradient(const Point3& p, Point3& g) const override {
+      g = {1.0, 0.0, 0.0};
+      return value(p);
+    }
+  } failing;
+  polygonizer_detail::ValuesAhead ahead(failing, false, 8);
+  REQUIRE(ahead.offer(0, {0.0, 0.0, 0.0}));
+  REQUIRE(ahead.offer(1, {0.7, 0.0, 0.0}));
+  REQUIRE_THROWS_WITH(ahead.finish(), "refused at 0.700000");
+  { polygonizer_detail::ValuesAhead idle(f, true, 4); }  // started, given nothing, destroyed
 }
 
 // With threads, a refinement round's new vertices are evaluated on a helper while the round inserts

@@ -681,7 +681,7 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
     const std::size_t most = n + thin_.size();
     if (resolve_thread_count(options_.threads) > 1 && most >= kAheadRoundMin)
       ahead.emplace(f_, options_.refine_thin_features, most);
-    struct Detach {  // ahead_ never outlives the helper, even when an insertion throws
+    struct Detach {  // ahead_ is cleared at the round's end, before the helper is joined, also on a throw
       polygonizer_detail::ValuesAhead*& p;
       ~Detach() { p = nullptr; }
     } detach{ahead_};
@@ -704,7 +704,6 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
       info.inserted += stats_.thin_insertions - before;
     }
     finish_round(created, dmin);
-    ahead_ = nullptr;
     for (const TetId t : retry)
       if (is_active(t)) push(t);
     retry.clear();

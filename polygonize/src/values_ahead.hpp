@@ -1,6 +1,6 @@
 #pragma once
 // f at the vertices a refinement round inserts, evaluated on a helper thread while the round's
-// insertions go on (docs/polygonize.md, "Threads").
+// insertions go on (docs/polygonize.md, "Pipeline", step 3).
 //
 // A round of the refinement inserts up to a few thousand points one after the other on the calling
 // thread (the Delaunay insertions are serial), then evaluates f at the new vertices in one batch before

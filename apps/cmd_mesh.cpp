@@ -539,7 +539,9 @@ int run_mesh(const Args& args) {
       throw ParseError(edits, line, e.what());
     }
   }
-  return 0;
+  // Every output file is closed (write_mesh), every line printed: the Mesher, the constraints and the
+  // meshes are left to the system (freeing them block by block took 0.5 s at 10^6 points).
+  exit_without_teardown(0);
 }
 
 }  // namespace vitri::cli

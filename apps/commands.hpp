@@ -25,4 +25,10 @@ const std::vector<Command>& commands();
 /// True when args holds -h or --help.
 bool wants_help(const Args& args);
 
+/// Ends the process with `code` once stdout and stderr are flushed, without running destructors: for a
+/// command whose output is complete (files closed) and whose structures are large, so that the process
+/// does not spend its last half second freeing millions of blocks one by one (a 10^6-point `vitri mesh`:
+/// 0.5 s) when the system reclaims its memory at once. Call it only where nothing else remains to write.
+[[noreturn]] void exit_without_teardown(int code);
+
 }  // namespace vitri::cli

@@ -65,27 +65,26 @@ class NodeStack {
 
 }  // namespace
 
-/// The running answer of nearest(): the k smallest (squared distance, id) so far, kept sorted in the
-/// caller's vectors (for the small k of the callers an insertion into a short sorted array beats a
-/// heap's sift-downs; the vectors' capacity is reused from query to query).
+/// The running answer of nearest(): the k smallest (squared distance, id) so far, kept sorted (for the
+/// small k of the callers an insertion into a short sorted array beats a heap's sift-downs) in arrays of
+/// the query's own (on the stack up to kInline entries, in thread-local vectors beyond), copied to the
+/// caller's vectors at the end (the shifts through the caller's vectors, reloaded at every step, were a
+/// tenth of a query).
 struct PointIndex::NearestState {
-  Point3 query;
-  std::size_t k = 0;
-  std::vector<double>& d2;
-  std::vector<Id>& ids;
-  /// Squared distance beyond which nothing can enter the answer (infinity until k are held).
-  double bound() const { return d2.size() < k ? std::numeric_limits<double>::infinity() : d2.back(); }
+  static constexpr std::size_t kInline = 64;
+  std::size_t k = 0, n = 0;
+  double* d2;
+  Id* ids;
+  double bound = std::numeric_limits<double>::infinity();  // nothing beyond can enter the answer
   void offer(double dist2, Id id) {
-    std::size_t n = d2.size();
+    std::size_t at;
     if (n == k) {
-      if (!(dist2 < d2.back() || (dist2 == d2.back() && id < ids.back()))) return;
+      if (!(dist2 < d2[n - 1] || (dist2 == d2[n - 1] && id < ids[n - 1]))) return;
+      at = n - 1;
     } else {
-      d2.push_back(0.0);
-      ids.push_back(0);
-      ++n;
+      at = n++;
     }
     // Shift the larger entries up by one: the new one goes after every (d, i) < (dist2, id).
-    std::size_t at = n - 1;
     while (at > 0 && (dist2 < d2[at - 1] || (dist2 == d2[at - 1] && id < ids[at - 1]))) {
       d2[at] = d2[at - 1];
       ids[at] = ids[at - 1];
@@ -93,6 +92,7 @@ struct PointIndex::NearestState {
     }
     d2[at] = dist2;
     ids[at] = id;
+    if (n == k) bound = d2[n - 1];
   }
 };
 
@@ -457,11 +457,24 @@ void PointIndex::close_pairs_below(std::uint32_t index, Point3 lo, Point3 hi, do
 
 void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, std::vector<double>* dist2) const {
   ids.clear();
-  thread_local std::vector<double> own_d2;
-  std::vector<double>& d2 = dist2 ? *dist2 : own_d2;
-  d2.clear();
+  if (dist2) dist2->clear();
   if (size_ == 0 || k == 0) return;
-  NearestState state{q, k, d2, ids};
+  k = std::min(k, size_);
+  double inline_d2[NearestState::kInline];
+  Id inline_ids[NearestState::kInline];
+  thread_local std::vector<double> big_d2;
+  thread_local std::vector<Id> big_ids;
+  NearestState state;
+  state.k = k;
+  if (k <= NearestState::kInline) {
+    state.d2 = inline_d2;
+    state.ids = inline_ids;
+  } else {
+    big_d2.resize(k);
+    big_ids.resize(k);
+    state.d2 = big_d2.data();
+    state.ids = big_ids.data();
+  }
   // Depth first, the nearer child first; a pending far child keeps its box distance so that it is
   // skipped once the answer's bound drops below it.
   struct Pending {
@@ -487,7 +500,7 @@ void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, s
   while (depth > 0) {
     const Pending top = pop();
     // <= keeps points at the bound's distance reachable: ties are broken by id.
-    if (!(top.dist2 <= state.bound())) continue;
+    if (!(top.dist2 <= state.bound)) continue;
     std::uint32_t node = top.node;
     for (;;) {
       const Node& n = nodes_[node];
@@ -495,7 +508,7 @@ void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, s
         const Entry* b = bucket_begin(n);
         for (std::uint32_t i = 0; i < n.bucket.count; ++i) {
           const double dd = squared_distance(b[i].p, q);
-          if (dd <= state.bound()) state.offer(dd, b[i].id);
+          if (dd <= state.bound) state.offer(dd, b[i].id);
         }
         break;
       }
@@ -505,11 +518,13 @@ void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, s
       const bool left_first = da <= dc;
       const std::uint32_t near = left_first ? n.child : n.child + 1;
       const double dnear = left_first ? da : dc, dfar = left_first ? dc : da;
-      if (dfar <= state.bound()) push(left_first ? n.child + 1 : n.child, dfar);
-      if (!(dnear <= state.bound())) break;
+      if (dfar <= state.bound) push(left_first ? n.child + 1 : n.child, dfar);
+      if (!(dnear <= state.bound)) break;
       node = near;
     }
   }
+  ids.assign(state.ids, state.ids + state.n);
+  if (dist2) dist2->assign(state.d2, state.d2 + state.n);
 }
 
 }  // namespace vitri

@@ -71,7 +71,7 @@ void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rn
     index.ball(c, r2, got);
     REQUIRE(got == brute.ball(c, r2));
     REQUIRE(index.count_ball(c, r2) == got.size());
-    for (std::size_t k : {1u, 7u, 33u}) {
+    for (std::size_t k : {1u, 7u, 33u, 64u, 65u, 100u}) {  // on the stack up to 64, beyond in vectors
       std::vector<double> d2;
       index.nearest(c, k, got, &d2);
       REQUIRE(got == brute.nearest(c, k));

@@ -7,9 +7,6 @@
 // runs with the multiplicative hash, and 16 bytes x 4/3 to 8/3 per entry); an empty slot holds kEmpty
 // (never a key: an edge key packs two vertex ids below 2^32 - 1); erase() shifts the following run back (no tombstones), so every key is reachable from its home slot
 // without crossing an empty slot.
-#include "slices.hpp"
-
-#include <algorithm>
 #include <cassert>
 #include <cstdint>
 #include <utility>
@@ -49,59 +46,6 @@ class EdgeMap {
   /// random; callers that know their next keys overlap the misses).
   void prefetch(std::uint64_t key) const {
     if (!slots_.empty()) __builtin_prefetch(&slots_[home(key)]);  // GCC and Clang, the supported compilers
-  }
-  /// Bulk insertion into an empty map on `parts` threads (a full extraction): for every i with keys[i] != kEmpty,
-  /// the key gets the index of its first occurrence as its value (when new), and first[i] receives that
-  /// index. The slots are cut into `parts` ranges; the thread of a range goes through all the keys in
-  /// order and inserts those whose home slot lies in its range, probing only inside it (no other
-  /// thread writes there); a key whose probe would leave its range is deferred, it and its later
-  /// occurrences alike (the run only fills), and done afterwards in order on the calling thread. The
-  /// values and first[] are those of a serial insertion in index order; only where colliding keys sit
-  /// may differ, which no lookup sees. Reserve first: the threads do not grow the table (a load past 3/4
-  /// is restored at the end).
-  void insert_first_occurrences(const std::uint64_t* keys, std::size_t n, std::uint32_t* first,
-                                std::size_t parts) {
-    assert(size_ == 0);
-    if (slots_.empty()) rehash(16);
-    parts = std::max<std::size_t>(1, std::min(parts, slots_.size() / 16));
-    std::vector<std::vector<std::uint32_t>> deferred(parts);
-    std::vector<std::size_t> inserted(parts, 0);
-    polygonizer_detail::run_slices(slots_.size(), parts, [&](std::size_t part, std::size_t lo, std::size_t hi) {
-      for (std::size_t i = 0; i < n; ++i) {
-        const std::uint64_t key = keys[i];
-        if (key == kEmpty) continue;
-        std::size_t j = home(key);
-        if (j < lo || j >= hi) continue;
-        for (; j < hi; ++j) {
-          if (slots_[j].first == kEmpty) {
-            slots_[j] = {key, static_cast<std::uint32_t>(i)};
-            first[i] = static_cast<std::uint32_t>(i);
-            ++inserted[part];
-            break;
-          }
-          if (slots_[j].first == key) {
-            first[i] = slots_[j].second;
-            break;
-          }
-        }
-        if (j == hi) deferred[part].push_back(static_cast<std::uint32_t>(i));
-      }
-    });
-    for (std::size_t c : inserted) size_ += c;
-    std::vector<std::uint32_t> rest;
-    for (const auto& d : deferred) rest.insert(rest.end(), d.begin(), d.end());
-    std::sort(rest.begin(), rest.end());
-    for (const std::uint32_t i : rest) {
-      const auto [value, fresh] = try_emplace(keys[i], i);
-      first[i] = fresh ? i : *value;
-    }
-    if (over_load(size_)) rehash(min_capacity(size_));
-  }
-  /// Replaces every value v by map(v).
-  template <class Map>
-  void map_values(const Map& map) {
-    for (auto& [key, value] : slots_)
-      if (key != kEmpty) value = map(value);
   }
   /// Removes key if present; returns whether it was.
   bool erase(std::uint64_t key) {

@@ -200,7 +200,6 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
 // placed again when an end of one of its edges changed). In chunks: each chunk is marched ahead (on the
 // threads when large), then its polygons and edges are made in order by this thread.
 void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
-  if (can_build_all(in, w)) return build_all_polygons(in, w);
   // The edge table is read at random (a full build: millions of edges): the crossed edges of the
   // tetrahedron kLookahead places ahead are prefetched.
   constexpr std::size_t kLookahead = 8;

@@ -48,9 +48,6 @@ struct TrackerInput {
   /// Large updates take the collapse tests' stars and fans from a lookahead on the threads; off, each is
   /// gathered when its vertex is decided (the same decisions: the tests compare both).
   bool snap_lookahead = true;
-  /// A full build makes its polygons and crossed edges on the threads (surface_build.cpp); off, one
-  /// tetrahedron at a time as an incremental update does (the same records: the tests compare both).
-  bool bulk_build = true;
   /// Per Delaunay vertex: f's gradient there where the Polygonizer knows it (NaN: unknown), or null.
   /// The normal of a mesh vertex collapsed onto a zero-valued vertex is read there instead of evaluated.
   const std::vector<Point3>* gradients = nullptr;
@@ -138,10 +135,6 @@ class SurfaceTracker {
     marching::CellPolygon cell;  // no corners when the tetrahedron is dead (v is then not read)
   };
   void rebuild_polygons(const TrackerInput& in, Work& w);
-  /// A full build (w.every_polygon) on the threads, the same result as rebuild_polygon() on every
-  /// tetrahedron of w.tets in order (surface_build.cpp); can_build_all says whether it applies.
-  static bool can_build_all(const TrackerInput& in, const Work& w);
-  void build_all_polygons(const TrackerInput& in, Work& w);
   static void march_ahead(const TrackerInput& in, const TetId* tets, std::size_t n, Marched* out);
   void rebuild_polygon(TetId t, const Marched& m, Work& w);
   std::uint32_t edge_slot(VertexId neg, VertexId pos, Work& w);

@@ -446,7 +446,7 @@ class Polygonizer {
   std::vector<std::uint8_t> neck_mark_;
   std::vector<VertexId> pending_;       // vertices waiting for their value (batch)
   // During a refinement round with threads: the helper evaluating f at the round's new vertices
-  // (values_ahead.hpp), owned by run_round(); null otherwise.
+  // (values_ahead.hpp), owned by drain_queue() for one round; null otherwise.
   polygonizer_detail::ValuesAhead* ahead_ = nullptr;
   std::vector<VertexId> seed_vertices_;
   std::deque<TetId> fifo_;

@@ -14,9 +14,9 @@
 #include "near_duplicates.hpp"
 #include "parallel.hpp"
 #include "spaced_subset.hpp"
-#include "spatial_order.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
+#include "vitri/core/spatial_order.hpp"
 #include "vitri/rbf/point_index.hpp"
 
 #include <Eigen/Geometry>
@@ -103,7 +103,7 @@ std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const
   // Queries in the index's spatial order: consecutive queries visit the same kd-tree leaves.
   std::vector<Point3> kept_points(keep.size());
   for (std::size_t k = 0; k < keep.size(); ++k) kept_points[k] = points[keep[k]];
-  const std::vector<std::size_t> order = rbf_detail::spatial_order(kept_points);
+  const std::vector<std::size_t> order = detail::spatial_order(kept_points);
   rbf_detail::parallel_chunks(keep.size(), opt.threads, 4096, [&](std::size_t b, std::size_t e) {
     for (std::size_t o = b; o < e; ++o) {
       const std::size_t k = order[o], i = keep[k];
@@ -145,7 +145,7 @@ std::size_t space_off_surface(std::vector<double>& offsets, const std::vector<Po
     candidates.push_back(k);
     at.push_back(points[keep[k]]);
   }
-  const std::vector<char> spaced = rbf_detail::spaced_subset(at, rbf_detail::spatial_order(at), spacing * d);
+  const std::vector<char> spaced = rbf_detail::spaced_subset(at, detail::spatial_order(at), spacing * d);
   std::size_t left_out = 0;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     if (spaced[c]) continue;
@@ -227,7 +227,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   {
     std::vector<Point3> merged(keep.size());
     for (std::size_t k = 0; k < keep.size(); ++k) merged[k] = points[keep[k]];
-    const std::vector<std::size_t> order = rbf_detail::spatial_order(merged);
+    const std::vector<std::size_t> order = detail::spatial_order(merged);
     for (std::size_t k = 0; k < order.size(); ++k) surf[k] = merged[order[k]];
   }
   const PointIndex surface(surf, opt.threads);

@@ -5,8 +5,8 @@
 
 #include "local_patch.hpp"
 #include "parallel.hpp"
-#include "radix_sort.hpp"
-#include "spatial_order.hpp"
+#include "vitri/core/radix_sort.hpp"
+#include "vitri/core/spatial_order.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -85,7 +85,7 @@ std::vector<std::uint32_t> batch_order(const Point3* points, std::size_t n, cons
     }
     keyed[i] = {code, static_cast<std::uint32_t>(i)};
   }
-  rbf_detail::sort_keyed(keyed);
+  detail::sort_keyed(keyed);
   std::vector<std::uint32_t> order(n);
   for (std::size_t i = 0; i < n; ++i) order[i] = keyed[i].second;
   return order;

@@ -14,9 +14,9 @@
 #include "near_duplicates.hpp"
 
 #include "parallel.hpp"
-#include "radix_sort.hpp"
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
+#include "vitri/core/radix_sort.hpp"
 
 #include <algorithm>
 #include <array>
@@ -52,7 +52,7 @@ GridRuns build_runs(const std::vector<Point3>& pts, const Box3& box, double cell
     keyed[i] = {(coord(p.x, box.lo.x) << 42) | (coord(p.y, box.lo.y) << 21) | coord(p.z, box.lo.z),
                 static_cast<std::uint32_t>(i)};
   }
-  sort_keyed(keyed);  // by (cell, index)
+  detail::sort_keyed(keyed);  // by (cell, index)
   GridRuns g;
   g.members.resize(pts.size());
   g.run_of.resize(pts.size());

@@ -1,6 +1,6 @@
-// sort_keyed (rbf/src/radix_sort.hpp): the order of std::sort on (key, index) pairs built as
+// sort_keyed (core/include/vitri/core/radix_sort.hpp): the order of std::sort on (key, index) pairs built as
 // {key(i), i}, for keys of every width, many ties, sizes on both sides of the std::sort threshold.
-#include "radix_sort.hpp"
+#include "vitri/core/radix_sort.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -10,8 +10,8 @@
 #include <utility>
 #include <vector>
 
-using vitri::rbf_detail::kRadixSortMin;
-using vitri::rbf_detail::sort_keyed;
+using vitri::detail::kRadixSortMin;
+using vitri::detail::sort_keyed;
 
 namespace {
 

@@ -1,6 +1,6 @@
 #pragma once
 // Bit spreading for space-filling-curve keys, shared by the Delaunay tree's Hilbert keys
-// (delaunay/src/spatial_sort.cpp) and the RBF's Morton order (rbf/src/spatial_order.hpp).
+// (delaunay/src/spatial_sort.cpp) and the RBF's Morton order (core/include/vitri/core/spatial_order.hpp).
 #include <cstdint>
 
 namespace vitri {

@@ -224,7 +224,9 @@ using ProgressCallback = std::function<bool(const RefineProgress&)>;
 /// being fitted, then hand it over to the constructor.
 struct SeedTetrahedralization {
   Box3 domain;
-  Triangulation tri;                   ///< the box corners and the seeds (canonical ids without history)
+  /// The box corners (vertices 0-7) and the seeds, which get their vertex ids in the order of a Morton
+  /// curve, not in the seeds' order (`inserted` maps them); canonical tetrahedron ids without history.
+  Triangulation tri;
   std::vector<InsertResult> inserted;  ///< per seed: its vertex, or (TooClose) the vertex it duplicates
   double insert_seconds = 0, canonical_seconds = 0;
 };
@@ -250,7 +252,10 @@ class Polygonizer {
   Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& seeds,
               const std::vector<double>& seed_values, const PolygonizerOptions& options);
   /// The first step of the constructor, which does not read the function: the domain box and the seeds
-  /// in a Delaunay tetrahedralization, renumbered canonically without the history.
+  /// in a Delaunay tetrahedralization, renumbered canonically without the history. The seeds' vertex ids
+  /// follow space (a Morton curve over the seeds' box): for a given function the Polygonizer's mesh does not
+  /// depend on the seeds' order, except through ties (seeds in one cell of 2^-21 of the box's longest
+  /// side keep their order) and which of two equal seeds gets the vertex.
   /// @throws as the constructor for the domain, the options and the seed points.
   static SeedTetrahedralization tetrahedralize_seeds(const Box3& domain, const std::vector<Point3>& seeds,
                                                      const PolygonizerOptions& options);

@@ -6,7 +6,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
-#include "radix_sort.hpp"
+#include "vitri/core/radix_sort.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -16,7 +16,7 @@
 #include <vector>
 
 namespace vitri {
-namespace rbf_detail {
+namespace detail {
 
 /// Indices of `points` sorted along the Morton curve of their bounding box (ties by index).
 /// @pre every point finite.
@@ -40,5 +40,5 @@ inline std::vector<std::size_t> spatial_order(const std::vector<Point3>& points)
   return order;
 }
 
-}  // namespace rbf_detail
+}  // namespace detail
 }  // namespace vitri

@@ -13,7 +13,7 @@
 #include <vector>
 
 namespace vitri {
-namespace rbf_detail {
+namespace detail {
 
 /// Below this many pairs std::sort is used (the radix passes' fixed costs dominate).
 constexpr std::size_t kRadixSortMin = std::size_t(1) << 12;
@@ -47,5 +47,5 @@ void sort_keyed(std::vector<std::pair<std::uint64_t, Index>>& keyed) {
   }
 }
 
-}  // namespace rbf_detail
+}  // namespace detail
 }  // namespace vitri

@@ -25,6 +25,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <numeric>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -145,7 +146,16 @@ std::size_t space_off_surface(std::vector<double>& offsets, const std::vector<Po
     candidates.push_back(k);
     at.push_back(points[keep[k]]);
   }
-  const std::vector<char> spaced = rbf_detail::spaced_subset(at, detail::spatial_order(at), spacing * d);
+  // Visited along the Morton curve: gathered in that order first, so that the visits read memory in
+  // order (the same visits, hence the same subset, as spaced_subset(at, order)).
+  const std::vector<std::size_t> order = detail::spatial_order(at);
+  std::vector<Point3> along(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) along[k] = at[order[k]];
+  std::vector<std::size_t> visit(order.size());
+  std::iota(visit.begin(), visit.end(), std::size_t{0});
+  const std::vector<char> spaced_along = rbf_detail::spaced_subset(along, visit, spacing * d);
+  std::vector<char> spaced(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) spaced[order[k]] = spaced_along[k];
   std::size_t left_out = 0;
   for (std::size_t c = 0; c < candidates.size(); ++c) {
     if (spaced[c]) continue;

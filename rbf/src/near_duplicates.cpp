@@ -7,7 +7,8 @@
 // with the members of its own cell in each grid (a "run" once the (cell, index) pairs are sorted).
 //
 // The points are then visited in input order; point i is compared with the kept members of its four
-// runs, all earlier than i. Kept members of a run are pairwise >= tol apart inside a cube of side L, so a
+// runs, all earlier than i. A point alone in its run of every grid (nearly all of them at the usual
+// tolerance) has no partner and is nobody's: it is kept without a visit. Kept members of a run are pairwise >= tol apart inside a cube of side L, so a
 // run holds a bounded number of them (L = 8 tol: at most about 9^3) and a cluster of a million copies of
 // one point costs O(n), not O(n^2). A run's kept members are compacted in place at the run's start, over
 // entries already visited.
@@ -30,16 +31,18 @@ namespace rbf_detail {
 
 namespace {
 
-constexpr int kGrids = 4;
+constexpr int kGrids = 4;  // merge_near_duplicates reads the four grids by name
 constexpr double kCellsPerAxis = 1 << 20;  // cell coordinates fit in 21 bits with the shift
 
 /// One shifted grid: its members sorted by (cell, index), the run of every point and the start of every
-/// run; `kept` counts the kept members compacted at the start of each run.
+/// run; `kept` counts the kept members compacted at the start of each run; `shared[i]` is 1 when point i
+/// is not alone in its run.
 struct GridRuns {
   std::vector<std::uint32_t> members;
   std::vector<std::uint32_t> run_of;
   std::vector<std::uint32_t> run_start;
   std::vector<std::uint32_t> kept;
+  std::vector<std::uint8_t> shared;
 };
 
 GridRuns build_runs(const std::vector<Point3>& pts, const Box3& box, double cell, double shift) {
@@ -62,6 +65,9 @@ GridRuns build_runs(const std::vector<Point3>& pts, const Box3& box, double cell
     g.run_of[keyed[k].second] = static_cast<std::uint32_t>(g.run_start.size() - 1);
   }
   g.kept.assign(g.run_start.size(), 0);
+  g.shared.assign(pts.size(), 0);
+  for (std::size_t k = 1; k < keyed.size(); ++k)
+    if (keyed[k].first == keyed[k - 1].first) g.shared[keyed[k].second] = g.shared[keyed[k - 1].second] = 1;
   return g;
 }
 
@@ -84,6 +90,7 @@ std::vector<std::size_t> merge_near_duplicates(const std::vector<Point3>& points
   });
   const double tol2 = tol * tol;
   for (std::size_t i = 0; i < n; ++i) {
+    if (!(grids[0].shared[i] | grids[1].shared[i] | grids[2].shared[i] | grids[3].shared[i])) continue;
     std::size_t partner = kKept;
     for (const GridRuns& g : grids) {
       const std::uint32_t run = g.run_of[i];

@@ -67,6 +67,14 @@ void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) 
   const std::size_t first = thin_.size();
   const auto check = [&](std::size_t lo, std::size_t hi, std::vector<ThinEdge>& out) {
     for (std::size_t k = lo; k < hi; ++k) {
+      // The test waits on memory: the records 16 ahead are fetched, and the values and gradients of
+      // the vertices of the one 8 ahead (its record fetched 8 iterations ago).
+      if (k + 16 < hi) tri_.prefetch_tet(tets[k + 16]);
+      if (k + 8 < hi && tri_.is_live(tets[k + 8]))
+        for (const VertexId u : tri_.tet_vertices(tets[k + 8])) {
+          __builtin_prefetch(&values_[u]);
+          __builtin_prefetch(&grad_[u]);
+        }
       const TetId t = tets[k];
       if (!tri_.is_live(t)) continue;
       const auto v = tri_.tet_vertices(t);

@@ -214,6 +214,9 @@ class Triangulation {
   const Point3& point(VertexId v) const { return pos_[pid(v)]; }
   /// t is a live tetrahedron (false for dead, recycled or out-of-range ids).
   bool is_live(TetId t) const { return t < tets_.size() && !tets_.is_dead(t); }
+  /// A hint for loops over many tetrahedra: starts fetching t's record and flags into the cache (no
+  /// other effect; t < tet_capacity()).
+  void prefetch_tet(TetId t) const { tets_.prefetch(t); }
   /// Vertex i (0..3) of tetrahedron t (live or dead).
   VertexId tet_vertex(TetId t, int i) const { return vid(tets_.vertex(t, i)); }
   /// Position of vertex i of t: point(tet_vertex(t, i)) without the id translation.

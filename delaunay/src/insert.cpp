@@ -35,8 +35,8 @@ Triangulation::Grow Triangulation::grow_cavity(const Point3& p, TetId start, boo
     // (below); now the positions of their vertices, so that its tests find both in the cache (the
     // refinement's cavities, about 30 tetrahedra, waited on these loads: its phase at 10^6 points took
     // 6.44 -> 5.79 s on average over five alternating pairs, docs/benchmarks.md; the bulk insertion's
-    // smaller cavities did not change). In a parallel pass u is owned and its neighbours
-    // share a face with it: records its thread may read (parallel_insert.cpp).
+    // smaller cavities did not change). In a parallel pass u is owned and its neighbours share a face
+    // with it: records its thread may read (parallel_insert.cpp).
     if (k + 1 < cav.tets.size()) {
       const TetId u = cav.tets[k + 1];
       for (int i = 0; i < 4; ++i) {

@@ -135,12 +135,12 @@ void check_options(const PolygonizerOptions& options) {
 }  // namespace
 
 // Batch insertion (randomized spatial order inside the Delaunay tree); exact duplicates are skipped.
-// The seeds get their vertex ids along a Morton curve (detail::spatial_order), not in the caller's order: the
-// per-vertex arrays, the canonical tetrahedron order below and with it the refinement queue then follow
-// space, whatever order the input came in (a shuffled 10^6-point input ran about 1.5-2 s slower in its
-// own order, docs/benchmarks.md). Without the history the tetrahedra are then renumbered canonically, so
-// that everything after (the refinement order follows tetrahedron ids) is the same whatever the threads of
-// the insertion.
+// The seeds get their vertex ids along a Morton curve (detail::spatial_order), not in the caller's order:
+// the per-vertex arrays, the canonical tetrahedron order below and with it the refinement queue then
+// follow space, whatever order the input came in (10^6 shuffled points ran 1.5-2 s slower than the same
+// points sorted, docs/benchmarks.md). Without the history the tetrahedra are then renumbered canonically,
+// so that everything after (the refinement order follows tetrahedron ids) is the same whatever the
+// threads of the insertion.
 SeedTetrahedralization Polygonizer::tetrahedralize_seeds(const Box3& domain, const std::vector<Point3>& seeds,
                                                          const PolygonizerOptions& options) {
   // The checks in the first constructor's order: the closing band, the domain (by the Triangulation), the

@@ -7,11 +7,11 @@
 // with the members of its own cell in each grid (a "run" once the (cell, index) pairs are sorted).
 //
 // The points are then visited in input order; point i is compared with the kept members of its four
-// runs, all earlier than i. A point alone in its run of every grid (nearly all of them at the usual
-// tolerance) has no partner and is nobody's: it is kept without a visit. Kept members of a run are pairwise >= tol apart inside a cube of side L, so a
+// runs, all earlier than i. Kept members of a run are pairwise >= tol apart inside a cube of side L, so a
 // run holds a bounded number of them (L = 8 tol: at most about 9^3) and a cluster of a million copies of
 // one point costs O(n), not O(n^2). A run's kept members are compacted in place at the run's start, over
-// entries already visited.
+// entries already visited. A point alone in its run of every grid (nearly all of them at the usual
+// tolerance) has no partner and is nobody's: it is kept without a visit.
 #include "near_duplicates.hpp"
 
 #include "parallel.hpp"

@@ -491,6 +491,36 @@ TEST_CASE("without the history, the seeds' threads do not change the mesh (canon
   REQUIRE(mesh[0].vertices == mesh[1].vertices);
 }
 
+TEST_CASE("the seeds' order does not change the mesh (their vertex ids follow a Morton curve)", "[polygonizer]") {
+  // Seeds given in two orders (one a shuffle of the other) get the same vertex ids, so the refinement
+  // (whose queue follows tetrahedron and vertex ids) and the mesh are the same, bit for bit; each seed
+  // maps to the vertex at its own position. With and without the history.
+  const TorusFunction f({0.0, 0.0, 0.1}, 1.0, 0.35);
+  const std::vector<Point3> seeds = uniform_seeds(20000, 5);
+  std::vector<std::size_t> perm(seeds.size());
+  for (std::size_t i = 0; i < perm.size(); ++i) perm[i] = i;
+  std::shuffle(perm.begin(), perm.end(), std::mt19937(17));
+  std::vector<Point3> shuffled(seeds.size());
+  for (std::size_t i = 0; i < perm.size(); ++i) shuffled[i] = seeds[perm[i]];
+  const bool history = GENERATE(false, true);
+  SurfaceMesh mesh[2];
+  std::vector<VertexId> vertex_of[2];
+  for (int k = 0; k < 2; ++k) {
+    PolygonizerOptions o;
+    o.keep_history = history;
+    Polygonizer poly(f, kCube, k == 0 ? seeds : shuffled, {}, o);
+    REQUIRE(poly.refine(0.2));
+    mesh[k] = poly.extract();
+    vertex_of[k] = poly.seed_vertices();
+    for (std::size_t i = 0; i < seeds.size(); ++i)
+      REQUIRE(poly.triangulation().point(vertex_of[k][i]) == (k == 0 ? seeds : shuffled)[i]);
+  }
+  require_closed(mesh[0], 0, 1);
+  for (std::size_t i = 0; i < perm.size(); ++i) REQUIRE(vertex_of[1][i] == vertex_of[0][perm[i]]);
+  REQUIRE(mesh[0].triangles == mesh[1].triangles);
+  REQUIRE(mesh[0].vertices == mesh[1].vertices);
+}
+
 // The helper on its own: the values (and gradients) of f at the points offered, in order; offers past
 // the capacity refused; an error of f rethrown by finish(); a helper given nothing stops cleanly.
 TEST_CASE("ValuesAhead: f at the points offered, on a helper thread", "[polygonizer]") {

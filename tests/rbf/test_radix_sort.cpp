@@ -1,5 +1,5 @@
-// sort_keyed (core/include/vitri/core/radix_sort.hpp): the order of std::sort on (key, index) pairs built as
-// {key(i), i}, for keys of every width, many ties, sizes on both sides of the std::sort threshold.
+// sort_keyed (core/include/vitri/core/radix_sort.hpp): the order of std::sort on (key, index) pairs
+// built as {key(i), i}, for keys of every width, many ties, sizes on both sides of the std::sort threshold.
 #include "vitri/core/radix_sort.hpp"
 
 #include <catch2/catch.hpp>

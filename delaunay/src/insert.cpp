@@ -25,14 +25,19 @@ Triangulation::Grow Triangulation::grow_cavity(const Point3& p, TetId start, boo
   cav.tets.clear();
   cav.boundary.clear();
   cav.tested.clear();
-  tets_.mark(start, Store::kMark);
-  cav.tets.push_back(start);
+  // A tetrahedron joining the cavity has its neighbours' records and flags fetched at once (they are
+  // tested when its turn comes).
+  const auto join = [&](TetId n) {
+    tets_.mark(n, Store::kMark);
+    cav.tets.push_back(n);
+    for (int j = 0; j < 4; ++j)
+      if (tets_.neighbor(n, j) != kNoTet) tets_.prefetch(tets_.neighbor(n, j));
+  };
+  join(start);
   for (std::size_t k = 0; k < cav.tets.size(); ++k) {
     const TetId t = cav.tets[k];
-    for (int i = 0; i < 4; ++i)
-      if (tets_.neighbor(t, i) != kNoTet) tets_.prefetch(tets_.neighbor(t, i));
-    // Two steps ahead: the next queued tetrahedron's neighbours' records were fetched when it joined
-    // (below); now the positions of their vertices, so that its tests find both in the cache (the
+    // Two steps ahead: the next queued tetrahedron's neighbours' records were fetched when it joined;
+    // now the positions of their vertices, so that its tests find both in the cache (the
     // refinement's cavities, about 30 tetrahedra, waited on these loads: its phase at 10^6 points took
     // 6.44 -> 5.79 s on average over five alternating pairs, docs/benchmarks.md; the bulk insertion's
     // smaller cavities did not change). In a parallel pass u is owned and its neighbours share a face
@@ -71,10 +76,7 @@ Triangulation::Grow Triangulation::grow_cavity(const Point3& p, TetId start, boo
           clear_cavity_marks(cav);
           return Grow::Blocked;
         }
-        tets_.mark(n, Store::kMark);
-        cav.tets.push_back(n);
-        for (int j = 0; j < 4; ++j)
-          if (tets_.neighbor(n, j) != kNoTet) tets_.prefetch(tets_.neighbor(n, j));
+        join(n);
       } else {
         tets_.mark(n, Store::kTested);
         cav.tested.push_back(n);

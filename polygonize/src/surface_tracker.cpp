@@ -29,10 +29,6 @@ std::uint32_t take_slot(std::vector<Record>& records, std::vector<std::uint32_t>
   return slot;
 }
 
-inline std::uint64_t edge_key(VertexId a, VertexId b) {
-  return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
-}
-
 Point3 unit_or_zero(const Point3& g) {
   const double l = norm(g);
   return (l > 0.0 && std::isfinite(l)) ? g / l : Point3{0.0, 0.0, 0.0};
@@ -103,6 +99,7 @@ void SurfaceTracker::update(const TrackerInput& in) {
     reset_all(in, w);
     w.every_polygon = true;  // every polygon is new, hence in w.remesh already
   } else {
+    if (!edge_index_ready_) index_edges();
     collect_tets(in, w);
   }
   rebuild_polygons(in, w);
@@ -146,14 +143,7 @@ void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
   max_edge_ = 0.0;
   w.tets = in.transverse;
   detail::sort_unique_ids(w.tets, id_bits_);  // distinct already: sorted
-  // About 0.7 crossed edges per transverse tetrahedron (each edge is shared by the 5 or 6 tetrahedra
-  // around it; 10^5 samples of man.off: 511,706 edges, 749,749 tetrahedra): room for 0.75.
-  // The records are reserved too: grown by doubling, the edges were reallocated and copied up to 671 MB
-  // at 10^6 points, for about 5 x 10^6 used (390 MB).
-  edge_index_.reserve(w.tets.size() * 3 / 4);
-  edges_.reserve(w.tets.size() * 3 / 4);
-  polygons_.reserve(w.tets.size());
-  rebuild_ = false;
+  rebuild_ = false;  // build_all_polygons sizes the records exactly
 }
 
 // The tetrahedra to rebuild: killed, created, and the stars of vertices whose value or position changed
@@ -200,8 +190,12 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
 // placed again when an end of one of its edges changed). In chunks: each chunk is marched ahead (on the
 // threads when large), then its polygons and edges are made in order by this thread.
 void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
-  // The edge table is read at random (a full build: millions of edges): the crossed edges of the
-  // tetrahedron kLookahead places ahead are prefetched.
+  if (w.every_polygon) {
+    build_all_polygons(in, w);
+    return;
+  }
+  // The edge table is read at random (a sweep: millions of edges): the crossed edges of the tetrahedron
+  // kLookahead places ahead are prefetched.
   constexpr std::size_t kLookahead = 8;
   constexpr std::size_t kChunk = std::size_t(1) << 16;
   std::vector<Marched> ahead;

@@ -26,6 +26,7 @@
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -135,6 +136,14 @@ class SurfaceTracker {
     marching::CellPolygon cell;  // no corners when the tetrahedron is dead (v is then not read)
   };
   void rebuild_polygons(const TrackerInput& in, Work& w);
+  /// A full build's polygons and edges, without the edge index (surface_full_build.cpp).
+  void build_all_polygons(const TrackerInput& in, Work& w);
+  /// edge_index_ for the live edges (the first incremental update after a full build).
+  void index_edges();
+  /// The edge index key of the vertex pair {a, b}.
+  static std::uint64_t edge_key(VertexId a, VertexId b) {
+    return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | std::max(a, b);
+  }
   static void march_ahead(const TrackerInput& in, const TetId* tets, std::size_t n, Marched* out);
   void rebuild_polygon(TetId t, const Marched& m, Work& w);
   std::uint32_t edge_slot(VertexId neg, VertexId pos, Work& w);
@@ -199,7 +208,8 @@ class SurfaceTracker {
   bool rebuild_ = true;
   bool sweep_ = false;
   double max_edge_ = 0.0;
-  EdgeMap edge_index_;  // vertex pair -> edge slot
+  EdgeMap edge_index_;  // vertex pair -> edge slot, for every live edge when edge_index_ready_
+  bool edge_index_ready_ = true;  // false after a full build, until an incremental update needs it
   std::vector<Edge> edges_;
   std::vector<std::uint32_t> free_edges_;
   std::vector<Polygon> polygons_;

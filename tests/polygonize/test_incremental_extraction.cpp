@@ -524,6 +524,41 @@ TEST_CASE("collapse decisions looked ahead on the threads equal those made one a
   test::require_closed(a, 2, 1);
 }
 
+TEST_CASE("a full build on several threads equals one on one thread, and later updates stay exact", "[incremental]") {
+  // A full build numbers the crossed edges by counting sort on slices of the threads (tens of thousands
+  // of polygons here: several slices), and leaves the vertex-pair index to the first incremental update.
+  // One thread and four must give the same mesh bit for bit; a change of f in a ball, then a finer level,
+  // must give the fresh extraction's mesh (the index was built from the slices' edges).
+  std::vector<SurfaceMesh> first, edited;
+  for (const unsigned threads : {1u, 4u}) {
+    INFO(threads << " threads");
+    BumpedSphere f;
+    PolygonizerOptions options;
+    options.warm_start_roots = false;  // the placement then depends on the state only
+    options.threads = threads;
+    const double precision = 0.04;
+    Polygonizer poly(f, kCube, {}, {}, options);
+    REQUIRE(poly.refine(precision));
+    REQUIRE(poly.transverse_tetrahedra().size() > 4 * (std::size_t(1) << 13));
+    first.push_back(poly.extract());
+    test::require_closed(first.back(), 2, 1);
+    f.a = 0.25;
+    poly.function_changed({Ball{f.b, f.R}});
+    REQUIRE(poly.refine(precision));
+    const MeshDelta d = poly.update_surface();
+    REQUIRE_FALSE(d.full);
+    REQUIRE(canonical(poly.live_surface().to_surface_mesh()) == canonical(poly.extract_fresh()));
+    REQUIRE(poly.refine(0.7 * precision));
+    REQUIRE_FALSE(poly.update_surface().full);
+    edited.push_back(poly.live_surface().to_surface_mesh());
+    REQUIRE(canonical(edited.back()) == canonical(poly.extract_fresh()));
+    test::require_closed(edited.back(), 2, 1);
+  }
+  REQUIRE(first[0].vertices == first[1].vertices);
+  REQUIRE(first[0].triangles == first[1].triangles);
+  REQUIRE(canonical(edited[0]) == canonical(edited[1]));
+}
+
 TEST_CASE("sort_unique_ids orders and deduplicates like std::sort + std::unique", "[extraction]") {
   std::mt19937_64 rng(21);
   std::vector<std::uint64_t> bits;

@@ -5,13 +5,13 @@
 // single cycle of length >= 3 (a disk around the new vertex, one fan per neighbour) and each is not flat
 // afterwards and keeps its orientation (a flat one has none to keep); triangles with two S_z corners
 // vanish. A crossing whose anchor does not collapse is kept off it (place_edges). The test sees the
-// collapses of lower ids already applied (their corners at their vertex, their vanished triangles gone) and the
-// higher ones not yet. An update re-decides the vertices of the tetrahedra it rebuilt in increasing id;
+// collapses of lower ids already applied (their corners at their vertex, their vanished triangles gone) and
+// the higher ones not yet. An update re-decides the vertices of the tetrahedra it rebuilt in increasing id;
 // when a decision flips, the higher anchored vertices of the flipped vertex's star are re-decided too
 // (their test may see the flipped triangles). Lower decisions are final when a vertex is decided, so the
 // result equals the one-pass result, which the tests check against a fresh tracker.
-#include "surface_tracker.hpp"
 #include "slices.hpp"
+#include "surface_tracker.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -70,14 +70,17 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
   SnapLookahead look;
   std::size_t next = 0;
   // A full build offered every anchored vertex above (each is a corner of a rebuilt transverse
-  // tetrahedron) and remeshes every polygon: a flip has nothing to re-offer or remesh there.
+  // tetrahedron) and remeshes every polygon: a flip has nothing to re-offer or remesh there, so no star
+  // is kept, and the fans are gathered at the anchored corners (no star is walked).
   const bool full = w.every_polygon;
+  AnchoredCorners corners;
+  if (ahead && full) anchored_corners(in, corners);
   while (next < first.size() || !heap.empty()) {
     VertexId z;
     bool now;
     if (heap.empty() || (next < first.size() && first[next] < heap.top())) {
       if (ahead) {
-        if (next == look.end) look_ahead(in, first, next, look);
+        if (next == look.end) look_ahead(in, first, next, full ? &corners : nullptr, look);
         const SnapLookahead::Span& sp = look.span(next);
         const SnapLookahead::Slice& slice = look.slices[sp.slice];
         if (!full) star_.assign(slice.stars.begin() + sp.star_first, slice.stars.begin() + sp.star_last);
@@ -110,7 +113,7 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
 // the chunk run on the threads and the serial pass reads what it would have computed. The targets join
 // the cache (the evaluations the serial pass would have made: same vertices, same calls of f).
 void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<VertexId>& first, std::size_t from,
-                                SnapLookahead& look) {
+                                const AnchoredCorners* at, SnapLookahead& look) {
   const std::size_t n = std::min(kLookaheadChunk, first.size() - from);
   look.begin = from;
   look.end = from + n;
@@ -124,15 +127,30 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
     out.targets.clear();
     std::vector<TetId> star, stars;
     std::vector<std::size_t> ends;
+    const auto add_target = [&](VertexId z) {
+      if (in.values[z] == 0.0 || snap_target_.count(z)) return;  // snap_target(z) evaluates nothing
+      const Point3& p = in.tri.point(z);
+      Point3 g;
+      const double fz = in.f.value_gradient(p, g);
+      out.targets.emplace_back(z, newton_target(p, fz, g));
+    };
     for (std::size_t k = lo; k < hi; ++k) {
       const VertexId z = first[from + k];
+      SnapLookahead::Span& sp = look.spans[k];
+      sp.slice = static_cast<std::uint32_t>(s);
+      if (at) {  // a full build: the fan from the anchored corners, no star
+        sp.fan_first = sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
+        if (!in.tri.is_vertex(z) || !may_collapse(in, z)) continue;
+        gather_fan_at(z, at->corners.data() + at->start[z], at->start[z + 1] - at->start[z], out.fans);
+        sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
+        add_target(z);
+        continue;
+      }
       if ((k - lo) % kStarChunk == 0)  // the next stars walked together: their cache misses overlap
         in.tri.incident_tetrahedra(first.data() + from + k, std::min(kStarChunk, hi - k), stars, ends);
       const std::size_t j = (k - lo) % kStarChunk;
       star.assign(stars.begin() + static_cast<std::ptrdiff_t>(j == 0 ? 0 : ends[j - 1]),
                   stars.begin() + static_cast<std::ptrdiff_t>(ends[j]));
-      SnapLookahead::Span& sp = look.spans[k];
-      sp.slice = static_cast<std::uint32_t>(s);
       sp.star_first = static_cast<std::uint32_t>(out.stars.size());
       out.stars.insert(out.stars.end(), star.begin(), star.end());
       sp.star_last = static_cast<std::uint32_t>(out.stars.size());
@@ -140,11 +158,7 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
       if (star.empty() || !may_collapse(in, z)) continue;  // the test reads nothing more
       gather_fan(z, star, out.fans);
       sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
-      if (in.values[z] == 0.0 || snap_target_.count(z)) continue;  // snap_target(z) evaluates nothing
-      const Point3& p = in.tri.point(z);
-      Point3 g;
-      const double fz = in.f.value_gradient(p, g);
-      out.targets.emplace_back(z, newton_target(p, fz, g));
+      add_target(z);
     }
   });
   for (const SnapLookahead::Slice& slice : look.slices) {
@@ -185,7 +199,8 @@ bool SurfaceTracker::collapse_test(const TrackerInput& in, VertexId z) {
 
 // The triangles of the polygons of z's star with exactly one corner anchored at z, that corner first
 // (the cyclic order kept). Triangles with none do not change; those with two or more vanish.
-void SurfaceTracker::gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const {
+void SurfaceTracker::gather_fan(VertexId z, const std::vector<TetId>& star,
+                                std::vector<FanTriangle>& out) const {
   for (const TetId t : star) {
     const std::uint32_t pi = t < polygon_of_.size() ? polygon_of_[t] : kNone;
     if (pi == kNone) continue;
@@ -209,6 +224,75 @@ void SurfaceTracker::gather_fan(VertexId z, const std::vector<TetId>& star, std:
       out.push_back(f);
     }
   }
+}
+
+void SurfaceTracker::gather_fan_at(VertexId z, const std::uint32_t* corners, std::size_t n,
+                                   std::vector<FanTriangle>& out) const {
+  for (std::size_t c = 0; c < n; ++c) {
+    const Polygon& poly = polygons_[corners[c] >> 2];
+    const int corner = static_cast<int>(corners[c] & 3);
+    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
+      const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
+      int inside = 0, first = -1;
+      for (int i = 0; i < 3; ++i)
+        if (edges_[poly.e[idx[i]]].anchor == z) {
+          ++inside;
+          if (idx[i] == corner) first = i;
+        }
+      // A triangle without this corner, or with another corner at z (it vanishes: not in the fan).
+      if (first < 0 || inside != 1) continue;
+      FanTriangle f;
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t e = poly.e[idx[(first + i) % 3]];
+        f.e[i] = e;
+        f.anchor[i] = edges_[e].anchor;
+        f.x[i] = edges_[e].x;
+      }
+      out.push_back(f);
+    }
+  }
+}
+
+// Each slice of polygons counts its anchored corners per anchor in its own row, then drops them into
+// the anchors' buckets (a counting sort; at most 8 slices for the rows' memory). The order in a bucket
+// (slices, then polygons) does not matter to the fans' test.
+void SurfaceTracker::anchored_corners(const TrackerInput& in, AnchoredCorners& out) const {
+  const std::size_t n = polygons_.size(), nv = in.tri.vertex_capacity();
+  constexpr std::size_t kSliceMin = std::size_t(1) << 13, kMaxSlices = 8;
+  const std::size_t slices = std::min(polygonizer_detail::slice_count(in.threads, n, kSliceMin), kMaxSlices);
+  // The edges' anchors in a compact array first: the polygon passes read them at random.
+  std::vector<VertexId> anchor(edges_.size());
+  polygonizer_detail::run_slices(edges_.size(), slices, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t e = lo; e < hi; ++e) anchor[e] = edges_[e].anchor;
+  });
+  std::vector<std::uint32_t> row(slices * nv, 0);
+  const auto each_anchored = [&](std::size_t lo, std::size_t hi, auto&& fn) {
+    for (std::size_t p = lo; p < hi; ++p)
+      for (int i = 0; i < polygons_[p].corners; ++i) {
+        const VertexId a = anchor[polygons_[p].e[i]];
+        if (a != kNoVertex) fn(a, static_cast<std::uint32_t>(4 * p + static_cast<std::size_t>(i)));
+      }
+  };
+  polygonizer_detail::run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
+    std::uint32_t* const count = row.data() + s * nv;
+    each_anchored(lo, hi, [&](VertexId a, std::uint32_t) { ++count[a]; });
+  });
+  out.start.assign(nv + 1, 0);
+  std::uint32_t sum = 0;  // at most 4 corners per polygon, below 2^30 polygons (build_all_polygons)
+  for (std::size_t a = 0; a < nv; ++a) {
+    out.start[a] = sum;
+    for (std::size_t s = 0; s < slices; ++s) {
+      const std::uint32_t here = row[s * nv + a];
+      row[s * nv + a] = sum;
+      sum += here;
+    }
+  }
+  out.start[nv] = sum;
+  out.corners.resize(sum);
+  polygonizer_detail::run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
+    std::uint32_t* const cursor = row.data() + s * nv;
+    each_anchored(lo, hi, [&](VertexId a, std::uint32_t c) { out.corners[cursor[a]++] = c; });
+  });
 }
 
 // The collapse test of z on its fan, with the collapses decided so far (all of lower ids) applied.

@@ -106,7 +106,7 @@ void SurfaceTracker::update(const TrackerInput& in) {
   report_.polygons_seconds = lap();
   place_edges(in, w);
   report_.placement_seconds = lap();
-  split_polygons(w);
+  split_polygons(in, w);
   decide_snapping(in, w);
   report_.snapping_seconds = lap();
   // A full build adds at most a vertex per crossed edge and two triangles per polygon: reserved, so that
@@ -364,14 +364,21 @@ void SurfaceTracker::project_pushed(const TrackerInput& in, const std::vector<st
   }
 }
 
-void SurfaceTracker::split_polygons(Work& w) {
+void SurfaceTracker::split_polygons(const TrackerInput& in, Work& w) {
   detail::sort_unique_ids(w.remesh, id_bits_);
-  for (const std::uint32_t p : w.remesh) {
-    Polygon& poly = polygons_[p];
-    if (poly.corners == 4)
-      poly.split = static_cast<std::uint8_t>(marching::quad_split(edges_[poly.e[0]].x, edges_[poly.e[1]].x,
-                                                                  edges_[poly.e[2]].x, edges_[poly.e[3]].x));
-  }
+  // Each polygon's split depends on its corners only: slices of a large list run on the threads.
+  constexpr std::size_t kSliceMin = std::size_t(1) << 14;
+  const std::size_t n = w.remesh.size();
+  polygonizer_detail::run_slices(
+      n, polygonizer_detail::slice_count(in.threads, n, kSliceMin),
+      [&](std::size_t, std::size_t lo, std::size_t hi) {
+        for (std::size_t k = lo; k < hi; ++k) {
+          Polygon& poly = polygons_[w.remesh[k]];
+          if (poly.corners != 4) continue;
+          poly.split = static_cast<std::uint8_t>(marching::quad_split(
+              edges_[poly.e[0]].x, edges_[poly.e[1]].x, edges_[poly.e[2]].x, edges_[poly.e[3]].x));
+        }
+      });
 }
 
 // The LiveMesh vertex of a corner: the collapsed vertex's, or the edge's own (created on first use).

@@ -152,7 +152,7 @@ class SurfaceTracker {
   void place_edges(const TrackerInput& in, Work& w);
   void project_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed);
   void set_anchor(std::uint32_t e, VertexId anchor);
-  void split_polygons(Work& w);
+  void split_polygons(const TrackerInput& in, Work& w);
   void decide_snapping(const TrackerInput& in, Work& w);
   /// A triangle around z with exactly one corner anchored at z (corner 0, the cyclic order kept): what
   /// the collapse test of z reads of it, fixed while the decisions are made.
@@ -177,8 +177,16 @@ class SurfaceTracker {
     std::vector<Slice> slices;
     const Span& span(std::size_t offer) const { return spans[offer - begin]; }
   };
+  /// The polygon corners (named 4 x polygon + corner) grouped by the vertex their crossing is anchored
+  /// at: corners[start[z], start[z + 1]) are z's. A full build's lookahead gathers fans there.
+  struct AnchoredCorners {
+    std::vector<std::uint32_t> start, corners;
+  };
+  void anchored_corners(const TrackerInput& in, AnchoredCorners& out) const;
+  /// `at`: null, or the anchored corners of a full build (the fans are then gathered from them, and no
+  /// star is kept).
   void look_ahead(const TrackerInput& in, const std::vector<VertexId>& first, std::size_t from,
-                  SnapLookahead& look);
+                  const AnchoredCorners* at, SnapLookahead& look);
   /// The star of z in star_, then collapse_test (false for a removed z).
   bool can_collapse(const TrackerInput& in, VertexId z);
   /// Snapping is on and z has anchored crossings: the collapse test has something to decide.
@@ -186,6 +194,8 @@ class SurfaceTracker {
   /// The test of a live z whose star is in star_: its fan (gather_fan), then fan_test.
   bool collapse_test(const TrackerInput& in, VertexId z);
   void gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const;
+  /// The same fan (in another order, which the test does not depend on) from z's anchored corners.
+  void gather_fan_at(VertexId z, const std::uint32_t* corners, std::size_t n, std::vector<FanTriangle>& out) const;
   bool fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count);
   void remesh_polygons(const TrackerInput& in, Work& w);
   std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);

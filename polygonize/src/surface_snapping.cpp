@@ -205,24 +205,7 @@ void SurfaceTracker::gather_fan(VertexId z, const std::vector<TetId>& star,
     const std::uint32_t pi = t < polygon_of_.size() ? polygon_of_[t] : kNone;
     if (pi == kNone) continue;
     const Polygon& poly = polygons_[pi];
-    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
-      const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
-      int inside = 0, first = -1;
-      for (int i = 0; i < 3; ++i)
-        if (edges_[poly.e[idx[i]]].anchor == z) {
-          ++inside;
-          if (first < 0) first = i;
-        }
-      if (inside != 1) continue;
-      FanTriangle f;
-      for (int i = 0; i < 3; ++i) {
-        const std::uint32_t e = poly.e[idx[(first + i) % 3]];
-        f.e[i] = e;
-        f.anchor[i] = edges_[e].anchor;
-        f.x[i] = edges_[e].x;
-      }
-      out.push_back(f);
-    }
+    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) add_fan_triangle(poly, k, z, -1, out);
   }
 }
 
@@ -230,27 +213,31 @@ void SurfaceTracker::gather_fan_at(VertexId z, const std::uint32_t* corners, std
                                    std::vector<FanTriangle>& out) const {
   for (std::size_t c = 0; c < n; ++c) {
     const Polygon& poly = polygons_[corners[c] >> 2];
-    const int corner = static_cast<int>(corners[c] & 3);
-    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k) {
-      const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
-      int inside = 0, first = -1;
-      for (int i = 0; i < 3; ++i)
-        if (edges_[poly.e[idx[i]]].anchor == z) {
-          ++inside;
-          if (idx[i] == corner) first = i;
-        }
-      // A triangle without this corner, or with another corner at z (it vanishes: not in the fan).
-      if (first < 0 || inside != 1) continue;
-      FanTriangle f;
-      for (int i = 0; i < 3; ++i) {
-        const std::uint32_t e = poly.e[idx[(first + i) % 3]];
-        f.e[i] = e;
-        f.anchor[i] = edges_[e].anchor;
-        f.x[i] = edges_[e].x;
-      }
-      out.push_back(f);
-    }
+    for (int k = 0; k < (poly.corners == 4 ? 2 : 1); ++k)
+      add_fan_triangle(poly, k, z, static_cast<int>(corners[c] & 3), out);
   }
+}
+
+// Triangle k of poly joins z's fan when exactly one of its corners is anchored at z, and (when `corner`
+// is a polygon corner, not -1) that corner is this one: each fan triangle is then found from one corner.
+void SurfaceTracker::add_fan_triangle(const Polygon& poly, int k, VertexId z, int corner,
+                                      std::vector<FanTriangle>& out) const {
+  const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
+  int inside = 0, first = -1;
+  for (int i = 0; i < 3; ++i)
+    if (edges_[poly.e[idx[i]]].anchor == z) {
+      ++inside;
+      if (first < 0 && (corner < 0 || idx[i] == corner)) first = i;
+    }
+  if (inside != 1 || first < 0) return;  // with two or three corners at z it vanishes
+  FanTriangle f;
+  for (int i = 0; i < 3; ++i) {
+    const std::uint32_t e = poly.e[idx[(first + i) % 3]];
+    f.e[i] = e;
+    f.anchor[i] = edges_[e].anchor;
+    f.x[i] = edges_[e].x;
+  }
+  out.push_back(f);
 }
 
 // Each slice of polygons counts its anchored corners per anchor in its own row, then drops them into

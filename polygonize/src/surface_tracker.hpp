@@ -196,6 +196,7 @@ class SurfaceTracker {
   void gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const;
   /// The same fan (in another order, which the test does not depend on) from z's anchored corners.
   void gather_fan_at(VertexId z, const std::uint32_t* corners, std::size_t n, std::vector<FanTriangle>& out) const;
+  void add_fan_triangle(const Polygon& poly, int k, VertexId z, int corner, std::vector<FanTriangle>& out) const;
   bool fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count);
   void remesh_polygons(const TrackerInput& in, Work& w);
   std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);

@@ -58,11 +58,17 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
     else
       first.push_back(u);
   };
-  for (const TetId t : w.tets)
-    if (in.tri.is_live(t))
-      for (const VertexId u : in.tri.tet_vertices(t)) offer(u);
-  for (const VertexId u : touched_) offer(u);  // removed vertices among them drop their collapse
-  std::sort(first.begin(), first.end());
+  if (w.every_polygon) {
+    // A full build: an anchored vertex is an end of a crossed edge, so a corner of a rebuilt transverse
+    // tetrahedron, and nothing is collapsed yet: the offers are the anchored vertices, in id order.
+    for (VertexId u = 0; u < anchored_.size(); ++u) offer(u);
+  } else {
+    for (const TetId t : w.tets)
+      if (in.tri.is_live(t))
+        for (const VertexId u : in.tri.tet_vertices(t)) offer(u);
+    for (const VertexId u : touched_) offer(u);  // removed vertices among them drop their collapse
+    std::sort(first.begin(), first.end());
+  }
   deciding = true;
   // A large update (a full build: about one offer per on-surface constraint) takes the stars and snap
   // targets of its first offers from a lookahead computed on the threads.

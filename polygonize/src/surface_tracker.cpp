@@ -478,15 +478,17 @@ void SurfaceTracker::retire_triangles(Work& w) {
 // Vertices of placed edges move to their new roots; vertices at a moved (or re-valued) Delaunay vertex
 // follow it; normals that the root finder did not give are evaluated in one batch.
 void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
-  for (const std::uint32_t e : w.placed) {
-    const Edge& edge = edges_[e];
-    if (edge.pos == kNoVertex || edge.out == kNone) continue;
-    const std::uint32_t v = edge.out;
-    const Point3 n = edge.has_gradient ? unit_or_zero(edge.gradient) : Point3{0.0, 0.0, 0.0};
-    if (mesh_.position(v) == edge.x && mesh_.normal(v) == n) continue;
-    mesh_.move_vertex(v, edge.x, n);
-    if (!edge.has_gradient) w.normals.push_back(v);
-  }
+  // A full build made every vertex of a placed edge just now, where it is and with its normal.
+  if (!w.every_polygon)
+    for (const std::uint32_t e : w.placed) {
+      const Edge& edge = edges_[e];
+      if (edge.pos == kNoVertex || edge.out == kNone) continue;
+      const std::uint32_t v = edge.out;
+      const Point3 n = edge.has_gradient ? unit_or_zero(edge.gradient) : Point3{0.0, 0.0, 0.0};
+      if (mesh_.position(v) == edge.x && mesh_.normal(v) == n) continue;
+      mesh_.move_vertex(v, edge.x, n);
+      if (!edge.has_gradient) w.normals.push_back(v);
+    }
   for (const VertexId z : touched_) {
     if (z >= zero_out_.size() || zero_out_[z] == kNone) continue;
     const std::uint32_t v = zero_out_[z];

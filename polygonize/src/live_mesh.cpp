@@ -1,8 +1,12 @@
 // LiveMesh: slots with free lists, and the record of one delta (live_mesh.hpp).
 #include "vitri/polygonize/live_mesh.hpp"
 
+#include "vitri/core/error.hpp"
+
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <string>
 
 namespace vitri {
 
@@ -111,6 +115,40 @@ void LiveMesh::clear() {
   removed_v_.clear();
   moved_v_.clear();
   full_ = true;
+}
+
+void LiveMesh::fill(std::vector<Point3> positions, std::vector<Point3> normals,
+                    std::vector<std::array<std::uint32_t, 3>> triangles) {
+  if (!vpos_.empty() || !tris_.empty())
+    throw InvalidArgument("LiveMesh::fill: the mesh is not empty (" + std::to_string(vpos_.size()) +
+                          " vertex and " + std::to_string(tris_.size()) + " triangle slots)");
+  if (normals.size() != positions.size())
+    throw InvalidArgument("LiveMesh::fill: " + std::to_string(positions.size()) + " positions but " +
+                          std::to_string(normals.size()) + " normals");
+  const std::size_t n = positions.size();
+  if (n >= kNone || triangles.size() >= kNone)
+    throw LimitError("LiveMesh::fill: more than 2^32 - 2 vertices or triangles");
+  std::vector<std::uint32_t> refs(n, 0);
+  for (std::size_t t = 0; t < triangles.size(); ++t) {
+    const auto& c = triangles[t];
+    if (c[0] >= n || c[1] >= n || c[2] >= n || c[0] == c[1] || c[1] == c[2] || c[0] == c[2])
+      throw InvalidArgument("LiveMesh::fill: triangle " + std::to_string(t) +
+                            " has a corner out of range or repeated");
+    for (const std::uint32_t v : c) ++refs[v];
+  }
+  for (std::size_t v = 0; v < n; ++v)
+    if (refs[v] == 0)
+      throw InvalidArgument("LiveMesh::fill: vertex " + std::to_string(v) + " has no triangle");
+  vpos_ = std::move(positions);
+  vnormal_ = std::move(normals);
+  vrefs_ = std::move(refs);
+  tris_ = std::move(triangles);
+  live_vertices_ = n;
+  live_triangles_ = tris_.size();
+  added_v_.resize(n);
+  std::iota(added_v_.begin(), added_v_.end(), 0u);
+  added_t_.resize(tris_.size());
+  std::iota(added_t_.begin(), added_t_.end(), 0u);
 }
 
 MeshDelta LiveMesh::whole_delta() const {

@@ -167,6 +167,117 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
   edge_index_ready_ = false;
 }
 
+// A full build's live mesh: the triangles and vertices that remesh_polygons would make over every
+// polygon in order, with the same ids, from passes on slices of the polygons. A triangle's id is its
+// rank among the kept triangles (polygon, then its triangle 0 and 1); a mesh vertex is made by the
+// first corner that uses it (its owner: a crossed edge, or a vertex its anchored crossings collapsed
+// onto), so its id is the rank of that corner's position 3 x triangle + corner among the first uses:
+// each slice marks its uses of an owner with an atomic minimum of the position, then the slices count
+// and number the first uses they hold, in order.
+void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
+  const std::size_t n = polygons_.size(), num_edges = edges_.size();
+  constexpr std::size_t kSliceMin = std::size_t(1) << 13;
+  const std::size_t slices = slice_count(in.threads, n, kSliceMin);
+  const auto slot_of = [&](std::uint32_t owner) {  // owners numbered: edges, then Delaunay vertices
+    return (owner & kZeroTag) ? num_edges + (owner & ~kZeroTag) : static_cast<std::size_t>(owner);
+  };
+  // Each edge's corner identity in a compact array first: the polygon passes read them at random.
+  std::vector<std::uint32_t> identity(num_edges);
+  run_slices(num_edges, slices, [&](std::size_t, std::size_t lo, std::size_t hi) {
+    for (std::size_t e = lo; e < hi; ++e) identity[e] = corner_identity(static_cast<std::uint32_t>(e));
+  });
+  // The corners' owners of polygon p's triangle k, and whether it is kept (no two corners merged).
+  const auto owners = [&](const Polygon& poly, int k, std::array<std::uint32_t, 3>& id) {
+    if (k == 1 && poly.corners != 4) return false;
+    const auto idx = marching::polygon_triangle(poly.corners, poly.split, k);
+    for (int i = 0; i < 3; ++i) id[i] = identity[poly.e[idx[i]]];
+    return id[0] != id[1] && id[1] != id[2] && id[0] != id[2];
+  };
+  // 1. Kept triangles per slice.
+  std::vector<std::size_t> tris_in(slices + 1, 0);
+  run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
+    std::array<std::uint32_t, 3> id{};
+    std::size_t count = 0;
+    for (std::size_t p = lo; p < hi; ++p)
+      for (int k = 0; k < 2; ++k) count += owners(polygons_[p], k, id);
+    tris_in[s + 1] = count;
+  });
+  std::partial_sum(tris_in.begin(), tris_in.end(), tris_in.begin());
+  const std::size_t num_tris = tris_in[slices];
+  if (num_tris >= LiveMesh::kNone) throw LimitError("surface extraction: more than 2^32 - 2 triangles");
+  // 2. Each owner's first use: the smallest position 3 t + i among its corners.
+  constexpr std::uint64_t kUnused = ~std::uint64_t{0};
+  std::vector<std::uint64_t> first_use(num_edges + zero_out_.size(), kUnused);
+  std::vector<std::array<std::uint32_t, 3>> triangles(num_tris);
+  run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
+    std::array<std::uint32_t, 3> id{};
+    std::uint64_t t = tris_in[s];
+    for (std::size_t p = lo; p < hi; ++p)
+      for (int k = 0; k < 2; ++k) {
+        polygons_[p].out[k] = kNone;
+        if (!owners(polygons_[p], k, id)) continue;
+        polygons_[p].out[k] = static_cast<std::uint32_t>(t);
+        for (int i = 0; i < 3; ++i) {
+          triangles[t][i] = id[i];  // the owner for now, the vertex id in step 4
+          std::uint64_t* const at = &first_use[slot_of(id[i])];
+          std::uint64_t seen = __atomic_load_n(at, __ATOMIC_RELAXED);
+          const std::uint64_t here = 3 * t + static_cast<std::uint64_t>(i);
+          while (here < seen && !__atomic_compare_exchange_n(at, &seen, here, true, __ATOMIC_RELAXED,
+                                                             __ATOMIC_RELAXED)) {
+          }
+        }
+        ++t;
+      }
+  });
+  // 3. First uses per slice (slice s holds the triangles tris_in[s] .. tris_in[s + 1] - 1), numbered in
+  // order.
+  std::vector<std::size_t> verts_in(slices + 1, 0);
+  run_slices(slices, slices, [&](std::size_t s, std::size_t, std::size_t) {
+    std::size_t count = 0;
+    for (std::size_t t = tris_in[s]; t < tris_in[s + 1]; ++t)
+      for (int i = 0; i < 3; ++i) count += first_use[slot_of(triangles[t][i])] == 3 * t + i;
+    verts_in[s + 1] = count;
+  });
+  std::partial_sum(verts_in.begin(), verts_in.end(), verts_in.begin());
+  const std::size_t num_verts = verts_in[slices];
+  std::vector<Point3> positions(num_verts), normals(num_verts);
+  owner_.assign(num_verts, kNone);
+  std::vector<std::vector<std::uint32_t>> no_normal(slices);
+  run_slices(slices, slices, [&](std::size_t s, std::size_t, std::size_t) {
+    std::uint32_t v = static_cast<std::uint32_t>(verts_in[s]);
+    for (std::size_t t = tris_in[s]; t < tris_in[s + 1]; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t owner = triangles[t][i];
+        if (first_use[slot_of(owner)] != 3 * t + i) continue;
+        owner_[v] = owner;
+        if (owner & kZeroTag) {
+          const VertexId z = owner & ~kZeroTag;
+          zero_out_[z] = v;
+          positions[v] = known_snap_target(in, z);
+          no_normal[s].push_back(v);
+        } else {
+          Edge& edge = edges_[owner];
+          edge.out = v;
+          positions[v] = edge.x;
+          if (edge.has_gradient) normals[v] = unit_or_zero(edge.gradient);
+          else no_normal[s].push_back(v);
+        }
+        ++v;
+      }
+  });
+  // 4. The corners' vertex ids.
+  run_slices(slices, slices, [&](std::size_t s, std::size_t, std::size_t) {
+    for (std::size_t t = tris_in[s]; t < tris_in[s + 1]; ++t)
+      for (int i = 0; i < 3; ++i) {
+        const std::uint32_t owner = triangles[t][i];
+        triangles[t][i] = (owner & kZeroTag) ? zero_out_[owner & ~kZeroTag] : edges_[owner].out;
+      }
+  });
+  for (const std::vector<std::uint32_t>& list : no_normal)
+    w.normals.insert(w.normals.end(), list.begin(), list.end());
+  mesh_.fill(std::move(positions), std::move(normals), std::move(triangles));
+}
+
 // The vertex-pair index of the live edges (after a full build, which leaves it out).
 void SurfaceTracker::index_edges() {
   edge_index_.clear();

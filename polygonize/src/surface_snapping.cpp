@@ -58,7 +58,7 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
     else
       first.push_back(u);
   };
-  if (w.every_polygon) {
+  if (w.bulk) {
     // A full build: an anchored vertex is an end of a crossed edge, so a corner of a rebuilt transverse
     // tetrahedron, and nothing is collapsed yet: the offers are the anchored vertices, in id order.
     for (VertexId u = 0; u < anchored_.size(); ++u) offer(u);
@@ -77,16 +77,16 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
   std::size_t next = 0;
   // A full build offered every anchored vertex above (each is a corner of a rebuilt transverse
   // tetrahedron) and remeshes every polygon: a flip has nothing to re-offer or remesh there, so no star
-  // is kept, and the fans are gathered at the anchored corners (no star is walked).
+  // is kept; in bulk, the fans are gathered at the anchored corners (no star is walked).
   const bool full = w.every_polygon;
   AnchoredCorners corners;
-  if (ahead && full) anchored_corners(in, corners);
+  if (ahead && w.bulk) anchored_corners(in, corners);
   while (next < first.size() || !heap.empty()) {
     VertexId z;
     bool now;
     if (heap.empty() || (next < first.size() && first[next] < heap.top())) {
       if (ahead) {
-        if (next == look.end) look_ahead(in, first, next, full ? &corners : nullptr, look);
+        if (next == look.end) look_ahead(in, first, next, w.bulk ? &corners : nullptr, look);
         const SnapLookahead::Span& sp = look.span(next);
         const SnapLookahead::Slice& slice = look.slices[sp.slice];
         if (!full) star_.assign(slice.stars.begin() + sp.star_first, slice.stars.begin() + sp.star_last);
@@ -185,6 +185,17 @@ Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
   const Point3 q = newton_target(p, fz, g);
   snap_target_.emplace(z, q);
   return q;
+}
+
+Point3 SurfaceTracker::known_snap_target(const TrackerInput& in, VertexId z) const {
+  const Point3& p = in.tri.point(z);
+  if (in.values[z] == 0.0) return p;
+  const auto it = snap_target_.find(z);
+  if (it != snap_target_.end()) return it->second;
+  // Not reached for a collapsed z (its collapse test cached the target): the same value, uncached.
+  Point3 g;
+  const double fz = in.f.value_gradient(p, g);
+  return newton_target(p, fz, g);
 }
 
 bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {

@@ -29,11 +29,6 @@ std::uint32_t take_slot(std::vector<Record>& records, std::vector<std::uint32_t>
   return slot;
 }
 
-Point3 unit_or_zero(const Point3& g) {
-  const double l = norm(g);
-  return (l > 0.0 && std::isfinite(l)) ? g / l : Point3{0.0, 0.0, 0.0};
-}
-
 }  // namespace
 
 void SurfaceTracker::note_tet(std::vector<TetId>& list, TetId t) {
@@ -98,6 +93,7 @@ void SurfaceTracker::update(const TrackerInput& in) {
   if (rebuild_) {
     reset_all(in, w);
     w.every_polygon = true;  // every polygon is new, hence in w.remesh already
+    w.bulk = in.bulk_full_build;
   } else {
     if (!edge_index_ready_) index_edges();
     collect_tets(in, w);
@@ -109,10 +105,10 @@ void SurfaceTracker::update(const TrackerInput& in) {
   split_polygons(in, w);
   decide_snapping(in, w);
   report_.snapping_seconds = lap();
-  // A full build adds at most a vertex per crossed edge and two triangles per polygon: reserved, so that
-  // millions of appends do not copy the growing arrays (about 4 x 10^6 records at 10^6 points).
-  if (w.every_polygon) mesh_.reserve(edges_.size(), 2 * polygons_.size());
-  remesh_polygons(in, w);
+  if (w.bulk)
+    remesh_all(in, w);  // the same mesh, on the threads (surface_full_build.cpp)
+  else
+    remesh_polygons(in, w);
   retire_triangles(w);
   refresh_vertices(in, w);
   report_.mesh_seconds = lap();
@@ -130,6 +126,7 @@ void SurfaceTracker::update(const TrackerInput& in) {
 void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
   mesh_.clear();
   edge_index_.clear();
+  edge_index_ready_ = true;  // (empty: build_all_polygons leaves it so)
   edges_.clear();
   free_edges_.clear();
   polygons_.clear();
@@ -190,7 +187,7 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
 // placed again when an end of one of its edges changed). In chunks: each chunk is marched ahead (on the
 // threads when large), then its polygons and edges are made in order by this thread.
 void SurfaceTracker::rebuild_polygons(const TrackerInput& in, Work& w) {
-  if (w.every_polygon) {
+  if (w.bulk) {
     build_all_polygons(in, w);
     return;
   }
@@ -478,8 +475,8 @@ void SurfaceTracker::retire_triangles(Work& w) {
 // Vertices of placed edges move to their new roots; vertices at a moved (or re-valued) Delaunay vertex
 // follow it; normals that the root finder did not give are evaluated in one batch.
 void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
-  // A full build made every vertex of a placed edge just now, where it is and with its normal.
-  if (!w.every_polygon)
+  // A bulk full build made every vertex of a placed edge just now, where it is and with its normal.
+  if (!w.bulk)
     for (const std::uint32_t e : w.placed) {
       const Edge& edge = edges_[e];
       if (edge.pos == kNoVertex || edge.out == kNone) continue;

@@ -28,6 +28,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <unordered_map>
@@ -49,6 +50,10 @@ struct TrackerInput {
   /// Large updates take the collapse tests' stars and fans from a lookahead on the threads; off, each is
   /// gathered when its vertex is decided (the same decisions: the tests compare both).
   bool snap_lookahead = true;
+  /// A full build makes its polygons, collapse fans and live mesh in bulk passes on the threads
+  /// (surface_full_build.cpp); off, it goes through the steps of an incremental update (the same mesh, bit
+  /// for bit: the tests compare both).
+  bool bulk_full_build = true;
   /// Per Delaunay vertex: f's gradient there where the Polygonizer knows it (NaN: unknown), or null.
   /// The normal of a mesh vertex collapsed onto a zero-valued vertex is read there instead of evaluated.
   const std::vector<Point3>* gradients = nullptr;
@@ -125,6 +130,7 @@ class SurfaceTracker {
     std::vector<std::uint32_t> retire;       // LiveMesh triangles replaced
     std::vector<std::uint32_t> normals;      // LiveMesh vertices whose normal is evaluated
     bool every_polygon = false;              // a full build: remesh holds every polygon, in order
+    bool bulk = false;                       // a full build in bulk passes (TrackerInput::bulk_full_build)
   };
 
   void note_tet(std::vector<TetId>& list, TetId t);
@@ -195,10 +201,21 @@ class SurfaceTracker {
   bool collapse_test(const TrackerInput& in, VertexId z);
   void gather_fan(VertexId z, const std::vector<TetId>& star, std::vector<FanTriangle>& out) const;
   /// The same fan (in another order, which the test does not depend on) from z's anchored corners.
-  void gather_fan_at(VertexId z, const std::uint32_t* corners, std::size_t n, std::vector<FanTriangle>& out) const;
-  void add_fan_triangle(const Polygon& poly, int k, VertexId z, int corner, std::vector<FanTriangle>& out) const;
+  void gather_fan_at(VertexId z, const std::uint32_t* corners, std::size_t n,
+                     std::vector<FanTriangle>& out) const;
+  void add_fan_triangle(const Polygon& poly, int k, VertexId z, int corner,
+                        std::vector<FanTriangle>& out) const;
   bool fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count);
   void remesh_polygons(const TrackerInput& in, Work& w);
+  /// remesh_polygons of a full build, on the threads (surface_full_build.cpp).
+  void remesh_all(const TrackerInput& in, Work& w);
+  /// snap_target of a vertex whose target is known (f(z) = 0, or cached by its collapse test), read only.
+  Point3 known_snap_target(const TrackerInput& in, VertexId z) const;
+  /// g / |g|, or the zero vector when that is undefined.
+  static Point3 unit_or_zero(const Point3& g) {
+    const double l = norm(g);
+    return (l > 0.0 && std::isfinite(l)) ? g / l : Point3{0.0, 0.0, 0.0};
+  }
   std::uint32_t out_vertex(const TrackerInput& in, std::uint32_t e, Work& w);
   void drop_triangle(std::uint32_t t);
   void retire_triangles(Work& w);

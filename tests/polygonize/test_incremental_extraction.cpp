@@ -9,6 +9,7 @@
 #include "sorted_ids.hpp"
 #include "surface_tracker.hpp"
 #include "support/mesh_checks.hpp"
+#include "vitri/core/error.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/analytic.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
@@ -103,6 +104,37 @@ void check_state(Polygonizer& poly, Client& client, long long euler) {
   test::require_closed(live, euler, 1);
   REQUIRE(canonical(live) == canonical(poly.extract_fresh()));
 }
+
+/// The Delaunay tetrahedralization of points on a sphere (every `jitter_every`-th moved off it by
+/// `jitter`, alternately out and in) and of offset points inside and out (`offset`), with f's values at
+/// its vertices and its transverse tetrahedra: the input of a tracker's full build with thousands of
+/// anchored crossings.
+struct SphereSamples {
+  Triangulation tri{Box3{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}}};
+  std::vector<double> values;
+  std::vector<TetId> transverse;
+  SphereSamples(const ImplicitFunction& f, const Point3& c, int n, double offset, int jitter_every,
+                double jitter) {
+    std::vector<Point3> seeds;
+    for (int k = 0; k < n; ++k) {  // a Fibonacci sphere
+      const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(1.0 - z * z), phi = 2.399963229728653 * k;
+      const Point3 u{r * std::cos(phi), r * std::sin(phi), z};
+      double moved = 0.0;
+      if (jitter_every > 0 && k % jitter_every == 0) moved = (k / jitter_every) % 2 ? jitter : -jitter;
+      seeds.push_back(c + (1.0 + moved) * u);
+      seeds.push_back(c + (k % 2 == 0 ? 1.0 + offset : 1.0 - offset) * u);
+    }
+    tri.insert_points(seeds);
+    values.assign(tri.vertex_capacity(), 0.0);
+    for (VertexId v = 0; v < tri.vertex_capacity(); ++v)
+      if (tri.is_vertex(v)) values[v] = f.value(tri.point(v));
+    for (const TetId t : tri.live_tetrahedra()) {
+      int negative = 0;
+      for (const VertexId v : tri.tet_vertices(t)) negative += values[v] < 0.0;
+      if (negative > 0 && negative < 4) transverse.push_back(t);
+    }
+  }
+};
 
 }  // namespace
 
@@ -486,29 +518,8 @@ TEST_CASE("collapse decisions looked ahead on the threads equal those made one a
   // tracker gathers stars and fans ahead on two threads; the same input decided one vertex at a time
   // must give the same mesh, bit for bit.
   const QuadricSphereFunction f({0.1, -0.05, 0.02}, 1.0);
-  const Box3 box{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
-  std::vector<Point3> seeds;
-  const int n = 6000;
-  for (int k = 0; k < n; ++k) {  // a Fibonacci sphere
-    const double z = 1.0 - (2.0 * k + 1.0) / n, r = std::sqrt(1.0 - z * z), phi = 2.399963229728653 * k;
-    const Point3 u{r * std::cos(phi), r * std::sin(phi), z};
-    const Point3 c{0.1, -0.05, 0.02};
-    seeds.push_back(c + u);
-    if (k % 2 == 0) seeds.push_back(c + 1.03 * u);
-    else seeds.push_back(c + 0.97 * u);
-  }
-  Triangulation tri(box);
-  tri.insert_points(seeds);
-  std::vector<double> values(tri.vertex_capacity(), 0.0);
-  for (VertexId v = 0; v < tri.vertex_capacity(); ++v)
-    if (tri.is_vertex(v)) values[v] = f.value(tri.point(v));
-  std::vector<TetId> transverse;
-  for (const TetId t : tri.live_tetrahedra()) {
-    int negative = 0;
-    for (const VertexId v : tri.tet_vertices(t)) negative += values[v] < 0.0;
-    if (negative > 0 && negative < 4) transverse.push_back(t);
-  }
-  TrackerInput in{tri, values, transverse, f, {}, true, 0.01, false};
+  const SphereSamples s(f, {0.1, -0.05, 0.02}, 6000, 0.03, 0, 0.0);
+  TrackerInput in{s.tri, s.values, s.transverse, f, {}, true, 0.01, false};
   in.threads = 2;
   SurfaceTracker ahead, one_by_one;
   ahead.update(in);
@@ -524,7 +535,8 @@ TEST_CASE("collapse decisions looked ahead on the threads equal those made one a
   test::require_closed(a, 2, 1);
 }
 
-TEST_CASE("a full build on several threads equals one on one thread, and later updates stay exact", "[incremental]") {
+TEST_CASE("a full build on several threads equals one on one thread, and later updates stay exact",
+          "[incremental]") {
   // A full build numbers the crossed edges by counting sort on slices of the threads (tens of thousands
   // of polygons here: several slices), and leaves the vertex-pair index to the first incremental update.
   // One thread and four must give the same mesh bit for bit; a change of f in a ball, then a finer level,
@@ -557,6 +569,89 @@ TEST_CASE("a full build on several threads equals one on one thread, and later u
   REQUIRE(first[0].vertices == first[1].vertices);
   REQUIRE(first[0].triangles == first[1].triangles);
   REQUIRE(canonical(edited[0]) == canonical(edited[1]));
+}
+
+TEST_CASE("a full build in bulk passes equals the step-by-step build, ids and bits", "[incremental]") {
+  // Thousands of seeds on a sphere up to rounding with offset points inside and out (anchored and
+  // collapsed crossings, kept and vanished triangles): the bulk passes of a full build (counting-sorted
+  // edges, fans at the anchored corners, the live mesh numbered by first use) on 1 and 3 threads must give
+  // the mesh of the incremental steps, with the same vertex and triangle ids and the same evaluations.
+  // Every 7th sample slightly off the sphere: its crossings are anchored at a vertex with f != 0 (a
+  // Newton target, cached by its collapse test).
+  const QuadricSphereFunction f({0.1, -0.05, 0.02}, 1.0);
+  const SphereSamples s(f, {0.1, -0.05, 0.02}, 8000, 0.02, 7, 1e-4);
+  const std::vector<TetId>& transverse = s.transverse;
+  TrackerInput in{s.tri, s.values, transverse, f, {}, true, 0.01, false};
+  in.threads = 1;
+  in.bulk_full_build = false;
+  SurfaceTracker steps;
+  steps.update(in);
+  const SurfaceMesh expected = steps.mesh().to_surface_mesh();
+  REQUIRE(steps.report().snapped > 1000);
+  REQUIRE(transverse.size() > 3 * (std::size_t(1) << 13));  // several slices on 3 threads
+  for (const unsigned threads : {1u, 3u}) {
+    INFO(threads << " threads");
+    in.threads = threads;
+    in.bulk_full_build = true;
+    SurfaceTracker bulk;
+    bulk.update(in);
+    REQUIRE(bulk.report().snapped == steps.report().snapped);
+    REQUIRE(bulk.report().offset == steps.report().offset);
+    REQUIRE(bulk.report().evaluations == steps.report().evaluations);
+    const LiveMesh& a = bulk.mesh();
+    const LiveMesh& b = steps.mesh();
+    REQUIRE(a.vertex_capacity() == b.vertex_capacity());
+    REQUIRE(a.triangle_capacity() == b.triangle_capacity());
+    for (std::uint32_t v = 0; v < a.vertex_capacity(); ++v) {
+      REQUIRE(a.is_vertex(v) == b.is_vertex(v));
+      if (!a.is_vertex(v)) continue;
+      REQUIRE(a.position(v) == b.position(v));
+      REQUIRE(a.normal(v) == b.normal(v));
+      REQUIRE(a.refs(v) == b.refs(v));
+    }
+    for (std::uint32_t t = 0; t < a.triangle_capacity(); ++t) {
+      REQUIRE(a.is_triangle(t) == b.is_triangle(t));
+      if (a.is_triangle(t)) REQUIRE(a.triangle(t) == b.triangle(t));
+    }
+    const SurfaceMesh m = bulk.mesh().to_surface_mesh();
+    REQUIRE(m.vertices == expected.vertices);
+    REQUIRE(m.triangles == expected.triangles);
+    test::require_closed(m, 2, 1);
+  }
+}
+
+TEST_CASE("LiveMesh::fill equals the same adds one by one, and refuses bad input", "[incremental]") {
+  // An octahedron.
+  const std::vector<Point3> p = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}, {0, 0, -1}};
+  const std::vector<std::array<std::uint32_t, 3>> t = {{0, 2, 4}, {2, 1, 4}, {1, 3, 4}, {3, 0, 4},
+                                                       {2, 0, 5}, {1, 2, 5}, {3, 1, 5}, {0, 3, 5}};
+  LiveMesh one;
+  for (const Point3& q : p) one.add_vertex(q, q);
+  for (const auto& tri : t) one.add_triangle(tri);
+  LiveMesh all;
+  all.fill(p, p, t);
+  REQUIRE(all.num_vertices() == 6);
+  REQUIRE(all.num_triangles() == 8);
+  for (std::uint32_t v = 0; v < 6; ++v) {
+    REQUIRE(all.position(v) == one.position(v));
+    REQUIRE(all.normal(v) == one.normal(v));
+    REQUIRE(all.refs(v) == one.refs(v));
+  }
+  for (std::uint32_t k = 0; k < 8; ++k) REQUIRE(all.triangle(k) == one.triangle(k));
+  const MeshDelta da = all.take_delta(), db = one.take_delta();
+  REQUIRE(da.added_vertices == db.added_vertices);
+  REQUIRE(da.added_triangles == db.added_triangles);
+  // Then edits as on any mesh: a triangle removed and its delta.
+  all.remove_triangle(3);
+  REQUIRE(all.take_delta().removed_triangles == std::vector<std::uint32_t>{3});
+  // Refused: a mesh in use, mismatched normals, a corner out of range or repeated, an unused vertex.
+  REQUIRE_THROWS_AS(all.fill(p, p, t), InvalidArgument);
+  LiveMesh e1, e2, e3, e4;
+  REQUIRE_THROWS_AS(e1.fill(p, {p[0]}, t), InvalidArgument);
+  REQUIRE_THROWS_AS(e2.fill(p, p, {{0, 2, 6}}), InvalidArgument);
+  REQUIRE_THROWS_AS(e3.fill(p, p, {{0, 2, 2}}), InvalidArgument);
+  REQUIRE_THROWS_AS(e4.fill(p, p, {{0, 2, 4}}), InvalidArgument);  // vertices 1, 3, 5 unused
+  REQUIRE(e4.num_vertices() == 0);
 }
 
 TEST_CASE("sort_unique_ids orders and deduplicates like std::sort + std::unique", "[extraction]") {

@@ -84,6 +84,12 @@ class LiveMesh {
   void remove_triangle(std::uint32_t t);
   /// Removes everything; the next delta is `full`.
   void clear();
+  /// An empty mesh (no slot used since clear() or construction) takes these vertices (ids 0..n-1) and
+  /// triangles (ids 0..m-1) at once, all recorded as added: what add_vertex and add_triangle in that
+  /// order would give. @throws InvalidArgument when the mesh is not empty, the normals do not match the
+  /// positions, or a triangle has a corner out of range, a repeated corner, or a vertex no triangle uses.
+  void fill(std::vector<Point3> positions, std::vector<Point3> normals,
+            std::vector<std::array<std::uint32_t, 3>> triangles);
   /// Room for this many vertex and triangle slots in all, and as many records in the current delta,
   /// without reallocation (a large build that knows its sizes: the slots are not touched).
   void reserve(std::size_t vertices, std::size_t triangles);

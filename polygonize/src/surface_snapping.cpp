@@ -134,7 +134,7 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
     std::vector<TetId> star, stars;
     std::vector<std::size_t> ends;
     const auto add_target = [&](VertexId z) {
-      if (in.values[z] == 0.0 || snap_target_.count(z)) return;  // snap_target(z) evaluates nothing
+      if (in.values[z] == 0.0 || snap_known_[z]) return;  // snap_target(z) evaluates nothing
       const Point3& p = in.tri.point(z);
       Point3 g;
       const double fz = in.f.value_gradient(p, g);
@@ -169,7 +169,10 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
   });
   for (const SnapLookahead::Slice& slice : look.slices) {
     report_.evaluations += slice.targets.size();
-    for (const auto& [z, q] : slice.targets) snap_target_.emplace(z, q);
+    for (const auto& [z, q] : slice.targets) {
+      snap_at_[z] = q;
+      snap_known_[z] = 1;
+    }
   }
 }
 
@@ -177,21 +180,19 @@ Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
   const Point3& p = in.tri.point(z);
   const double value = in.values[z];
   if (value == 0.0) return p;
-  const auto it = snap_target_.find(z);
-  if (it != snap_target_.end()) return it->second;
+  if (snap_known_[z]) return snap_at_[z];
   Point3 g;
   const double fz = in.f.value_gradient(p, g);
   ++report_.evaluations;
-  const Point3 q = newton_target(p, fz, g);
-  snap_target_.emplace(z, q);
-  return q;
+  snap_at_[z] = newton_target(p, fz, g);
+  snap_known_[z] = 1;
+  return snap_at_[z];
 }
 
 Point3 SurfaceTracker::known_snap_target(const TrackerInput& in, VertexId z) const {
   const Point3& p = in.tri.point(z);
   if (in.values[z] == 0.0) return p;
-  const auto it = snap_target_.find(z);
-  if (it != snap_target_.end()) return it->second;
+  if (snap_known_[z]) return snap_at_[z];
   // Not reached for a collapsed z (its collapse test cached the target): the same value, uncached.
   Point3 g;
   const double fz = in.f.value_gradient(p, g);

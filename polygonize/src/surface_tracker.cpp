@@ -69,6 +69,8 @@ void SurfaceTracker::grow_vertex_arrays(std::size_t n) {
   stamp_.resize(n, 0);
   moved_stamp_.resize(n, 0);
   decide_stamp_.resize(n, 0);
+  snap_at_.resize(n);
+  snap_known_.resize(n, 0);
 }
 
 std::uint32_t SurfaceTracker::corner_identity(std::uint32_t e) const {
@@ -80,8 +82,8 @@ void SurfaceTracker::update(const TrackerInput& in) {
   report_ = {};
   ++epoch_;
   grow_vertex_arrays(in.tri.vertex_capacity());
-  for (const VertexId v : touched_) snap_target_.erase(v);
-  if (rebuild_) snap_target_.clear();
+  for (const VertexId v : touched_) snap_known_[v] = 0;
+  if (rebuild_) std::fill(snap_known_.begin(), snap_known_.end(), 0);
   Work w;
   using Clock = std::chrono::steady_clock;
   auto lap = [t = Clock::now()]() mutable {

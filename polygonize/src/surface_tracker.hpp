@@ -31,7 +31,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 namespace vitri {
@@ -254,7 +253,10 @@ class SurfaceTracker {
   std::size_t num_collapsed_ = 0, num_anchored_ = 0;  // vertices collapsed / with anchored edges
   // Owner of each LiveMesh vertex: an edge slot, or kZeroTag | Delaunay vertex.
   std::vector<std::uint32_t> owner_;
-  std::unordered_map<VertexId, Point3> snap_target_;  // cache of snap_target() for f(z) != 0
+  // Per Delaunay vertex: snap_target() for f(z) != 0, cached when snap_known_[z] (until z's value or
+  // position changes; a flat array: the collapse tests read it at every lower collapsed corner).
+  std::vector<Point3> snap_at_;
+  std::vector<std::uint8_t> snap_known_;
   // can_collapse(z) scratch: the star of z (read again by decide_snapping when z's decision changes)
   // and the directed link edges.
   std::vector<TetId> star_;

@@ -12,14 +12,17 @@ namespace vitri {
 
 namespace {
 
+// (A full build's lists come sorted: ids handed out in increasing order.)
 void sort_unique(std::vector<std::uint32_t>& v) {
-  std::sort(v.begin(), v.end());
+  if (!std::is_sorted(v.begin(), v.end())) std::sort(v.begin(), v.end());
   v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
 // Elements of `a` not in `b` (both sorted, unique).
 std::vector<std::uint32_t> minus(const std::vector<std::uint32_t>& a, const std::vector<std::uint32_t>& b) {
+  if (b.empty()) return a;
   std::vector<std::uint32_t> out;
+  out.reserve(a.size());
   std::set_difference(a.begin(), a.end(), b.begin(), b.end(), std::back_inserter(out));
   return out;
 }

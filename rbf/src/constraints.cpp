@@ -76,16 +76,21 @@ void subsample(std::vector<std::size_t>& keep, std::size_t m, std::uint64_t seed
 
 /// The median distance from points[i] to its nearest other point of `index` (which holds `points`),
 /// over at most 100,000 of them taken evenly, exact duplicates skipped; 0 when every point coincides.
-double spacing_median(const PointIndex& index, const std::vector<Point3>& points) {
+/// The queries are independent: on `threads` threads, the same median.
+double spacing_median(const PointIndex& index, const std::vector<Point3>& points, unsigned threads) {
   const std::size_t step = std::max<std::size_t>(1, points.size() / 100000);
-  std::vector<double> spacing;
-  std::vector<PointIndex::Id> ids;
-  std::vector<double> d2;
-  for (std::size_t i = 0; i < points.size(); i += step) {
-    index.nearest(points[i], 8, ids, &d2);
-    const auto first = std::find_if(d2.begin(), d2.end(), [](double d) { return d > 0; });
-    if (first != d2.end()) spacing.push_back(std::sqrt(*first));
-  }
+  const std::size_t m = (points.size() + step - 1) / step;
+  std::vector<double> spacing(m, -1.0);  // -1: every neighbour coincides with the point
+  rbf_detail::parallel_chunks(m, threads, 4096, [&](std::size_t b, std::size_t e) {
+    std::vector<PointIndex::Id> ids;
+    std::vector<double> d2;
+    for (std::size_t k = b; k < e; ++k) {
+      index.nearest(points[k * step], 8, ids, &d2);
+      const auto first = std::find_if(d2.begin(), d2.end(), [](double d) { return d > 0; });
+      if (first != d2.end()) spacing[k] = std::sqrt(*first);
+    }
+  });
+  spacing.erase(std::remove(spacing.begin(), spacing.end(), -1.0), spacing.end());
   if (spacing.empty()) return 0.0;
   const auto mid = spacing.begin() + static_cast<std::ptrdiff_t>(spacing.size() / 2);
   std::nth_element(spacing.begin(), mid, spacing.end());
@@ -242,7 +247,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   }
   const PointIndex surface(surf, opt.threads);
   // The merge tolerance above stays measured on the box grown by the largest d.
-  const double spacing = opt.offset_spacings > 0 && surf.size() > 1 ? spacing_median(surface, surf) : 0.0;
+  const double spacing = opt.offset_spacings > 0 && surf.size() > 1 ? spacing_median(surface, surf, opt.threads) : 0.0;
   const double d = spacing > 0 ? std::min(d0, opt.offset_spacings * spacing) : d0;
   rep.offset = d;
   rep.median_spacing = spacing;
@@ -259,7 +264,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
 }
 
 double median_spacing(const std::vector<Point3>& points) {
-  const double m = points.size() > 1 ? spacing_median(PointIndex(points), points) : 0.0;
+  const double m = points.size() > 1 ? spacing_median(PointIndex(points), points, 1) : 0.0;
   if (!(m > 0)) throw InvalidArgument("median_spacing: fewer than 2 distinct positions");
   return m;
 }

@@ -128,7 +128,7 @@ void SurfaceTracker::update(const TrackerInput& in) {
 void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
   mesh_.clear();
   edge_index_.clear();
-  edge_index_ready_ = true;  // (empty: build_all_polygons leaves it so)
+  edge_index_ready_ = true;  // empty, as the edges; build_all_polygons marks it stale
   edges_.clear();
   free_edges_.clear();
   polygons_.clear();

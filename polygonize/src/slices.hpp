@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <thread>
 #include <vector>
 
@@ -31,5 +32,12 @@ void run_slices(std::size_t n, std::size_t slices, const Fn& fn) {
   fn(std::size_t{0}, std::size_t{0}, n / slices);
   for (std::thread& th : pool) th.join();
 }
+
+/// The rows of a counting sort on slices: row[s * (start.size() - 1) + u] holds slice s's count for
+/// bucket u; they become each slice's first place in the bucket (lower slices first), start[u] the
+/// bucket's first place and start.back() the total, which is returned (the caller keeps it below 2^32).
+/// surface_full_build.cpp.
+std::uint32_t row_starts(std::vector<std::uint32_t>& row, std::size_t slices,
+                         std::vector<std::uint32_t>& start);
 
 }  // namespace vitri::polygonizer_detail

@@ -24,6 +24,7 @@ namespace vitri {
 
 namespace {
 
+using polygonizer_detail::row_starts;
 using polygonizer_detail::run_slices;
 using polygonizer_detail::slice_count;
 
@@ -45,10 +46,43 @@ std::vector<std::size_t> balanced_vertex_slices(const std::vector<std::uint32_t>
 
 }  // namespace
 
+namespace polygonizer_detail {
+
+std::uint32_t row_starts(std::vector<std::uint32_t>& row, std::size_t slices,
+                         std::vector<std::uint32_t>& start) {
+  const std::size_t nv = start.size() - 1;
+  std::uint32_t sum = 0;  // the callers' totals are below 2^32
+  for (std::size_t u = 0; u < nv; ++u) {
+    start[u] = sum;
+    for (std::size_t s = 0; s < slices; ++s) {
+      const std::uint32_t here = row[s * nv + u];
+      row[s * nv + u] = sum;
+      sum += here;
+    }
+  }
+  start[nv] = sum;
+  return sum;
+}
+
+}  // namespace polygonizer_detail
+
 void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
-  const std::size_t n = w.tets.size();
+  const CornerBuckets buckets = bucket_corners(in, w.tets);
+  number_edges(in, buckets);
+  w.placed.resize(edges_.size());
+  std::iota(w.placed.begin(), w.placed.end(), 0u);
+  w.remesh.resize(polygons_.size());
+  std::iota(w.remesh.begin(), w.remesh.end(), 0u);
+  edge_index_ready_ = false;
+}
+
+// Passes 1 and 2 of a full build: the polygons of `tets` (in order), and their corners in the buckets of
+// their edges' lower vertices.
+SurfaceTracker::CornerBuckets SurfaceTracker::bucket_corners(const TrackerInput& in,
+                                                             const std::vector<TetId>& tets) {
+  const std::size_t n = tets.size();
   const std::size_t nv = in.tri.vertex_capacity();
-  if (!w.tets.empty() && polygon_of_.size() <= w.tets.back()) polygon_of_.resize(w.tets.back() + 1, kNone);
+  if (!tets.empty() && polygon_of_.size() <= tets.back()) polygon_of_.resize(tets.back() + 1, kNone);
   // Smaller builds run on one thread; the counting rows (4 bytes per vertex and slice) limit the slices.
   constexpr std::size_t kSliceMin = std::size_t(1) << 13, kMaxSlices = 8;
   const std::size_t slices = std::min(slice_count(in.threads, n, kSliceMin), kMaxSlices);
@@ -71,11 +105,11 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
     std::array<VertexId, 4> v{};
     std::size_t polygons = 0;
     for (std::size_t k = lo; k < hi; ++k) {
-      if (!in.tri.is_live(w.tets[k])) {
+      if (!in.tri.is_live(tets[k])) {
         pattern[k] = kDead;
         continue;
       }
-      v = in.tri.tet_vertices(w.tets[k]);
+      v = in.tri.tet_vertices(tets[k]);
       pattern[k] = static_cast<std::uint8_t>((in.values[v[0]] < 0.0) | (in.values[v[1]] < 0.0) << 1 |
                                              (in.values[v[2]] < 0.0) << 2 | (in.values[v[3]] < 0.0) << 3);
       const marching::CellPolygon& cell = cells[pattern[k]];
@@ -90,20 +124,13 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
     throw LimitError("surface extraction: " + std::to_string(num_polygons) +
                      " transverse tetrahedra exceed the 2^30 polygons of a full build");
   // Bucket u starts at start[u]; slice s writes its corners of bucket u from row[s][u] on.
-  std::vector<std::uint32_t> start(nv + 1, 0);
-  std::uint32_t sum = 0;  // at most 4 x 2^30 corners: below 2^32
-  for (std::size_t u = 0; u < nv; ++u) {
-    start[u] = sum;
-    for (std::size_t s = 0; s < slices; ++s) {
-      const std::uint32_t here = row[s * nv + u];
-      row[s * nv + u] = sum;
-      sum += here;
-    }
-  }
-  start[nv] = sum;
+  CornerBuckets out;
+  out.start.assign(nv + 1, 0);
+  const std::uint32_t sum = row_starts(row, slices, out.start);  // at most 4 x 2^30 corners
   // 2. The polygons, and each corner in its bucket: (higher vertex << 32) | corner name.
   polygons_.assign(num_polygons, Polygon{});
-  std::unique_ptr<std::uint64_t[]> entries(new std::uint64_t[sum]);  // every entry is written below
+  out.entries.reset(new std::uint64_t[sum]);  // every entry is written below
+  std::uint64_t* const entries = out.entries.get();
   run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
     std::uint32_t* const cursor = row.data() + s * nv;
     std::array<VertexId, 4> v{};
@@ -111,11 +138,11 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
     for (std::size_t k = lo; k < hi; ++k) {
       const marching::CellPolygon& cell = cells[pattern[k]];
       if (cell.corners == 0) continue;
-      v = in.tri.tet_vertices(w.tets[k]);
+      v = in.tri.tet_vertices(tets[k]);
       Polygon& poly = polygons_[p];
       poly.corners = static_cast<std::uint8_t>(cell.corners);
-      poly.tet = w.tets[k];
-      polygon_of_[w.tets[k]] = static_cast<std::uint32_t>(p);
+      poly.tet = tets[k];
+      polygon_of_[tets[k]] = static_cast<std::uint32_t>(p);
       for (int i = 0; i < cell.corners; ++i) {
         const VertexId a = v[cell.edges[i][0]], b = v[cell.edges[i][1]];
         entries[cursor[std::min(a, b)]++] =
@@ -124,16 +151,23 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
       ++p;
     }
   });
-  std::vector<std::uint32_t>().swap(row);
-  // 3. Buckets sorted by (higher vertex, corner); edges per vertex slice.
-  const std::size_t vslices = slice_count(in.threads, sum, kSliceMin);
+  return out;
+}
+
+// Passes 3 and 4 of a full build: the buckets sorted by (higher vertex, corner), each run of one higher
+// vertex an edge, numbered in (lower, higher) vertex order; the polygons' corners set to them.
+void SurfaceTracker::number_edges(const TrackerInput& in, const CornerBuckets& buckets) {
+  const std::vector<std::uint32_t>& start = buckets.start;
+  std::uint64_t* const entries = buckets.entries.get();
+  constexpr std::size_t kSliceMin = std::size_t(1) << 13;
+  const std::size_t vslices = slice_count(in.threads, start.back(), kSliceMin);
   const std::vector<std::size_t> bounds = balanced_vertex_slices(start, vslices);
   std::vector<std::size_t> edges_in(vslices + 1, 0);
   run_slices(vslices, vslices, [&](std::size_t s, std::size_t, std::size_t) {
     std::size_t count = 0;
     for (std::size_t u = bounds[s]; u < bounds[s + 1]; ++u) {
-      std::uint64_t* const b = entries.get() + start[u];
-      std::uint64_t* const e = entries.get() + start[u + 1];
+      std::uint64_t* const b = entries + start[u];
+      std::uint64_t* const e = entries + start[u + 1];
       std::sort(b, e);
       for (const std::uint64_t* x = b; x != e; ++x) count += x == b || (x[0] >> 32) != (x[-1] >> 32);
     }
@@ -160,11 +194,6 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
       }
     }
   });
-  w.placed.resize(edges_.size());
-  std::iota(w.placed.begin(), w.placed.end(), 0u);
-  w.remesh.resize(polygons_.size());
-  std::iota(w.remesh.begin(), w.remesh.end(), 0u);
-  edge_index_ready_ = false;
 }
 
 // A full build's live mesh: the triangles and vertices that remesh_polygons would make over every
@@ -175,6 +204,12 @@ void SurfaceTracker::build_all_polygons(const TrackerInput& in, Work& w) {
 // each slice marks its uses of an owner with an atomic minimum of the position, then the slices count
 // and number the first uses they hold, in order.
 void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
+  MeshCorners m = mesh_corners(in);
+  number_mesh_vertices(in, m, w);
+}
+
+// Steps 1 and 2 of remesh_all: the kept triangles with their corners' owners, and each owner's first use.
+SurfaceTracker::MeshCorners SurfaceTracker::mesh_corners(const TrackerInput& in) {
   const std::size_t n = polygons_.size(), num_edges = edges_.size();
   constexpr std::size_t kSliceMin = std::size_t(1) << 13;
   const std::size_t slices = slice_count(in.threads, n, kSliceMin);
@@ -194,7 +229,10 @@ void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
     return id[0] != id[1] && id[1] != id[2] && id[0] != id[2];
   };
   // 1. Kept triangles per slice.
-  std::vector<std::size_t> tris_in(slices + 1, 0);
+  MeshCorners m;
+  m.slices = slices;
+  std::vector<std::size_t>& tris_in = m.tris_in;
+  tris_in.assign(slices + 1, 0);
   run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
     std::array<std::uint32_t, 3> id{};
     std::size_t count = 0;
@@ -207,8 +245,10 @@ void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
   if (num_tris >= LiveMesh::kNone) throw LimitError("surface extraction: more than 2^32 - 2 triangles");
   // 2. Each owner's first use: the smallest position 3 t + i among its corners.
   constexpr std::uint64_t kUnused = ~std::uint64_t{0};
-  std::vector<std::uint64_t> first_use(num_edges + zero_out_.size(), kUnused);
-  std::vector<std::array<std::uint32_t, 3>> triangles(num_tris);
+  m.first_use.assign(num_edges + zero_out_.size(), kUnused);
+  m.triangles.resize(num_tris);
+  std::vector<std::uint64_t>& first_use = m.first_use;
+  std::vector<std::array<std::uint32_t, 3>>& triangles = m.triangles;
   run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
     std::array<std::uint32_t, 3> id{};
     std::uint64_t t = tris_in[s];
@@ -222,13 +262,26 @@ void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
           std::uint64_t* const at = &first_use[slot_of(id[i])];
           std::uint64_t seen = __atomic_load_n(at, __ATOMIC_RELAXED);
           const std::uint64_t here = 3 * t + static_cast<std::uint64_t>(i);
-          while (here < seen && !__atomic_compare_exchange_n(at, &seen, here, true, __ATOMIC_RELAXED,
-                                                             __ATOMIC_RELAXED)) {
+          while (here < seen &&
+                 !__atomic_compare_exchange_n(at, &seen, here, true, __ATOMIC_RELAXED, __ATOMIC_RELAXED)) {
           }
         }
         ++t;
       }
   });
+  return m;
+}
+
+// Steps 3 and 4 of remesh_all: the first uses numbered in order (the mesh vertices, made where their
+// owners say), the corners' vertex ids, and the live mesh filled.
+void SurfaceTracker::number_mesh_vertices(const TrackerInput& in, MeshCorners& m, Work& w) {
+  const std::size_t slices = m.slices, num_edges = edges_.size();
+  const std::vector<std::size_t>& tris_in = m.tris_in;
+  const std::vector<std::uint64_t>& first_use = m.first_use;
+  std::vector<std::array<std::uint32_t, 3>>& triangles = m.triangles;
+  const auto slot_of = [&](std::uint32_t owner) {  // as in mesh_corners
+    return (owner & kZeroTag) ? num_edges + (owner & ~kZeroTag) : static_cast<std::size_t>(owner);
+  };
   // 3. First uses per slice (slice s holds the triangles tris_in[s] .. tris_in[s + 1] - 1), numbered in
   // order.
   std::vector<std::size_t> verts_in(slices + 1, 0);
@@ -259,8 +312,10 @@ void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
           Edge& edge = edges_[owner];
           edge.out = v;
           positions[v] = edge.x;
-          if (edge.has_gradient) normals[v] = unit_or_zero(edge.gradient);
-          else no_normal[s].push_back(v);
+          if (edge.has_gradient)
+            normals[v] = unit_or_zero(edge.gradient);
+          else
+            no_normal[s].push_back(v);
         }
         ++v;
       }

@@ -283,17 +283,8 @@ void SurfaceTracker::anchored_corners(const TrackerInput& in, AnchoredCorners& o
     each_anchored(lo, hi, [&](VertexId a, std::uint32_t) { ++count[a]; });
   });
   out.start.assign(nv + 1, 0);
-  std::uint32_t sum = 0;  // at most 4 corners per polygon, below 2^30 polygons (build_all_polygons)
-  for (std::size_t a = 0; a < nv; ++a) {
-    out.start[a] = sum;
-    for (std::size_t s = 0; s < slices; ++s) {
-      const std::uint32_t here = row[s * nv + a];
-      row[s * nv + a] = sum;
-      sum += here;
-    }
-  }
-  out.start[nv] = sum;
-  out.corners.resize(sum);
+  // At most 4 corners per polygon, below 2^30 polygons (build_all_polygons): below 2^32.
+  out.corners.resize(polygonizer_detail::row_starts(row, slices, out.start));
   polygonizer_detail::run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
     std::uint32_t* const cursor = row.data() + s * nv;
     each_anchored(lo, hi, [&](VertexId a, std::uint32_t c) { out.corners[cursor[a]++] = c; });

@@ -31,6 +31,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 namespace vitri {
@@ -143,6 +144,14 @@ class SurfaceTracker {
   void rebuild_polygons(const TrackerInput& in, Work& w);
   /// A full build's polygons and edges, without the edge index (surface_full_build.cpp).
   void build_all_polygons(const TrackerInput& in, Work& w);
+  /// A full build's polygon corners bucketed by their edge's lower vertex: bucket u is entries[start[u],
+  /// start[u + 1]), each entry (higher vertex << 32) | (4 x polygon + corner).
+  struct CornerBuckets {
+    std::vector<std::uint32_t> start;
+    std::unique_ptr<std::uint64_t[]> entries;
+  };
+  CornerBuckets bucket_corners(const TrackerInput& in, const std::vector<TetId>& tets);
+  void number_edges(const TrackerInput& in, const CornerBuckets& buckets);
   /// edge_index_ for the live edges (the first incremental update after a full build).
   void index_edges();
   /// The edge index key of the vertex pair {a, b}.
@@ -208,6 +217,17 @@ class SurfaceTracker {
   void remesh_polygons(const TrackerInput& in, Work& w);
   /// remesh_polygons of a full build, on the threads (surface_full_build.cpp).
   void remesh_all(const TrackerInput& in, Work& w);
+  /// remesh_all's kept triangles: slice s holds triangles tris_in[s] .. tris_in[s + 1] - 1, each corner
+  /// its owner (an edge slot, or kZeroTag | Delaunay vertex); first_use per owner slot (edges, then
+  /// Delaunay vertices): the smallest position 3 x triangle + corner among its corners.
+  struct MeshCorners {
+    std::size_t slices = 1;
+    std::vector<std::size_t> tris_in;
+    std::vector<std::array<std::uint32_t, 3>> triangles;
+    std::vector<std::uint64_t> first_use;
+  };
+  MeshCorners mesh_corners(const TrackerInput& in);
+  void number_mesh_vertices(const TrackerInput& in, MeshCorners& m, Work& w);
   /// snap_target of a vertex whose target is known (f(z) = 0, or cached by its collapse test), read only.
   Point3 known_snap_target(const TrackerInput& in, VertexId z) const;
   /// g / |g|, or the zero vector when that is undefined.

@@ -213,9 +213,6 @@ SurfaceTracker::MeshCorners SurfaceTracker::mesh_corners(const TrackerInput& in)
   const std::size_t n = polygons_.size(), num_edges = edges_.size();
   constexpr std::size_t kSliceMin = std::size_t(1) << 13;
   const std::size_t slices = slice_count(in.threads, n, kSliceMin);
-  const auto slot_of = [&](std::uint32_t owner) {  // owners numbered: edges, then Delaunay vertices
-    return (owner & kZeroTag) ? num_edges + (owner & ~kZeroTag) : static_cast<std::size_t>(owner);
-  };
   // Each edge's corner identity in a compact array first: the polygon passes read them at random.
   std::vector<std::uint32_t> identity(num_edges);
   run_slices(num_edges, slices, [&](std::size_t, std::size_t lo, std::size_t hi) {
@@ -259,7 +256,7 @@ SurfaceTracker::MeshCorners SurfaceTracker::mesh_corners(const TrackerInput& in)
         polygons_[p].out[k] = static_cast<std::uint32_t>(t);
         for (int i = 0; i < 3; ++i) {
           triangles[t][i] = id[i];  // the owner for now, the vertex id in step 4
-          std::uint64_t* const at = &first_use[slot_of(id[i])];
+          std::uint64_t* const at = &first_use[owner_slot(id[i])];
           std::uint64_t seen = __atomic_load_n(at, __ATOMIC_RELAXED);
           const std::uint64_t here = 3 * t + static_cast<std::uint64_t>(i);
           while (here < seen &&
@@ -275,20 +272,17 @@ SurfaceTracker::MeshCorners SurfaceTracker::mesh_corners(const TrackerInput& in)
 // Steps 3 and 4 of remesh_all: the first uses numbered in order (the mesh vertices, made where their
 // owners say), the corners' vertex ids, and the live mesh filled.
 void SurfaceTracker::number_mesh_vertices(const TrackerInput& in, MeshCorners& m, Work& w) {
-  const std::size_t slices = m.slices, num_edges = edges_.size();
+  const std::size_t slices = m.slices;
   const std::vector<std::size_t>& tris_in = m.tris_in;
   const std::vector<std::uint64_t>& first_use = m.first_use;
   std::vector<std::array<std::uint32_t, 3>>& triangles = m.triangles;
-  const auto slot_of = [&](std::uint32_t owner) {  // as in mesh_corners
-    return (owner & kZeroTag) ? num_edges + (owner & ~kZeroTag) : static_cast<std::size_t>(owner);
-  };
   // 3. First uses per slice (slice s holds the triangles tris_in[s] .. tris_in[s + 1] - 1), numbered in
   // order.
   std::vector<std::size_t> verts_in(slices + 1, 0);
   run_slices(slices, slices, [&](std::size_t s, std::size_t, std::size_t) {
     std::size_t count = 0;
     for (std::size_t t = tris_in[s]; t < tris_in[s + 1]; ++t)
-      for (int i = 0; i < 3; ++i) count += first_use[slot_of(triangles[t][i])] == 3 * t + i;
+      for (int i = 0; i < 3; ++i) count += first_use[owner_slot(triangles[t][i])] == 3 * t + i;
     verts_in[s + 1] = count;
   });
   std::partial_sum(verts_in.begin(), verts_in.end(), verts_in.begin());
@@ -301,7 +295,7 @@ void SurfaceTracker::number_mesh_vertices(const TrackerInput& in, MeshCorners& m
     for (std::size_t t = tris_in[s]; t < tris_in[s + 1]; ++t)
       for (int i = 0; i < 3; ++i) {
         const std::uint32_t owner = triangles[t][i];
-        if (first_use[slot_of(owner)] != 3 * t + i) continue;
+        if (first_use[owner_slot(owner)] != 3 * t + i) continue;
         owner_[v] = owner;
         if (owner & kZeroTag) {
           const VertexId z = owner & ~kZeroTag;

@@ -226,6 +226,10 @@ class SurfaceTracker {
     std::vector<std::array<std::uint32_t, 3>> triangles;
     std::vector<std::uint64_t> first_use;
   };
+  /// The first_use slot of a corner owner: edges first, then Delaunay vertices.
+  std::size_t owner_slot(std::uint32_t owner) const {
+    return (owner & kZeroTag) ? edges_.size() + (owner & ~kZeroTag) : static_cast<std::size_t>(owner);
+  }
   MeshCorners mesh_corners(const TrackerInput& in);
   void number_mesh_vertices(const TrackerInput& in, MeshCorners& m, Work& w);
   /// snap_target of a vertex whose target is known (f(z) = 0, or cached by its collapse test), read only.

@@ -224,6 +224,7 @@ InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, 
 
 // Room for a bulk insertion of n points.
 void Triangulation::reserve_bulk(std::size_t n) {
+  const std::size_t capacity = tets_.capacity();
   if (keep_history_) {  // about 28 tetrahedra are created per insertion of a uniform point
     tets_.reserve_more(29 * n + n / 2);
     ops_.reserve(ops_.size() + n);
@@ -231,6 +232,9 @@ void Triangulation::reserve_bulk(std::size_t n) {
     const std::size_t extra = 6 * n + n * 9 / 10 + 64;
     if (tets_.size() + extra > tets_.capacity()) tets_.reserve_more(extra);
   }
+  // The build fills a fresh reserve: backed at once rather than page by page (a reserve that did not grow
+  // was backed by the call that made it, or is being filled).
+  if (tets_.capacity() != capacity) tets_.prefault_reserved();
   pos_.reserve(pos_.size() + n);
   vtet_.reserve(vtet_.size() + n);
 }

@@ -14,6 +14,10 @@
 #include <type_traits>
 #include <utility>
 
+#if defined(__linux__)
+#include <sys/mman.h>
+#endif
+
 namespace vitri {
 namespace detail {
 
@@ -62,6 +66,22 @@ class PodArray {
     if (!q) throw std::bad_alloc();
     p_ = static_cast<T*>(q);
     cap_ = n;
+  }
+  /// Backs the reserved, unused part [size, capacity) with memory now, in 2 MB pages where the kernel
+  /// has them, for a caller that is about to fill it (a bulk insertion's reserve). Faulting it in page by
+  /// page cost a bulk build with the history about a seventh of its time (1.2 GB of records at 10^6
+  /// points; docs/benchmarks.md, "Delaunay"). Only blocks of at least 4 MB, only on Linux; where the
+  /// kernel refuses (older kernels), the pages come on first touch as before. Nothing observable changes.
+  void prefault_reserved() {
+#if defined(__linux__) && defined(MADV_HUGEPAGE) && defined(MADV_POPULATE_WRITE)
+    constexpr std::uintptr_t kPage = 4096, kHuge = std::uintptr_t(1) << 21;
+    const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p_ + n_) + kPage - 1) & ~(kPage - 1);
+    const std::uintptr_t e = reinterpret_cast<std::uintptr_t>(p_ + cap_) & ~(kPage - 1);
+    if (e < a + 2 * kHuge) return;
+    const std::uintptr_t ha = (a + kHuge - 1) & ~(kHuge - 1), he = e & ~(kHuge - 1);
+    if (he > ha) (void)madvise(reinterpret_cast<void*>(ha), he - ha, MADV_HUGEPAGE);
+    (void)madvise(reinterpret_cast<void*>(a), e - a, MADV_POPULATE_WRITE);
+#endif
   }
   void resize(std::size_t n) {
     reserve(n);
@@ -248,6 +268,12 @@ class TetStore {
     slots_.reserve(slots_.size() + 8 * n);
     flags_.reserve(flags_.size() + n);
     if (with_offsets_) offsets_.reserve(offsets_.size() + n);
+  }
+  /// The reserved records backed by memory now (PodArray::prefault_reserved): for a caller that will use them.
+  void prefault_reserved() {
+    slots_.prefault_reserved();
+    flags_.prefault_reserved();
+    if (with_offsets_) offsets_.prefault_reserved();
   }
   std::size_t capacity() const { return flags_.capacity(); }
   std::size_t memory_bytes() const {

@@ -234,7 +234,7 @@ void Triangulation::reserve_bulk(std::size_t n) {
   }
   // The build fills a fresh reserve: backed at once rather than page by page (a reserve that did not grow
   // was backed by the call that made it, or is being filled).
-  if (tets_.capacity() != capacity) tets_.prefault_reserved();
+  if (tets_.capacity() != capacity) prefault_reserve(threads_);
   pos_.reserve(pos_.size() + n);
   vtet_.reserve(vtet_.size() + n);
 }

@@ -341,6 +341,7 @@ class Triangulation {
   void commit_cavity(PointId q, Cavity& cavity, ChangeSet* changes);
   void commit_insertion(PointId q, Cavity& cavity, ChangeSet* changes);
   void reserve_bulk(std::size_t n);
+  void prefault_reserve(unsigned threads);
   // parallel_insert.cpp
   unsigned bulk_threads(std::size_t n, double min_distance, const ChangeSet* changes) const;
   void insert_parallel(const std::vector<Point3>& points, std::vector<InsertResult>& results);

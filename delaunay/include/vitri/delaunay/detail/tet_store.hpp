@@ -14,10 +14,6 @@
 #include <type_traits>
 #include <utility>
 
-#if defined(__linux__)
-#include <sys/mman.h>
-#endif
-
 namespace vitri {
 namespace detail {
 
@@ -67,22 +63,8 @@ class PodArray {
     p_ = static_cast<T*>(q);
     cap_ = n;
   }
-  /// Backs the reserved, unused part [size, capacity) with memory now, in 2 MB pages where the kernel
-  /// has them, for a caller that is about to fill it (a bulk insertion's reserve). Faulting it in page by
-  /// page cost a bulk build with the history about a seventh of its time (1.2 GB of records at 10^6
-  /// points; docs/benchmarks.md, "Delaunay"). Only blocks of at least 4 MB, only on Linux; where the
-  /// kernel refuses (older kernels), the pages come on first touch as before. Nothing observable changes.
-  void prefault_reserved() {
-#if defined(__linux__) && defined(MADV_HUGEPAGE) && defined(MADV_POPULATE_WRITE)
-    constexpr std::uintptr_t kPage = 4096, kHuge = std::uintptr_t(1) << 21;
-    const std::uintptr_t a = (reinterpret_cast<std::uintptr_t>(p_ + n_) + kPage - 1) & ~(kPage - 1);
-    const std::uintptr_t e = reinterpret_cast<std::uintptr_t>(p_ + cap_) & ~(kPage - 1);
-    if (e < a + 2 * kHuge) return;
-    const std::uintptr_t ha = (a + kHuge - 1) & ~(kHuge - 1), he = e & ~(kHuge - 1);
-    if (he > ha) (void)madvise(reinterpret_cast<void*>(ha), he - ha, MADV_HUGEPAGE);
-    (void)madvise(reinterpret_cast<void*>(a), e - a, MADV_POPULATE_WRITE);
-#endif
-  }
+  /// The reserved, unused part [size, capacity) as raw memory (Triangulation::prefault_reserve).
+  std::pair<void*, std::size_t> unused_bytes() { return {p_ + n_, (cap_ - n_) * sizeof(T)}; }
   void resize(std::size_t n) {
     reserve(n);
     n_ = n;
@@ -269,11 +251,10 @@ class TetStore {
     flags_.reserve(flags_.size() + n);
     if (with_offsets_) offsets_.reserve(offsets_.size() + n);
   }
-  /// The reserved records backed by memory now (PodArray::prefault_reserved): for a caller that will use them.
-  void prefault_reserved() {
-    slots_.prefault_reserved();
-    flags_.prefault_reserved();
-    if (with_offsets_) offsets_.prefault_reserved();
+  /// The reserved, unused parts of the arrays (at most three ranges of raw memory; empty ones included).
+  std::array<std::pair<void*, std::size_t>, 3> unused_bytes() {
+    return {slots_.unused_bytes(), flags_.unused_bytes(),
+            with_offsets_ ? offsets_.unused_bytes() : std::pair<void*, std::size_t>{nullptr, 0}};
   }
   std::size_t capacity() const { return flags_.capacity(); }
   std::size_t memory_bytes() const {

@@ -35,7 +35,8 @@ void prefault(void* p, std::size_t bytes, unsigned threads) {
   const std::uintptr_t e = (reinterpret_cast<std::uintptr_t>(p) + bytes) & ~(kPage - 1);
   const std::size_t pages = (e - a) / kPage;
   detail::parallel_slices(pages, threads, [&](std::size_t lo, std::size_t hi) {
-    if (hi > lo) (void)madvise(reinterpret_cast<void*>(a + lo * kPage), (hi - lo) * kPage, MADV_POPULATE_WRITE);
+    if (hi > lo)
+      (void)madvise(reinterpret_cast<void*>(a + lo * kPage), (hi - lo) * kPage, MADV_POPULATE_WRITE);
   });
 #else
   (void)p;

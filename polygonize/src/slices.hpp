@@ -33,6 +33,12 @@ void run_slices(std::size_t n, std::size_t slices, const Fn& fn) {
   for (std::thread& th : pool) th.join();
 }
 
+/// Below this many items per slice the tracker's bulk passes run on fewer threads (starting one costs
+/// more than the items' work).
+inline constexpr std::size_t kTrackerSliceMin = std::size_t(1) << 13;
+/// At most this many slices for the passes that keep a row of counts per slice (4 bytes per vertex each).
+inline constexpr std::size_t kMaxCountingSlices = 8;
+
 /// The rows of a counting sort on slices: row[s * (start.size() - 1) + u] holds slice s's count for
 /// bucket u; they become each slice's first place in the bucket (lower slices first), start[u] the
 /// bucket's first place and start.back() the total, which is returned (the caller keeps it below 2^32).

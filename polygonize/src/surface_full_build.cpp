@@ -24,6 +24,8 @@ namespace vitri {
 
 namespace {
 
+using polygonizer_detail::kMaxCountingSlices;
+using polygonizer_detail::kTrackerSliceMin;
 using polygonizer_detail::row_starts;
 using polygonizer_detail::run_slices;
 using polygonizer_detail::slice_count;
@@ -84,8 +86,7 @@ SurfaceTracker::CornerBuckets SurfaceTracker::bucket_corners(const TrackerInput&
   const std::size_t nv = in.tri.vertex_capacity();
   if (!tets.empty() && polygon_of_.size() <= tets.back()) polygon_of_.resize(tets.back() + 1, kNone);
   // Smaller builds run on one thread; the counting rows (4 bytes per vertex and slice) limit the slices.
-  constexpr std::size_t kSliceMin = std::size_t(1) << 13, kMaxSlices = 8;
-  const std::size_t slices = std::min(slice_count(in.threads, n, kSliceMin), kMaxSlices);
+  const std::size_t slices = std::min(slice_count(in.threads, n, kTrackerSliceMin), kMaxCountingSlices);
   // The cell of each sign pattern (bit i: vertex i negative), and each tetrahedron's pattern (kDead when
   // it is not live), kept from the first pass for the second.
   static const std::array<marching::CellPolygon, 16> cells = [] {
@@ -159,8 +160,7 @@ SurfaceTracker::CornerBuckets SurfaceTracker::bucket_corners(const TrackerInput&
 void SurfaceTracker::number_edges(const TrackerInput& in, const CornerBuckets& buckets) {
   const std::vector<std::uint32_t>& start = buckets.start;
   std::uint64_t* const entries = buckets.entries.get();
-  constexpr std::size_t kSliceMin = std::size_t(1) << 13;
-  const std::size_t vslices = slice_count(in.threads, start.back(), kSliceMin);
+  const std::size_t vslices = slice_count(in.threads, start.back(), kTrackerSliceMin);
   const std::vector<std::size_t> bounds = balanced_vertex_slices(start, vslices);
   std::vector<std::size_t> edges_in(vslices + 1, 0);
   run_slices(vslices, vslices, [&](std::size_t s, std::size_t, std::size_t) {
@@ -211,8 +211,7 @@ void SurfaceTracker::remesh_all(const TrackerInput& in, Work& w) {
 // Steps 1 and 2 of remesh_all: the kept triangles with their corners' owners, and each owner's first use.
 SurfaceTracker::MeshCorners SurfaceTracker::mesh_corners(const TrackerInput& in) {
   const std::size_t n = polygons_.size(), num_edges = edges_.size();
-  constexpr std::size_t kSliceMin = std::size_t(1) << 13;
-  const std::size_t slices = slice_count(in.threads, n, kSliceMin);
+  const std::size_t slices = slice_count(in.threads, n, kTrackerSliceMin);
   // Each edge's corner identity in a compact array first: the polygon passes read them at random.
   std::vector<std::uint32_t> identity(num_edges);
   run_slices(num_edges, slices, [&](std::size_t, std::size_t lo, std::size_t hi) {

@@ -263,8 +263,9 @@ void SurfaceTracker::add_fan_triangle(const Polygon& poly, int k, VertexId z, in
 // (slices, then polygons) does not matter to the fans' test.
 void SurfaceTracker::anchored_corners(const TrackerInput& in, AnchoredCorners& out) const {
   const std::size_t n = polygons_.size(), nv = in.tri.vertex_capacity();
-  constexpr std::size_t kSliceMin = std::size_t(1) << 13, kMaxSlices = 8;
-  const std::size_t slices = std::min(polygonizer_detail::slice_count(in.threads, n, kSliceMin), kMaxSlices);
+  const std::size_t slices = std::min(
+      polygonizer_detail::slice_count(in.threads, n, polygonizer_detail::kTrackerSliceMin),
+      polygonizer_detail::kMaxCountingSlices);
   // The edges' anchors in a compact array first: the polygon passes read them at random.
   std::vector<VertexId> anchor(edges_.size());
   polygonizer_detail::run_slices(edges_.size(), slices, [&](std::size_t, std::size_t lo, std::size_t hi) {

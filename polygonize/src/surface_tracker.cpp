@@ -180,8 +180,9 @@ void SurfaceTracker::march_ahead(const TrackerInput& in, const TetId* tets, std:
                                             in.values[m.v[2]] < 0.0, in.values[m.v[3]] < 0.0});
     }
   };
-  constexpr std::size_t kSliceMin = std::size_t(1) << 13;  // smaller batches: one thread
-  polygonizer_detail::run_slices(n, polygonizer_detail::slice_count(in.threads, n, kSliceMin),
+  using polygonizer_detail::kTrackerSliceMin;  // smaller batches: one thread
+  const std::size_t slices = polygonizer_detail::slice_count(in.threads, n, kTrackerSliceMin);
+  polygonizer_detail::run_slices(n, slices,
                                  [&](std::size_t, std::size_t lo, std::size_t hi) { march(lo, hi); });
 }
 

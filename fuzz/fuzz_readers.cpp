@@ -21,6 +21,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)vitri::parse_xyzv(text, "fuzz.xyzv");
 #elif defined(VITRI_FUZZ_points)
     (void)vitri::parse_points(text, "fuzz.xyz");
+#elif defined(VITRI_FUZZ_pcd)
+    (void)vitri::parse_input(text, "fuzz.pcd");
 #endif
   } catch (const vitri::Error&) {
   }

@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/deps.sh cmake make g++ libeigen3-dev catch2 libstb-dev pkg-config libcpp-httplib-dev libjs-three \
-                   chromium chromium-driver python3-selenium
+                   chromium chromium-driver python3-selenium liblzf-dev
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVITRI_SANITIZE=address,undefined \
       -DVITRI_BUILD_BENCH=OFF -DVITRI_WERROR=ON

@@ -1,7 +1,7 @@
-// Readers and writers of the text formats (xyzv, xyz, pwn, OFF, OBJ), the PLY reader/writer, and
-// read_input(). Every reader works on an in-memory view of the file so that the fuzz targets exercise
-// exactly the same code; counts read from a file are checked against what the rest of the file can hold
-// before anything is allocated.
+// Readers and writers of the text formats (xyzv, xyz, pwn, OFF, OBJ), the `.viewpoint` files, and
+// read_input() (PLY: ply.cpp and mesh_writers.cpp; PCD: pcd.cpp). Every reader works on an in-memory view
+// of the file so that the fuzz targets exercise exactly the same code; counts read from a file are checked
+// against what the rest of the file can hold before anything is allocated.
 
 #include "vitri/io/io.hpp"
 
@@ -14,9 +14,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <system_error>
 
 namespace vitri {
 
@@ -199,6 +201,22 @@ void write_points(const std::string& path, const OrientedPoints& p) {
     out << '\n';
   }
   finish_out(out, path);
+}
+
+// ------------------------------------------------------------------ viewpoint
+Point3 parse_viewpoint(std::string_view text, const std::string& name) {
+  LineScanner s(text, name);
+  if (!s.next_data_line()) throw ParseError(name, 0, "no viewpoint in file (expected one line 'x y z')");
+  if (s.tokens().size() != 3)
+    s.fail("expected 3 numbers 'x y z' (the sensor position), got " + std::to_string(s.tokens().size()) +
+           " tokens");
+  const Point3 p{s.number(0), s.number(1), s.number(2)};
+  if (s.next_data_line()) s.fail("a viewpoint file holds one line 'x y z'; this is a second one");
+  return p;
+}
+
+Point3 read_viewpoint(const std::string& path) {
+  return parse_viewpoint(io_detail::slurp(path), path);
 }
 
 // ------------------------------------------------------------------ OFF
@@ -389,22 +407,45 @@ Input parse_input(std::string_view bytes, const std::string& name) {
   } else if (e == "xyz" || e == "pwn") {
     in.points = parse_points(bytes, name, e == "pwn");
     in.kind = in.points.has_normals() ? InputKind::OrientedPoints : InputKind::Points;
+  } else if (e == "pcd") {
+    in.points = parse_pcd(bytes, name);
+    in.kind = in.points.has_normals() ? InputKind::OrientedPoints : InputKind::Points;
   } else if (e == "off" || e == "obj" || e == "ply") {
     in.kind = InputKind::Mesh;
-    in.mesh = e == "off" ? parse_off(bytes, name) : e == "obj" ? parse_obj(bytes, name) : parse_ply(bytes, name);
-    if (in.mesh.F.rows() == 0) in = point_cloud(std::move(in.mesh));  // vertices only: a point cloud
+    std::vector<Point3> sensors;
+    in.mesh = e == "off"   ? parse_off(bytes, name)
+              : e == "obj" ? parse_obj(bytes, name)
+                           : io_detail::parse_ply_with_sensors(bytes, name, sensors);
+    if (in.mesh.F.rows() == 0) {  // vertices only: a point cloud
+      in = point_cloud(std::move(in.mesh));
+      in.points.sensors = std::move(sensors);
+    }
   } else {
-    throw ParseError(name, 0,
-                     "unknown input extension '." + e + "' (expected .xyzv, .xyz, .pwn, .off, .obj or .ply)");
+    throw ParseError(
+        name, 0,
+        "unknown input extension '." + e + "' (expected .xyzv, .xyz, .pwn, .pcd, .off, .obj or .ply)");
   }
   return in;
 }
 
 Input read_input(const std::string& path) {
   const std::string e = file_extension(path);
-  if (e != "xyzv" && e != "xyz" && e != "pwn" && e != "off" && e != "obj" && e != "ply")
+  if (e != "xyzv" && e != "xyz" && e != "pwn" && e != "pcd" && e != "off" && e != "obj" && e != "ply")
     return parse_input({}, path);  // the unknown-extension error, before the file is opened
-  return parse_input(io_detail::slurp(path), path);
+  Input in = parse_input(io_detail::slurp(path), path);
+  if ((in.kind == InputKind::Points || in.kind == InputKind::OrientedPoints) && !in.points.viewpoint) {
+    // The sensor position beside the file: the same path, extension ".viewpoint" (known extension: the
+    // path has a dot after its last separator).
+    const std::string sidecar = path.substr(0, path.find_last_of('.')) + ".viewpoint";
+    std::error_code ec;
+    const auto status = std::filesystem::status(sidecar, ec);
+    if (std::filesystem::exists(status)) {
+      if (!std::filesystem::is_regular_file(status))
+        throw ParseError(sidecar, 0, "viewpoint file exists but is not a regular file");
+      in.points.viewpoint = read_viewpoint(sidecar);
+    }
+  }
+  return in;
 }
 
 }  // namespace vitri

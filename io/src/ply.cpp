@@ -1,10 +1,11 @@
-// PLY reader (ascii 1.0, binary_little_endian 1.0) and writer.
+// PLY reader (ascii 1.0, binary_little_endian 1.0).
 //
 // The header is parsed into elements with their properties; the vertex element gives x y z (and nx ny
-// nz when all three are present), the face element a list named vertex_indices or vertex_index; every
-// other element or property is skipped by its declared type. Binary reads are bounds-checked against the
-// buffer, and element counts are checked against the bytes (binary) or lines (ascii) left before any
-// allocation, so a corrupt header cannot make the reader allocate or read out of bounds.
+// nz, and the sensor positions vx vy vz, each when all three are present), the face element a list named
+// vertex_indices or vertex_index; every other element or property is skipped by its declared type.
+// Binary reads are bounds-checked against the buffer, and element counts are checked against the bytes
+// (binary) or lines (ascii) left before any allocation, so a corrupt header cannot make the reader
+// allocate or read out of bounds.
 
 #include "text.hpp"
 #include "vitri/core/error.hpp"
@@ -146,6 +147,13 @@ std::size_t min_record_size(const PlyElement& e) {
 }  // namespace
 
 TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
+  std::vector<Point3> sensors;
+  return io_detail::parse_ply_with_sensors(bytes, name, sensors);
+}
+
+TriangleMesh io_detail::parse_ply_with_sensors(std::string_view bytes, const std::string& name,
+                                               std::vector<Point3>& sensors) {
+  sensors.clear();
   LineScanner s(bytes, name, /*comments=*/false);
   if (!s.next_data_line() || s.tokens()[0] != "ply")
     throw ParseError(name, 1, "not a PLY file (missing 'ply')");
@@ -203,7 +211,7 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
     if (e.name == "face" && !fe) fe = &e;
   }
   if (!ve) throw ParseError(name, s.line(), "PLY file has no 'vertex' element");
-  int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ilist = -1;
+  int ix = -1, iy = -1, iz = -1, inx = -1, iny = -1, inz = -1, ivx = -1, ivy = -1, ivz = -1, ilist = -1;
   for (std::size_t k = 0; k < ve->props.size(); ++k) {
     const auto& p = ve->props[k];
     if (p.is_list) continue;
@@ -214,9 +222,13 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
     if (p.name == "nx") inx = kk;
     if (p.name == "ny") iny = kk;
     if (p.name == "nz") inz = kk;
+    if (p.name == "vx") ivx = kk;
+    if (p.name == "vy") ivy = kk;
+    if (p.name == "vz") ivz = kk;
   }
   if (ix < 0 || iy < 0 || iz < 0) throw ParseError(name, ve->header_line, "vertex element lacks x, y or z");
   const bool normals = inx >= 0 && iny >= 0 && inz >= 0;
+  const bool with_sensors = ivx >= 0 && ivy >= 0 && ivz >= 0;
   if (fe) {
     for (std::size_t k = 0; k < fe->props.size(); ++k)
       if (fe->props[k].is_list &&
@@ -250,6 +262,7 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
   std::vector<int> tris, poly;
   v.reserve(3 * ve->count);
   if (normals) n.reserve(3 * ve->count);
+  if (with_sensors) sensors.reserve(ve->count);
   std::vector<double> rec;
   BinaryReader br(bytes, s.offset(), name);
   for (const auto& e : elements) {
@@ -325,6 +338,13 @@ TriangleMesh parse_ply(std::string_view bytes, const std::string& name) {
             if (!std::isfinite(x)) fail_at("vertex " + std::to_string(r) + ": non-finite normal", record_at);
             n.push_back(x);
           }
+        if (with_sensors) {
+          const Point3 sensor{rec[static_cast<std::size_t>(ivx)], rec[static_cast<std::size_t>(ivy)],
+                              rec[static_cast<std::size_t>(ivz)]};
+          if (!std::isfinite(sensor.x) || !std::isfinite(sensor.y) || !std::isfinite(sensor.z))
+            fail_at("vertex " + std::to_string(r) + ": non-finite sensor position (vx vy vz)", record_at);
+          sensors.push_back(sensor);
+        }
       } else if (is_f) {
         if (poly.size() < 3)
           fail_at("face " + std::to_string(r) + " has " + std::to_string(poly.size()) +

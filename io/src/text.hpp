@@ -111,6 +111,10 @@ class LineScanner {
 
 /// Reads a whole file; ParseError(path, 0, ...) when it cannot be opened.
 std::string slurp(const std::string& path);
+/// parse_ply() that also gives the vertices' sensor positions (properties vx vy vz, float or double, when
+/// all three are present; `sensors` is left empty otherwise), for read_input()'s PLY point clouds.
+TriangleMesh parse_ply_with_sensors(std::string_view bytes, const std::string& name,
+                                    std::vector<Point3>& sensors);
 /// Opens `path` for writing; ParseError(path, 0, ...) when it cannot be opened.
 std::ofstream open_out(const std::string& path, bool binary = false);
 /// Flushes; ParseError(path, 0, "write error") when the stream failed.

@@ -3,8 +3,10 @@
 /// Reading and writing the files vitri consumes and produces (formats in docs/formats.md):
 /// - constraints `.xyzv`: `x y z value` per line;
 /// - points `.xyz` (3 columns: positions; 6 columns: positions and normals) and `.pwn` (6 columns);
+/// - point clouds `.pcd` (PCL's format: ascii, binary, binary_compressed), read only;
 /// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little-endian) in;
-///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known.
+///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known;
+/// - sensor positions: `.viewpoint` files (`x y z`), read beside point inputs by read_input().
 ///
 /// Every reader throws vitri::ParseError(file, line, what) on a malformed file (truncated, wrong counts,
 /// non-numeric tokens, indices out of range, non-finite numbers), and ParseError with line 0 when the file
@@ -21,6 +23,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -34,13 +37,23 @@ struct PointValues {
   std::vector<double> values;  ///< One value per position.
 };
 
-/// Points, optionally with one normal each (normals empty when the file had none). Normals are stored as
-/// read (not normalized).
+/// Points, optionally with one normal each (normals empty when the file had none), and the sensor
+/// position(s) when the input gives them. Normals are stored as read (not normalized).
 struct OrientedPoints {
   std::vector<Point3> points;   ///< Positions.
   std::vector<Point3> normals;  ///< Empty, or one per point.
+  /// One sensor position for the whole cloud, in the points' coordinates, when the input gives one: the
+  /// translation of a PCD VIEWPOINT line, or else (read_input() only) a `STEM.viewpoint` file beside the
+  /// input. Unset otherwise.
+  /// @note Given, not verified: PCL writes `VIEWPOINT 0 0 0 1 0 0 0` for any cloud, merged multi-view
+  /// clouds included. Check it against the data before relying on it.
+  std::optional<Point3> viewpoint{};
+  /// Empty, or one sensor position per point (PLY vertex properties vx vy vz).
+  std::vector<Point3> sensors{};
   /// True when every point has a normal.
   bool has_normals() const { return !normals.empty() && normals.size() == points.size(); }
+  /// True when every point has its own sensor position.
+  bool has_sensors() const { return !sensors.empty() && sensors.size() == points.size(); }
 };
 
 /// An indexed triangle mesh at the API boundary.
@@ -79,8 +92,21 @@ OrientedPoints parse_points(std::string_view text, const std::string& name = "<m
                             bool require_normals = false);
 /// Reads `.xyz` (3 or 6 columns) or `.pwn` (6 columns required).
 OrientedPoints read_points(const std::string& path);
-/// Writes 3 columns, or 6 when normals are present.
+/// Writes 3 columns, or 6 when normals are present (viewpoint and sensors are not written).
 void write_points(const std::string& path, const OrientedPoints& p);
+/// Parses a PCD point cloud (PCL's format, docs/formats.md): DATA ascii, binary or binary_compressed
+/// (LZF); fields x y z (float or double) and, when all three are present, normal_x normal_y normal_z;
+/// every other field (rgb, intensity, curvature, "_" padding, ...) is skipped, whatever its SIZE, TYPE
+/// and COUNT. Points with a non-finite x, y or z (the holes of organized clouds) are skipped. Non-finite
+/// normals: when some point has a finite normal, the points without one are skipped; when none has, the
+/// normals are dropped. `viewpoint` is set to the VIEWPOINT line's translation when the header has one.
+/// Header errors carry the line; data errors line 0 and the point index or byte offset.
+OrientedPoints parse_pcd(std::string_view bytes, const std::string& name = "<memory>");
+/// Reads a sensor-position file (`.viewpoint`): one line `x y z` of finite numbers; `#` comments and
+/// blank lines allowed. @throws ParseError naming the file otherwise.
+Point3 read_viewpoint(const std::string& path);
+/// read_viewpoint() on text in memory.
+Point3 parse_viewpoint(std::string_view text, const std::string& name = "<memory>");
 
 // ----- meshes -----
 /// OFF, COFF, NOFF, CNOFF (header keyword alone on its line or followed by the counts), `#` comments.
@@ -113,9 +139,11 @@ void write_ply(const std::string& path, const TriangleMeshView& mesh, PlyEncodin
 /// What read_input() found.
 enum class InputKind {
   Constraints,     ///< .xyzv: `constraints` is set.
-  OrientedPoints,  ///< .pwn, 6-column .xyz, or a mesh file without faces with vertex normals: `points`.
-  Points,          ///< 3-column .xyz, or a mesh file without faces and normals: `points` without normals
-                   ///< (their normals must be estimated: constraints_from_points in vitri::rbf).
+  OrientedPoints,  ///< .pwn, 6-column .xyz, .pcd with normals, or a mesh file without faces with vertex
+                   ///< normals: `points`.
+  Points,          ///< 3-column .xyz, .pcd without normals, or a mesh file without faces and normals:
+                   ///< `points` without normals (their normals must be estimated: constraints_from_points
+                   ///< in vitri::rbf).
   Mesh,            ///< .off, .obj, .ply with at least one face: `mesh`.
 };
 
@@ -127,14 +155,17 @@ struct Input {
   TriangleMesh mesh;
 };
 
-/// Reads any supported input, detected by extension (.xyzv, .xyz, .pwn, .off, .obj, .ply). A mesh file
-/// with no face (a PLY point cloud, an OFF with 0 faces) is read as points, with normals when its
-/// vertices have them (PLY nx ny nz, NOFF, OBJ vn).
-/// @throws ParseError for an unknown extension (line 0) or a malformed file.
+/// Reads any supported input, detected by extension (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply). A mesh
+/// file with no face (a PLY point cloud, an OFF with 0 faces) is read as points, with normals when its
+/// vertices have them (PLY nx ny nz, NOFF, OBJ vn), and per-point sensor positions from PLY vx vy vz.
+/// When the result is points (kind Points or OrientedPoints) without a viewpoint from the file itself,
+/// `STEM.viewpoint` beside it (the path with its extension replaced by `.viewpoint`), when it exists,
+/// gives `points.viewpoint` (read_viewpoint()).
+/// @throws ParseError for an unknown extension (line 0) or a malformed file or `.viewpoint` file.
 Input read_input(const std::string& path);
 /// Parses the bytes of any supported input held in memory; the kind is detected by the extension of
 /// `name` (a file name used for the detection and in messages, never opened). read_input() = this on the
-/// file's contents. @throws as read_input.
+/// file's contents, and the `.viewpoint` file beside it. @throws as read_input.
 Input parse_input(std::string_view bytes, const std::string& name);
 
 /// Lower-case extension of path without the dot ("" when none).

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <fstream>
 #include <limits>
+#include <memory>
 #include <iostream>
 #include <sstream>
 #include <string>
@@ -197,6 +198,21 @@ void print_fit_split(const LocalFitReport& r) {
                1e3 * r.patches_seconds, r.patches, r.mean_fitted, r.max_fitted);
 }
 
+/// What the constraint builder merged and left out (stderr).
+void print_build_report(const ConstraintBuildReport& merged, const ConstraintBuildOptions& build) {
+  if (merged.merged_points + merged.merged_off_surface > 0)
+    std::fprintf(stderr, "merged %zu near-duplicate points and dropped %zu off-surface constraints on another "
+                 "constraint (closer than %g x the diagonal)\n", merged.merged_points, merged.merged_off_surface,
+                 build.merge_tolerance);
+  if (merged.offset > 0)
+    std::fprintf(stderr, "off-surface constraints at distance %.4g (%s)\n", merged.offset,
+                 build.offset_spacings > 0 ? "the data's spacing, see --offset" : "--offset");
+  if (merged.spaced_out > 0)
+    std::fprintf(stderr, "%zu off-surface constraints left out: the points that keep theirs are at least %g x "
+                 "that distance apart (see --off-surface-spacing)\n",
+                 merged.spaced_out, build.off_surface_spacing);
+}
+
 void write_current(Mesher& mesher, const std::string& path, PlyEncoding ply) {
   write_mesh(path, view_of(mesher.surface()), ply);
 }
@@ -215,6 +231,10 @@ constexpr double kSpacingFactor = 2.5;
 /// the incremental extraction, which adds about 0.4 KB.
 constexpr double kBytesPerVertexBatch = 1600.0;
 constexpr double kBytesPerVertexHistory = 2900.0;
+/// A scan without --precision: at most this many Delaunay vertices per input point (plus the base), about
+/// 2 mesh vertices per input point (docs/scans.md "Budget").
+constexpr std::size_t kScanVerticesPerPoint = 12;
+constexpr std::size_t kScanVerticesBase = 200000;
 
 /// The Delaunay vertex budget of this machine: 80% of the physical memory over the bytes per vertex
 /// (0: unknown, no limit).
@@ -225,12 +245,21 @@ std::size_t vertex_budget(bool keep_history) {
   return static_cast<std::size_t>(bytes / (keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch));
 }
 
-/// mesher.refine(), its LimitError (MesherOptions::max_vertices, set from the machine's memory) said in
-/// the CLI's terms.
-void refine_within_memory(Mesher& mesher, double precision, const ProgressCallback& progress) {
+/// mesher.refine(), its LimitError (MesherOptions::max_vertices, set from the machine's memory and, for a
+/// scan without --precision, from the input's size) said in the CLI's terms. Without an explicit
+/// precision (`lenient`) the limit gives the mesh refined so far (coarser) with a warning, not an error.
+void refine_within_budget(Mesher& mesher, double precision, bool lenient, bool quiet,
+                          const ProgressCallback& progress) {
   try {
     mesher.refine(precision, progress);
   } catch (const LimitError& e) {
+    if (lenient) {
+      if (!quiet)
+        std::fprintf(stderr, "\nvitri mesh: warning: the refinement reached its budget of %zu Delaunay vertices "
+                     "(the input's size and this machine's memory, docs/scans.md) before the default precision: "
+                     "the mesh is coarser than it, partly (%s)\n", mesher.options().max_vertices, e.what());
+      return;
+    }
     std::ostringstream what;
     what << "this machine's memory holds about " << mesher.options().max_vertices
          << " Delaunay vertices (80% of the physical memory at "
@@ -250,6 +279,7 @@ int run_mesh(const Args& args) {
   std::vector<double> distances;  // quality mode: --max-distance per level (relative)
   double relative_size = std::numeric_limits<double>::infinity();  // quality mode: --max-size
   bool quiet = false;
+  bool surface_given = false;  // --surface
   PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  // --ascii: text
   unsigned threads = 0;  // --threads: 0 = every available CPU
   MesherOptions options;
@@ -305,8 +335,24 @@ int run_mesh(const Args& args) {
       options.constraint_build.off_surface_spacing = sp;
     } else if (a == "--neighbours") {
       std::size_t k = 0;
-      if (!value(v) || !parse_index(v, k) || k < 3) return usage_error("--neighbours needs an integer >= 3");
+      if (!value(v) || !parse_index(v, k) || k < 6) return usage_error("--neighbours needs an integer >= 6");
       options.constraint_build.normals.k = k;
+      options.scan.k = k;
+    } else if (a == "--surface") {
+      if (!value(v)) return usage_error("--surface needs closed, open or auto");
+      if (v == "closed") options.surface = SurfaceKind::Closed;
+      else if (v == "open") options.surface = SurfaceKind::Open;
+      else if (v == "auto") options.surface = SurfaceKind::Auto;
+      else return usage_error("--surface must be closed, open or auto, got '" + v + "'");
+      surface_given = true;
+    } else if (a == "--viewpoint") {
+      double xyz[3];
+      for (double& c : xyz) {
+        std::string w;
+        if (!value(w) || !parse_double(w, c) || !std::isfinite(c))
+          return usage_error("--viewpoint needs three finite numbers X Y Z");
+      }
+      options.scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
     } else if (a == "--function") {
       if (!value(v)) return usage_error("--function needs global, local or auto");
       if (v == "global") options.function = FunctionKind::Global;
@@ -318,6 +364,7 @@ int run_mesh(const Args& args) {
       if (!value(v) || !parse_double(v, sm) || !(sm >= 0.0) || !std::isfinite(sm))
         return usage_error("--smoothing needs a number >= 0");
       options.local.smoothing = sm;
+      options.scan.approximate = sm > 0.0;  // 0: interpolate the points as they are
     } else if (a == "--threads") {
       std::size_t k = 0;
       if (!value(v) || !parse_index(v, k) || k > kMaxThreads)
@@ -375,49 +422,88 @@ int run_mesh(const Args& args) {
   options.max_vertices = vertex_budget(options.polygonizer.keep_history);
   phases.start("read", "reading " + input);
   Input data = read_input(input);
-  phases.start("constraints");
-  ConstraintBuildReport merged;
-  Constraints constraints = constraints_for_function(std::move(data), input, options.constraint_build,
-                                                     options.function, options.auto_local_above, merged);
-  if (!quiet && merged.merged_points + merged.merged_off_surface > 0)
-    std::fprintf(stderr, "merged %zu near-duplicate points and dropped %zu off-surface constraints on another "
-                 "constraint (closer than %g x the diagonal)\n", merged.merged_points, merged.merged_off_surface,
-                 options.constraint_build.merge_tolerance);
-  if (!quiet && merged.offset > 0)
-    std::fprintf(stderr, "off-surface constraints at distance %.4g (%s)\n", merged.offset,
-                 options.constraint_build.offset_spacings > 0 ? "the data's spacing, see --offset" : "--offset");
-  if (!quiet && merged.spaced_out > 0)
-    std::fprintf(stderr, "%zu off-surface constraints left out: the points that keep theirs are at least %g x "
-                 "that distance apart (see --off-surface-spacing)\n",
-                 merged.spaced_out, options.constraint_build.off_surface_spacing);
-  if (default_precision) {
-    // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
-    phases.start("precision", "median spacing");
-    Box3 box;
-    for (const Point3& p : constraints.points) box.extend(p);
-    // Measured already when the builder's off-surface distance followed the data (the same estimate).
-    const double spacing = merged.median_spacing > 0 ? merged.median_spacing : median_spacing(constraints);
-    precisions.push_back(kSpacingFactor * spacing / box.diagonal());
-    if (!quiet) std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", precisions[0]);
-  }
-  const std::size_t levels = std::max(precisions.size(), distances.size());
-  const bool announce_fit = constraints.size() >= kFitProgressConstraints;
+  // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
+  // orientation, open or closed. Constraints (.xyzv) and meshes are interpolated as they are.
+  const bool scan_input = data.kind == InputKind::Points || data.kind == InputKind::OrientedPoints;
+  if (surface_given && !scan_input && options.surface != SurfaceKind::Closed)
+    std::fprintf(stderr, "vitri mesh: warning: --surface applies to point inputs; %s gives a closed surface\n",
+                 input.c_str());
+  std::size_t input_points = 0;
+  std::size_t announced_constraints = 0;
   options.on_phase = [&](const char* phase) {
     const std::string name = phase;
     if (name != "fit" && name != "fit+seeds") return phases.start(name);
     const std::string beside = name == "fit" ? "" : ", their Delaunay tetrahedralization beside it";
-    phases.start(name, announce_fit ? "fitting the implicit function to " + std::to_string(constraints.size()) +
-                                          " constraints" + beside
-                                    : name);
+    phases.start(name, announced_constraints >= kFitProgressConstraints
+                           ? "fitting the implicit function to " + std::to_string(announced_constraints) +
+                                 " constraints" + beside
+                           : scan_input ? "fitting the implicit function" + beside : name);
   };
-  Mesher mesher(constraints, options);
-  constraints = Constraints{};  // the Mesher has its own copy: 32 bytes per constraint freed for the rest
+  std::unique_ptr<Mesher> built;
+  if (scan_input) {
+    input_points = data.points.points.size();
+    if (!options.scan.viewpoint && data.points.viewpoint) options.scan.viewpoint = data.points.viewpoint;
+    if (data.points.has_sensors()) options.scan.sensors = std::move(data.points.sensors);
+    if (!quiet && options.scan.viewpoint)
+      std::fprintf(stderr, "viewpoint %g %g %g (%s)\n", options.scan.viewpoint->x, options.scan.viewpoint->y,
+                   options.scan.viewpoint->z, data.points.viewpoint ? "from the input" : "--viewpoint");
+    // The default budget follows the input (docs/scans.md): a coarser mesh with a warning beyond it.
+    if (default_precision) {
+      const std::size_t by_input = kScanVerticesPerPoint * input_points + kScanVerticesBase;
+      options.max_vertices = options.max_vertices ? std::min(options.max_vertices, by_input) : by_input;
+    }
+    phases.start("scan", "preparing " + std::to_string(input_points) + " scanned points");
+    try {
+      built = std::make_unique<Mesher>(Mesher::from_scan(data.points.points, data.points.normals, options));
+    } catch (const InvalidPoint& e) {  // say which file (the message names the point)
+      throw InvalidPoint(e.index(), input + ": " + e.what());
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(input + ": " + e.what());
+    }
+    data = Input{};
+  } else {
+    phases.start("constraints");
+    ConstraintBuildReport merged;
+    Constraints constraints = constraints_for_function(std::move(data), input, options.constraint_build,
+                                                       options.function, options.auto_local_above, merged);
+    if (!quiet) print_build_report(merged, options.constraint_build);
+    if (default_precision) {
+      // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
+      phases.start("precision", "median spacing");
+      Box3 box;
+      for (const Point3& p : constraints.points) box.extend(p);
+      // Measured already when the builder's off-surface distance followed the data (the same estimate).
+      const double spacing = merged.median_spacing > 0 ? merged.median_spacing : median_spacing(constraints);
+      precisions.push_back(kSpacingFactor * spacing / box.diagonal());
+      if (!quiet) std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", precisions[0]);
+    }
+    announced_constraints = constraints.size();
+    built = std::make_unique<Mesher>(constraints, options);
+    constraints = Constraints{};  // the Mesher has its own copy: 32 bytes per constraint freed for the rest
+  }
+  Mesher& mesher = *built;
   phases.stop();
+  if (scan_input) {
+    const ScanReport& sr = mesher.stats().scan;
+    if (!quiet) {
+      std::fprintf(stderr, "%s\n", describe(sr).c_str());
+      print_build_report(mesher.stats().scan_constraints, options.constraint_build);
+    }
+    if (default_precision) {
+      // The resolution the data resolve, not the raw spacing of noisy points (docs/scans.md).
+      precisions.push_back(kSpacingFactor * sr.resolution / mesher.diagonal());
+      if (!quiet)
+        std::fprintf(stderr, "no --precision: using the data's resolution (%.4g: spacing and noise), %.4g\n",
+                     sr.resolution, precisions[0]);
+    }
+  }
+  const bool announce_fit = mesher.size() >= kFitProgressConstraints;
   if (announce_fit && !quiet) {
     std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
     if (const LocalRbf* local = mesher.local_function()) print_fit_split(local->report());
     print_init_split(mesher.stats().polygonizer);
   }
+  const std::size_t levels = std::max(precisions.size(), distances.size());
   const double diag = mesher.diagonal();
   const double build_ms = 1e3 * phases.elapsed();
   if (!quiet) {
@@ -443,7 +529,7 @@ int run_mesh(const Args& args) {
     const auto t0 = Clock::now();
     auto last_report = Clock::now();
     bool reported = false;
-    refine_within_memory(mesher, precision * diag, [&](const RefineProgress& p) {
+    refine_within_budget(mesher, precision * diag, default_precision, quiet, [&](const RefineProgress& p) {
       if (!quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
         std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
                      p.queued);
@@ -465,6 +551,14 @@ int run_mesh(const Args& args) {
     phases.start("writing", "writing " + path);
     write_current(mesher, path, ply);
     phases.stop();
+    if (!quiet && scan_input) {
+      const MesherStats st = mesher.stats();
+      std::fprintf(stderr, "surface: %s (%.1f%% of the closed surface's area away from the data%s); %zu small or "
+                   "unsupported components dropped%s\n", st.open ? "open, trimmed to the data" : "closed",
+                   100 * st.unsupported_area,
+                   options.surface == SurfaceKind::Auto ? ", --surface auto" : "", st.scan_small_components,
+                   st.open ? (", " + std::to_string(st.trimmed_triangles) + " triangles trimmed").c_str() : "");
+    }
     if (!quiet)
       std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
                   m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());

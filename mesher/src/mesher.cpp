@@ -17,6 +17,7 @@
 // The mesh is extracted on demand afterwards.
 #include "vitri/mesher.hpp"
 
+#include "scan_support.hpp"
 #include "support_filter.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/point_index.hpp"
@@ -122,6 +123,44 @@ Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std
 
 Mesher Mesher::from_points(const std::vector<Point3>& points, const MesherOptions& options) {
   return Mesher(constraints_from_points(points, options.constraint_build), options);
+}
+
+Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                         const MesherOptions& options) {
+  ScanReport report;
+  ScanOptions scan = options.scan;
+  if (scan.threads == 0) scan.threads = options.polygonizer.threads;
+  ScanPoints prepared = prepare_scan(points, normals, scan, &report);
+  auto support = std::make_shared<ScanSupport>(prepared, report.resolution, scan.threads);
+  MesherOptions o = options;
+  // The sizing field follows the data as they were scanned; an editing session (history kept) moves
+  // constraints away from them, so it keeps the uniform precision.
+  if (!o.polygonizer.size_scale && !o.polygonizer.keep_history)
+    o.polygonizer.size_scale = [support](const Point3& x) { return support->size_scale(x); };
+  // The function: Auto decided on the constraint count without the off-surface spacing (which serves the
+  // local function only), as the CLI always did.
+  ConstraintBuildOptions build = o.constraint_build;
+  ConstraintBuildReport built;
+  Constraints c;
+  if (o.function == FunctionKind::Auto && prepared.points.size() > o.auto_local_above)
+    o.function = FunctionKind::Local;
+  if (o.function != FunctionKind::Local) {
+    build.off_surface_spacing = 0.0;
+    c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &built);
+    if (o.function == FunctionKind::Auto) {
+      o.function = c.size() > o.auto_local_above ? FunctionKind::Local : FunctionKind::Global;
+      if (o.function == FunctionKind::Local && o.constraint_build.off_surface_spacing > 0)
+        c = constraints_from_oriented_points(prepared.points, prepared.normals, o.constraint_build, &built);
+    }
+  } else {
+    c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &built);
+  }
+  prepared = ScanPoints{};
+  Mesher m(c, o);
+  m.scan_ = std::move(support);
+  m.stats_.scan = report;
+  m.stats_.scan_constraints = built;
+  return m;
 }
 
 Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options) {
@@ -294,14 +333,26 @@ const SurfaceMesh& Mesher::surface() {
     mesh_ = poly_->live_surface().to_surface_mesh();
     if (filtering()) mesh_ = keep_supported_components(std::move(mesh_), support_query(), &dropped);
     stats_.dropped_components = dropped;
+    finish_scan_surface();
     mesh_valid_ = true;
   } else if (!mesh_valid_) {
     sync_surface();
     if (!deltas_wanted_) filter_->view().take_delta();  // nobody reads the record: free the ids
     mesh_ = filter_->view().to_surface_mesh();
+    finish_scan_surface();
     mesh_valid_ = true;
   }
   return mesh_;
+}
+
+void Mesher::finish_scan_surface() {
+  if (!scan_ || !std::isfinite(precision_)) return;
+  ScanFinishReport r;
+  mesh_ = scan_->finish(std::move(mesh_), precision_, options_.surface, options_.polygonizer.keep_history, &r);
+  stats_.scan_small_components = r.small_components;
+  stats_.open = r.open;
+  stats_.unsupported_area = r.unsupported_area;
+  stats_.trimmed_triangles = r.trimmed_triangles;
 }
 
 void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { to_eigen(surface(), V, F, &N); }

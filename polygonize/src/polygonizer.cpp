@@ -404,9 +404,15 @@ bool Polygonizer::is_active(TetId t) const {
   return (t < tpos_.size() && tpos_[t] != kNotListed) || touches_lonely(t);
 }
 
+double Polygonizer::sized_radius(TetId t) const {
+  const double r = tri_.circumradius(t);
+  if (!options_.size_scale) return r;
+  return r / std::max(1.0, options_.size_scale(tri_.circumcenter(t)));
+}
+
 void Polygonizer::push_if_big(TetId t) {
   if (!std::isfinite(precision_)) return;  // before the first refine(): nothing is queued
-  radius_[t] = tri_.circumradius(t);
+  radius_[t] = sized_radius(t);
   if (radius_[t] > precision_) push(t);
 }
 
@@ -458,7 +464,7 @@ void Polygonizer::classify(TetId t, bool requeue) {
   if (!tri_.is_live(t)) return;
   const bool now = is_transverse(t);
   const bool was = tpos_[t] != kNotListed;
-  classify_as(t, requeue, now, now && (!was || requeue) ? tri_.circumradius(t) : 0.0);
+  classify_as(t, requeue, now, now && (!was || requeue) ? sized_radius(t) : 0.0);
 }
 
 // classify() of the live tetrahedron t, whose transverse flag `now` (and circumradius, read when it is
@@ -483,7 +489,7 @@ void Polygonizer::classify_all() {
     for (std::size_t t = lo; t < hi; ++t) {
       if (!is_transverse(static_cast<TetId>(t))) continue;  // dead ones are not
       transverse[t] = 1;
-      radius_[t] = tri_.circumradius(static_cast<TetId>(t));
+      radius_[t] = sized_radius(static_cast<TetId>(t));
     }
   });
   for (std::size_t t = 0; t < n; ++t)
@@ -513,7 +519,7 @@ void Polygonizer::classify_created(std::vector<TetId>& created) {
       Ahead& a = ahead[k];
       a.live = tri_.is_live(t);
       a.transverse = a.live && is_transverse(t);
-      if (a.transverse) a.radius = tri_.circumradius(t);
+      if (a.transverse) a.radius = sized_radius(t);
     }
   });
   for (std::size_t k = 0; k < n; ++k) {

@@ -195,7 +195,7 @@ std::vector<Point3> pca_normals(const DistinctPoints& d, const NeighbourTable& t
     }
   });
   for (std::size_t u = 0; u < n; ++u)
-    if (!(planarity[u] > opt.collinear_tolerance))
+    if (!(planarity[u] > opt.collinear_tolerance) && opt.strict)
       throw DegenerateNeighbourhood(d.first[u],
                                     "its " + std::to_string(opt.k) +
                                         " nearest neighbours are (nearly) collinear: no tangent plane "
@@ -231,7 +231,8 @@ double edge_cost(const DistinctPoints& d, const std::vector<Point3>& n, Id a, Id
 
 /// Orients the normals of one component by Prim's algorithm from `seed`; updates the report.
 void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed, std::vector<Point3>& n,
-                      std::vector<char>& done, OrientationReport& rep, double min_link, std::size_t k) {
+                      std::vector<char>& done, OrientationReport& rep, double min_link, std::size_t k,
+                      bool strict) {
   using Item = std::tuple<double, Id, Id>;  // (cost, to, from): ties broken by ids, deterministic
   std::priority_queue<Item, std::vector<Item>, std::greater<Item>> frontier;
   auto visit = [&](Id u) {
@@ -246,7 +247,9 @@ void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed,
     (void)cost;
     if (done[to]) continue;
     const double c = dot(n[from], n[to]);
-    if (std::abs(c) < min_link)
+    if (std::abs(c) < min_link && !strict) {
+      ++rep.ambiguous;
+    } else if (std::abs(c) < min_link) {
       throw OrientationError(
           d.first[to],
           "its orientation is ambiguous: the most reliable path to it from the rest of its "
@@ -255,6 +258,7 @@ void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed,
               ", from point " + std::to_string(d.first[from]) +
               "): a sharp edge or a thin part sampled too sparsely for k = " + std::to_string(k) +
               "; sample more densely, change k, or lower min_link");
+    }
     rep.weakest_link = std::min(rep.weakest_link, std::abs(c));
     if (c < 0) {
       n[to] = -n[to];
@@ -353,13 +357,16 @@ OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable&
   for (const Component& part : parts) {
     if (part.size == 0) continue;
     const Id s = part.seed;
-    if (part.size < min_size)
+    const bool small = part.size < min_size;
+    const bool unseeded = std::abs(dot(n[s], part.outward)) < kMinSeedAlignment;
+    if (!opt.strict && (small || unseeded)) rep.ambiguous += part.size;
+    if (small && opt.strict)
       throw OrientationError(d.first[s],
                              "isolated group of " + std::to_string(part.size) + " points (fewer than " +
                                  std::to_string(min_size) +
                                  ", see NormalOptions::min_component) not connected to the rest "
                                  "by nearest neighbours: outliers, or a part too sparse to orient");
-    if (std::abs(dot(n[s], part.outward)) < kMinSeedAlignment)
+    if (unseeded && opt.strict)
       throw OrientationError(d.first[s],
                              "the extreme points of its component (largest and smallest x, y, z) all have "
                              "normals nearly perpendicular to their direction: the component does not look "
@@ -369,11 +376,11 @@ OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable&
       ++rep.flipped;
     }
     ++rep.components;
-    orient_component(d, g, s, n, done, rep, opt.min_link, opt.k);
+    orient_component(d, g, s, n, done, rep, opt.min_link, opt.k, opt.strict);
   }
   const Disagreement dis = disagreement(d, t, n);
   rep.disagreement = dis.fraction;
-  if (dis.fraction > opt.max_disagreement)
+  if (dis.fraction > opt.max_disagreement && opt.strict)
     throw OrientationError(d.first[dis.worst],
                            "the orientation is not consistent: " + fmt_ratio(100 * dis.fraction) +
                                "% of the neighbour pairs along the surface get opposite normals (more than "

@@ -26,6 +26,7 @@
 #include "vitri/rbf/local_rbf.hpp"
 #include "vitri/rbf/point_index.hpp"
 #include "vitri/rbf/rbf.hpp"
+#include "vitri/rbf/scan.hpp"
 
 #include <Eigen/Core>
 
@@ -37,6 +38,15 @@
 namespace vitri {
 
 class SupportFilter;
+class ScanSupport;
+
+/// What kind of surface a scan gives (Mesher::from_scan, docs/scans.md).
+enum class SurfaceKind {
+  Closed,  ///< the zero set as it is: a closed surface (what the paper's method gives)
+  Open,    ///< only the part the data support: an open 2-manifold with boundary where the data end
+  Auto,    ///< Open when more than a fifth of the closed surface's area is unsupported (a scan seen from
+           ///< one side), else Closed; decided at the first surface() and kept
+};
 
 /// Which variational function the Mesher fits (docs/local_rbf.md).
 enum class FunctionKind {
@@ -79,6 +89,10 @@ struct MesherOptions {
   bool keep_unsupported_components = false;
   /// Refinement and extraction options (queue order, root finder, sampling, zero-vertex snapping).
   PolygonizerOptions polygonizer;
+  /// from_scan(): how the scanned points are prepared (noise, outliers, orientation; docs/scans.md).
+  ScanOptions scan;
+  /// from_scan(): closed, open (trimmed to the data) or decided from the data. Other constructors: Closed.
+  SurfaceKind surface = SurfaceKind::Auto;
   /// Fit and edit options of the RBF.
   RbfOptions rbf;
   /// Normal constraints built by from_oriented_points() and from_mesh() (off-surface distance, ...).
@@ -126,6 +140,18 @@ struct MesherStats {
   /// Last surface(): components dropped as unsupported (MesherOptions::keep_unsupported_components).
   std::size_t dropped_components = 0;
   QualityStats quality;            ///< quality mode: counters of the QualityMesher (zero otherwise)
+  /// from_scan(): what the preparation of the points measured and set aside (outliers, noise, ...).
+  ScanReport scan;
+  /// from_scan(): what the normal constraints' builder merged, the off-surface distance and what the
+  /// off-surface spacing left out (constraints_from_oriented_points' report).
+  ConstraintBuildReport scan_constraints;
+  /// from_scan(), last surface(): components dropped as smaller than the data resolve or unsupported,
+  /// whether the mesh was left open (trimmed to the data), the unsupported share of the closed mesh's
+  /// area that decided it, and the triangles the trimming removed or clipped.
+  std::size_t scan_small_components = 0;
+  bool open = false;
+  double unsupported_area = 0;
+  std::size_t trimmed_triangles = 0;
 };
 
 /// Stateful mesher of one variational implicit surface. Not thread-safe. Movable, not copyable.
@@ -147,6 +173,14 @@ class Mesher {
   /// docs/normals.md), then as above. @throws as constraints_from_points (DegenerateNeighbourhood,
   /// OrientationError naming a point, InvalidArgument for too few points) and Mesher::Mesher.
   static Mesher from_points(const std::vector<Point3>& points, const MesherOptions& options = {});
+  /// Scanned points (noise, outliers, uneven density, single views; docs/scans.md): prepare_scan() with
+  /// options.scan (`normals` empty or one per point, checked; options.scan.viewpoint / sensors orient
+  /// them otherwise), normal constraints of the prepared points, then as above; the refinement is coarse
+  /// far from the data, and surface() drops components the data do not support or resolve and, for an
+  /// open surface (options.surface), trims the mesh to the data. stats().scan says what was set aside.
+  /// @throws as prepare_scan (only for inputs with no surface) and Mesher::Mesher.
+  static Mesher from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                          const MesherOptions& options = {});
   /// Normal constraints from a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3;
   /// constraints_from_mesh), then as above. @throws InvalidArgument for an open or non-manifold mesh.
   static Mesher from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options = {});
@@ -241,6 +275,8 @@ class Mesher {
   double value_of(std::size_t i) const;
   Point3 constraints_point(std::size_t i) const;
   void refine_quality();
+  /// from_scan(): mesh_ finished by the scan support (components, open or closed, trimming).
+  void finish_scan_surface();
   bool filtering() const;
   std::function<bool(const Point3&)> support_query() const;  // a zero constraint within reach?
   bool inside_domain(const Point3& p) const;
@@ -283,6 +319,7 @@ class Mesher {
   SurfaceMesh mesh_;
   bool mesh_valid_ = false;
   std::unique_ptr<SupportFilter> filter_;  // the live mesh without unsupported components
+  std::shared_ptr<ScanSupport> scan_;        // from_scan(): the data (sizing field, finishing), else null
   double filter_precision_ = 0;             // precision of its last support check
   bool filter_behind_ = false;              // batch surface() calls skipped it (it missed their deltas)
   bool deltas_wanted_ = false;              // update_surface() was called: keep the records

@@ -72,6 +72,11 @@ enum class VertexKind : std::uint8_t {
 struct PolygonizerOptions {
   /// Refinement order of transverse tetrahedra.
   QueueOrder order = QueueOrder::Fifo;
+  /// A sizing field: when set, a transverse tetrahedron is refined while its circumradius exceeds the
+  /// precision times size_scale(its circumcenter) (a value >= 1 where the surface may stay coarser, e.g.
+  /// far from scanned data; values below 1 are taken as 1). Called from several threads at once: it must
+  /// be safe to call concurrently. Empty (default): the precision holds everywhere.
+  std::function<double(const Point3&)> size_scale;
   /// Initial sampling: a cubic lattice of cell centers is inserted whose covering radius r_s (every
   /// point of the domain is within r_s of a lattice point) is this fraction of the domain diagonal.
   /// Every component of {f < 0} or {f > 0} that contains a ball of radius r_s then holds a vertex of its
@@ -420,6 +425,9 @@ class Polygonizer {
   void set_value(VertexId v, double value);
   void set_lonely(VertexId v, bool on);
   void push_if_big(TetId t);
+  /// The circumradius of t over options_.size_scale at its circumcenter (at least 1): what the queue compares
+  /// with the precision.
+  double sized_radius(TetId t) const;
   void settle_zeros(const std::vector<TetId>& created);
   bool touches_lonely(TetId t) const;
   bool crossed_twice(VertexId a, VertexId b, double min_length, double& s) const;

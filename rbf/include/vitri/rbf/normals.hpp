@@ -49,6 +49,13 @@ struct NormalOptions {
   /// the bundled models) orient_normals() throws OrientationError naming the point with the most such
   /// pairs. 1 disables the check.
   double max_disagreement = 0.01;
+  /// true (the library's default): the checks above refuse (OrientationError) and a collinear
+  /// neighbourhood throws DegenerateNeighbourhood. false (what the scan path, prepare_scan() in scan.hpp,
+  /// uses): nothing is refused; a small component, a seed whose extreme points are all perpendicular to
+  /// their directions, a sign decided across a link below `min_link` and a collinear neighbourhood are
+  /// oriented as well as the data allow (the best-aligned seed, the tree edge as found, the normal of
+  /// the smallest eigenvalue) and counted in OrientationReport::ambiguous.
+  bool strict = true;
 };
 
 /// A point whose neighbourhood does not define a tangent plane (collinear neighbours).
@@ -82,6 +89,10 @@ struct OrientationReport {
   /// Fraction of the neighbour pairs along the surface (edge at most 30 degrees out of both tangent
   /// planes) whose oriented normals point to opposite sides; see NormalOptions::max_disagreement.
   double disagreement = 0.0;
+  /// NormalOptions::strict = false: the points whose sign was decided where a strict run would have
+  /// refused (reached across a link below min_link, or in a component smaller than min_component or with
+  /// no reliable seed), and the neighbourhoods that were collinear.
+  std::size_t ambiguous = 0;
 };
 
 /// Orients unit normals consistently (flips signs only), in place: minimum spanning tree of the

@@ -1,0 +1,144 @@
+#include "scan_support.hpp"
+
+#include "vitri/mesher.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+namespace vitri {
+namespace {
+
+/// Beyond this many local spacings from the data, the refinement may coarsen (sizing field > 1).
+constexpr double kFineReach = 3.0;
+/// A mesh vertex is supported by the data when a point lies within max(this x its local spacing,
+/// kReachPrecision x the precision).
+constexpr double kReachSpacings = 4.0;
+constexpr double kReachPrecision = 1.5;
+/// Auto: a closed mesh with more than this fraction of its area unsupported is a scan seen from one side
+/// (or a few): it is left open.
+constexpr double kOpenAreaFraction = 0.2;
+/// Components smaller than this many resolutions squared, or this fraction of the largest component's
+/// area, are below what the data resolve (bubbles and blobs of noise).
+constexpr double kMinComponentResolutions = 8.0;
+constexpr double kMinComponentFraction = 0.005;
+
+double triangle_area(const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t) {
+  return 0.5 * norm(cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]));
+}
+
+}  // namespace
+
+ScanSupport::ScanSupport(const ScanPoints& points, double resolution, unsigned threads)
+    : points_(points.points), spacing_(points.spacing), index_(points_, threads), resolution_(resolution) {}
+
+double ScanSupport::distance(const Point3& x, double* spacing) const {
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  index_.nearest(x, 1, ids, &d2);
+  if (ids.empty()) {
+    if (spacing) *spacing = resolution_;
+    return std::numeric_limits<double>::infinity();
+  }
+  if (spacing) *spacing = spacing_[ids[0]];
+  return std::sqrt(d2[0]);
+}
+
+double ScanSupport::size_scale(const Point3& x) const {
+  double h = 0;
+  const double d = distance(x, &h);
+  // Sparser data than the median resolve less: the precision follows the local spacing (a region
+  // sampled 10x more sparsely gets a 10x coarser mesh, not one full of detail the data do not have).
+  const double sparse = std::max(1.0, h / resolution_);
+  const double reach = kFineReach * std::max(h, resolution_);
+  return sparse * (d <= reach ? 1.0 : d / reach);
+}
+
+SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing,
+                                ScanFinishReport* report) {
+  ScanFinishReport rep;
+  const std::size_t nv = mesh.vertices.size();
+  std::vector<double> s(nv, 0.0);  // distance to the data minus the reach: <= 0 supported
+  for (std::size_t v = 0; v < nv; ++v) {
+    double h = 0;
+    const double d = distance(mesh.vertices[v], &h);
+    s[v] = d - std::max(kReachSpacings * h, kReachPrecision * precision);
+  }
+  // Components through shared vertices: area and support.
+  std::vector<std::uint32_t> root(nv);
+  std::iota(root.begin(), root.end(), 0u);
+  auto find = [&](std::uint32_t v) {
+    while (root[v] != v) v = root[v] = root[root[v]];
+    return v;
+  };
+  for (const auto& t : mesh.triangles)
+    for (int c = 1; c < 3; ++c) {
+      const std::uint32_t a = find(t[0]), b = find(t[static_cast<std::size_t>(c)]);
+      if (a != b) root[std::max(a, b)] = std::min(a, b);
+    }
+  std::vector<double> area(nv, 0.0);
+  std::vector<std::uint8_t> supported(nv, 0);
+  double total = 0, unsupported = 0;
+  for (const auto& t : mesh.triangles) {
+    const double a = triangle_area(mesh, t);
+    area[find(t[0])] += a;
+    total += a;
+    if (s[t[0]] > 0 && s[t[1]] > 0 && s[t[2]] > 0) unsupported += a;
+  }
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (s[v] <= 0) supported[find(v)] = 1;
+  double largest = 0;
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (root[v] == v && supported[v]) largest = std::max(largest, area[v]);
+  const double min_area = std::max(std::pow(kMinComponentResolutions * resolution_, 2), kMinComponentFraction * largest);
+  std::vector<std::uint8_t> keep(nv, 0);
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (root[v] == v && area[v] > 0) {
+      keep[v] = editing || (supported[v] && area[v] >= min_area);
+      rep.small_components += !keep[v];
+    }
+  if (rep.small_components) {
+    std::vector<std::array<std::uint32_t, 3>> kept;
+    kept.reserve(mesh.triangles.size());
+    for (const auto& t : mesh.triangles)
+      if (keep[find(t[0])]) kept.push_back(t);
+      else if (s[t[0]] > 0 && s[t[1]] > 0 && s[t[2]] > 0) unsupported -= triangle_area(mesh, t), total -= triangle_area(mesh, t);
+      else total -= triangle_area(mesh, t);
+    mesh.triangles.swap(kept);
+  }
+  rep.unsupported_area = total > 0 ? std::max(0.0, unsupported) / total : 0.0;
+  bool open = kind == SurfaceKind::Open;
+  if (kind == SurfaceKind::Auto) {
+    if (!decided_open_) decided_open_ = rep.unsupported_area > kOpenAreaFraction;
+    open = *decided_open_;
+  }
+  rep.open = open;
+  if (open) {
+    std::vector<std::array<std::uint32_t, 3>> kept;
+    for (const auto& t : mesh.triangles)
+      if (s[t[0]] <= 0 && s[t[1]] <= 0 && s[t[2]] <= 0) kept.push_back(t);
+    rep.trimmed_triangles = mesh.triangles.size() - kept.size();
+    mesh.triangles.swap(kept);
+  }
+  if (rep.small_components || open) {
+    // Unreferenced vertices out (what trim_mesh does for an open mesh).
+    std::vector<std::uint32_t> renumber(nv, 0xffffffffu);
+    std::vector<Point3> vertices, normals;
+    const bool with_normals = mesh.normals.size() == nv;
+    for (auto& t : mesh.triangles)
+      for (auto& c : t) {
+        if (renumber[c] == 0xffffffffu) {
+          renumber[c] = static_cast<std::uint32_t>(vertices.size());
+          vertices.push_back(mesh.vertices[c]);
+          if (with_normals) normals.push_back(mesh.normals[c]);
+        }
+        c = renumber[c];
+      }
+    mesh.vertices.swap(vertices);
+    mesh.normals.swap(normals);
+  }
+  if (report) *report = rep;
+  return mesh;
+}
+
+}  // namespace vitri

@@ -1,0 +1,56 @@
+#pragma once
+// The Mesher's view of the scanned points a surface was made from (Mesher::from_scan, docs/scans.md):
+// where the data are, how dense, and what that means for the mesh: the refinement's sizing field (coarse
+// far from the data), and the finishing of each extracted mesh (components the data do not support or
+// smaller than the data resolve dropped; an open scan's mesh trimmed to where the data are).
+#include "vitri/polygonize/surface_mesh.hpp"
+#include "vitri/rbf/point_index.hpp"
+#include "vitri/rbf/scan.hpp"
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+namespace vitri {
+
+enum class SurfaceKind;
+
+/// What finish() did to a mesh.
+struct ScanFinishReport {
+  std::size_t small_components = 0;  ///< components dropped: smaller than the data resolve, or unsupported
+  bool open = false;                 ///< the mesh was trimmed to the data
+  double unsupported_area = 0;       ///< fraction of the (closed) mesh's area farther than the reach
+  std::size_t trimmed_triangles = 0; ///< triangles removed or clipped by the trimming
+};
+
+class ScanSupport {
+ public:
+  /// Keeps the points (an index of them) and their local spacings; `resolution` as ScanReport's.
+  ScanSupport(const ScanPoints& points, double resolution, unsigned threads);
+
+  /// The refinement's sizing field: 1 within a few local spacings of the data, growing with the
+  /// distance beyond (the surface far from every point may stay coarse: it is trimmed or spans a hole).
+  double size_scale(const Point3& x) const;
+
+  /// Distance from x to the nearest point, and that point's local spacing.
+  double distance(const Point3& x, double* spacing = nullptr) const;
+
+  /// Finishes an extracted mesh at absolute precision `precision`: drops components without support or
+  /// smaller than the data resolve, decides open or closed (`kind`; Auto decides once, the first time,
+  /// and keeps it), trims an open one. Returns the finished mesh.
+  /// `editing`: an editing session (constraints moved away from the scan): components are not judged by
+  /// the scan's data (the Mesher's own support filter, on the current zero constraints, still applies).
+  SurfaceMesh finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing, ScanFinishReport* report);
+
+  /// The decision of Auto, once made.
+  std::optional<bool> decided_open() const { return decided_open_; }
+
+ private:
+  std::vector<Point3> points_;
+  std::vector<double> spacing_;
+  PointIndex index_;
+  double resolution_ = 0;
+  std::optional<bool> decided_open_;
+};
+
+}  // namespace vitri

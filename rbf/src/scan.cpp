@@ -1,0 +1,656 @@
+// prepare_scan(): scanned points to oriented points (docs/scans.md). The steps, each a named function:
+//   distinct positions -> neighbourhoods (k from the data) -> outliers set aside -> neighbourhoods of the
+//   inliers -> local quadric fits (noise, tangent planes) -> projection onto them -> orientation (given
+//   normals checked, viewpoint or sensors checked, or estimated) -> a neighbour vote on the signs.
+#include "vitri/rbf/scan.hpp"
+
+#include "vitri/core/error.hpp"
+#include "vitri/rbf/normals.hpp"
+#include "vitri/rbf/point_index.hpp"
+
+#include "parallel.hpp"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <sstream>
+#include <cstdio>
+#include <cstdlib>
+
+namespace vitri {
+namespace {
+
+using Id = PointIndex::Id;
+constexpr std::size_t kGrain = 2048;
+constexpr double kPi = 3.14159265358979323846;
+
+/// k nearest neighbours of every point of an index (itself excluded), row-major n x k, and their distances.
+struct Neighbours {
+  std::size_t k = 0;
+  std::vector<Id> ids;
+  std::vector<double> dist;
+  Id at(std::size_t i, std::size_t c) const { return ids[i * k + c]; }
+  double d(std::size_t i, std::size_t c) const { return dist[i * k + c]; }
+};
+
+Neighbours nearest_neighbours(const std::vector<Point3>& p, const PointIndex& index, std::size_t k,
+                              unsigned threads) {
+  Neighbours nb;
+  nb.k = k;
+  nb.ids.resize(p.size() * k);
+  nb.dist.resize(p.size() * k);
+  rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Id> ids;
+    std::vector<double> d2;
+    for (std::size_t i = b; i < e; ++i) {
+      index.nearest(p[i], k + 1, ids, &d2);
+      std::size_t c = 0;
+      for (std::size_t j = 0; j < ids.size() && c < k; ++j) {
+        if (ids[j] == i) continue;
+        nb.ids[i * k + c] = ids[j];
+        nb.dist[i * k + c] = std::sqrt(d2[j]);
+        ++c;
+      }
+      for (; c < k; ++c) {  // fewer points than k + 1 (never: callers check), repeat the last
+        nb.ids[i * k + c] = nb.ids[i * k + c - 1];
+        nb.dist[i * k + c] = nb.dist[i * k + c - 1];
+      }
+    }
+  });
+  return nb;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
+  std::nth_element(v.begin(), mid, v.end());
+  return *mid;
+}
+
+/// The local fit of one neighbourhood: tangent frame, the quadric height field over it, residual scale.
+struct LocalFit {
+  Point3 normal;      ///< unit normal of the quadric at the point's projection (unoriented)
+  Point3 projected;   ///< the point moved onto the quadric along the frame's normal
+  double noise = 0;   ///< weighted RMS residual of the neighbourhood to the quadric
+  double plane = 0;   ///< RMS residual to the least-squares plane (curvature included)
+  bool collinear = false;
+};
+
+/// Fits point i's neighbourhood (itself included): PCA plane, then the weighted quadric height field
+/// z = a + b x + c y + d x^2 + e xy + f y^2 in the plane's frame (Wendland weights over the neighbourhood
+/// radius); a plane when the quadric is ill-conditioned.
+LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, std::size_t i) {
+  LocalFit out;
+  const std::size_t k = nb.k;
+  const Point3 o = p[i];
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (std::size_t c = 0; c < k; ++c) mean += (p[nb.at(i, c)] - o).eigen();
+  mean /= static_cast<double>(k + 1);
+  Eigen::Matrix3d cov = mean * mean.transpose();
+  for (std::size_t c = 0; c < k; ++c) {
+    const Eigen::Vector3d v = (p[nb.at(i, c)] - o).eigen() - mean;
+    cov += v * v.transpose();
+  }
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
+  const Eigen::Vector3d ev = solver.eigenvalues();
+  out.collinear = !(ev(1) > 1e-6 * ev(2));
+  out.plane = std::sqrt(std::max(0.0, ev(0)) / static_cast<double>(k + 1));
+  const Eigen::Vector3d nrm = solver.eigenvectors().col(0).normalized();
+  const Eigen::Vector3d e1 = solver.eigenvectors().col(2).normalized();
+  const Eigen::Vector3d e2 = nrm.cross(e1);
+  out.normal = Point3::from(nrm);
+  out.projected = o;
+  out.noise = out.plane;
+  if (out.collinear) return out;
+  // Quadric in the frame centred at the neighbourhood's mean.
+  const double radius = std::max(nb.d(i, k - 1), 1e-300) * 1.1;
+  Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 1> atz = Eigen::Matrix<double, 6, 1>::Zero();
+  double wsum = 0;
+  auto row = [&](const Eigen::Vector3d& q, double& z) {
+    const Eigen::Vector3d r = q - mean;
+    const double x = r.dot(e1) / radius, y = r.dot(e2) / radius;
+    z = r.dot(nrm);
+    Eigen::Matrix<double, 6, 1> a;
+    a << 1, x, y, x * x, x * y, y * y;
+    return a;
+  };
+  auto weight = [&](double dist) {
+    const double t = std::min(1.0, dist / radius);
+    const double s = 1 - t;
+    return s * s * s * s * (4 * t + 1) + 1e-3;
+  };
+  std::vector<std::pair<Eigen::Matrix<double, 6, 1>, std::pair<double, double>>> rows;
+  rows.reserve(k + 1);
+  {
+    double z;
+    const auto a = row(Eigen::Vector3d::Zero(), z);
+    rows.push_back({a, {z, weight(0)}});
+  }
+  for (std::size_t c = 0; c < k; ++c) {
+    double z;
+    const auto a = row((p[nb.at(i, c)] - o).eigen(), z);
+    rows.push_back({a, {z, weight(nb.d(i, c))}});
+  }
+  for (const auto& [a, zw] : rows) {
+    ata += zw.second * a * a.transpose();
+    atz += zw.second * zw.first * a;
+    wsum += zw.second;
+  }
+  Eigen::Matrix<double, 6, 1> coef;
+  const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(ata);
+  bool quadric = k >= 9 && ldlt.info() == Eigen::Success && ldlt.isPositive();
+  if (quadric) {
+    coef = ldlt.solve(atz);
+    const Eigen::Matrix<double, 6, 1> d = ldlt.vectorD();
+    quadric = coef.allFinite() && d.minCoeff() > 1e-10 * d.maxCoeff();
+  }
+  if (!quadric) {  // the plane through the weighted mean
+    coef.setZero();
+    coef(0) = atz(0) / ata(0, 0);
+  }
+  double r2 = 0;
+  for (const auto& [a, zw] : rows) {
+    const double r = zw.first - a.dot(coef);
+    r2 += zw.second * r * r;
+  }
+  out.noise = std::sqrt(r2 / wsum);
+  // The point's own height over the quadric, and the quadric's normal there.
+  const Eigen::Vector3d r0 = -mean;
+  const double x = r0.dot(e1) / radius, y = r0.dot(e2) / radius;
+  const double z = r0.dot(nrm);
+  const double zq = coef(0) + coef(1) * x + coef(2) * y + coef(3) * x * x + coef(4) * x * y + coef(5) * y * y;
+  const double dzdx = (coef(1) + 2 * coef(3) * x + coef(4) * y) / radius;
+  const double dzdy = (coef(2) + coef(4) * x + 2 * coef(5) * y) / radius;
+  const Eigen::Vector3d qn = (nrm - dzdx * e1 - dzdy * e2).normalized();
+  if (qn.allFinite()) out.normal = Point3::from(qn);
+  double move = zq - z;
+  // Never further than the neighbourhood's own scale: a bad fit does not throw a point away.
+  const double cap = std::max(3 * out.noise, 3 * out.plane);
+  move = std::max(-cap, std::min(cap, move));
+  out.projected = o + Point3::from(move * nrm);
+  return out;
+}
+
+/// Outliers among distinct points: far off the plane of their neighbours, much sparser than their
+/// neighbours, or in a small cluster cut off from the rest. Returns a flag per point.
+std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neighbours& nb,
+                                        const std::vector<double>& noise, unsigned threads) {
+  const std::size_t n = p.size(), k = nb.k;
+  std::vector<double> mean_d(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    double s = 0;
+    for (std::size_t c = 0; c < k; ++c) s += nb.d(i, c);
+    mean_d[i] = s / static_cast<double>(k);
+  }
+  std::vector<std::uint8_t> out(n, 0);
+  rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<double> tmp;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+    for (std::size_t i = b; i < e; ++i) {
+      tmp.clear();
+      for (std::size_t c = 0; c < k; ++c) tmp.push_back(mean_d[nb.at(i, c)]);
+      const double local_d = median(tmp);
+      // Density: a point whose neighbours are 3x farther than theirs are (flying pixels, stray returns).
+      if (mean_d[i] > 3.0 * local_d) {
+        out[i] = 1;
+        continue;
+      }
+      // Plane of the neighbours without the point.
+      Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+      for (std::size_t c = 0; c < k; ++c) mean += (p[nb.at(i, c)] - p[i]).eigen();
+      mean /= static_cast<double>(k);
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (std::size_t c = 0; c < k; ++c) {
+        const Eigen::Vector3d v = (p[nb.at(i, c)] - p[i]).eigen() - mean;
+        cov += v * v.transpose();
+      }
+      solver.compute(cov);
+      const Eigen::Vector3d nrm = solver.eigenvectors().col(0);
+      const double off = std::abs(mean.dot(nrm));
+      tmp.clear();
+      for (std::size_t c = 0; c < k; ++c) tmp.push_back(noise[nb.at(i, c)]);
+      const double local_noise = median(tmp);
+      // Spacing of the neighbourhood (side of the area per point) as the floor: clean data lose nothing.
+      const double h = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+      if (off > std::max(4.0 * local_noise, 2.0 * h)) out[i] = 1;
+    }
+  });
+  // Small clusters: components of the neighbour graph (edges no longer than 3 local spacings) among the
+  // points kept so far, fewer than max(2k, n / 1000) points (at most n / 4: a small input is not all outliers).
+  std::vector<Id> parent(n);
+  std::iota(parent.begin(), parent.end(), Id(0));
+  auto find = [&](Id a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (out[i]) continue;
+    const double hi = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+    for (std::size_t c = 0; c < k; ++c) {
+      const Id j = nb.at(i, c);
+      if (out[j]) continue;
+      const double hj = nb.d(j, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+      if (nb.d(i, c) > 3.0 * std::max(hi, hj)) continue;
+      const Id a = find(static_cast<Id>(i)), bb = find(j);
+      if (a != bb) parent[std::max(a, bb)] = std::min(a, bb);
+    }
+  }
+  std::vector<std::size_t> size(n, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!out[i]) ++size[find(static_cast<Id>(i))];
+  const std::size_t min_size = std::min(std::max<std::size_t>(2 * k, n / 1000), n / 4);
+  for (std::size_t i = 0; i < n; ++i)
+    if (!out[i] && size[find(static_cast<Id>(i))] < min_size) out[i] = 1;
+  return out;
+}
+
+/// Fraction of neighbour pairs along the surface whose normals point to opposite sides.
+double disagreement(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Point3>& n) {
+  std::size_t along = 0, opposite = 0;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    for (std::size_t c = 0; c < nb.k; ++c) {
+      const Id j = nb.at(i, c);
+      const Point3 e = p[j] - p[i];
+      const double half = 0.5 * norm(e);
+      if (std::abs(dot(n[i], e)) > half || std::abs(dot(n[j], e)) > half) continue;
+      ++along;
+      opposite += dot(n[i], n[j]) < 0;
+    }
+  return along ? static_cast<double>(opposite) / static_cast<double>(along) : 0.0;
+}
+
+/// One vote: a point whose sign disagrees with a clear majority (weighted by |n_i . n_j|, pairs along the
+/// surface) of its neighbours takes theirs. `strong` = the majority needed, as a fraction of the weight.
+/// Points flagged in `undecided` always take the majority. Returns the flips.
+std::size_t vote_signs(const std::vector<Point3>& p, const Neighbours& nb, std::vector<Point3>& n,
+                       const std::vector<std::uint8_t>* undecided, double strong) {
+  std::vector<Point3> next = n;
+  std::size_t flips = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    double agree = 0, against = 0;
+    for (std::size_t c = 0; c < nb.k; ++c) {
+      const Id j = nb.at(i, c);
+      if (undecided && (*undecided)[j]) continue;
+      const Point3 e = p[j] - p[i];
+      const double half = 0.5 * norm(e);
+      if (std::abs(dot(n[i], e)) > half || std::abs(dot(n[j], e)) > half) continue;
+      const double w = dot(n[i], n[j]);
+      (w >= 0 ? agree : against) += std::abs(w);
+    }
+    const double total = agree + against;
+    const bool must = undecided && (*undecided)[i];
+    if (total > 0 && (against > strong * total || (must && against > agree))) {
+      next[i] = -n[i];
+      ++flips;
+    }
+  }
+  n.swap(next);
+  return flips;
+}
+
+/// Settles the sign of each connected component of the neighbour graph (edges no longer than 3 local
+/// spacings) that the spanning tree oriented on its own: a closed component's outward normals satisfy
+/// sum n . (p - c) > 0 (the divergence theorem: 3 x its volume), so a component whose normals give a clear
+/// negative sum is flipped whole; an open one (no clear sign) is made to agree with a common direction:
+/// the mean normal of the largest open component, itself turned toward +z (up) when nothing else says.
+/// Returns the points whose sign changed.
+std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb, std::vector<Point3>& n) {
+  const std::size_t count = p.size(), k = nb.k;
+  std::vector<Id> parent(count);
+  std::iota(parent.begin(), parent.end(), Id(0));
+  auto find = [&](Id a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t i = 0; i < count; ++i) {
+    const double hi = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+    for (std::size_t c = 0; c < k; ++c) {
+      const Id j = nb.at(i, c);
+      const double hj = nb.d(j, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+      if (nb.d(i, c) > 3.0 * std::max(hi, hj)) continue;
+      const Id a = find(static_cast<Id>(i)), b = find(j);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  struct Part {
+    std::size_t size = 0;
+    Point3 centroid, normal_sum;
+    Eigen::Matrix3d tensor = Eigen::Matrix3d::Zero();  // sum of n n^T: where the normals point, unsigned
+    double signed_sum = 0, abs_sum = 0;
+    int verdict = 0;  // +1 closed outward, -1 closed inward, 0 open, 2 a sheet seen along `axis`
+    Point3 axis;
+  };
+  std::vector<Part> part(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    Part& q = part[find(static_cast<Id>(i))];
+    ++q.size;
+    q.centroid = q.centroid + p[i];
+    q.tensor += n[i].eigen() * n[i].eigen().transpose();
+  }
+  for (Part& q : part)
+    if (q.size) q.centroid = q.centroid * (1.0 / static_cast<double>(q.size));
+  for (std::size_t i = 0; i < count; ++i) {
+    Part& q = part[find(static_cast<Id>(i))];
+    const double v = dot(n[i], p[i] - q.centroid);
+    q.signed_sum += v;
+    q.abs_sum += std::abs(v);
+    q.normal_sum = q.normal_sum + n[i];
+  }
+  for (Part& q : part) {
+    if (!q.size) continue;
+    // A sheet: most normals along one axis (airborne scans, facades, a table top). The tree cannot be
+    // trusted across its sharp edges (roof to ground through a wall); it is seen from one side instead:
+    // from above when the axis is within 45 degrees of z, else from the side most normals face.
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(q.tensor / static_cast<double>(q.size));
+    if (es.eigenvalues()(2) >= 0.6) {
+      Point3 axis = Point3::from(es.eigenvectors().col(2).normalized());
+      const bool vertical = std::abs(axis.z) >= std::sqrt(0.5);
+      const double sign = vertical ? axis.z : dot(q.normal_sum, axis);
+      q.axis = sign < 0 ? -axis : axis;
+      q.verdict = 2;
+      continue;
+    }
+    // Closed: the normals of a closed surface sum to about 0 (the integral of n dA vanishes), and the
+    // divergence sum n . (p - c) has a clear sign (3 x the enclosed volume).
+    const double ratio = q.abs_sum > 0 ? q.signed_sum / q.abs_sum : 0.0;
+    const bool closed = norm(q.normal_sum) < 0.3 * static_cast<double>(q.size);
+    q.verdict = !closed ? 0 : ratio > 0.5 ? 1 : ratio < -0.5 ? -1 : 0;
+  }
+  std::size_t changed = 0;
+  std::vector<std::uint8_t> undecided(count, 0);
+  bool sheets = false;
+  for (std::size_t i = 0; i < count; ++i) {
+    const Part& q = part[find(static_cast<Id>(i))];
+    bool flip = false;
+    if (q.verdict == 2) {
+      const double c = dot(n[i], q.axis);
+      flip = c < 0;
+      if (std::abs(c) < 0.2) undecided[i] = 1, sheets = true;
+    } else if (q.verdict != 0) {
+      flip = q.verdict < 0;
+    } else {
+      flip = dot(q.normal_sum, Point3{0, 0, 1}) < 0;  // open, not a sheet: up when nothing else says
+    }
+    if (flip) n[i] = -n[i], ++changed;
+  }
+  if (sheets)
+    for (int pass = 0; pass < 3; ++pass)
+      if (vote_signs(p, nb, n, pass == 0 ? &undecided : nullptr, 0.8) == 0) break;
+  return changed;
+}
+
+}  // namespace
+
+ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Point3>& normals,
+                        const ScanOptions& options, ScanReport* report) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ScanReport rep;
+  rep.input = input.size();
+  if (!normals.empty() && normals.size() != input.size())
+    throw InvalidArgument("prepare_scan: " + std::to_string(input.size()) + " points but " +
+                          std::to_string(normals.size()) + " normals");
+  if (!options.sensors.empty() && options.sensors.size() != input.size())
+    throw InvalidArgument("prepare_scan: " + std::to_string(input.size()) + " points but " +
+                          std::to_string(options.sensors.size()) + " sensor positions");
+  for (std::size_t i = 0; i < input.size(); ++i) {
+    if (!is_finite(input[i])) throw InvalidPoint(i, "non-finite coordinate (NaN or infinity)");
+    if (!normals.empty() && !is_finite(normals[i])) throw InvalidPoint(i, "non-finite normal");
+    if (!options.sensors.empty() && !is_finite(options.sensors[i]))
+      throw InvalidPoint(i, "non-finite sensor position");
+  }
+  if (options.viewpoint && !is_finite(*options.viewpoint))
+    throw InvalidArgument("prepare_scan: the viewpoint is not finite");
+
+  // Distinct positions (the first copy of each kept, input order).
+  std::vector<std::size_t> order(input.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const Point3 &p = input[a], &q = input[b];
+    if (p.x != q.x) return p.x < q.x;
+    if (p.y != q.y) return p.y < q.y;
+    if (p.z != q.z) return p.z < q.z;
+    return a < b;
+  });
+  std::vector<std::uint8_t> first(input.size(), 0);
+  for (std::size_t r = 0; r < order.size(); ++r)
+    first[order[r]] = r == 0 || !(input[order[r]] == input[order[r - 1]]);
+  std::vector<std::size_t> src;  // input index of each distinct point
+  for (std::size_t i = 0; i < input.size(); ++i)
+    if (first[i]) src.push_back(i);
+  rep.duplicates = input.size() - src.size();
+  constexpr std::size_t kMinPoints = 8;
+  if (src.size() < kMinPoints)
+    throw InvalidArgument("no surface: " + std::to_string(src.size()) + " distinct points (at least " +
+                          std::to_string(kMinPoints) + " needed)");
+  std::vector<Point3> p(src.size());
+  for (std::size_t u = 0; u < src.size(); ++u) p[u] = input[src[u]];
+
+  // Neighbourhoods: k from the data. 16 neighbours first; where the noise is large against their
+  // radius, more (the plane residual grows with the noise, the radius with sqrt(k)).
+  const unsigned threads = options.threads;
+  auto clamp_k = [&](std::size_t k) { return std::min(k, p.size() - 1); };
+  std::size_t k = clamp_k(options.k ? std::max<std::size_t>(6, options.k) : 16);
+  PointIndex index(p, threads);
+  Neighbours nb = nearest_neighbours(p, index, k, threads);
+  std::vector<LocalFit> fit(p.size());
+  auto fit_all = [&](const std::vector<Point3>& pts) {
+    fit.assign(pts.size(), LocalFit{});
+    rbf_detail::parallel_chunks(pts.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) fit[i] = fit_neighbourhood(pts, nb, i);
+    });
+  };
+  fit_all(p);
+  if (options.k == 0) {
+    // Two signs that 16 neighbours are too few: noise large against their radius (the plane residual
+    // grows with the noise, the radius with sqrt(k)), or structure between their scale and 3x it that a
+    // quadric does not follow (depth quantized into layers: each small neighbourhood lies in one layer,
+    // and the residual grows with the scale). Sharp edges also grow it, but on few points: medians.
+    std::vector<double> ratio(p.size()), small(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      ratio[i] = fit[i].noise / std::max(nb.d(i, k - 1), 1e-300);
+      small[i] = fit[i].noise;
+    }
+    const double rho = median(ratio), noise_small = median(small);
+    const double want = 16.0 * (rho / 0.06) * (rho / 0.06);
+    std::size_t k2 = clamp_k(static_cast<std::size_t>(std::min(64.0, std::max(16.0, std::ceil(want)))));
+    if (k2 < 48 && p.size() > 64) {
+      const std::size_t k3 = clamp_k(48);
+      Neighbours wide = nearest_neighbours(p, index, k3, threads);
+      std::vector<double> big(p.size());
+      rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) big[i] = fit_neighbourhood(p, wide, i).noise;
+      });
+      // Only structure that matters against the spacing (a clean curved surface also fits a quadric a
+      // little worse at a larger scale).
+      if (median(big) > std::max(1.5 * noise_small, 0.1 * median(nb.dist))) k2 = k3;
+    }
+    if (k2 > k) {
+      k = k2;
+      nb = nearest_neighbours(p, index, k, threads);
+      fit_all(p);
+    }
+  }
+  rep.k = k;
+
+  // Outliers: set aside, then the neighbourhoods of the inliers.
+  std::vector<std::uint8_t> outlier(p.size(), 0);
+  if (options.remove_outliers) {
+    std::vector<double> noise(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) noise[i] = fit[i].noise;
+    outlier = find_outliers(p, nb, noise, threads);
+  }
+  std::vector<std::size_t> keep;
+  for (std::size_t u = 0; u < p.size(); ++u)
+    if (!outlier[u]) keep.push_back(u);
+  rep.outliers = p.size() - keep.size();
+  if (keep.size() < kMinPoints)
+    throw InvalidArgument("no surface: " + std::to_string(keep.size()) + " of " + std::to_string(p.size()) +
+                          " distinct points agree on a surface, the others are outliers");
+  if (keep.size() < p.size()) {
+    std::vector<Point3> q(keep.size());
+    std::vector<std::size_t> s(keep.size());
+    for (std::size_t r = 0; r < keep.size(); ++r) q[r] = p[keep[r]], s[r] = src[keep[r]];
+    p.swap(q);
+    src.swap(s);
+    k = clamp_k(k);
+    index = PointIndex(p, threads);
+    nb = nearest_neighbours(p, index, k, threads);
+    fit_all(p);
+  }
+  std::size_t collinear = 0;
+  for (const LocalFit& f : fit) collinear += f.collinear;
+  if (collinear == p.size())
+    throw InvalidArgument("no surface: every neighbourhood of the " + std::to_string(p.size()) +
+                          " points is collinear (the points lie on a line)");
+  {
+    std::vector<double> noise(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) noise[i] = fit[i].noise;
+    rep.noise = median(noise);
+  }
+
+  // Approximation: the projection onto the local quadrics (twice where the data are noisy: the second
+  // fit sees the smoother points).
+  std::vector<Point3> moved_from = p;
+  if (options.approximate) {
+    const int passes = rep.noise > 0.1 * median(nb.dist) ? 2 : 1;
+    for (int pass = 0; pass < passes; ++pass) {
+      if (pass > 0) fit_all(p);
+      for (std::size_t i = 0; i < p.size(); ++i) p[i] = fit[i].projected;
+    }
+    fit_all(p);
+    std::vector<double> d(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) d[i] = norm(p[i] - moved_from[i]);
+    rep.moved = median(d);
+  }
+  std::vector<Point3> n(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) n[i] = fit[i].normal;
+
+  // Orientation.
+  const bool given = !normals.empty();
+  std::vector<std::uint8_t> undecided(p.size(), 0);
+  bool need_tree = !given && !options.viewpoint && options.sensors.empty();
+  if (given) {
+    rep.orientation = OrientationSource::Given;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Point3 g = normals[src[i]];
+      const double len = norm(g);
+      const double c = len > 0 ? dot(n[i], g) / len : 0.0;
+      if (len > 0 && std::abs(c) < 0.5) ++rep.repaired;  // more than 60 degrees off the tangent plane's normal
+      if (!(len > 0) || std::abs(c) < 0.05) undecided[i] = 1;
+      if (c < 0) n[i] = -n[i];
+    }
+  } else if (options.viewpoint || !options.sensors.empty()) {
+    rep.orientation = options.sensors.empty() ? OrientationSource::Viewpoint : OrientationSource::Sensors;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const Point3 eye = options.sensors.empty() ? *options.viewpoint : options.sensors[src[i]];
+      const Point3 ray = eye - p[i];
+      const double len = norm(ray);
+      const double c = len > 0 ? dot(n[i], ray) / len : 0.0;
+      if (std::abs(c) < 0.05) undecided[i] = 1;  // seen edge-on: the neighbours decide
+      if (c < 0) n[i] = -n[i];
+    }
+    // A viewpoint the data contradict (a merged multi-view cloud with PCL's default VIEWPOINT 0 0 0, a
+    // wrong sensor): one view cannot see every side of a closed object, so the orientation it gives
+    // differs from the data's own (the spanning tree, closed parts settled outward) on a large share of
+    // the points, whatever the sign of each; or neighbours along the surface get opposite signs.
+    // A viewpoint inside the data's box (a room around the sensor) sees every side: only the second test.
+    Point3 lo = p[0], hi = p[0];
+    for (const Point3& q : p)
+      for (std::size_t a = 0; a < 3; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);
+    bool outside = false;
+    if (options.sensors.empty())
+      for (std::size_t a = 0; a < 3; ++a) outside = outside || (*options.viewpoint)[a] < lo[a] || (*options.viewpoint)[a] > hi[a];
+    std::vector<Point3> own = n;
+    double agree = 1.0;
+    if (outside) {
+      NormalOptions no;
+      no.k = std::min<std::size_t>(k, 12);
+      no.threads = threads;
+      no.strict = false;
+      orient_normals(p, own, no);
+      settle_components(p, nb, own);
+      std::size_t same = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) same += dot(own[i], n[i]) > 0;
+      agree = static_cast<double>(same) / static_cast<double>(p.size());
+    }
+    const double dis = disagreement(p, nb, n);
+    if (dis > 0.05 || std::max(agree, 1 - agree) < 0.9) {
+      rep.viewpoint_rejected = true;
+      std::ostringstream why;
+      why << "the " << (options.sensors.empty() ? "viewpoint" : "sensor positions") << " orient only "
+          << std::round(1000 * std::max(agree, 1 - agree)) / 10
+          << "% of the points as the data's own orientation does (at least 90% expected of one view), "
+          << std::round(1000 * dis) / 10 << "% of the neighbour pairs along the surface opposite (at most 5%): "
+             "the data are not seen from there; normals oriented without it";
+      rep.viewpoint_note = why.str();
+      std::fill(undecided.begin(), undecided.end(), 0);
+      rep.orientation = OrientationSource::Estimated;
+      if (outside) n.swap(own);
+      else need_tree = true;
+    }
+  }
+  if (need_tree) {
+    rep.orientation = OrientationSource::Estimated;
+    NormalOptions no;
+    no.k = std::min<std::size_t>(k, 12);
+    no.threads = threads;
+    no.strict = false;
+    no.min_link = 0.1;
+    const OrientationReport orep = orient_normals(p, n, no);
+    rep.ambiguous += orep.ambiguous;
+    settle_components(p, nb, n);
+  }
+  std::size_t undecided_count = 0;
+  for (const std::uint8_t u : undecided) undecided_count += u;
+  rep.ambiguous += undecided_count;
+  // Votes: the undecided take their neighbours' majority; isolated wrong signs (a flipped given normal,
+  // a tree step across a sharp edge) are outvoted by a strong majority.
+  for (int pass = 0; pass < 3; ++pass) {
+    const std::size_t flips = vote_signs(p, nb, n, undecided_count ? &undecided : nullptr, 0.8);
+    if (given) rep.repaired += flips;
+    else rep.ambiguous += flips;
+    std::fill(undecided.begin(), undecided.end(), 0);
+    undecided_count = 0;
+    if (flips == 0) break;
+  }
+
+  ScanPoints out;
+  out.points = std::move(p);
+  out.normals = std::move(n);
+  out.spacing.resize(out.points.size());
+  std::vector<double> nn(out.points.size());
+  for (std::size_t i = 0; i < out.points.size(); ++i) {
+    out.spacing[i] = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+    nn[i] = nb.d(i, 0);
+  }
+  rep.kept = out.points.size();
+  rep.spacing = median(nn);
+  rep.resolution = std::max(rep.spacing, 2 * rep.noise);
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (report) *report = rep;
+  return out;
+}
+
+std::string describe(const ScanReport& r) {
+  std::ostringstream s;
+  s.precision(3);
+  const char* source = r.orientation == OrientationSource::Given       ? "the input's normals"
+                       : r.orientation == OrientationSource::Viewpoint ? "the viewpoint"
+                       : r.orientation == OrientationSource::Sensors   ? "the sensor positions"
+                                                                        : "estimated (spanning tree)";
+  s << "scan: " << r.kept << " of " << r.input << " points kept (" << r.duplicates << " duplicates, "
+    << r.outliers << " outliers set aside); " << r.k << " neighbours; spacing " << r.spacing << ", noise "
+    << r.noise << " (" << (r.spacing > 0 ? r.noise / r.spacing : 0) << " spacings), points moved by "
+    << r.moved << " (median); normals from " << source;
+  if (r.repaired) s << ", " << r.repaired << " given normals repaired";
+  if (r.ambiguous) s << ", " << r.ambiguous << " signs ambiguous";
+  if (r.viewpoint_rejected) s << "; " << r.viewpoint_note;
+  return s.str();
+}
+
+}  // namespace vitri

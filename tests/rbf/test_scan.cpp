@@ -1,0 +1,195 @@
+// prepare_scan(): noise absorbed, outliers set aside, orientation from normals, a viewpoint or the data,
+// nothing refused for the data's defects (docs/scans.md).
+#include "vitri/core/error.hpp"
+#include "vitri/rbf/scan.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <vector>
+
+using vitri::Point3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// A Gaussian from a seeded engine (Box-Muller), the same sequence everywhere.
+struct Gauss {
+  std::mt19937_64 rng;
+  explicit Gauss(std::uint64_t seed) : rng(seed) {}
+  double uniform() { return (static_cast<double>(rng() >> 11) + 0.5) * (1.0 / 9007199254740992.0); }
+  double operator()() { return std::sqrt(-2 * std::log(uniform())) * std::cos(2 * kPi * uniform()); }
+};
+
+/// n points on the unit sphere (Fibonacci), moved radially by Gaussian noise of `sigma`.
+std::vector<Point3> noisy_sphere(std::size_t n, double sigma, std::uint64_t seed) {
+  Gauss g(seed);
+  std::vector<Point3> p;
+  const double golden = kPi * (3.0 - std::sqrt(5.0));
+  for (std::size_t i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (static_cast<double>(i) + 0.5) / static_cast<double>(n), r = std::sqrt(1 - z * z);
+    const Point3 u{r * std::cos(golden * static_cast<double>(i)), r * std::sin(golden * static_cast<double>(i)), z};
+    p.push_back(u * (1.0 + sigma * g()));
+  }
+  return p;
+}
+
+double rms_radial_error(const std::vector<Point3>& p) {
+  double s = 0;
+  for (const Point3& q : p) s += (vitri::norm(q) - 1) * (vitri::norm(q) - 1);
+  return std::sqrt(s / static_cast<double>(p.size()));
+}
+
+std::size_t outward(const std::vector<Point3>& p, const std::vector<Point3>& n) {
+  std::size_t k = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) k += vitri::dot(p[i], n[i]) > 0;
+  return k;
+}
+
+}  // namespace
+
+TEST_CASE("prepare_scan: noise of one spacing is measured and absorbed, normals outward", "[scan]") {
+  // 4000 points: spacing about sqrt(4 pi / 4000) = 0.056; noise 0.056 (one spacing).
+  const double spacing = std::sqrt(4 * kPi / 4000);
+  const std::vector<Point3> p = noisy_sphere(4000, spacing, 7);
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.input == 4000);
+  CHECK(r.kept + r.outliers + r.duplicates == 4000);
+  CHECK(r.outliers < 40);  // Gaussian noise is not an outlier
+  CHECK(r.k > 16);         // the noise asked for a wider neighbourhood
+  CHECK(r.noise > 0.3 * spacing);
+  CHECK(r.noise < 2.0 * spacing);
+  CHECK(r.resolution >= r.spacing);
+  // The projection halves the error at least (a smooth fit of noisy data).
+  std::vector<Point3> kept_input;  // the same points before projection are not returned: compare RMS only
+  CHECK(rms_radial_error(s.points) < 0.5 * rms_radial_error(p));
+  CHECK(outward(s.points, s.normals) >= s.points.size() * 995 / 1000);
+  CHECK(r.orientation == vitri::OrientationSource::Estimated);
+  for (const double h : s.spacing) CHECK(h > 0);
+}
+
+TEST_CASE("prepare_scan: outliers in the box get no vote, the surface keeps its points", "[scan]") {
+  std::vector<Point3> p = noisy_sphere(3000, 0.0, 3);
+  Gauss g(11);
+  const std::size_t clean = p.size();
+  for (int i = 0; i < 60; ++i) {  // 2% uniform in [-1.5, 1.5]^3, more than 5 spacings (0.3) off the sphere
+    Point3 q{3 * g.uniform() - 1.5, 3 * g.uniform() - 1.5, 3 * g.uniform() - 1.5};
+    if (std::abs(vitri::norm(q) - 1) < 0.3) continue;
+    p.push_back(q);
+  }
+  const std::size_t added = p.size() - clean;
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.outliers >= added * 95 / 100);
+  CHECK(r.outliers <= added + clean / 100);
+  std::size_t stray = 0;
+  for (const Point3& q : s.points) stray += std::abs(vitri::norm(q) - 1) > 0.1;
+  CHECK(stray <= added / 20);
+  CHECK(outward(s.points, s.normals) >= s.points.size() * 995 / 1000);
+  // Without the removal every point stays.
+  vitri::ScanOptions keep;
+  keep.remove_outliers = false;
+  CHECK(vitri::prepare_scan(p, {}, keep, &r).points.size() == p.size());
+  CHECK(r.outliers == 0);
+}
+
+TEST_CASE("prepare_scan: a single view is oriented toward its viewpoint; a contradicting one is rejected",
+          "[scan]") {
+  // The top of the sphere, seen from (0, 0, 5): every normal toward the sensor (outward here).
+  std::vector<Point3> half;
+  for (const Point3& q : noisy_sphere(6000, 0.0, 5))
+    if (q.z > 0.3) half.push_back(q);  // all of it in front of the horizon seen from z = 5 (z = 0.2)
+  vitri::ScanOptions o;
+  o.viewpoint = Point3{0, 0, 5};
+  vitri::ScanReport r;
+  vitri::ScanPoints s = vitri::prepare_scan(half, {}, o, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.orientation == vitri::OrientationSource::Viewpoint);
+  CHECK_FALSE(r.viewpoint_rejected);
+  CHECK(outward(s.points, s.normals) == s.points.size());
+  // Seen from inside (0, 0, 0.2): every normal inward, toward it; a room scan's convention.
+  o.viewpoint = Point3{0, 0, 0.2};
+  s = vitri::prepare_scan(half, {}, o, &r);
+  CHECK(outward(s.points, s.normals) == 0);
+  // The whole closed sphere cannot be seen from one outside point: the viewpoint is rejected and the
+  // normals come out outward anyway.
+  const std::vector<Point3> whole = noisy_sphere(4000, 0.0, 5);
+  o.viewpoint = Point3{0, 0, 5};
+  s = vitri::prepare_scan(whole, {}, o, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.viewpoint_rejected);
+  CHECK(r.orientation == vitri::OrientationSource::Estimated);
+  CHECK(outward(s.points, s.normals) >= s.points.size() * 995 / 1000);
+  // Per-point sensors: the same as a viewpoint per point.
+  vitri::ScanOptions per;
+  per.sensors.assign(half.size(), Point3{0, 0, 5});
+  s = vitri::prepare_scan(half, {}, per, &r);
+  CHECK(r.orientation == vitri::OrientationSource::Sensors);
+  CHECK(outward(s.points, s.normals) == s.points.size());
+}
+
+TEST_CASE("prepare_scan: given normals are checked; flipped ones are repaired", "[scan]") {
+  const std::vector<Point3> p = noisy_sphere(3000, 0.0, 9);
+  std::vector<Point3> n = p;  // outward
+  for (std::size_t i = 0; i < n.size(); i += 37) n[i] = -n[i];  // about 80 flipped scanner normals
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, n, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.orientation == vitri::OrientationSource::Given);
+  CHECK(r.repaired >= 3000 / 37);
+  CHECK(outward(s.points, s.normals) == s.points.size());
+}
+
+TEST_CASE("prepare_scan: an open sheet with sharp folds and no viewpoint is oriented one way", "[scan]") {
+  // A 2.5D step: ground z = 0 and a roof z = 0.5 over a square, joined by sparse walls (airborne data).
+  std::vector<Point3> p;
+  for (int i = 0; i < 80; ++i)
+    for (int j = 0; j < 80; ++j) {
+      const double x = i * 0.025, y = j * 0.025;
+      const bool roof = x > 0.6 && x < 1.4 && y > 0.6 && y < 1.4;
+      p.push_back({x + 1e-4 * j, y, roof ? 0.5 : 0.0});
+    }
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  std::size_t up = 0;
+  for (const Point3& n : s.normals) up += n.z > 0.5;
+  CHECK(up >= s.normals.size() * 99 / 100);
+}
+
+TEST_CASE("prepare_scan: duplicates counted; inputs with no surface refused with the reason", "[scan][errors]") {
+  std::vector<Point3> p = noisy_sphere(500, 0.0, 1);
+  p.insert(p.end(), p.begin(), p.begin() + 100);
+  vitri::ScanReport r;
+  vitri::prepare_scan(p, {}, {}, &r);
+  CHECK(r.duplicates == 100);
+  CHECK(r.kept + r.outliers == 500);
+  // Too few points.
+  const std::vector<Point3> few(p.begin(), p.begin() + 5);
+  CHECK_THROWS_AS(vitri::prepare_scan(few), vitri::InvalidArgument);
+  // On a line.
+  std::vector<Point3> line;
+  for (int i = 0; i < 100; ++i) line.push_back({0.01 * i, 0, 0});
+  try {
+    vitri::prepare_scan(line);
+    FAIL("a line has no surface");
+  } catch (const vitri::InvalidArgument& e) {
+    CHECK(std::string(e.what()).find("line") != std::string::npos);
+  }
+  // A non-finite coordinate is named.
+  p[42].y = std::nan("");
+  try {
+    vitri::prepare_scan(p);
+    FAIL("NaN");
+  } catch (const vitri::InvalidPoint& e) {
+    CHECK(e.index() == 42);
+  }
+  // Sizes.
+  CHECK_THROWS_AS(vitri::prepare_scan(few, std::vector<Point3>(3)), vitri::InvalidArgument);
+}

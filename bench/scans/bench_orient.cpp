@@ -1,0 +1,108 @@
+// bench_orient: vitri's normal estimation and orientation of unoriented points, timed and checked against
+// the true normals (bench/scans/README.md, "Orientation"). Uses only the points and the default options of
+// vitri::estimate_oriented_normals (its options change while the CLI is reworked); a refusal (an
+// exception: a component too small, a weak link, too much disagreement) is recorded, not fatal.
+//
+// usage: bench_orient POINTS.xyz [--reference CASE-n.xyz] [--exclude CASE.outliers]
+//   --reference  the same points with their true normals (6 columns, same order)
+//   --exclude    indices (one a line) left out of the agreement (the outliers, whose normals mean nothing)
+// Prints one JSON object: points, seconds, status ("ok" or "refused: <message>"), and with a reference:
+// oriented (fraction of points with n . n_true > 0), tangent (fraction with |n . n_true| >= cos 25
+// degrees: the plane is right whatever the sign), flipped_tangent (tangent but n . n_true < 0).
+#include "vitri/io/io.hpp"
+#include "vitri/rbf/normals.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iostream>
+#include <string>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+std::string escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    if (c == '"' || c == '\\') out += '\\';
+    if (c == '\n') {
+      out += "\\n";
+      continue;
+    }
+    out += c;
+  }
+  return out;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  std::string points_path, reference_path, exclude_path;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--reference" && i + 1 < argc) {
+      reference_path = argv[++i];
+    } else if (a == "--exclude" && i + 1 < argc) {
+      exclude_path = argv[++i];
+    } else if (!a.empty() && a[0] != '-' && points_path.empty()) {
+      points_path = a;
+    } else {
+      std::cerr << "usage: bench_orient POINTS.xyz [--reference CASE-n.xyz] [--exclude CASE.outliers]\n";
+      return 2;
+    }
+  }
+  if (points_path.empty()) {
+    std::cerr << "usage: bench_orient POINTS.xyz [--reference CASE-n.xyz] [--exclude CASE.outliers]\n";
+    return 2;
+  }
+  try {
+    const OrientedPoints input = read_points(points_path);
+    OrientedPoints reference;
+    if (!reference_path.empty()) {
+      reference = read_points(reference_path);
+      if (!reference.has_normals() || reference.points.size() != input.points.size())
+        throw std::runtime_error("the reference must hold the same points with normals");
+    }
+    std::vector<char> excluded(input.points.size(), 0);
+    if (!exclude_path.empty()) {
+      std::ifstream f(exclude_path);
+      for (std::size_t i; f >> i;)
+        if (i < excluded.size()) excluded[i] = 1;
+    }
+    std::string status = "ok";
+    std::vector<Point3> normals;
+    const auto start = std::chrono::steady_clock::now();
+    try {
+      normals = estimate_oriented_normals(input.points);
+    } catch (const std::exception& e) {
+      status = std::string("refused: ") + e.what();
+    }
+    const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    std::cout << "{\"points\": " << input.points.size() << ", \"seconds\": " << seconds << ", \"status\": \""
+              << escape(status) << "\"";
+    if (!reference_path.empty() && status == "ok") {
+      const double cos_tangent = std::cos(25.0 * 3.14159265358979323846 / 180.0);
+      std::size_t counted = 0, oriented = 0, tangent = 0, flipped = 0;
+      for (std::size_t i = 0; i < normals.size(); ++i) {
+        if (excluded[i]) continue;
+        const Point3& t = reference.normals[i];
+        const double c = dot(normals[i], t) / (norm(normals[i]) * norm(t));
+        ++counted;
+        oriented += c > 0;
+        tangent += std::abs(c) >= cos_tangent;
+        flipped += c <= -cos_tangent;
+      }
+      const double n = static_cast<double>(counted ? counted : 1u);
+      std::cout << ", \"counted\": " << counted << ", \"oriented\": " << static_cast<double>(oriented) / n
+                << ", \"tangent\": " << static_cast<double>(tangent) / n
+                << ", \"flipped_tangent\": " << static_cast<double>(flipped) / n;
+    }
+    std::cout << "}\n";
+    return 0;
+  } catch (const std::exception& e) {
+    std::cerr << "bench_orient: " << e.what() << "\n";
+    return 1;
+  }
+}

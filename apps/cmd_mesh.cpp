@@ -288,6 +288,7 @@ int run_mesh(const Args& args) {
   double relative_size = std::numeric_limits<double>::infinity();  // quality mode: --max-size
   bool quiet = false;
   bool surface_given = false;  // --surface
+  bool viewpoint_given = false;  // --viewpoint
   PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  // --ascii: text
   unsigned threads = 0;  // --threads: 0 = every available CPU
   MesherOptions options;
@@ -361,6 +362,7 @@ int run_mesh(const Args& args) {
           return usage_error("--viewpoint needs three finite numbers X Y Z");
       }
       options.scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
+      viewpoint_given = true;
     } else if (a == "--function") {
       if (!value(v)) return usage_error("--function needs global, local or auto");
       if (v == "global") options.function = FunctionKind::Global;
@@ -454,7 +456,7 @@ int run_mesh(const Args& args) {
     if (data.points.has_sensors()) options.scan.sensors = std::move(data.points.sensors);
     if (!quiet && options.scan.viewpoint)
       std::fprintf(stderr, "viewpoint %g %g %g (%s)\n", options.scan.viewpoint->x, options.scan.viewpoint->y,
-                   options.scan.viewpoint->z, data.points.viewpoint ? "from the input" : "--viewpoint");
+                   options.scan.viewpoint->z, viewpoint_given ? "--viewpoint" : "from the input");
     // The default budget follows the input (docs/scans.md): a coarser mesh with a warning beyond it.
     if (default_precision) {
       const std::size_t by_input = kScanVerticesPerPoint * input_points + kScanVerticesBase;

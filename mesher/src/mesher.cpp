@@ -139,6 +139,20 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
     o.polygonizer.size_scale = [support](const Point3& x) { return support->size_scale(x); };
   // The function: Auto decided on the constraint count without the off-surface spacing (which serves the
   // local function only), as the CLI always did.
+  // The off-surface distance must clear what noise the projection left: at least 3 x the measured noise
+  // (in spacings of the data, as ConstraintBuildOptions::offset_spacings counts), so that the +-D
+  // constraints of neighbouring points never cross and leave tunnels.
+  // The data-following distance (offset_spacings > 0) is then set here, absolute: max(offset_spacings x
+  // the scan's spacing (before the projection, which clusters points), 3 x its noise), at most
+  // offset x the diagonal as the builder caps it.
+  if (o.constraint_build.offset_spacings > 0 && report.spacing > 0) {
+    Box3 box;
+    for (const Point3& q : prepared.points) box.extend(q);
+    const double spaced = std::min(o.constraint_build.offset * box.diagonal(),
+                                   o.constraint_build.offset_spacings * report.spacing);
+    o.constraint_build.offset = std::max(spaced, 3 * report.noise) / box.diagonal();
+    o.constraint_build.offset_spacings = 0;
+  }
   ConstraintBuildOptions build = o.constraint_build;
   ConstraintBuildReport built;
   Constraints c;

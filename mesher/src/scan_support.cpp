@@ -1,6 +1,7 @@
 #include "scan_support.hpp"
 
 #include "vitri/mesher.hpp"
+#include "vitri/polygonize/mesh_trim.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -13,8 +14,9 @@ namespace {
 constexpr double kFineReach = 3.0;
 /// A mesh vertex is supported by the data when a point lies within max(this x its local spacing,
 /// kReachPrecision x the precision).
-constexpr double kReachSpacings = 4.0;
-constexpr double kReachPrecision = 1.5;
+constexpr double kReachSpacings = 2.0;
+constexpr double kReachPrecision = 1.0;
+constexpr double kReachResolutions = 6.0;
 /// Auto: a closed mesh with more than this fraction of its area unsupported is a scan seen from one side
 /// (or a few): it is left open.
 constexpr double kOpenAreaFraction = 0.2;
@@ -30,9 +32,13 @@ double triangle_area(const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t
 }  // namespace
 
 ScanSupport::ScanSupport(const ScanPoints& points, double resolution, unsigned threads)
-    : points_(points.points), spacing_(points.spacing), index_(points_, threads), resolution_(resolution) {}
+    : points_(points.points),
+      spacing_(points.spacing),
+      normals_(points.normals),
+      index_(points_, threads),
+      resolution_(resolution) {}
 
-double ScanSupport::distance(const Point3& x, double* spacing) const {
+double ScanSupport::distance(const Point3& x, double* spacing, Point3* normal) const {
   std::vector<PointIndex::Id> ids;
   std::vector<double> d2;
   index_.nearest(x, 1, ids, &d2);
@@ -41,6 +47,7 @@ double ScanSupport::distance(const Point3& x, double* spacing) const {
     return std::numeric_limits<double>::infinity();
   }
   if (spacing) *spacing = spacing_[ids[0]];
+  if (normal) *normal = normals_[ids[0]];
   return std::sqrt(d2[0]);
 }
 
@@ -59,10 +66,17 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   ScanFinishReport rep;
   const std::size_t nv = mesh.vertices.size();
   std::vector<double> s(nv, 0.0);  // distance to the data minus the reach: <= 0 supported
+  // (Tried and not kept, 2026-11-28: also unsupported where the mesh faces away from the nearest point,
+  // to cut the lip where an open scan's zero set turns back: the partial cuts left more small boundary
+  // loops at the rim, 3 -> 5-8 on a single view of a sphere cap.)
   for (std::size_t v = 0; v < nv; ++v) {
     double h = 0;
     const double d = distance(mesh.vertices[v], &h);
-    s[v] = d - std::max(kReachSpacings * h, kReachPrecision * precision);
+    // Sparse regions reach farther, but never beyond kReachResolutions (the "far from the data" of a
+    // user's check is in the data's median spacing), unless the precision itself is coarser.
+    const double reach = std::min(std::max(kReachSpacings * h, kReachPrecision * precision),
+                                  std::max(kReachResolutions * resolution_, precision));
+    s[v] = d - reach;
   }
   // Components through shared vertices: area and support.
   std::vector<std::uint32_t> root(nv);
@@ -114,13 +128,13 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   }
   rep.open = open;
   if (open) {
-    std::vector<std::array<std::uint32_t, 3>> kept;
-    for (const auto& t : mesh.triangles)
-      if (s[t[0]] <= 0 && s[t[1]] <= 0 && s[t[2]] <= 0) kept.push_back(t);
-    rep.trimmed_triangles = mesh.triangles.size() - kept.size();
-    mesh.triangles.swap(kept);
-  }
-  if (rep.small_components || open) {
+    // Clipped along the zero level of s (marching triangles on the surface, trim_mesh): a clean open
+    // 2-manifold whose boundary follows where the data end, not the mesh's edges.
+    TrimReport trim;
+    mesh = trim_mesh(mesh, s, TrimOptions{}, &trim);
+    rep.trimmed_triangles = trim.removed_triangles + trim.clipped_triangles;
+    rep.small_components += trim.removed_components;
+  } else if (rep.small_components) {
     // Unreferenced vertices out (what trim_mesh does for an open mesh).
     std::vector<std::uint32_t> renumber(nv, 0xffffffffu);
     std::vector<Point3> vertices, normals;

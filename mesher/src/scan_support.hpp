@@ -32,8 +32,8 @@ class ScanSupport {
   /// distance beyond (the surface far from every point may stay coarse: it is trimmed or spans a hole).
   double size_scale(const Point3& x) const;
 
-  /// Distance from x to the nearest point, and that point's local spacing.
-  double distance(const Point3& x, double* spacing = nullptr) const;
+  /// Distance from x to the nearest point, and that point's local spacing and (oriented) normal.
+  double distance(const Point3& x, double* spacing = nullptr, Point3* normal = nullptr) const;
 
   /// Finishes an extracted mesh at absolute precision `precision`: drops components without support or
   /// smaller than the data resolve, decides open or closed (`kind`; Auto decides once, the first time,
@@ -48,6 +48,7 @@ class ScanSupport {
  private:
   std::vector<Point3> points_;
   std::vector<double> spacing_;
+  std::vector<Point3> normals_;
   PointIndex index_;
   double resolution_ = 0;
   std::optional<bool> decided_open_;

@@ -9,6 +9,7 @@
 #include "vitri/rbf/point_index.hpp"
 
 #include "parallel.hpp"
+#include "spaced_subset.hpp"
 
 #include <Eigen/Dense>
 
@@ -82,32 +83,50 @@ struct LocalFit {
 
 /// Fits point i's neighbourhood (itself included): PCA plane, then the weighted quadric height field
 /// z = a + b x + c y + d x^2 + e xy + f y^2 in the plane's frame (Wendland weights over the neighbourhood
-/// radius); a plane when the quadric is ill-conditioned.
-LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, std::size_t i) {
+/// radius); a plane when the quadric is ill-conditioned. `side`, when given (oriented normals), keeps only
+/// the neighbours on the point's own side of the surface (n_j . n_i > 0.3): the two sheets of a thin part
+/// face away from each other, and a neighbourhood that straddles them must not fit one surface between.
+LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, std::size_t i,
+                           const std::vector<Point3>* side = nullptr) {
   LocalFit out;
-  const std::size_t k = nb.k;
   const Point3 o = p[i];
+  // The neighbours used (relative positions and distances), the point itself first.
+  thread_local std::vector<std::pair<Eigen::Vector3d, double>> near;
+  near.clear();
+  near.push_back({Eigen::Vector3d::Zero(), 0.0});
+  for (std::size_t c = 0; c < nb.k; ++c) {
+    const Id j = nb.at(i, c);
+    if (side && dot((*side)[j], (*side)[i]) < 0.3) continue;
+    near.push_back({(p[j] - o).eigen(), nb.d(i, c)});
+  }
+  const std::size_t m = near.size();
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  for (std::size_t c = 0; c < k; ++c) mean += (p[nb.at(i, c)] - o).eigen();
-  mean /= static_cast<double>(k + 1);
-  Eigen::Matrix3d cov = mean * mean.transpose();
-  for (std::size_t c = 0; c < k; ++c) {
-    const Eigen::Vector3d v = (p[nb.at(i, c)] - o).eigen() - mean;
+  for (const auto& q : near) mean += q.first;
+  mean /= static_cast<double>(m);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& q : near) {
+    const Eigen::Vector3d v = q.first - mean;
     cov += v * v.transpose();
   }
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
   const Eigen::Vector3d ev = solver.eigenvalues();
-  out.collinear = !(ev(1) > 1e-6 * ev(2));
-  out.plane = std::sqrt(std::max(0.0, ev(0)) / static_cast<double>(k + 1));
+  out.collinear = m < 3 || !(ev(1) > 1e-6 * ev(2));
+  out.plane = std::sqrt(std::max(0.0, ev(0)) / static_cast<double>(m));
   const Eigen::Vector3d nrm = solver.eigenvectors().col(0).normalized();
   const Eigen::Vector3d e1 = solver.eigenvectors().col(2).normalized();
   const Eigen::Vector3d e2 = nrm.cross(e1);
   out.normal = Point3::from(nrm);
+  if (side && dot(out.normal, (*side)[i]) < 0) out.normal = -out.normal;
   out.projected = o;
   out.noise = out.plane;
-  if (out.collinear) return out;
+  if (out.collinear) {
+    if (side) out.normal = (*side)[i];
+    return out;
+  }
   // Quadric in the frame centred at the neighbourhood's mean.
-  const double radius = std::max(nb.d(i, k - 1), 1e-300) * 1.1;
+  double reach = 0;
+  for (const auto& q : near) reach = std::max(reach, q.second);
+  const double radius = std::max(reach, 1e-300) * 1.1;
   Eigen::Matrix<double, 6, 6> ata = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 1> atz = Eigen::Matrix<double, 6, 1>::Zero();
   double wsum = 0;
@@ -121,20 +140,15 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   };
   auto weight = [&](double dist) {
     const double t = std::min(1.0, dist / radius);
-    const double s = 1 - t;
-    return s * s * s * s * (4 * t + 1) + 1e-3;
+    const double u = 1 - t;
+    return u * u * u * u * (4 * t + 1) + 1e-3;
   };
-  std::vector<std::pair<Eigen::Matrix<double, 6, 1>, std::pair<double, double>>> rows;
-  rows.reserve(k + 1);
-  {
+  thread_local std::vector<std::pair<Eigen::Matrix<double, 6, 1>, std::pair<double, double>>> rows;
+  rows.clear();
+  for (const auto& q : near) {
     double z;
-    const auto a = row(Eigen::Vector3d::Zero(), z);
-    rows.push_back({a, {z, weight(0)}});
-  }
-  for (std::size_t c = 0; c < k; ++c) {
-    double z;
-    const auto a = row((p[nb.at(i, c)] - o).eigen(), z);
-    rows.push_back({a, {z, weight(nb.d(i, c))}});
+    const auto a = row(q.first, z);
+    rows.push_back({a, {z, weight(q.second)}});
   }
   for (const auto& [a, zw] : rows) {
     ata += zw.second * a * a.transpose();
@@ -143,7 +157,7 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   }
   Eigen::Matrix<double, 6, 1> coef;
   const Eigen::LDLT<Eigen::Matrix<double, 6, 6>> ldlt(ata);
-  bool quadric = k >= 9 && ldlt.info() == Eigen::Success && ldlt.isPositive();
+  bool quadric = m >= 10 && ldlt.info() == Eigen::Success && ldlt.isPositive();
   if (quadric) {
     coef = ldlt.solve(atz);
     const Eigen::Matrix<double, 6, 1> d = ldlt.vectorD();
@@ -167,7 +181,10 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   const double dzdx = (coef(1) + 2 * coef(3) * x + coef(4) * y) / radius;
   const double dzdy = (coef(2) + coef(4) * x + 2 * coef(5) * y) / radius;
   const Eigen::Vector3d qn = (nrm - dzdx * e1 - dzdy * e2).normalized();
-  if (qn.allFinite()) out.normal = Point3::from(qn);
+  if (qn.allFinite()) {
+    out.normal = Point3::from(qn);
+    if (side && dot(out.normal, (*side)[i]) < 0) out.normal = -out.normal;
+  }
   double move = zq - z;
   // Never further than the neighbourhood's own scale: a bad fit does not throw a point away.
   const double cap = std::max(3 * out.noise, 3 * out.plane);
@@ -513,20 +530,6 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     rep.noise = median(noise);
   }
 
-  // Approximation: the projection onto the local quadrics (twice where the data are noisy: the second
-  // fit sees the smoother points).
-  std::vector<Point3> moved_from = p;
-  if (options.approximate) {
-    const int passes = rep.noise > 0.1 * median(nb.dist) ? 2 : 1;
-    for (int pass = 0; pass < passes; ++pass) {
-      if (pass > 0) fit_all(p);
-      for (std::size_t i = 0; i < p.size(); ++i) p[i] = fit[i].projected;
-    }
-    fit_all(p);
-    std::vector<double> d(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) d[i] = norm(p[i] - moved_from[i]);
-    rep.moved = median(d);
-  }
   std::vector<Point3> n(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) n[i] = fit[i].normal;
 
@@ -619,18 +622,57 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     if (flips == 0) break;
   }
 
-  ScanPoints out;
-  out.points = std::move(p);
-  out.normals = std::move(n);
-  out.spacing.resize(out.points.size());
-  std::vector<double> nn(out.points.size());
-  for (std::size_t i = 0; i < out.points.size(); ++i) {
-    out.spacing[i] = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+  // Approximation: the projection onto the local quadrics of each point's own side (twice where the data
+  // are noisy: the second fit sees the smoother points), once the normals are oriented; the normals are
+  // then those of the quadrics at the projected points, with the signs decided.
+  if (options.approximate) {
+    const std::vector<Point3> before = p;
+    std::vector<double> first(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) first[i] = nb.d(i, 0);
+    const double scale = median(first);  // the spacing
+    const int passes = rep.noise > 0.5 * scale ? 3 : rep.noise > 0.1 * scale ? 2 : 1;
+    for (int pass = 0; pass < passes; ++pass) {
+      rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) fit[i] = fit_neighbourhood(p, nb, i, &n);
+      });
+      for (std::size_t i = 0; i < p.size(); ++i) p[i] = fit[i].projected;
+    }
+    rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) fit[i] = fit_neighbourhood(p, nb, i, &n);
+    });
+    for (std::size_t i = 0; i < p.size(); ++i) n[i] = fit[i].normal;
+    std::vector<double> d(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) d[i] = norm(p[i] - before[i]);
+    rep.moved = median(d);
+  }
+
+  std::vector<double> nn(p.size()), local(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    local[i] = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
     nn[i] = nb.d(i, 0);
   }
-  rep.kept = out.points.size();
   rep.spacing = median(nn);
   rep.resolution = std::max(rep.spacing, 2 * rep.noise);
+  // Thinning to the resolution: where the noise exceeds the spacing, the projected points carry no
+  // detail finer than the resolution, and clusters of them closer than that only make the interpolant
+  // fold between them (small handles at the default precision). A Poisson-disk subset (input order) at
+  // half the resolution keeps one point per such cluster.
+  std::vector<char> kept(p.size(), 1);
+  const bool thin = options.approximate && rep.resolution > 1.5 * rep.spacing;
+  if (thin) {
+    std::vector<std::size_t> order(p.size());
+    std::iota(order.begin(), order.end(), std::size_t(0));
+    kept = rbf_detail::spaced_subset(p, order, 0.5 * rep.resolution);
+  }
+  ScanPoints out;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (!kept[i]) continue;
+    out.points.push_back(p[i]);
+    out.normals.push_back(n[i]);
+    out.spacing.push_back(thin ? std::max(local[i], 0.5 * rep.resolution) : local[i]);
+  }
+  rep.thinned = p.size() - out.points.size();
+  rep.kept = out.points.size();
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (report) *report = rep;
   return out;
@@ -646,7 +688,9 @@ std::string describe(const ScanReport& r) {
   s << "scan: " << r.kept << " of " << r.input << " points kept (" << r.duplicates << " duplicates, "
     << r.outliers << " outliers set aside); " << r.k << " neighbours; spacing " << r.spacing << ", noise "
     << r.noise << " (" << (r.spacing > 0 ? r.noise / r.spacing : 0) << " spacings), points moved by "
-    << r.moved << " (median); normals from " << source;
+    << r.moved << " (median)";
+  if (r.thinned) s << ", " << r.thinned << " thinned to the resolution " << r.resolution;
+  s << "; normals from " << source;
   if (r.repaired) s << ", " << r.repaired << " given normals repaired";
   if (r.ambiguous) s << ", " << r.ambiguous << " signs ambiguous";
   if (r.viewpoint_rejected) s << "; " << r.viewpoint_note;

@@ -59,7 +59,8 @@ TEST_CASE("prepare_scan: noise of one spacing is measured and absorbed, normals 
   const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
   INFO(vitri::describe(r));
   CHECK(r.input == 4000);
-  CHECK(r.kept + r.outliers + r.duplicates == 4000);
+  CHECK(r.kept + r.thinned + r.outliers + r.duplicates == 4000);
+  CHECK(r.thinned > 0);  // noise above the spacing: thinned to the resolution
   CHECK(r.outliers < 40);  // Gaussian noise is not an outlier
   CHECK(r.k > 16);         // the noise asked for a wider neighbourhood
   CHECK(r.noise > 0.3 * spacing);
@@ -169,7 +170,7 @@ TEST_CASE("prepare_scan: duplicates counted; inputs with no surface refused with
   vitri::ScanReport r;
   vitri::prepare_scan(p, {}, {}, &r);
   CHECK(r.duplicates == 100);
-  CHECK(r.kept + r.outliers == 500);
+  CHECK(r.kept + r.thinned + r.outliers == 500);
   // Too few points.
   const std::vector<Point3> few(p.begin(), p.begin() + 5);
   CHECK_THROWS_AS(vitri::prepare_scan(few), vitri::InvalidArgument);

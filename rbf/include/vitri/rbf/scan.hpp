@@ -56,6 +56,9 @@ struct ScanReport {
   std::size_t duplicates = 0;  ///< exact duplicate positions dropped (the first copy kept)
   std::size_t outliers = 0;    ///< points set aside as outliers (ScanOptions::remove_outliers)
   std::size_t kept = 0;        ///< points returned
+  /// Points left out after the projection because a kept one lay within half the resolution (only
+  /// where the resolution exceeds 1.5 spacings: noise larger than the spacing; ScanOptions::approximate).
+  std::size_t thinned = 0;
   std::size_t k = 0;           ///< neighbours per point used
   /// The median distance from a returned point to its nearest other one.
   double spacing = 0;

@@ -1,0 +1,319 @@
+// `vitri mesh` on scans with its defaults (docs/scans.md): real scans bundled in data/ (lidar_cars.xyz,
+// hippo1_view.xyz, see data/README.md) and synthetic ones with a known truth (a sphere with noise and
+// outliers, a single view of it with its viewpoint): a mesh every time, a 2-manifold, one component for
+// one object, within a bound of the truth computed from the noise, no area far from the data, open where
+// a single view ends, closed when asked or when the data surround the object.
+#include "vitri/core/point.hpp"
+#include "vitri/io/io.hpp"
+#include "vitri/rbf/point_index.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <sys/wait.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <fstream>
+#include <map>
+#include <numeric>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+using vitri::Point3;
+
+namespace {
+
+const std::string kDir = VITRI_TEST_WORK_DIR;
+const std::string kData = VITRI_DATA_DIR;
+constexpr double kPi = 3.14159265358979323846;
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+int run(const std::string& args, std::string& out, std::string& err) {
+  const std::string o = kDir + "/scan_stdout.txt", e = kDir + "/scan_stderr.txt";
+  const int rc = std::system((std::string(VITRI_CLI) + " mesh " + args + " > " + o + " 2> " + e).c_str());
+  out = slurp(o);
+  err = slurp(e);
+  return WIFEXITED(rc) ? WEXITSTATUS(rc) : -1;
+}
+
+/// What a test asserts of an output mesh.
+struct Shape {
+  std::size_t vertices = 0, triangles = 0, components = 0;
+  std::size_t boundary_edges = 0, nonmanifold_edges = 0;
+  long euler = 0;
+  std::vector<Point3> v;
+  std::vector<std::array<int, 3>> f;
+};
+
+Shape shape_of(const std::string& path) {
+  const vitri::TriangleMesh m = vitri::read_mesh(path);
+  Shape s;
+  s.vertices = static_cast<std::size_t>(m.V.rows());
+  s.triangles = static_cast<std::size_t>(m.F.rows());
+  for (long i = 0; i < m.V.rows(); ++i) s.v.push_back({m.V(i, 0), m.V(i, 1), m.V(i, 2)});
+  for (long i = 0; i < m.F.rows(); ++i) s.f.push_back({m.F(i, 0), m.F(i, 1), m.F(i, 2)});
+  std::map<std::pair<int, int>, int> edges;
+  std::vector<int> root(s.vertices);
+  std::iota(root.begin(), root.end(), 0);
+  auto find = [&](int a) {
+    while (root[static_cast<std::size_t>(a)] != a) a = root[static_cast<std::size_t>(a)] = root[static_cast<std::size_t>(root[static_cast<std::size_t>(a)])];
+    return a;
+  };
+  for (const auto& t : s.f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = t[static_cast<std::size_t>(c)], b = t[static_cast<std::size_t>((c + 1) % 3)];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+      const int ra = find(a), rb = find(b);
+      if (ra != rb) root[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
+    }
+  for (const auto& [e, count] : edges) {
+    s.boundary_edges += count == 1;
+    s.nonmanifold_edges += count > 2;
+  }
+  std::vector<char> used(s.vertices, 0);
+  for (const auto& t : s.f)
+    for (const int c : t) used[static_cast<std::size_t>(c)] = 1;
+  std::size_t used_count = 0;
+  for (std::size_t i = 0; i < s.vertices; ++i)
+    if (used[i]) {
+      ++used_count;
+      s.components += find(static_cast<int>(i)) == static_cast<int>(i);
+    }
+  s.euler = static_cast<long>(used_count) - static_cast<long>(edges.size()) + static_cast<long>(s.triangles);
+  return s;
+}
+
+/// The largest distance from an output vertex to the nearest input point, in units of `spacing`.
+double farthest_vertex(const Shape& s, const std::vector<Point3>& input, double spacing) {
+  const vitri::PointIndex index(input);
+  std::vector<vitri::PointIndex::Id> ids;
+  std::vector<double> d2;
+  double worst = 0;
+  for (const Point3& p : s.v) {
+    index.nearest(p, 1, ids, &d2);
+    worst = std::max(worst, std::sqrt(d2[0]));
+  }
+  return worst / spacing;
+}
+
+/// Fraction of input points within `reach` of an output vertex.
+double completeness(const Shape& s, const std::vector<Point3>& input, double reach) {
+  const vitri::PointIndex index(s.v);
+  std::vector<vitri::PointIndex::Id> ids;
+  std::vector<double> d2;
+  std::size_t near = 0;
+  for (const Point3& p : input) {
+    index.nearest(p, 1, ids, &d2);
+    near += std::sqrt(d2[0]) <= reach;
+  }
+  return static_cast<double>(near) / static_cast<double>(input.size());
+}
+
+double median_nn(const std::vector<Point3>& p) {
+  const vitri::PointIndex index(p);
+  std::vector<vitri::PointIndex::Id> ids;
+  std::vector<double> d2, d;
+  for (const Point3& q : p) {
+    index.nearest(q, 2, ids, &d2);
+    d.push_back(std::sqrt(d2.back()));
+  }
+  std::nth_element(d.begin(), d.begin() + static_cast<long>(d.size() / 2), d.end());
+  return d[d.size() / 2];
+}
+
+struct Gauss {
+  std::mt19937_64 rng;
+  explicit Gauss(std::uint64_t seed) : rng(seed) {}
+  double uniform() { return (static_cast<double>(rng() >> 11) + 0.5) * (1.0 / 9007199254740992.0); }
+  double operator()() { return std::sqrt(-2 * std::log(uniform())) * std::cos(2 * kPi * uniform()); }
+};
+
+/// n points of the unit sphere (uniform at random), radial Gaussian noise sigma; `outliers` extra points
+/// uniform in [-1.6, 1.6]^3 at least 0.25 off the sphere. Written as a 3-column .xyz.
+std::vector<Point3> write_noisy_sphere(const std::string& path, std::size_t n, double sigma, std::size_t outliers,
+                                       std::uint64_t seed) {
+  Gauss g(seed);
+  std::vector<Point3> p;
+  while (p.size() < n) {
+    const Point3 d{g(), g(), g()};
+    const double len = vitri::norm(d);
+    if (len < 1e-9) continue;
+    p.push_back(d * ((1 + sigma * g()) / len));
+  }
+  for (std::size_t k = 0; k < outliers;) {
+    const Point3 q{3.2 * g.uniform() - 1.6, 3.2 * g.uniform() - 1.6, 3.2 * g.uniform() - 1.6};
+    if (std::abs(vitri::norm(q) - 1) < 0.25) continue;
+    p.push_back(q);
+    ++k;
+  }
+  std::ofstream f(path);
+  f.precision(17);
+  for (const Point3& q : p) f << q.x << ' ' << q.y << ' ' << q.z << '\n';
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("vitri mesh, scan defaults: a noisy sphere with outliers gives one closed sphere within the noise",
+          "[cli][scan]") {
+  // 6000 points: spacing about sqrt(4 pi / 6000) = 0.046; noise sigma = one spacing; 2% outliers.
+  const double spacing = std::sqrt(4 * kPi / 6000);
+  const std::string in = kDir + "/scan_sphere.xyz", out = kDir + "/scan_sphere.ply";
+  const std::vector<Point3> pts = write_noisy_sphere(in, 6000, spacing, 120, 5);
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out, o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("outliers set aside") != std::string::npos);
+  CHECK(e.find("surface: closed") != std::string::npos);
+  const Shape s = shape_of(out);
+  CHECK(s.components == 1);
+  CHECK(s.boundary_edges == 0);
+  CHECK(s.nonmanifold_edges == 0);
+  CHECK(s.euler == 2);
+  // Distance to the truth (the unit sphere): the points' noise is one spacing RMS; the mesh's RMS
+  // radial error must be well below it (the noise absorbed), and no vertex farther than 3 sigma.
+  double sum = 0, worst = 0;
+  for (const Point3& v : s.v) {
+    const double r = std::abs(vitri::norm(v) - 1);
+    sum += r * r;
+    worst = std::max(worst, r);
+  }
+  const double rms = std::sqrt(sum / static_cast<double>(s.v.size()));
+  INFO("rms " << rms / spacing << " spacings, worst " << worst / spacing);
+  CHECK(rms < 0.5 * spacing);
+  CHECK(worst < 3 * spacing);
+  // At most 2 mesh vertices per input point.
+  CHECK(s.vertices <= 2 * pts.size());
+}
+
+TEST_CASE("vitri mesh, scan defaults: a single view with its viewpoint is left open where the data end",
+          "[cli][scan]") {
+  // The cap z > 0.3 of the unit sphere seen from (0, 0, 5), with NAME.viewpoint beside it; noise 0.3
+  // spacings.
+  const std::string in = kDir + "/scan_view.xyz", out = kDir + "/scan_view.ply";
+  std::vector<Point3> all = write_noisy_sphere(kDir + "/scan_view_all.xyz", 12000, 0.0, 0, 9);
+  std::vector<Point3> cap;
+  Gauss g(3);
+  for (const Point3& q : all)
+    if (q.z > 0.3) cap.push_back(q * (1 + 0.01 * g()));
+  {
+    std::ofstream f(in);
+    f.precision(17);
+    for (const Point3& q : cap) f << q.x << ' ' << q.y << ' ' << q.z << '\n';
+    std::ofstream(kDir + "/scan_view.viewpoint") << "0 0 5\n";
+  }
+  const double spacing = median_nn(cap);
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out, o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("viewpoint 0 0 5 (from the input)") != std::string::npos);
+  CHECK(e.find("normals from the viewpoint") != std::string::npos);
+  CHECK(e.find("surface: open") != std::string::npos);
+  const Shape s = shape_of(out);
+  CHECK(s.components == 1);
+  CHECK(s.nonmanifold_edges == 0);
+  CHECK(s.boundary_edges > 0);
+  // A disk, up to the few small loops and handles that the rim can carry where the closed zero set turns
+  // back (docs/scans.md, limits): Euler characteristic 1 for a disk, measured -3.
+  CHECK(s.euler <= 1);
+  CHECK(s.euler >= -5);
+  CHECK(farthest_vertex(s, cap, spacing) < 10);
+  CHECK(completeness(s, cap, 3 * spacing) > 0.99);
+  // The boundary lies where the data end (z = 0.3), within a few spacings.
+  std::map<std::pair<int, int>, int> edges;
+  for (const auto& t : s.f)
+    for (int c = 0; c < 3; ++c) {
+      const int a = t[static_cast<std::size_t>(c)], b = t[static_cast<std::size_t>((c + 1) % 3)];
+      ++edges[{std::min(a, b), std::max(a, b)}];
+    }
+  for (const auto& [edge, count] : edges)
+    if (count == 1) {
+      const double z = s.v[static_cast<std::size_t>(edge.first)].z;
+      CHECK(std::abs(z - 0.3) < 6 * spacing);
+    }
+  // The winding faces the viewpoint (outward here): the signed volume against the origin is positive.
+  double volume = 0;
+  for (const auto& t : s.f)
+    volume += vitri::dot(s.v[static_cast<std::size_t>(t[0])],
+                         vitri::cross(s.v[static_cast<std::size_t>(t[1])], s.v[static_cast<std::size_t>(t[2])]));
+  CHECK(volume > 0);
+
+  SECTION("--surface closed keeps the closed surface") {
+    REQUIRE(run(in + " -o " + out + " --surface closed", o, e) == 0);
+    const Shape c = shape_of(out);
+    CHECK(c.boundary_edges == 0);
+    CHECK(c.nonmanifold_edges == 0);
+    CHECK(e.find("surface: closed") != std::string::npos);
+  }
+  SECTION("levels of detail on the open surface") {
+    const std::string lod = kDir + "/scan_view_lod.obj";
+    REQUIRE(run(in + " -o " + lod + " --precision 0.05 --precision 0.03", o, e) == 0);
+    for (const char* level : {"/scan_view_lod-0.obj", "/scan_view_lod-1.obj"}) {
+      INFO(level);
+      const Shape l = shape_of(kDir + level);
+      CHECK(l.triangles > 100);
+      CHECK(l.boundary_edges > 0);
+      CHECK(l.nonmanifold_edges == 0);
+      CHECK(farthest_vertex(l, cap, spacing) < 10);
+    }
+  }
+  SECTION("--viewpoint overrides the file; a bad --surface is a usage error") {
+    REQUIRE(run(in + " -o " + out + " --viewpoint 0 0 0.2", o, e) == 0);
+    CHECK(e.find("(--viewpoint)") != std::string::npos);
+    REQUIRE(run(in + " -o " + out + " --surface half", o, e) == 2);
+    REQUIRE(run(in + " -o " + out + " --viewpoint 0 0", o, e) == 2);
+  }
+}
+
+TEST_CASE("vitri mesh, scan defaults: the bundled real scans mesh with no parameter", "[cli][scan][real]") {
+  for (const char* name : {"lidar_cars.xyz", "hippo1_view.xyz"}) {
+    INFO(name);
+    const std::string in = kData + "/" + name, out = kDir + "/scan_real_" + std::string(name) + ".ply";
+    const vitri::Input input = vitri::read_input(in);
+    const std::vector<Point3>& pts = input.points.points;
+    const double spacing = median_nn(pts);
+    std::string o, e;
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(o << e);
+    const Shape s = shape_of(out);
+    CHECK(s.triangles > pts.size() / 2);
+    CHECK(s.nonmanifold_edges == 0);
+    CHECK(farthest_vertex(s, pts, spacing) < 10);  // no area far from the data
+    CHECK(completeness(s, pts, 3 * spacing) > 0.9);
+    CHECK(s.components < 40);
+  }
+}
+
+TEST_CASE("vitri mesh, scan defaults: a PCD file with its VIEWPOINT", "[cli][scan]") {
+  // The cap of the previous case as an ascii PCD with a VIEWPOINT line.
+  std::vector<Point3> all = write_noisy_sphere(kDir + "/scan_pcd_all.xyz", 6000, 0.0, 0, 13);
+  const std::string in = kDir + "/scan_cap.pcd", out = kDir + "/scan_cap.ply";
+  std::vector<Point3> cap;
+  for (const Point3& q : all)
+    if (q.z > 0.3) cap.push_back(q);
+  {
+    std::ofstream f(in);
+    f << "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " << cap.size()
+      << "\nHEIGHT 1\nVIEWPOINT 0 0 5 1 0 0 0\nPOINTS " << cap.size() << "\nDATA ascii\n";
+    f.precision(9);
+    for (const Point3& q : cap) f << static_cast<float>(q.x) << ' ' << static_cast<float>(q.y) << ' ' << static_cast<float>(q.z) << '\n';
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out, o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("viewpoint 0 0 5 (from the input)") != std::string::npos);
+  CHECK(e.find("surface: open") != std::string::npos);
+  const Shape s = shape_of(out);
+  CHECK(s.components == 1);
+  CHECK(s.nonmanifold_edges == 0);
+}

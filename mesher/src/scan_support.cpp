@@ -24,6 +24,8 @@ constexpr double kOpenAreaFraction = 0.2;
 /// area, are below what the data resolve (bubbles and blobs of noise).
 constexpr double kMinComponentResolutions = 8.0;
 constexpr double kMinComponentFraction = 0.005;
+/// ... or nearest to fewer than max(this, 1 / 2000 of the points) of the data points.
+constexpr std::size_t kMinComponentPoints = 30;
 
 double triangle_area(const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t) {
   return 0.5 * norm(cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]));
@@ -105,10 +107,30 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   for (std::uint32_t v = 0; v < nv; ++v)
     if (root[v] == v && supported[v]) largest = std::max(largest, area[v]);
   const double min_area = std::max(std::pow(kMinComponentResolutions * resolution_, 2), kMinComponentFraction * largest);
+  // The data behind each component: every point votes for the component of its nearest mesh vertex. A
+  // blob grown around a few stray points that survived the outlier rules has only their votes.
+  std::vector<std::size_t> votes(nv, 0);
+  {
+    std::vector<PointIndex::Id> ids;
+    std::vector<Point3> used_at;
+    std::vector<std::uint32_t> used_id;
+    std::vector<std::uint8_t> used(nv, 0);
+    for (const auto& t : mesh.triangles) used[t[0]] = used[t[1]] = used[t[2]] = 1;
+    for (std::uint32_t v = 0; v < nv; ++v)
+      if (used[v]) used_at.push_back(mesh.vertices[v]), used_id.push_back(v);
+    if (!used_at.empty()) {
+      const PointIndex vertices(used_at);
+      for (const Point3& q : points_) {
+        vertices.nearest(q, 1, ids);
+        ++votes[find(used_id[ids[0]])];
+      }
+    }
+  }
+  const std::size_t min_votes = std::max<std::size_t>(kMinComponentPoints, points_.size() / 2000);
   std::vector<std::uint8_t> keep(nv, 0);
   for (std::uint32_t v = 0; v < nv; ++v)
     if (root[v] == v && area[v] > 0) {
-      keep[v] = editing || (supported[v] && area[v] >= min_area);
+      keep[v] = editing || (supported[v] && area[v] >= min_area && votes[v] >= min_votes);
       rep.small_components += !keep[v];
     }
   if (rep.small_components) {

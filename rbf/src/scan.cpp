@@ -205,6 +205,9 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neig
     mean_d[i] = s / static_cast<double>(k);
   }
   std::vector<std::uint8_t> out(n, 0);
+  std::vector<double> reach(n);
+  for (std::size_t i = 0; i < n; ++i) reach[i] = nb.d(i, k - 1);
+  const double typical_reach = median(reach);
   rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
     std::vector<double> tmp;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
@@ -229,11 +232,24 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neig
       solver.compute(cov);
       const Eigen::Vector3d nrm = solver.eigenvectors().col(0);
       const double off = std::abs(mean.dot(nrm));
+      // Scattered in a volume rather than on a surface (the neighbours' spread is nearly isotropic: the
+      // smallest of the three variances is over 12% of their sum, where a noisy surface gives a few
+      // percent) and sparser than the data at large (the k-th neighbour 3x farther than is typical):
+      // outliers spread over the box, whose neighbours are other outliers, so that the rules relative to
+      // the neighbours see nothing wrong. A sparse part of a surface stays flat and is kept.
+      const Eigen::Vector3d ev = solver.eigenvalues();
+      if (ev(0) > 0.08 * ev.sum() && nb.d(i, k - 1) > 2.0 * typical_reach) {
+        out[i] = 1;
+        continue;
+      }
       tmp.clear();
       for (std::size_t c = 0; c < k; ++c) tmp.push_back(noise[nb.at(i, c)]);
       const double local_noise = median(tmp);
-      // Spacing of the neighbourhood (side of the area per point) as the floor: clean data lose nothing.
-      const double h = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+      // Spacing of the neighbourhood (side of the area per point, the neighbours' own: a point off the
+      // surface sees its neighbours from afar) as the floor: clean data lose nothing.
+      tmp.clear();
+      for (std::size_t c = 0; c < k; ++c) tmp.push_back(reach[nb.at(i, c)]);
+      const double h = median(tmp) * std::sqrt(kPi / static_cast<double>(k));
       if (off > std::max(4.0 * local_noise, 2.0 * h)) out[i] = 1;
     }
   });
@@ -494,21 +510,22 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   }
   rep.k = k;
 
-  // Outliers: set aside, then the neighbourhoods of the inliers.
-  std::vector<std::uint8_t> outlier(p.size(), 0);
-  if (options.remove_outliers) {
+  // Outliers: set aside, then the neighbourhoods of the inliers; again, up to three rounds, while some
+  // are found: outliers whose neighbours were other outliers (spread over the box) look ordinary among
+  // them, and stand out once those are gone (their neighbours are then surface points).
+  for (int round = 0; round < 3 && options.remove_outliers; ++round) {
     std::vector<double> noise(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) noise[i] = fit[i].noise;
-    outlier = find_outliers(p, nb, noise, threads);
-  }
-  std::vector<std::size_t> keep;
-  for (std::size_t u = 0; u < p.size(); ++u)
-    if (!outlier[u]) keep.push_back(u);
-  rep.outliers = p.size() - keep.size();
-  if (keep.size() < kMinPoints)
-    throw InvalidArgument("no surface: " + std::to_string(keep.size()) + " of " + std::to_string(p.size()) +
-                          " distinct points agree on a surface, the others are outliers");
-  if (keep.size() < p.size()) {
+    const std::vector<std::uint8_t> outlier = find_outliers(p, nb, noise, threads);
+    std::vector<std::size_t> keep;
+    for (std::size_t u = 0; u < p.size(); ++u)
+      if (!outlier[u]) keep.push_back(u);
+    if (keep.size() == p.size()) break;
+    rep.outliers += p.size() - keep.size();
+    if (keep.size() < kMinPoints)
+      throw InvalidArgument("no surface: " + std::to_string(keep.size()) + " of " +
+                            std::to_string(keep.size() + rep.outliers) +
+                            " distinct points agree on a surface, the others are outliers");
     std::vector<Point3> q(keep.size());
     std::vector<std::size_t> s(keep.size());
     for (std::size_t r = 0; r < keep.size(); ++r) q[r] = p[keep[r]], s[r] = src[keep[r]];
@@ -627,9 +644,9 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // then those of the quadrics at the projected points, with the signs decided.
   if (options.approximate) {
     const std::vector<Point3> before = p;
-    std::vector<double> first(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) first[i] = nb.d(i, 0);
-    const double scale = median(first);  // the spacing
+    std::vector<double> nearest(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) nearest[i] = nb.d(i, 0);
+    const double scale = median(nearest);  // the spacing
     const int passes = rep.noise > 0.5 * scale ? 3 : rep.noise > 0.1 * scale ? 2 : 1;
     for (int pass = 0; pass < passes; ++pass) {
       rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
@@ -658,11 +675,11 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // fold between them (small handles at the default precision). A Poisson-disk subset (input order) at
   // half the resolution keeps one point per such cluster.
   std::vector<char> kept(p.size(), 1);
-  const bool thin = options.approximate && rep.resolution > 1.5 * rep.spacing;
+  const bool thin = options.approximate && rep.resolution > 1.2 * rep.spacing;
   if (thin) {
-    std::vector<std::size_t> order(p.size());
-    std::iota(order.begin(), order.end(), std::size_t(0));
-    kept = rbf_detail::spaced_subset(p, order, 0.5 * rep.resolution);
+    std::vector<std::size_t> visit(p.size());
+    std::iota(visit.begin(), visit.end(), std::size_t(0));
+    kept = rbf_detail::spaced_subset(p, visit, 0.5 * rep.resolution);
   }
   ScanPoints out;
   for (std::size_t i = 0; i < p.size(); ++i) {

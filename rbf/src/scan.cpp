@@ -19,8 +19,6 @@
 #include <cstdint>
 #include <numeric>
 #include <sstream>
-#include <cstdio>
-#include <cstdlib>
 
 namespace vitri {
 namespace {

@@ -7,7 +7,7 @@
 # on 2 cores; --quick: 10^4 and 10^5 points only). Results: bench/compare/results/poisson.{md,csv}.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-bash tools/deps.sh cmake ninja-build g++ libeigen3-dev libstb-dev time python3 python3-open3d python3-numpy \
+bash tools/deps.sh cmake ninja-build g++ libeigen3-dev libstb-dev liblzf-dev time python3 python3-open3d python3-numpy \
   python3-scipy
 cmake -S . -B build-rel -G Ninja -DCMAKE_BUILD_TYPE=Release -DVITRI_BUILD_TESTS=OFF -DVITRI_BUILD_BENCH=OFF
 cmake --build build-rel --target vitri_cli -j"$(nproc 2>/dev/null || echo 2)"

@@ -335,15 +335,22 @@ def run_orientation(a, tools, inputs, work):
         folder.mkdir(parents=True, exist_ok=True)
         row = {"input": inp.name}
         for name, cmd in (("vitri", [tools["orient"], inp.path, "--reference", inp.reference]),
+                          ("vitri_scan", [tools["orient"], inp.path, "--reference", inp.reference,
+                                          "--method", "scan"]),
                           ("open3d", [PYTHON, HERE / "open3d_orient.py", inp.path, "--reference", inp.reference])):
             if inp.outliers:
                 cmd += ["--exclude", inp.outliers]
-            if name == "open3d" and inp.viewpoint:
+            if name in ("open3d", "vitri_scan") and inp.viewpoint:
                 cmd += ["--viewpoint", inp.viewpoint]
+            record = folder / f"orient-{name}.json"
+            if a.resume and record.exists():
+                row[name] = json.loads(record.read_text())
+                continue
             print(f"orientation {inp.name}: {name}", flush=True)
             r = run_measured(cmd, a.timeout, a.mem_gb, folder / f"orient-{name}.log")
             row[name] = r["stdout_json"] or {"status": f"{r['status']}: {r['tail']}"}
             row[name]["peak_mb"] = r["peak_mb"]
+            record.write_text(json.dumps(row[name], indent=1))
         rows.append(row)
     return rows
 
@@ -422,16 +429,22 @@ def write_results(a, out, rows, orient_rows, inputs, seconds, pictures):
     if orient_rows:
         lines += ["", "## Orientation of unoriented points (synthetic cases)", "",
                   "oriented: points whose normal points to the same side as the true normal (n . n_true > 0; "
-                  "outliers excluded); tangent: |n . n_true| >= cos 25 degrees. vitri: "
-                  "`estimate_oriented_normals(points)` with default options; Open3D: estimate_normals(KNN 30) + "
-                  "orient_normals_consistent_tangent_plane(30) (towards the camera for single views).", "",
-                  "| input | vitri s | vitri status | vitri oriented % | vitri tangent % | Open3D s | "
-                  "Open3D oriented % | Open3D tangent % |", "|---|---:|---|---:|---:|---:|---:|---:|"]
+                  "outliers excluded); tangent: |n . n_true| >= cos 25 degrees. vitri strict: "
+                  "`estimate_oriented_normals(points)` with default options; vitri scan: `prepare_scan(points)` "
+                  "with default ScanOptions (what `vitri mesh` does; its points, moved and without outliers and "
+                  "thinned ones, matched to the nearest input point; kept = points it returned); Open3D: "
+                  "estimate_normals(KNN 30) + orient_normals_consistent_tangent_plane(30) (towards the camera "
+                  "for single views).", "",
+                  "| input | strict s | strict status | strict oriented % | strict tangent % | scan s | scan status | "
+                  "scan kept | scan oriented % | scan tangent % | Open3D s | Open3D oriented % | Open3D tangent % |",
+                  "|---|---:|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|"]
         for r in orient_rows:
-            v, o = r["vitri"], r["open3d"]
+            v, sc, o = r["vitri"], r.get("vitri_scan", {}), r["open3d"]
             pct = lambda d, k: fmt(100 * d[k], 1) if k in d else "-"
             lines.append(f"| {r['input']} | {fmt(v.get('seconds'))} | {str(v.get('status'))[:90]} | "
-                         f"{pct(v, 'oriented')} | {pct(v, 'tangent')} | {fmt(o.get('seconds'))} | "
+                         f"{pct(v, 'oriented')} | {pct(v, 'tangent')} | {fmt(sc.get('seconds'))} | "
+                         f"{str(sc.get('status'))[:90]} | {fmt(sc.get('returned'))} | {pct(sc, 'oriented')} | "
+                         f"{pct(sc, 'tangent')} | {fmt(o.get('seconds'))} | "
                          f"{pct(o, 'oriented')} | {pct(o, 'tangent')} |")
         with open(Path(a.work) / "orient.json", "w") as fh:
             json.dump(orient_rows, fh, indent=1)

@@ -12,7 +12,7 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/../.." && pwd)
 cd "$root"
 build=${BUILD:-build-scans}
-bash tools/deps.sh cmake ninja-build g++ libeigen3-dev libstb-dev libcgal-dev time imagemagick python3 \
+bash tools/deps.sh cmake ninja-build g++ libeigen3-dev libstb-dev libcgal-dev liblzf-dev time imagemagick python3 \
   python3-open3d python3-numpy
 targets="vitri_scan_cases vitri_scan_metrics bench_orient vitri_scan_cgal_poisson"
 vitri=${VITRI:-build-release/apps/vitri}

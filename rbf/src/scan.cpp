@@ -498,7 +498,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       });
       // Only structure that matters against the spacing (a clean curved surface also fits a quadric a
       // little worse at a larger scale).
-      if (median(big) > std::max(1.5 * noise_small, 0.1 * median(nb.dist))) k2 = k3;
+      if (median(big) > std::max(1.5 * noise_small, 0.05 * median(nb.dist))) k2 = k3;
     }
     if (k2 > k) {
       k = k2;

@@ -191,6 +191,35 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   return out;
 }
 
+/// The side of the area per point around point i (its k-th neighbour's distance x sqrt(pi / k)).
+double local_spacing(const Neighbours& nb, std::size_t i) {
+  return nb.d(i, nb.k - 1) * std::sqrt(kPi / static_cast<double>(nb.k));
+}
+
+/// Connected components of the neighbour graph restricted to edges no longer than 3 local spacings (of
+/// the longer-spaced end), among the points not flagged in `skip` (null: all): the root of each point's
+/// component (the smallest id in it).
+std::vector<Id> surface_components(const Neighbours& nb, std::size_t n, const std::vector<std::uint8_t>* skip) {
+  std::vector<Id> parent(n);
+  std::iota(parent.begin(), parent.end(), Id(0));
+  auto find = [&](Id a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    if (skip && (*skip)[i]) continue;
+    for (std::size_t c = 0; c < nb.k; ++c) {
+      const Id j = nb.at(i, c);
+      if (skip && (*skip)[j]) continue;
+      if (nb.d(i, c) > 3.0 * std::max(local_spacing(nb, i), local_spacing(nb, j))) continue;
+      const Id a = find(static_cast<Id>(i)), b = find(j);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  }
+  for (std::size_t i = 0; i < n; ++i) parent[i] = find(static_cast<Id>(i));
+  return parent;
+}
+
 /// Outliers among distinct points: far off the plane of their neighbours, much sparser than their
 /// neighbours, or in a small cluster cut off from the rest. Returns a flag per point.
 std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neighbours& nb,
@@ -253,30 +282,13 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neig
   });
   // Small clusters: components of the neighbour graph (edges no longer than 3 local spacings) among the
   // points kept so far, fewer than max(2k, n / 1000) points (at most n / 4: a small input is not all outliers).
-  std::vector<Id> parent(n);
-  std::iota(parent.begin(), parent.end(), Id(0));
-  auto find = [&](Id a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  for (std::size_t i = 0; i < n; ++i) {
-    if (out[i]) continue;
-    const double hi = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
-    for (std::size_t c = 0; c < k; ++c) {
-      const Id j = nb.at(i, c);
-      if (out[j]) continue;
-      const double hj = nb.d(j, k - 1) * std::sqrt(kPi / static_cast<double>(k));
-      if (nb.d(i, c) > 3.0 * std::max(hi, hj)) continue;
-      const Id a = find(static_cast<Id>(i)), bb = find(j);
-      if (a != bb) parent[std::max(a, bb)] = std::min(a, bb);
-    }
-  }
+  const std::vector<Id> root = surface_components(nb, n, &out);
   std::vector<std::size_t> size(n, 0);
   for (std::size_t i = 0; i < n; ++i)
-    if (!out[i]) ++size[find(static_cast<Id>(i))];
+    if (!out[i]) ++size[root[i]];
   const std::size_t min_size = std::min(std::max<std::size_t>(2 * k, n / 1000), n / 4);
   for (std::size_t i = 0; i < n; ++i)
-    if (!out[i] && size[find(static_cast<Id>(i))] < min_size) out[i] = 1;
+    if (!out[i] && size[root[i]] < min_size) out[i] = 1;
   return out;
 }
 
@@ -331,23 +343,9 @@ std::size_t vote_signs(const std::vector<Point3>& p, const Neighbours& nb, std::
 /// the mean normal of the largest open component, itself turned toward +z (up) when nothing else says.
 /// Returns the points whose sign changed.
 std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb, std::vector<Point3>& n) {
-  const std::size_t count = p.size(), k = nb.k;
-  std::vector<Id> parent(count);
-  std::iota(parent.begin(), parent.end(), Id(0));
-  auto find = [&](Id a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  for (std::size_t i = 0; i < count; ++i) {
-    const double hi = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
-    for (std::size_t c = 0; c < k; ++c) {
-      const Id j = nb.at(i, c);
-      const double hj = nb.d(j, k - 1) * std::sqrt(kPi / static_cast<double>(k));
-      if (nb.d(i, c) > 3.0 * std::max(hi, hj)) continue;
-      const Id a = find(static_cast<Id>(i)), b = find(j);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-  }
+  const std::size_t count = p.size();
+  const std::vector<Id> root = surface_components(nb, count, nullptr);
+  auto find = [&](Id a) { return root[a]; };
   struct Part {
     std::size_t size = 0;
     Point3 centroid, normal_sum;
@@ -663,7 +661,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
 
   std::vector<double> nn(p.size()), local(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) {
-    local[i] = nb.d(i, k - 1) * std::sqrt(kPi / static_cast<double>(k));
+    local[i] = local_spacing(nb, i);
     nn[i] = nb.d(i, 0);
   }
   rep.spacing = median(nn);

@@ -67,7 +67,6 @@ TEST_CASE("prepare_scan: noise of one spacing is measured and absorbed, normals 
   CHECK(r.noise < 2.0 * spacing);
   CHECK(r.resolution >= r.spacing);
   // The projection halves the error at least (a smooth fit of noisy data).
-  std::vector<Point3> kept_input;  // the same points before projection are not returned: compare RMS only
   CHECK(rms_radial_error(s.points) < 0.5 * rms_radial_error(p));
   CHECK(outward(s.points, s.normals) >= s.points.size() * 995 / 1000);
   CHECK(r.orientation == vitri::OrientationSource::Estimated);

@@ -151,6 +151,12 @@ void Triangulation::canonicalize() {
   });
   tets_ = std::move(fresh);
   free_head_ = kNoTet;
+  std::vector<TetId> old_to_new;  // for the property maps that carry values across (TetRenumbering::Permute)
+  if (maps_.wants_permutation()) {
+    old_to_new.assign(cap, kNoTet);
+    for (std::size_t n = 0; n < order.size(); ++n) old_to_new[order[n].t] = static_cast<TetId>(n);
+  }
+  renumber_maps(old_to_new);
   // The state that later operations start from must be canonical too, or they would number their new
   // tetrahedra differently (a removal starts its star at vtet_, an insertion walks from a hint): each
   // vertex's incident tetrahedron is its first one, the location grid is rebuilt in vertex id order, and

@@ -21,6 +21,8 @@
 // gives exactly the live tetrahedra, under new ids; vertex ids are kept through the translation tables.
 #include "scratch.hpp"
 
+#include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <string>
 
@@ -28,6 +30,21 @@ namespace vitri {
 
 namespace {
 constexpr std::size_t kRebuildLevels = 16;  // excess levels per vertex that pay for a rebuild (above)
+
+// The live tetrahedra of `tri` under their sorted vertex ids (which a rebuild keeps), in key order: the
+// rebuild matches old and new ids through them for the property maps that carry values across it.
+using KeyedTet = std::pair<std::array<VertexId, 4>, TetId>;
+std::vector<KeyedTet> sorted_live_keys(const Triangulation& tri) {
+  std::vector<KeyedTet> keys;
+  keys.reserve(tri.num_tetrahedra());
+  tri.for_each_tetrahedron([&](TetId t) {
+    std::array<VertexId, 4> k = tri.tet_vertices(t);
+    std::sort(k.begin(), k.end());
+    keys.emplace_back(k, t);
+  });
+  std::sort(keys.begin(), keys.end());
+  return keys;
+}
 }  // namespace
 
 void Triangulation::record_op(TetId first, std::uint32_t count, PointId apex) {
@@ -69,8 +86,26 @@ void Triangulation::rebuild_history(ChangeSet* changes) {
   options.max_wrap_link = max_wrap_link_;
   Triangulation fresh(box_, options);
   const std::vector<InsertResult> res = fresh.insert_points(pts);
+  // Property maps that carry values across (TetRenumbering::Permute): old id -> new id, matched on the
+  // vertex ids (the same tetrahedra come back). The others are reset.
+  const std::size_t old_capacity = tet_capacity();
+  std::vector<KeyedTet> old_keys;
+  if (maps_.wants_permutation()) old_keys = sorted_live_keys(*this);
   adopt(std::move(fresh), live, res);
   ++rebuilds_;
+  std::vector<TetId> old_to_new;
+  if (!old_keys.empty()) {
+    const std::vector<KeyedTet> new_keys = sorted_live_keys(*this);
+    if (new_keys.size() != old_keys.size())
+      throw std::logic_error("Triangulation::rebuild_history: tetrahedron count changed");
+    old_to_new.assign(old_capacity, kNoTet);
+    for (std::size_t i = 0; i < old_keys.size(); ++i) {
+      if (old_keys[i].first != new_keys[i].first)
+        throw std::logic_error("Triangulation::rebuild_history: the tetrahedra changed");
+      old_to_new[old_keys[i].second] = new_keys[i].second;
+    }
+  }
+  renumber_maps(old_to_new);
   if (changes) report_renumbered(changes);
 }
 

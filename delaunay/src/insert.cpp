@@ -202,7 +202,9 @@ InsertResult Triangulation::insert(const Point3& p, double min_distance, ChangeS
   detail::check_min_distance(min_distance);
   if (changes) changes->clear();
   const TetId t = locate_for_edit(p);
-  return insert_at(p, t, true, min_distance, changes, kNoVertex);
+  const InsertResult r = insert_at(p, t, true, min_distance, changes, kNoVertex);
+  sync_maps();
+  return r;
 }
 
 InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, double min_distance,
@@ -216,10 +218,10 @@ InsertResult Triangulation::insert_in_conflict(const Point3& p, TetId conflict, 
   const Points4 A = points_of(conflict);
   for (int i = 0; i < 4; ++i)
     if (*A[std::size_t(i)] == p) return {InsertStatus::TooClose, kNoVertex, vid(tets_.vertex(conflict, i))};
-  if (insphere_sos(*A[0], *A[1], *A[2], *A[3], p) != Sign::Positive)
-    throw InvalidArgument("Triangulation::insert_in_conflict: point " + detail::fmt_point(p) +
-                          " is not in conflict with tetrahedron " + std::to_string(conflict));
-  return insert_at(p, conflict, false, min_distance, changes, kNoVertex);
+  if (insphere_sos(*A[0], *A[1], *A[2], *A[3], p) != Sign::Positive) return {InsertStatus::NotInConflict};
+  const InsertResult r = insert_at(p, conflict, false, min_distance, changes, kNoVertex);
+  sync_maps();
+  return r;
 }
 
 // Room for a bulk insertion of n points.
@@ -250,6 +252,7 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
   if (points.empty()) return results;
   if (bulk_threads(points.size(), min_distance, changes) > 1) {
     insert_parallel(points, results);
+    sync_maps();
     return results;
   }
   const std::vector<std::uint32_t> order = detail::brio_order(points, box_);
@@ -263,6 +266,7 @@ std::vector<InsertResult> Triangulation::insert_points(const std::vector<Point3>
     if (changes) detail::append_events(one, events);
   }
   if (changes) detail::net_changes(events, *changes);
+  sync_maps();
   return results;
 }
 

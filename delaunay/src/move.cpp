@@ -24,6 +24,7 @@ InsertResult Triangulation::move(VertexId v, const Point3& p, double min_distanc
   const bool renumbered = maybe_rebuild();
   const InsertResult result = move_impl(v, p, min_distance, changes);
   if (renumbered) report_renumbered(changes);
+  sync_maps();
   return result;
 }
 

@@ -54,6 +54,7 @@ void Triangulation::remove(VertexId v, ChangeSet* changes) {
   collect_star(pid(v), star);
   remove_star(pid(v), star, changes);
   if (renumbered) report_renumbered(changes);
+  sync_maps();
 }
 
 // Removes the point pv whose star the caller collected (marked) in `star`.

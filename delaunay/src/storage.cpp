@@ -111,6 +111,16 @@ Triangulation::Triangulation(const Triangulation& o)
       root_(o.root_),
       scratch_(std::make_unique<Scratch>()) {}
 
+// A fresh triangulation with the same options, assigned: the registry resets the maps (MapRegistry).
+void Triangulation::clear() {
+  TriangulationOptions options;
+  options.keep_history = keep_history_;
+  options.history_rebuild_factor = rebuild_factor_;
+  options.max_wrap_link = max_wrap_link_;
+  options.threads = threads_;
+  *this = Triangulation(box_, options);
+}
+
 Triangulation& Triangulation::operator=(const Triangulation& o) {
   if (this != &o) {
     Triangulation copy(o);

@@ -573,13 +573,8 @@ int Polygonizer::hull_face(TetId t) const {
 bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, VertexKind kind,
                                std::vector<TetId>& created) {
   changes_.clear();
-  InsertResult r;
-  try {
-    r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
-  } catch (const InvalidArgument&) {
-    changes_.clear();
-    r = tri_.insert(p, min_distance, &changes_);
-  }
+  InsertResult r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
+  if (r.status == InsertStatus::NotInConflict) r = tri_.insert(p, min_distance, &changes_);
   if (r.status != InsertStatus::Inserted) return false;
   grow_vertex_arrays();
   grow_tet_arrays();

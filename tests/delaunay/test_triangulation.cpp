@@ -715,13 +715,23 @@ TEST_CASE("delaunay: insert_in_conflict inserts circumcenters without location")
   check(tr);
   auto direct = build(kUnitBox, pts, shuffled(pts.size(), 62), false);
   CHECK(tet_set(tr, b.label) == tet_set(direct.tr, direct.label));
-  // A tetrahedron that is not in conflict, or dead, is refused.
+  // A point not in conflict is refused with a status (nothing changes); a dead tetrahedron is misuse.
   const TetId t = tr.live_tetrahedra().front();
   const Point3 far =
       tr.tet_point(t, 0) == Point3{0, 0, 0} ? Point3{0.99, 0.99, 0.99} : Point3{0.01, 0.01, 0.01};
   if (insphere_sos(tr.tet_point(t, 0), tr.tet_point(t, 1), tr.tet_point(t, 2), tr.tet_point(t, 3), far) !=
-      Sign::Positive)
-    CHECK_THROWS_AS(tr.insert_in_conflict(far, t), InvalidArgument);
+      Sign::Positive) {
+    const std::size_t nv = tr.num_vertices(), cap = tr.tet_capacity();
+    ChangeSet ch;
+    const InsertResult r = tr.insert_in_conflict(far, t, 0.0, &ch);
+    CHECK(r.status == InsertStatus::NotInConflict);
+    CHECK(r.vertex == kNoVertex);
+    CHECK(tr.num_vertices() == nv);
+    CHECK(tr.tet_capacity() == cap);
+    CHECK(ch.created.empty());
+    CHECK(ch.killed.empty());
+    CHECK(tr.insert(far).status == InsertStatus::Inserted);  // the fallback of a refinement
+  }
   CHECK_THROWS_AS(tr.insert_in_conflict({0.5, 0.5, 0.5}, kNoTet), InvalidArgument);
 }
 

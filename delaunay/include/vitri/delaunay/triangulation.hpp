@@ -33,19 +33,55 @@
 
 namespace vitri {
 
-namespace detail {
-struct Partition;  // parallel bulk insertion: which thread owns a tetrahedron (delaunay/src/scratch.hpp)
-}  // namespace detail
-
 using VertexId = std::uint32_t;  ///< Stable id of a vertex; never reused after removal.
 using TetId = std::uint32_t;     ///< Id of a tetrahedron (live or in the history).
 inline constexpr VertexId kNoVertex = std::numeric_limits<VertexId>::max();
 inline constexpr TetId kNoTet = std::numeric_limits<TetId>::max();
 
+class PropertyMapBase;  // per-element data that follow the triangulation (property_map.hpp)
+
+namespace detail {
+struct Partition;  // parallel bulk insertion: which thread owns a tetrahedron (delaunay/src/scratch.hpp)
+
+/// The property maps registered with one Triangulation (property_map.hpp states their invariants).
+/// Registrations belong to the object, not to its content, so the special members never carry a map:
+/// a copy or a move starts with none; a move leaves the source's maps registered with the source, reset
+/// to its (moved-from, empty) content; a move assignment keeps this registry's maps and resets them to
+/// the content just assigned. The registry is the Triangulation's last member, so that these run after
+/// every other member was copied or moved (the maps read the new capacities), and the destructor, which
+/// detaches the maps, runs first.
+class MapRegistry {
+ public:
+  MapRegistry() = default;
+  ~MapRegistry();
+  MapRegistry(const MapRegistry&) {}
+  MapRegistry(MapRegistry&& other) noexcept;
+  MapRegistry& operator=(const MapRegistry&) = delete;  // Triangulation's copy assignment moves a copy
+  MapRegistry& operator=(MapRegistry&& other) noexcept;
+
+  bool empty() const { return maps_.empty(); }
+  std::size_t size() const { return maps_.size(); }
+  void add(PropertyMapBase* map) { maps_.push_back(map); }
+  void remove(PropertyMapBase* map);
+  /// Every map to its triangulation's capacities (growth only).
+  void grow() const;
+  /// Every map back to its default value.
+  void reset() const;
+  /// Some tet map wants old_to_new on a renumbering (TetRenumbering::Permute).
+  bool wants_permutation() const;
+  /// The tetrahedra were renumbered (old_to_new as PropertyMapBase::renumber; empty: reset the tet maps).
+  void renumber(const std::vector<TetId>& old_to_new) const;
+
+ private:
+  std::vector<PropertyMapBase*> maps_;
+};
+}  // namespace detail
+
 /// What an insertion did.
 enum class InsertStatus {
   Inserted,  ///< the point is a new vertex
   TooClose,  ///< rejected: closer than min_distance to `nearest` (exact duplicates included)
+  NotInConflict,  ///< insert_in_conflict() only: p is not in conflict with the given tetrahedron
 };
 
 struct InsertResult {
@@ -154,8 +190,12 @@ class Triangulation {
 
   /// Inserts p known to be in conflict with the live tetrahedron `conflict` (p inside its
   /// circumsphere, perturbed sense): no point location. Used by refinement to insert circumcenters.
-  /// @pre is_live(conflict) and p in conflict with it.
-  /// @throws InvalidArgument when `conflict` is not live or p is not in conflict with it, and as insert().
+  /// Returns NotInConflict (and changes nothing) when p is not in conflict with `conflict` (rounding can
+  /// put the computed circumcenter of a nearly flat tetrahedron just outside its exact circumsphere: the
+  /// caller then inserts it with insert()), TooClose as insert() (a vertex of `conflict` at exactly p is
+  /// found before the conflict test).
+  /// @pre is_live(conflict).
+  /// @throws InvalidArgument when `conflict` is not live, and as insert().
   InsertResult insert_in_conflict(const Point3& p, TetId conflict, double min_distance = 0.0,
                                   ChangeSet* changes = nullptr);
 
@@ -178,6 +218,10 @@ class Triangulation {
   /// (`changes->renumbered`). Vertex ids do not change. Frees the history of removed vertices and old
   /// positions of moved ones. O(n log n) expected. Without the history: does nothing.
   void rebuild_history(ChangeSet* changes = nullptr);
+  /// Removes every vertex but the 8 corners: the triangulation of construction, with the same options
+  /// (vertex ids start again at 8, history_rebuilds() at 0). Registered property maps go back to their
+  /// default values (property_map.hpp).
+  void clear();
   /// Renumbers the live tetrahedra canonically: ids 0 .. num_tetrahedra() - 1 in the order of their
   /// sorted vertex ids, each tetrahedron's vertices from its smallest by an even permutation (the
   /// orientation kept), the smallest of the other three second; no free slot left. Afterwards ids and
@@ -185,6 +229,8 @@ class Triangulation {
   /// a parallel insert_points. Vertex ids do not change. O(n). Only without the history.
   /// @throws InvalidArgument when the triangulation keeps its history.
   void canonicalize();
+  /// Number of property maps registered with this triangulation (property_map.hpp).
+  std::size_t registered_maps() const { return maps_.size(); }
   /// Number of history rebuilds so far (automatic or explicit).
   std::size_t history_rebuilds() const { return rebuilds_; }
   /// How the last insert_points split its work between serial and parallel insertion.
@@ -269,6 +315,7 @@ class Triangulation {
   // on the hot path of refinement and extraction).
  private:
   friend struct TriangulationTestAccess;  // tests only: corrupts the structure to show the validators fail
+  friend class PropertyMapBase;           // registers and unregisters itself in maps_
   // Internal point ids (PointId) index pos_, whose entries never change once written, because dead
   // tetrahedra of the history refer to them. A moved vertex gets a new PointId and keeps its VertexId;
   // until the first move the two numberings coincide and the translation tables are empty.
@@ -395,6 +442,11 @@ class Triangulation {
                       InsertResult& result);
   InsertResult move_by_reinsertion(VertexId v, const Point3& p, TetId start, MoveState& m,
                                    ChangeSet* changes);
+  // property maps (property_map.cpp): to the capacities at the end of every operation that may grow them
+  void sync_maps() const {
+    if (!maps_.empty()) maps_.grow();
+  }
+  void renumber_maps(const std::vector<TetId>& old_to_new) const { maps_.renumber(old_to_new); }
   // history.cpp
   void record_op(TetId first, std::uint32_t count, PointId apex);
   bool maybe_rebuild();
@@ -427,6 +479,10 @@ class Triangulation {
   detail::VertexGrid grid_;           // location hints: the last vertex inserted in each cell
   Store root_;                        // the 8-corner triangulation, for reset_to_corners()
   std::unique_ptr<Scratch> scratch_;  // work buffers, never shared between copies
+  // The registered property maps. Last member: its copy and move run after the content's (see
+  // detail::MapRegistry). Grown by sync_maps() at the end of each modifying operation, permuted or reset
+  // where tetrahedra are renumbered (rebuild_history, canonicalize), reset by clear() and assignment.
+  detail::MapRegistry maps_;
 };
 
 }  // namespace vitri

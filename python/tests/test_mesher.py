@@ -1,0 +1,123 @@
+"""vitri.Mesher: construction from every input, refinement and levels, meshes, deltas, edits equal to
+fresh fits, stats."""
+import numpy as np
+import pytest
+
+import vitri
+from conftest import assert_closed_manifold, euler_characteristic, sphere_constraints, sphere_points
+
+
+def test_from_constraints_levels():
+    pts, vals = sphere_constraints(150)
+    m = vitri.Mesher(pts, vals)
+    assert len(m) == len(pts) and m.function == "global"
+    m.refine(0.1, relative=True)
+    coarse = m.mesh()
+    m.refine(0.04 * m.diagonal)  # absolute; continues the same structure
+    fine = m.mesh()
+    assert len(fine.vertices) > len(coarse.vertices)
+    for V, F, _ in (coarse, fine):
+        assert_closed_manifold(V, F)
+        assert euler_characteristic(V, F) == 2
+    s = m.stats()
+    assert s["constraints"] == len(pts) and s["precision"] == pytest.approx(0.04 * m.diagonal)
+
+
+@pytest.mark.parametrize("make", [
+    lambda p, n: vitri.Mesher.from_oriented_points(p, n),
+    lambda p, n: vitri.Mesher.from_points(p),
+    lambda p, n: vitri.Mesher.from_scan(p),
+    lambda p, n: vitri.Mesher.from_scan(p, n, surface="closed"),
+])
+def test_point_constructors(make):
+    p, n = sphere_points(400)
+    m = make(p, n)
+    m.refine(0.06, relative=True)
+    V, F, _ = m.mesh()
+    assert euler_characteristic(V, F) == 2
+
+
+def test_from_mesh():
+    sphere = vitri.reconstruct(sphere_points(300)[0], precision=0.1)
+    m = vitri.Mesher.from_mesh(sphere.vertices, sphere.faces)
+    m.refine(0.08, relative=True)
+    V, F, _ = m.mesh()
+    assert euler_characteristic(V, F) == 2
+
+
+def test_edits_equal_a_fresh_fit():
+    pts, vals = sphere_constraints(100)
+    m = vitri.Mesher(pts, vals, function="global")
+    m.refine(0.08, relative=True)
+    i = m.add([0.0, 0.0, 1.3], 0.0)  # a bump on top
+    m.move(5, pts[5] * 1.05)
+    m.set_value(2, 0.01)
+    m.remove(40)
+    cp, cv = m.constraints()
+    fresh = vitri.Rbf(cp, cv)
+    q = np.random.default_rng(0).uniform(-1.2, 1.2, size=(100, 3))
+    assert np.max(np.abs(m.value(q) - fresh(q))) < 1e-6
+    assert i == len(pts)
+    V, F, _ = m.mesh()
+    assert_closed_manifold(V, F)
+    assert np.max(V[:, 2]) > 1.2  # the bump is in the mesh
+    # the same surface as a fresh Mesher of the edited constraints, to the precision
+    other = vitri.Mesher(cp, cv)
+    other.refine(0.08, relative=True)
+    W = other.mesh().vertices
+    assert abs(np.max(W[:, 2]) - np.max(V[:, 2])) < 0.08 * m.diagonal
+
+
+def test_update_surface_deltas_rebuild_the_mesh():
+    pts, vals = sphere_constraints(100)
+    m = vitri.Mesher(pts, vals)
+    m.refine(0.08, relative=True)
+    tris, verts = {}, {}
+
+    def apply(d):
+        if d["full"]:
+            tris.clear()
+            verts.clear()
+        for t in d["removed_triangles"]:
+            del tris[int(t)]
+        for v in d["removed_vertices"]:
+            del verts[int(v)]
+        changed = np.concatenate([d["added_vertices"], d["moved_vertices"]])
+        for v, x in zip(changed, d["changed_vertex_positions"]):
+            verts[int(v)] = tuple(x)
+        for t, c in zip(d["added_triangles"], d["added_triangle_vertices"]):
+            tris[int(t)] = tuple(int(v) for v in c)
+
+    first = m.update_surface()
+    assert first["full"]
+    apply(first)
+    m.move(3, pts[3] * 1.2)
+    apply(m.update_surface())
+    V, F, _ = m.mesh()
+    assert len(tris) == len(F) and len(verts) == len(V)
+    mine = sorted(tuple(sorted(verts[v] for v in t)) for t in tris.values())
+    ref = sorted(tuple(sorted(map(tuple, V[list(f)]))) for f in F)
+    assert mine == ref
+
+
+def test_quality_mesher_and_restart():
+    pts, vals = sphere_constraints(100)
+    m = vitri.Mesher(pts, vals, min_angle=20)
+    m.refine(0.1, relative=True)
+    V, F, _ = m.mesh()
+    assert_closed_manifold(V, F)
+    m.restart()
+    assert m.precision == float("inf")
+    m.refine(0.1, relative=True)
+    assert len(m.mesh().faces) > 0
+
+
+def test_edit_errors():
+    pts, vals = sphere_constraints(50)
+    m = vitri.Mesher(pts, vals)
+    with pytest.raises(vitri.InvalidPoint):
+        m.move(10**6, [0, 0, 0])
+    with pytest.raises(vitri.InvalidPoint):
+        m.add(pts[0], 0.0)  # a duplicate
+    with pytest.raises(vitri.InvalidArgument):
+        m.refine(-1)

@@ -1,0 +1,125 @@
+"""vitri.reconstruct and vitri.mesh_constraints: closed meshes of the right topology, the CLI's result,
+levels, the array conventions (dtype, memory order, views)."""
+import os
+import subprocess
+
+import numpy as np
+import pytest
+
+import vitri
+from conftest import (assert_closed_manifold, euler_characteristic, signed_volume, sphere_constraints,
+                      sphere_points)
+
+
+def test_version():
+    assert isinstance(vitri.__version__, str) and vitri.__version__.count(".") == 2
+
+
+def test_sphere_scan_is_a_closed_sphere():
+    p, _ = sphere_points(800)
+    mesh = vitri.reconstruct(p)
+    V, F, N = mesh
+    assert V.dtype == np.float64 and V.shape[1] == 3 and F.dtype == np.uint32 and N.shape == V.shape
+    assert_closed_manifold(V, F)
+    assert euler_characteristic(V, F) == 2
+    assert signed_volume(V, F) > 0  # counter-clockwise seen from outside
+    r = np.linalg.norm(V, axis=1)
+    assert np.all(np.abs(r - 1.0) < 0.05)
+    assert np.allclose(np.linalg.norm(N, axis=1), 1.0)
+    assert np.all(np.einsum("ij,ij->i", N, V) > 0)  # outward normals
+
+
+def test_outputs_own_their_memory():
+    p, _ = sphere_points(300)
+    V, F, N = vitri.reconstruct(p, precision=0.1)
+    for a in (V, F, N):
+        assert a.base is not None and a.flags.c_contiguous  # a view of the library's vector, no copy
+        a[0] = a[0]  # writeable
+
+
+def test_with_normals_and_options():
+    p, n = sphere_points(600)
+    V, F, _ = vitri.reconstruct(p, n, precision=0.05, function="global", threads=1, surface="closed")
+    assert_closed_manifold(V, F)
+    assert euler_characteristic(V, F) == 2
+
+
+def test_levels_of_detail():
+    p, n = sphere_points(500)
+    meshes = vitri.reconstruct(p, n, precision=[0.1, 0.02])
+    assert isinstance(meshes, list) and len(meshes) == 2
+    assert len(meshes[1].vertices) > len(meshes[0].vertices)
+    for V, F, _ in meshes:
+        assert euler_characteristic(V, F) == 2
+
+
+def test_quality_mode():
+    p, n = sphere_points(400)
+    V, F, _ = vitri.reconstruct(p, n, precision=0.08, min_angle=25)
+    assert_closed_manifold(V, F)
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+
+    def angle(u, v):
+        return np.degrees(np.arccos(np.clip(np.einsum("ij,ij->i", u, v) /
+                                            (np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1)), -1, 1)))
+    smallest = np.minimum(np.minimum(angle(b - a, c - a), angle(a - b, c - b)), angle(a - c, b - c))
+    assert smallest.min() >= 25 - 1e-6
+
+
+def test_dtypes_and_memory_orders_give_the_same_mesh():
+    p, _ = sphere_points(400)
+    ref = vitri.reconstruct(p, precision=0.08, threads=1)
+    big = np.zeros((800, 6))
+    big[::2, 1:4] = p  # a strided view: neither C nor Fortran contiguous
+    for variant in (np.asfortranarray(p), big[::2, 1:4], p.tolist()):
+        m = vitri.reconstruct(variant, precision=0.08, threads=1)
+        assert np.array_equal(m.vertices, ref.vertices) and np.array_equal(m.faces, ref.faces)
+    m32 = vitri.reconstruct(p.astype(np.float32), precision=0.08, threads=1)
+    assert euler_characteristic(m32.vertices, m32.faces) == 2
+
+
+def test_mesh_constraints():
+    pts, vals = sphere_constraints(200)
+    V, F, N = vitri.mesh_constraints(pts, vals, precision=0.05)
+    assert_closed_manifold(V, F)
+    assert euler_characteristic(V, F) == 2
+    assert np.all(np.abs(np.linalg.norm(V, axis=1) - 1) < 0.05)
+
+
+def test_same_mesh_as_the_cli(cli, tmp_path):
+    p, n = sphere_points(700)
+    src = tmp_path / "sphere.xyz"
+    np.savetxt(src, np.hstack([p, n]), fmt="%.17g")
+    out = tmp_path / "out.ply"
+    subprocess.run([cli, "mesh", str(src), "-o", str(out), "-q", "--threads", "1", "--precision", "0.04"], check=True)
+    cli_mesh = vitri.read(str(out))
+    read = vitri.read(str(src))  # the same points as the CLI read them
+    mine = vitri.reconstruct(read.points, read.normals, precision=0.04, threads=1)
+    assert np.array_equal(mine.faces, cli_mesh.faces)
+    assert np.allclose(mine.vertices, cli_mesh.vertices, rtol=0, atol=1e-6)  # binary PLY stores floats
+
+
+def test_same_mesh_as_the_cli_constraints(cli, tmp_path):
+    pts, vals = sphere_constraints(150)
+    src = tmp_path / "c.xyzv"
+    vitri.write(str(src), type("C", (), {"points": pts, "values": vals})())
+    out = tmp_path / "out.obj"
+    subprocess.run([cli, "mesh", str(src), "-o", str(out), "-q", "--threads", "1"], check=True)
+    cli_mesh = vitri.read(str(out))
+    mine = vitri.mesh_constraints(pts, vals, threads=1)
+    assert np.array_equal(mine.faces, cli_mesh.faces)
+    assert np.allclose(mine.vertices, cli_mesh.vertices, rtol=0, atol=1e-12)
+
+
+def test_unknown_and_bad_options():
+    p, _ = sphere_points(100)
+    with pytest.raises(TypeError, match="precsion"):
+        vitri.reconstruct(p, precsion=0.1)
+    with pytest.raises(vitri.InvalidArgument, match="precision"):
+        vitri.reconstruct(p, precision=-1)
+    with pytest.raises(ValueError, match="coarse to fine"):
+        vitri.reconstruct(p, precision=[0.05, 0.1])
+    with pytest.raises(vitri.InvalidArgument, match="function"):
+        vitri.reconstruct(p, function="spline")
+    with pytest.raises(vitri.LimitError):
+        vitri.reconstruct(p, precision=0.001, max_vertices=2000)

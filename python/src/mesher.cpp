@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <thread>
+#include <type_traits>
 
 namespace vitri::python {
 namespace {
@@ -285,6 +286,16 @@ py::object mesh_constraints(py::handle points, py::handle values, const py::kwar
 }
 
 // ---- vitri.Mesher -------------------------------------------------------------------------------------------
+/// The type the Mesher's edits name a constraint by: an index (std::size_t) in the library of this
+/// writing, a stable ConstraintId once that lands; the bindings follow whichever the header declares.
+template <class T>
+struct FirstArgument;
+template <class C, class R, class A, class... Rest>
+struct FirstArgument<R (C::*)(A, Rest...)> {
+  using type = std::decay_t<A>;
+};
+using EditId = FirstArgument<decltype(&Mesher::move_constraint)>::type;
+
 struct PyMesher {
   std::unique_ptr<Mesher> mesher;
   Options options;
@@ -497,15 +508,15 @@ Options as reconstruct() (those of point inputs do not apply).)");
            py::arg("point"), py::arg("value"),
            "Adds the constraint f(point) = value and updates the mesh; returns its id (its index: len - 1).")
       .def("move",
-           [](PyMesher& s, std::size_t id, py::handle p) {
+           [](PyMesher& s, EditId id, py::handle p) {
              const Point3 q = point_arg(p, "point");
              without_gil(*s.mutex, [&] { s.mesher->move_constraint(id, q); });
            },
            py::arg("id"), py::arg("point"), "Moves a constraint (keeps its value) and updates the mesh.")
-      .def("remove", [](PyMesher& s, std::size_t id) { without_gil(*s.mutex, [&] { s.mesher->remove_constraint(id); }); },
+      .def("remove", [](PyMesher& s, EditId id) { without_gil(*s.mutex, [&] { s.mesher->remove_constraint(id); }); },
            py::arg("id"), "Removes a constraint (later indices shift down by one) and updates the mesh.")
       .def("set_value",
-           [](PyMesher& s, std::size_t id, double value) {
+           [](PyMesher& s, EditId id, double value) {
              without_gil(*s.mutex, [&] { s.mesher->set_value(id, value); });
            },
            py::arg("id"), py::arg("value"), "Changes a constraint's value and updates the mesh.")

@@ -62,13 +62,23 @@ const char* const kUsage =
     "                       resolution, max(spacing, 2 x noise), and a budget of Delaunay vertices\n"
     "                       (12 per point): beyond it a coarser mesh with a warning.\n"
     "  --edits SCRIPT       after the last level, replay edits, one per line (# comments allowed):\n"
-    "                         add X Y Z V      add the constraint f(X, Y, Z) = V\n"
-    "                         move I X Y Z     move constraint I (0-based, see below) to (X, Y, Z)\n"
-    "                         remove I         remove constraint I (later indices shift down by one)\n"
+    "                         add X Y Z V      add the constraint f(X, Y, Z) = V; it gets the next id\n"
+    "                                          (printed in its row: the first add gets the count of\n"
+    "                                          constraints as fitted, each later add one more)\n"
+    "                         move I X Y Z     move constraint I (a stable id, see below) to (X, Y, Z)\n"
+    "                         remove I         remove constraint I (no other id changes)\n"
     "                         value I V        set the value of constraint I to V\n"
     "                         write PATH       write the current mesh\n"
-    "                       and print the update time of each edit. Indices I refer to the constraints\n"
-    "                       as fitted: for .xyzv input, the file's lines; for oriented points or a mesh,\n"
+    "                       and print the update time of each edit. Ids I are stable: the constraints\n"
+    "                       as fitted have ids 0..n-1 in their order, an id names its constraint until\n"
+    "                       it is removed and is never given again, and a removal changes no other id\n"
+    "                       (after 'remove 3', id 4 is still the same constraint). Until 2026-11, I was\n"
+    "                       an index that 'remove' shifted down: such a script renumbers each I to the\n"
+    "                       id of the (I+1)-th constraint still there, i.e. I plus the number of\n"
+    "                       constraints removed earlier whose id is below the result; scripts whose\n"
+    "                       removals come last, or that name only ids below every removed one, are\n"
+    "                       unchanged. The order of the constraints as fitted:\n"
+    "                       for .xyzv input, the file's lines; for oriented points or a mesh,\n"
     "                       the generated constraints (the count is printed first): the surface points\n"
     "                       first (f = 0; input order after merging exact duplicates, a mesh's\n"
     "                       unreferenced vertices skipped), then the off-surface ones, per kept point in\n"
@@ -126,7 +136,8 @@ const char* const kUsage =
     "Prints, per level: vertices, triangles, refinement and extraction times, and the running total\n"
     "(the paper's Table 1); then the seconds of every phase, the total wall time and the peak memory.\n"
     "Without --edits the Delaunay history is not kept (a batch run: an equivalent mesh in well under\n"
-    "half the memory). A bad edit line is reported with its line number; index I out of range is bad input.\n"
+    "half the memory). A bad edit line is reported with its line number; an id I that names no constraint\n"
+    "(never given, or removed) is bad input.\n"
     "Exit status: 0 ok, 1 bad input (unreadable or malformed file, bad edit line, singular fit),\n"
     "2 usage error (unknown option, missing or bad argument, e.g. a precision <= 0 or NaN, or\n"
     "precisions not strictly decreasing),\n"
@@ -602,25 +613,31 @@ int run_mesh(const Args& args) {
         continue;
       }
       const auto t0 = Clock::now();
+      // Constraints are named by their stable ids (Mesher::add_constraint and the others; help above).
+      auto known = [&](const std::string& text) {
+        if (!mesher.has_constraint(idx))
+          throw bad("no constraint with id " + text + " (never given, or removed; ids do not shift)");
+      };
+      std::string added;  // "(id N)" of an add, for its row
       if (op == "add") {
         if (tok.size() != 5 || !parse_double(tok[1], x[0]) || !parse_double(tok[2], x[1]) ||
             !parse_double(tok[3], x[2]) || !parse_double(tok[4], x[3]))
           throw bad("expected 'add X Y Z V'");
-        mesher.add_constraint({x[0], x[1], x[2]}, x[3]);
+        added = "(id " + std::to_string(mesher.add_constraint({x[0], x[1], x[2]}, x[3])) + ")";
       } else if (op == "move") {
         if (tok.size() != 5 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]) ||
             !parse_double(tok[3], x[1]) || !parse_double(tok[4], x[2]))
           throw bad("expected 'move I X Y Z'");
-        if (idx >= mesher.size()) throw bad("constraint index " + tok[1] + " out of range (" + std::to_string(mesher.size()) + " constraints)");
+        known(tok[1]);
         mesher.move_constraint(idx, {x[0], x[1], x[2]});
       } else if (op == "remove") {
         if (tok.size() != 2 || !parse_index(tok[1], idx)) throw bad("expected 'remove I'");
-        if (idx >= mesher.size()) throw bad("constraint index " + tok[1] + " out of range (" + std::to_string(mesher.size()) + " constraints)");
+        known(tok[1]);
         mesher.remove_constraint(idx);
       } else if (op == "value") {
         if (tok.size() != 3 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]))
           throw bad("expected 'value I V'");
-        if (idx >= mesher.size()) throw bad("constraint index " + tok[1] + " out of range (" + std::to_string(mesher.size()) + " constraints)");
+        known(tok[1]);
         mesher.set_value(idx, x[0]);
       } else {
         throw bad("unknown edit '" + op + "' (add, move, remove, value, write)");
@@ -630,8 +647,8 @@ int run_mesh(const Args& args) {
       const SurfaceMesh& m = mesher.surface();
       const double extract_ms = ms_since(t1);
       const MesherStats s = mesher.stats();
-      std::string text;
-      for (const auto& t : tok) text += (text.empty() ? "" : " ") + t;
+      std::string text = added.empty() ? op : op + " " + added;
+      for (std::size_t k = 1; k < tok.size(); ++k) text += " " + tok[k];
       if (text.size() > 28) text = text.substr(0, 25) + "...";
       if (!quiet)
         std::printf("%5zu %-28s %9zu %10zu %9.1f %9.1f %11.1f %9.1f\n", line, text.c_str(), m.vertices.size(),

@@ -50,20 +50,16 @@ Constraints constraints_for_function(Input in, const std::string& name, Constrai
   if (function == FunctionKind::Global) build.off_surface_spacing = 0.0;
   if (function != FunctionKind::Auto || in.kind == InputKind::Constraints || build.off_surface_spacing == 0.0) {
     Constraints c = constraints_of(std::move(in), name, build, &report);
-    if (function == FunctionKind::Auto)
-      function = c.size() > auto_local_above ? FunctionKind::Local : FunctionKind::Global;
+    function = choose_function(function, c.size(), auto_local_above);
     return c;
   }
   // A global choice needs at most auto_local_above constraints, hence as many surface points after the
   // merge: keep a copy of a small input to build them again without the spacing.
   std::optional<Input> copy;
-  if (input_points(in) <= auto_local_above) copy = in;
+  if (choose_function(function, input_points(in), auto_local_above) == FunctionKind::Global) copy = in;
   Constraints c = constraints_of(std::move(in), name, build, &report);
-  if (c.size() + report.spaced_out > auto_local_above) {
-    function = FunctionKind::Local;
-    return c;
-  }
-  function = FunctionKind::Global;
+  function = choose_function(function, c.size() + report.spaced_out, auto_local_above);
+  if (function == FunctionKind::Local) return c;
   build.off_surface_spacing = 0.0;
   return constraints_of(copy ? std::move(*copy) : read_input(name), name, build, &report);
 }

@@ -31,9 +31,7 @@ Session::Session(Constraints constraints, std::string name, const SessionOptions
 
 void Session::load(Constraints constraints, std::string name) {
   if (constraints.size() == 0) throw InvalidArgument(name + ": no constraints");
-  const bool local = options_.mesher.function == FunctionKind::Local ||
-                     (options_.mesher.function == FunctionKind::Auto &&
-                      constraints.size() > options_.mesher.auto_local_above);
+  const bool local = choose_function(constraints.size(), options_.mesher) == FunctionKind::Local;
   const std::size_t limit = local ? options_.max_local_constraints : options_.max_constraints;
   if (constraints.size() > limit)
     throw LimitError(name + ": " + std::to_string(constraints.size()) +
@@ -46,8 +44,14 @@ void Session::load(Constraints constraints, std::string name) {
   behind_.clear();
   showing_preview_ = switched_ = preview_wanted_ = false;
   name_ = std::move(name);
-  ids_.resize(mesher_->size());
-  for (auto& id : ids_) id = next_id_++;
+  // The Mesher's ids of a new model are 0..n-1.
+  mesher_id_.clear();
+  studio_id_.resize(mesher_->size());
+  for (std::size_t k = 0; k < studio_id_.size(); ++k) {
+    studio_id_[k] = next_id_++;
+    mesher_id_.emplace(studio_id_[k], k);
+  }
+  ranks_.reset(studio_id_.size());
   undo_.clear();
   redo_.clear();
   log_.clear();
@@ -62,17 +66,17 @@ void Session::load(Constraints constraints, std::string name) {
 }
 
 // ---------------------------------------------------------------------------------------------- edits
-std::size_t Session::checked_index(std::size_t index) const {
-  if (index >= ids_.size())
-    throw InvalidArgument("constraint index " + std::to_string(index) + " out of range (" +
-                          std::to_string(ids_.size()) + " constraints)");
-  return index;
+std::uint64_t Session::id_at(std::size_t index) const {
+  if (index >= size())
+    throw InvalidArgument("constraint index " + std::to_string(index) + " out of range (" + std::to_string(size()) +
+                          " constraints)");
+  return studio_id_[ranks_.select(index)];
 }
 
-std::size_t Session::index_of(std::uint64_t id) const {
-  const auto it = std::find(ids_.begin(), ids_.end(), id);
-  if (it == ids_.end()) throw InvalidArgument("no constraint with id " + std::to_string(id));  // not reached
-  return static_cast<std::size_t>(it - ids_.begin());
+ConstraintId Session::mesher_id(std::uint64_t id) const {
+  const auto it = mesher_id_.find(id);
+  if (it == mesher_id_.end()) throw InvalidArgument("no constraint with id " + std::to_string(id));  // not reached
+  return it->second;
 }
 
 void Session::check_position(const Point3& p) const {
@@ -97,47 +101,57 @@ Edit Session::apply(const Edit& e, bool dragging) {
   if (!preview_) building_.reset();  // its function would differ from the target's after this edit
   Lag lag{e.op, 0, e.position, e.value};
   switch (e.op) {
-    case Edit::Op::Add:
-      if (ids_.size() >= (m.local_function() ? options_.max_local_constraints : options_.max_constraints))
-        throw LimitError("the studio holds at most " + std::to_string(ids_.size()) +
-                         " constraints with this function");
+    case Edit::Op::Add: {
+      if (size() >= (m.local_function() ? options_.max_local_constraints : options_.max_constraints))
+        throw LimitError("the studio holds at most " + std::to_string(size()) + " constraints with this function");
       check_position(e.position);
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
-      timed_edit([&] { m.add_constraint(e.position, e.value); });
-      lag.index = ids_.size();
-      ids_.push_back(e.id);
-      log_change(ConstraintChange::Op::Add, info(ids_.size() - 1));
+      ConstraintId added = 0;
+      timed_edit([&] { added = m.add_constraint(e.position, e.value); });
+      lag.id = added;
+      // Mesher ids are given in turn: the new one is the next slot of ranks_.
+      if (studio_id_.size() <= added) studio_id_.resize(added + 1, 0);
+      studio_id_[added] = e.id;
+      mesher_id_[e.id] = added;
+      while (ranks_.slots() < added) {  // ids the Mesher gave out elsewhere (none today): dead here
+        ranks_.push_back_alive();
+        ranks_.set_dead(ranks_.slots() - 1);
+      }
+      ranks_.push_back_alive();
+      log_change(ConstraintChange::Op::Add, info(added));
       inverse.op = Edit::Op::Remove;
       break;
+    }
     case Edit::Op::Remove: {
-      if (ids_.size() <= 1) throw InvalidArgument("cannot remove the last constraint");
-      const std::size_t i = lag.index = index_of(e.id);
+      if (size() <= 1) throw InvalidArgument("cannot remove the last constraint");
+      const ConstraintId id = lag.id = mesher_id(e.id);
       inverse.op = Edit::Op::Add;
-      inverse.position = m.constraints().points[i];
-      inverse.value = m.constraints().values[i];
-      const ConstraintInfo gone = info(i);
-      timed_edit([&] { m.remove_constraint(i); });
-      ids_.erase(ids_.begin() + static_cast<std::ptrdiff_t>(i));
+      inverse.position = m.constraint_point(id);
+      inverse.value = m.constraint_value(id);
+      const ConstraintInfo gone = info(id);
+      timed_edit([&] { m.remove_constraint(id); });
+      ranks_.set_dead(id);
+      mesher_id_.erase(e.id);
       log_change(ConstraintChange::Op::Remove, gone);
       break;
     }
     case Edit::Op::Move: {
       check_position(e.position);
-      const std::size_t i = lag.index = index_of(e.id);
-      inverse.position = m.constraints().points[i];
+      const ConstraintId id = lag.id = mesher_id(e.id);
+      inverse.position = m.constraint_point(id);
       timed_edit([&] {
         if (dragging && !preview_) drop_to_drag_level();  // validated first: a refused move keeps the level
-        m.move_constraint(i, e.position);
+        m.move_constraint(id, e.position);
       });
-      log_change(ConstraintChange::Op::Update, info(i));
+      log_change(ConstraintChange::Op::Update, info(id));
       break;
     }
     case Edit::Op::SetValue: {
       if (!std::isfinite(e.value)) throw InvalidArgument("constraint value must be finite");
-      const std::size_t i = lag.index = index_of(e.id);
-      inverse.value = m.constraints().values[i];
-      timed_edit([&] { m.set_value(i, e.value); });
-      log_change(ConstraintChange::Op::Update, info(i));
+      const ConstraintId id = lag.id = mesher_id(e.id);
+      inverse.value = m.constraint_value(id);
+      timed_edit([&] { m.set_value(id, e.value); });
+      log_change(ConstraintChange::Op::Update, info(id));
       break;
     }
   }
@@ -149,7 +163,7 @@ Edit Session::apply(const Edit& e, bool dragging) {
 // the next refine_step(). Consecutive moves of one constraint (a drag) replay as one.
 void Session::landed(const Lag& lag) {
   if (lag.op == Edit::Op::Move && !behind_.empty() && behind_.back().op == Edit::Op::Move &&
-      behind_.back().index == lag.index)
+      behind_.back().id == lag.id)
     behind_.back().position = lag.position;
   else
     behind_.push_back(lag);
@@ -157,9 +171,9 @@ void Session::landed(const Lag& lag) {
   showing_preview_ = true;
 }
 
-ConstraintInfo Session::info(std::size_t index) const {
-  const Constraints& c = latest_constraints();
-  return {index, ids_[index], c.points[index], c.values[index]};
+ConstraintInfo Session::info(ConstraintId id) const {
+  const Mesher& m = latest();
+  return {ranks_.rank(id), studio_id_[id], m.constraint_point(id), m.constraint_value(id)};
 }
 
 void Session::log_change(ConstraintChange::Op op, const ConstraintInfo& c) {
@@ -181,13 +195,13 @@ std::size_t Session::add(const Point3& p, double value) {
   e.value = value;
   record(apply(e));
   ++next_id_;
-  return ids_.size() - 1;
+  return size() - 1;
 }
 
 void Session::move(std::size_t index, const Point3& p, bool merge) {
   Edit e;
   e.op = Edit::Op::Move;
-  e.id = ids_[checked_index(index)];
+  e.id = id_at(index);
   e.position = p;
   const bool joins = merge && !undo_.empty() && undo_.back().op == Edit::Op::Move && undo_.back().id == e.id;
   const Edit inverse = apply(e, joins);
@@ -222,9 +236,9 @@ void Session::catch_up() {
   try {
     for (const Lag& l : behind_) switch (l.op) {
         case Edit::Op::Add: mesher_->add_constraint(l.position, l.value); break;
-        case Edit::Op::Remove: mesher_->remove_constraint(l.index); break;
-        case Edit::Op::Move: mesher_->move_constraint(l.index, l.position); break;
-        case Edit::Op::SetValue: mesher_->set_value(l.index, l.value); break;
+        case Edit::Op::Remove: mesher_->remove_constraint(l.id); break;
+        case Edit::Op::Move: mesher_->move_constraint(l.id, l.position); break;
+        case Edit::Op::SetValue: mesher_->set_value(l.id, l.value); break;
       }
     behind_.clear();
     return;
@@ -281,14 +295,14 @@ void Session::build_preview(const KeepGoing& keep_going) {
 void Session::remove(std::size_t index) {
   Edit e;
   e.op = Edit::Op::Remove;
-  e.id = ids_[checked_index(index)];
+  e.id = id_at(index);
   record(apply(e));
 }
 
 void Session::set_value(std::size_t index, double value) {
   Edit e;
   e.op = Edit::Op::SetValue;
-  e.id = ids_[checked_index(index)];
+  e.id = id_at(index);
   e.value = value;
   record(apply(e));
 }
@@ -385,10 +399,12 @@ ClientDelta Session::delta(std::uint32_t since, bool exact) {
 }
 
 std::vector<ConstraintInfo> Session::constraints() const {
-  const Constraints& c = latest_constraints();
+  const Mesher& m = latest();
+  const Constraints& c = m.constraints();
+  const std::vector<ConstraintId> ids = m.constraint_ids();  // the same order
   std::vector<ConstraintInfo> out;
   out.reserve(c.size());
-  for (std::size_t i = 0; i < c.size(); ++i) out.push_back(info(i));
+  for (std::size_t i = 0; i < c.size(); ++i) out.push_back({i, studio_id_[ids[i]], c.points[i], c.values[i]});
   return out;
 }
 

@@ -1,9 +1,15 @@
 #pragma once
 // The studio's model: one vitri::Mesher, the constraints with stable ids, undo/redo, the target
 // precision and its progressive refinement, and the delta tracker of the mesh the page holds.
+// Three numberings meet here: the Mesher's constraint ids (stable until removal, never reused), the
+// studio's ids (the API's "id": stable across undo and redo, which give a removed constraint back under
+// a new Mesher id), and the API's indices (positions in the page's list, which a removal shifts: the
+// wire format). Each edit maps between them in O(1) (hash map, table by Mesher id) or O(log n) (the
+// index: a Fenwick tree over the Mesher ids, SlotRanks).
 // Not thread-safe: the server serializes every call (docs/studio.md).
 #include "delta.hpp"
 
+#include "vitri/core/slot_ranks.hpp"
 #include "vitri/mesher.hpp"
 
 #include <cstdint>
@@ -11,6 +17,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 namespace vitri::studio {
@@ -152,7 +159,7 @@ class Session {
   std::uint64_t constraint_version() const { return constraint_version_; }
   /// The constraint changes from version `since` to now (incremental when the log reaches back to it).
   ConstraintDelta constraint_delta(std::uint64_t since) const;
-  std::size_t size() const { return ids_.size(); }
+  std::size_t size() const { return latest().size(); }
   const std::string& name() const { return name_; }
   /// The Mesher whose mesh is shown; it holds every edit (the target mesh may lag behind the preview).
   Mesher& mesher() { return showing_preview_ ? *preview_ : *mesher_; }
@@ -166,27 +173,31 @@ class Session {
   /// `dragging`: a merged move of a drag, which may first drop the mesh to the drag level.
   Edit apply(const Edit& e, bool dragging = false);
   void record(Edit inverse);
-  std::size_t index_of(std::uint64_t id) const;
-  std::size_t checked_index(std::size_t index) const;
+  /// The Mesher id of a studio id (an id the undo stacks hold is always live when applied).
+  ConstraintId mesher_id(std::uint64_t id) const;
+  /// The studio id of the constraint at `index` of the page's list. @throws InvalidArgument out of range.
+  std::uint64_t id_at(std::size_t index) const;
   void check_position(const Point3& p) const;
   void start(Constraints constraints);
   void timed_edit(const std::function<void()>& op);
   void drop_to_drag_level();
-  /// One edit as the target mesh replays it (in the index space of the moment it was made).
+  /// One edit as the target mesh replays it, on a Mesher id (the preview and the target mesh give the
+  /// same ids: the same edits in the same order).
   struct Lag {
     Edit::Op op = Edit::Op::Add;
-    std::size_t index = 0;
+    ConstraintId id = 0;
     Point3 position;
     double value = 0;
   };
   /// The Mesher an edit lands on (the preview when there is one) and what it keeps for the replay.
   Mesher& edited() { return preview_ ? *preview_ : *mesher_; }
-  const Constraints& latest_constraints() const { return (preview_ ? *preview_ : *mesher_).constraints(); }
+  const Mesher& latest() const { return preview_ ? *preview_ : *mesher_; }
   void landed(const Lag& lag);
   void catch_up();
   void build_preview(const KeepGoing& keep_going);
   void drop_preview();
-  ConstraintInfo info(std::size_t index) const;
+  /// The API's view of the constraint with this Mesher id (its index from ranks_).
+  ConstraintInfo info(ConstraintId id) const;
   void log_change(ConstraintChange::Op op, const ConstraintInfo& c);
 
   SessionOptions options_;
@@ -199,7 +210,9 @@ class Session {
   bool switched_ = false;            // the shown Mesher changed: the next delta is its whole mesh
   bool preview_wanted_ = false;      // mesher_ is at the target and big enough; preview_ not built yet
   double preview_level_ = 0;
-  std::vector<std::uint64_t> ids_;  // stable id of constraint i
+  std::unordered_map<std::uint64_t, ConstraintId> mesher_id_;  // studio id -> Mesher id, live ones
+  std::vector<std::uint64_t> studio_id_;  // Mesher id -> studio id (entries of removed ids unused)
+  SlotRanks ranks_;                       // over Mesher ids: the live ones, for the API's indices
   std::uint64_t next_id_ = 1;
   std::vector<Edit> undo_, redo_;  // inverses to apply
   double unit_ = 1, target_ = 0.02, level_ = 0;  // level_: precision mesher_ has reached

@@ -113,21 +113,24 @@ void BM_Edit(benchmark::State& state) {
   std::mt19937 rng(9);
   std::uniform_real_distribution<double> u(-0.3, 0.3);
   const int kind = static_cast<int>(state.range(0));
+  std::vector<vitri::ConstraintId> ids = f.constraint_ids();  // stable ids (a re-added one gets a new id)
   for (auto _ : state) {
-    const std::size_t i = rng() % f.size();
-    const vitri::Point3 p = f.constraints().points[i] + vitri::Point3{u(rng), u(rng), u(rng)} * 0.01;
+    const std::size_t k = rng() % ids.size();
+    const vitri::Point3 p = f.point(ids[k]) + vitri::Point3{u(rng), u(rng), u(rng)} * 0.01;
     if (kind == 0) {
+      const vitri::ConstraintId added = f.next_id();
       f.add_constraint(p, 0.0);
       state.PauseTiming();
-      f.remove_constraint(f.size() - 1);
+      f.remove_constraint(added);
       state.ResumeTiming();
     } else if (kind == 1) {
-      f.move_constraint(i, p);
+      f.move_constraint(ids[k], p);
     } else {
-      const vitri::Point3 old = f.constraints().points[i];
-      const double v = f.constraints().values[i];
-      f.remove_constraint(i);
+      const vitri::Point3 old = f.point(ids[k]);
+      const double v = f.value_of(ids[k]);
+      f.remove_constraint(ids[k]);
       state.PauseTiming();
+      ids[k] = f.next_id();
       f.add_constraint(old, v);
       state.ResumeTiming();
     }

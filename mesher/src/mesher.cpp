@@ -49,16 +49,15 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
   if (!(options_.garbage_fraction >= 0.0) || !std::isfinite(options_.garbage_fraction))
     throw InvalidArgument("MesherOptions::garbage_fraction must be >= 0");
   QualityMesher::validate(options_.quality);
-  const bool local = options_.function == FunctionKind::Local ||
-                     (options_.function == FunctionKind::Auto && constraints.size() > options_.auto_local_above);
-  if (local) {
+  if (choose_function(constraints.size(), options_) == FunctionKind::Local) {
     fit_local_beside_seeds(constraints);
     return;
   }
   if (options_.on_phase) options_.on_phase("fit");
   const double t0 = now_seconds();
-  rbf_ = std::make_unique<Rbf>();
-  rbf_->fit(constraints, options_.rbf);
+  auto rbf = std::make_unique<Rbf>();
+  rbf->fit(constraints, options_.rbf);
+  function_ = std::move(rbf);
   stats_.fit_seconds = now_seconds() - t0;
   if (options_.on_phase) options_.on_phase("tetrahedralization");
   build();
@@ -73,13 +72,13 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
 // the two ran in turn.
 void Mesher::fit_local_beside_seeds(const Constraints& constraints) {
   if (options_.on_phase) options_.on_phase("fit+seeds");
-  local_ = std::make_unique<LocalRbf>();
+  auto local = std::make_unique<LocalRbf>();
   std::exception_ptr fit_error;
   double fit_seconds = 0;
   std::thread fit([&] {
     const double t0 = now_seconds();
     try {
-      local_->fit(constraints, options_.local);
+      local->fit(constraints, options_.local);
     } catch (...) {
       fit_error = std::current_exception();
     }
@@ -97,24 +96,37 @@ void Mesher::fit_local_beside_seeds(const Constraints& constraints) {
   stats_.fit_seconds = fit_seconds;
   if (fit_error) std::rethrow_exception(fit_error);
   if (seeds_error) std::rethrow_exception(seeds_error);
+  function_ = std::move(local);
   if (options_.on_phase) options_.on_phase("tetrahedralization");
   build(std::move(*seeds));
 }
 
-const ImplicitFunction& Mesher::function() const {
-  if (rbf_) return *rbf_;
-  return *local_;
+FunctionKind choose_function(FunctionKind requested, std::size_t constraints, std::size_t auto_local_above) {
+  if (requested != FunctionKind::Auto) return requested;
+  return constraints > auto_local_above ? FunctionKind::Local : FunctionKind::Global;
 }
 
-const Constraints& Mesher::constraints() const { return rbf_ ? rbf_->constraints() : local_->constraints(); }
-
-std::size_t Mesher::size() const { return rbf_ ? rbf_->size() : local_->size(); }
-
-Point3 Mesher::constraints_point(std::size_t i) const {
-  return rbf_ ? rbf_->constraints().points[i] : local_->point(i);
+FunctionKind choose_function(std::size_t constraints, const MesherOptions& options) {
+  return choose_function(options.function, constraints, options.auto_local_above);
 }
 
-double Mesher::value_of(std::size_t i) const { return rbf_ ? rbf_->constraints().values[i] : local_->value_of(i); }
+const ImplicitFunction& Mesher::function() const { return *function_; }
+
+const Rbf* Mesher::global_function() const { return dynamic_cast<const Rbf*>(function_.get()); }
+
+const LocalRbf* Mesher::local_function() const { return dynamic_cast<const LocalRbf*>(function_.get()); }
+
+const Constraints& Mesher::constraints() const { return function_->constraints(); }
+
+std::size_t Mesher::size() const { return function_->size(); }
+
+std::vector<ConstraintId> Mesher::constraint_ids() const { return function_->constraint_ids(); }
+
+bool Mesher::has_constraint(ConstraintId id) const { return function_->contains(id); }
+
+Point3 Mesher::constraint_point(ConstraintId id) const { return function_->point(id); }
+
+double Mesher::constraint_value(ConstraintId id) const { return function_->value_of(id); }
 
 Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                                    const MesherOptions& options) {
@@ -156,13 +168,12 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
   ConstraintBuildOptions build = o.constraint_build;
   ConstraintBuildReport built;
   Constraints c;
-  if (o.function == FunctionKind::Auto && prepared.points.size() > o.auto_local_above)
-    o.function = FunctionKind::Local;
+  if (choose_function(prepared.points.size(), o) == FunctionKind::Local) o.function = FunctionKind::Local;
   if (o.function != FunctionKind::Local) {
     build.off_surface_spacing = 0.0;
     c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &built);
     if (o.function == FunctionKind::Auto) {
-      o.function = c.size() > o.auto_local_above ? FunctionKind::Local : FunctionKind::Global;
+      o.function = choose_function(c.size(), o);
       if (o.function == FunctionKind::Local && o.constraint_build.off_surface_spacing > 0)
         c = constraints_from_oriented_points(prepared.points, prepared.normals, o.constraint_build, &built);
     }
@@ -196,29 +207,36 @@ void Mesher::build(SeedTetrahedralization&& seeds) {
   poly_ = std::make_unique<Polygonizer>(function(), std::move(seeds), c.values, options_.polygonizer);
   filter_ = std::make_unique<SupportFilter>();  // a new polygonizer: the next delta is full
   filter_precision_ = 0;
-  vertex_of_.assign(poly_->seed_vertices());
+  // The seeds come in the order of c, which is the order of the ids.
+  const std::vector<VertexId>& seed_of = poly_->seed_vertices();
+  const std::vector<ConstraintId> ids = function_->constraint_ids();
+  vertex_of_.assign(function_->next_id(), kNoVertex);
+  for (std::size_t k = 0; k < ids.size(); ++k) vertex_of_[ids[k]] = seed_of[k];
   // The on-surface constraints' vertices, in one balanced build (as many track_zero insertions before).
   std::vector<PointIndex::Id> zero_ids;
   std::vector<Point3> zero_points;
   for (std::size_t i = 0; i < c.size(); ++i)
-    if (vertex_of_[i] != kNoVertex && c.values[i] == 0) {
-      zero_ids.push_back(vertex_of_[i]);
+    if (seed_of[i] != kNoVertex && c.values[i] == 0) {
+      zero_ids.push_back(seed_of[i]);
       zero_points.push_back(c.points[i]);
     }
   zero_index_.build(zero_ids, zero_points, options_.polygonizer.threads);
   quality_.reset();
   mesh_valid_ = false;
-  if (local_) local_->release_constraints_cache();  // read once here; 32 bytes per constraint freed
+  if (const LocalRbf* local = local_function())
+    local->release_constraints_cache();  // read once here; 32 bytes per constraint freed
 }
 
 Mesher::Mesher(const Rbf& function, const MesherOptions& options)
-    : options_(options), rbf_(std::make_unique<Rbf>(function)), precision_(std::numeric_limits<double>::infinity()) {
+    : options_(options), function_(std::make_unique<Rbf>(function)),
+      precision_(std::numeric_limits<double>::infinity()) {
   build();
 }
 
 Mesher Mesher::restarted_copy() const {
-  if (!rbf_) throw InvalidArgument("Mesher::restarted_copy: the local function is not copied (global only)");
-  return Mesher(*rbf_, options_);
+  const Rbf* rbf = global_function();
+  if (!rbf) throw InvalidArgument("Mesher::restarted_copy: the local function is not copied (global only)");
+  return Mesher(*rbf, options_);
 }
 
 void Mesher::restart() {
@@ -226,12 +244,7 @@ void Mesher::restart() {
   precision_ = std::numeric_limits<double>::infinity();
 }
 
-double Mesher::diagonal() const {
-  if (local_) return local_->bounding_box().diagonal();
-  Box3 b;
-  for (const Point3& p : constraints().points) b.extend(p);
-  return b.diagonal();
-}
+double Mesher::diagonal() const { return function_->bounding_box().diagonal(); }
 
 bool Mesher::inside_domain(const Point3& p) const {
   // Inside the box and, when the polygonizer closes the surface by the box, out of the band where it
@@ -371,13 +384,25 @@ void Mesher::finish_scan_surface() {
 
 void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { to_eigen(surface(), V, F, &N); }
 
-void Mesher::after_edit(double rbf_seconds, double t_start, const ChangedRegion* region) {
+// The edit skeleton shared by the four edits: function, then (unless a rebuild) the constraint's vertex,
+// then the re-evaluation where f changed, refinement and cleanup (after_edit).
+void Mesher::edit(const std::function<ChangedRegion()>& change_function, const Point3* moved_to,
+                  const std::function<void()>& change_vertex) {
+  const double t0 = now_seconds();
+  const ChangedRegion region = change_function();  // validates; throws before anything changes
+  const double t_rbf = now_seconds() - t0;
+  if (moved_to && rebuild_if_outside(*moved_to, t0, t_rbf)) return;
+  change_vertex();
+  after_edit(region, t_rbf, t0);
+}
+
+void Mesher::after_edit(const ChangedRegion& region, double rbf_seconds, double t_start) {
   const double t1 = now_seconds();
   const std::size_t insertions = poly_->stats().insertions;
-  if (region && !region->everywhere) {
-    poly_->function_changed(region->balls);  // the vertices near the balls only (no scan)
+  if (region.everywhere) {
+    poly_->function_changed();  // every vertex without a fixed value (the global function's edits)
   } else {
-    poly_->function_changed();
+    poly_->function_changed(region.balls);  // the vertices near the balls only (no scan)
   }
   if (std::isfinite(precision_)) poly_->refine(precision_);
   if (options_.collect_garbage) {
@@ -407,75 +432,47 @@ bool Mesher::rebuild_if_outside(const Point3& p, double t_start, double t_rbf) {
   return true;
 }
 
-std::size_t Mesher::add_constraint(const Point3& p, double value) {
-  const double t0 = now_seconds();
-  ChangedRegion region;  // validates p and value; throws before anything changes
-  if (rbf_) rbf_->add_constraint(p, value);
-  else region = local_->add_constraint(p, value);
-  const double t_rbf = now_seconds() - t0;
-  if (rebuild_if_outside(p, t0, t_rbf)) return size() - 1;
-  const VertexId v = poly_->insert_vertex(p, value, VertexKind::Seed);
-  vertex_of_.push_back(v);
-  track_zero(v, p, value);
-  after_edit(t_rbf, t0, local_ ? &region : nullptr);
-  return size() - 1;
+ConstraintId Mesher::add_constraint(const Point3& p, double value) {
+  const ConstraintId id = function_->next_id();
+  edit([&] { return function_->add_constraint(p, value); }, &p, [&] {
+    if (vertex_of_.size() <= id) vertex_of_.resize(id + 1, kNoVertex);
+    vertex_of_[id] = poly_->insert_vertex(p, value, VertexKind::Seed);
+    track_zero(vertex_of_[id], p, value);
+  });
+  return id;
 }
 
-void Mesher::move_constraint(std::size_t i, const Point3& p) {
-  const double t0 = now_seconds();
-  ChangedRegion region;
-  if (rbf_) rbf_->move_constraint(i, p);
-  else region = local_->move_constraint(i, p);
-  const double t_rbf = now_seconds() - t0;
-  if (rebuild_if_outside(p, t0, t_rbf)) return;
-  const double value = value_of(i);
-  const VertexId v = vertex_of_[i];
-  forget_zero(v);  // back in below under the vertex it ends with
-  if (v != kNoVertex) {
-    if (!poly_->move_vertex(v, p, value)) {
-      // p duplicates another constraint's vertex: this constraint lives in the RBF only.
+void Mesher::move_constraint(ConstraintId id, const Point3& p) {
+  edit([&] { return function_->move_constraint(id, p); }, &p, [&] {
+    const double value = function_->value_of(id);
+    VertexId& v = vertex_of_[id];
+    forget_zero(v);  // back in below under the vertex it ends with
+    if (v == kNoVertex) {
+      v = poly_->insert_vertex(p, value, VertexKind::Seed);
+    } else if (!poly_->move_vertex(v, p, value)) {
+      // p duplicates another constraint's vertex: this constraint lives in the function only.
       poly_->remove_vertex(v);
-      vertex_of_[i] = kNoVertex;
+      v = kNoVertex;
     }
-  } else {
-    vertex_of_[i] = poly_->insert_vertex(p, value, VertexKind::Seed);
-  }
-  track_zero(vertex_of_[i], p, value);
-  after_edit(t_rbf, t0, local_ ? &region : nullptr);
+    track_zero(v, p, value);
+  });
 }
 
-void Mesher::ConstraintVertices::erase(std::size_t i) {
-  ranks_.set_dead(ranks_.select(i));
-  --live_;
-  if (slots_.size() - live_ <= live_ + 1024) return;
-  std::vector<VertexId> live;  // compact: keep the live slots in order
-  live.reserve(live_);
-  for (std::size_t k = 0; k < live_; ++k) live.push_back(slots_[ranks_.select(k)]);
-  assign(std::move(live));
+void Mesher::remove_constraint(ConstraintId id) {
+  edit([&] { return function_->remove_constraint(id); }, nullptr, [&] {
+    const VertexId v = vertex_of_[id];
+    vertex_of_[id] = kNoVertex;
+    forget_zero(v);
+    if (v != kNoVertex) poly_->remove_vertex(v);
+  });
 }
 
-void Mesher::remove_constraint(std::size_t i) {
-  const double t0 = now_seconds();
-  ChangedRegion region;  // throws on a bad index or an impossible removal
-  if (rbf_) rbf_->remove_constraint(i);
-  else region = local_->remove_constraint(i);
-  const double t_rbf = now_seconds() - t0;
-  const VertexId v = vertex_of_[i];
-  vertex_of_.erase(i);
-  forget_zero(v);
-  if (v != kNoVertex) poly_->remove_vertex(v);
-  after_edit(t_rbf, t0, local_ ? &region : nullptr);
-}
-
-void Mesher::set_value(std::size_t i, double value) {
-  const double t0 = now_seconds();
-  ChangedRegion region;
-  if (rbf_) rbf_->set_value(i, value);
-  else region = local_->set_value(i, value);
-  const double t_rbf = now_seconds() - t0;
-  if (vertex_of_[i] != kNoVertex) poly_->set_vertex_value(vertex_of_[i], value);
-  track_zero(vertex_of_[i], constraints_point(i), value);
-  after_edit(t_rbf, t0, local_ ? &region : nullptr);
+void Mesher::set_value(ConstraintId id, double value) {
+  edit([&] { return function_->set_value(id, value); }, nullptr, [&] {
+    const VertexId v = vertex_of_[id];
+    if (v != kNoVertex) poly_->set_vertex_value(v, value);
+    track_zero(v, function_->point(id), value);
+  });
 }
 
 MesherStats Mesher::stats() const {

@@ -6,6 +6,7 @@
 #include "local_rbf_impl.hpp"
 #include "vitri/core/error.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -15,28 +16,6 @@
 namespace vitri {
 
 using namespace local_detail;
-
-bool ChangedRegion::contains(const Point3& x) const {
-  if (everywhere) return true;
-  for (const Ball& b : balls)
-    if (squared_distance(x, b.center) < b.radius * b.radius) return true;
-  return false;
-}
-
-Box3 ChangedRegion::bounds() const {
-  Box3 box;
-  if (everywhere) {
-    const double inf = std::numeric_limits<double>::infinity();
-    box.lo = {-inf, -inf, -inf};
-    box.hi = {inf, inf, inf};
-    return box;
-  }
-  for (const Ball& b : balls) {
-    box.extend(b.center - Point3{b.radius, b.radius, b.radius});
-    box.extend(b.center + Point3{b.radius, b.radius, b.radius});
-  }
-  return box;
-}
 
 LocalRbf::LocalRbf() : impl_(std::make_unique<Impl>()) {}
 LocalRbf::LocalRbf(const Constraints& constraints, const LocalRbfOptions& options) : LocalRbf() {
@@ -95,15 +74,21 @@ Box3 LocalRbf::bounding_box() const {
   return b;
 }
 
-Point3 LocalRbf::point(std::size_t i) const {
-  if (i >= size()) throw InvalidPoint(i, "no such constraint (size " + std::to_string(size()) + ")");
-  return impl_->slot_point[impl_->slot_of(i)];
+std::vector<ConstraintId> LocalRbf::constraint_ids() const {
+  std::vector<ConstraintId> ids;
+  ids.reserve(size());
+  for (std::size_t s = 0; s < impl_->slot_alive.size(); ++s)
+    if (impl_->slot_alive[s]) ids.push_back(s);
+  return ids;
 }
 
-double LocalRbf::value_of(std::size_t i) const {
-  if (i >= size()) throw InvalidPoint(i, "no such constraint (size " + std::to_string(size()) + ")");
-  return impl_->slot_value[impl_->slot_of(i)];
-}
+ConstraintId LocalRbf::next_id() const { return impl_->slot_point.size(); }
+
+bool LocalRbf::contains(ConstraintId id) const { return id < impl_->slot_alive.size() && impl_->slot_alive[id]; }
+
+Point3 LocalRbf::point(ConstraintId id) const { return impl_->slot_point[impl_->slot_of(id)]; }
+
+double LocalRbf::value_of(ConstraintId id) const { return impl_->slot_value[impl_->slot_of(id)]; }
 
 void LocalRbf::validate() const {
   const Impl& m = *impl_;
@@ -122,7 +107,8 @@ void LocalRbf::validate() const {
         r->terms != cell.terms)
       throw std::logic_error("local RBF: the patch record of leaf " + std::to_string(c) + " is stale");
   }
-  if (m.index.size() != m.live || m.ranks.rank(m.ranks.slots()) != m.live)
+  if (m.index.size() != m.live ||
+      static_cast<std::size_t>(std::count(m.slot_alive.begin(), m.slot_alive.end(), std::uint8_t{1})) != m.live)
     throw std::logic_error("local RBF: constraint counts disagree");
 }
 

@@ -18,9 +18,12 @@ namespace vitri {
 
 using namespace local_detail;
 
-std::size_t LocalRbf::Impl::slot_of(std::size_t i) const { return ranks.select(i); }
+std::uint32_t LocalRbf::Impl::slot_of(ConstraintId id) const {
+  if (id >= slot_alive.size() || !slot_alive[id]) throw UnknownConstraint(id, live);
+  return static_cast<std::uint32_t>(id);
+}
 
-void LocalRbf::Impl::check_new_position(const Point3& p, std::size_t idx, std::optional<std::uint32_t> moving) const {
+void LocalRbf::Impl::check_new_position(const Point3& p, ConstraintId idx, std::optional<std::uint32_t> moving) const {
   if (!is_finite(p)) throw InvalidPoint(idx, "non-finite constraint position");
   std::vector<PointIndex::Id> ids;
   std::vector<double> d2;
@@ -28,7 +31,7 @@ void LocalRbf::Impl::check_new_position(const Point3& p, std::size_t idx, std::o
   for (std::size_t k = 0; k < ids.size(); ++k) {
     if (moving && ids[k] == *moving) continue;
     if (too_close(d2[k]))
-      throw InvalidPoint(idx, "duplicates constraint " + std::to_string(ranks.rank(ids[k])) + " at " +
+      throw InvalidPoint(idx, "duplicates constraint " + std::to_string(ids[k]) + " at " +
                                   format_point(slot_point[ids[k]]));
   }
 }
@@ -88,10 +91,7 @@ ChangedRegion LocalRbf::Impl::change(std::optional<Point3> old_pos, std::optiona
     fit_leaves(touched);
   } catch (const NumericalError&) {
     undo();  // leave the function as it was: refit everything from the constraints before the edit
-    Constraints before;
-    for (std::size_t s = 0; s < slot_point.size(); ++s)
-      if (slot_alive[s]) before.add(slot_point[s], slot_value[s]);
-    fit_all(before, tree.root_box());
+    fit_slots(tree.root_box());
     throw;
   }
   for (std::uint32_t c : touched) tree.update_reach(c);
@@ -106,35 +106,23 @@ ChangedRegion LocalRbf::Impl::change(std::optional<Point3> old_pos, std::optiona
   return region;
 }
 
-ChangedRegion LocalRbf::Impl::refit_everything(const Constraints& c) {
-  fit_all(c, Box3{});
-  ChangedRegion region;
-  region.everywhere = true;
-  return region;
-}
-
-void LocalRbf::Impl::compact_if_sparse() {
-  const std::size_t dead = slot_point.size() - live;
-  if (dead <= std::max<std::size_t>(live, 4096)) return;
-  // Renumber the live slots densely, in the same order: patch fits do not change (they follow slot order).
-  std::vector<Point3> points;
-  std::vector<double> values;
-  for (std::size_t s = 0; s < slot_point.size(); ++s)
-    if (slot_alive[s]) {
-      points.push_back(slot_point[s]);
-      values.push_back(slot_value[s]);
-    }
-  slot_point = std::move(points);
-  slot_value = std::move(values);
-  slot_alive.assign(slot_point.size(), 1);
-  ranks.reset(slot_point.size());
-  index.build(slot_point, threads());
+ChangedRegion LocalRbf::Impl::refit_everything(const std::function<void()>& apply,
+                                               const std::function<void()>& undo) {
+  const Box3 before = tree.root_box();
+  apply();
+  try {
+    fit_slots(Box3{});
+  } catch (...) {
+    undo();
+    fit_slots(before);
+    throw;
+  }
+  return ChangedRegion::whole();
 }
 
 void LocalRbf::Impl::kill_slot(std::uint32_t slot) {
   index.erase(slot);
   slot_alive[slot] = 0;
-  ranks.set_dead(slot);
   --live;
   nonzero -= slot_value[slot] != 0;
 }
@@ -142,7 +130,6 @@ void LocalRbf::Impl::kill_slot(std::uint32_t slot) {
 void LocalRbf::Impl::revive_slot(std::uint32_t slot) {
   index.insert(slot, slot_point[slot]);
   slot_alive[slot] = 1;
-  ranks.set_alive(slot);
   ++live;
   nonzero += slot_value[slot] != 0;
 }
@@ -156,40 +143,44 @@ void require_fitted(bool fitted) {
 ChangedRegion LocalRbf::add_constraint(const Point3& p, double value) {
   require_fitted(fitted());
   Impl& m = *impl_;
-  if (!std::isfinite(value)) throw InvalidPoint(size(), "non-finite constraint value");
-  m.check_new_position(p, size(), std::nullopt);
-  if (!m.tree.root_box().contains(p)) {
-    Constraints c = constraints();
-    c.add(p, value);
-    return m.refit_everything(c);
-  }
   const auto slot = static_cast<std::uint32_t>(m.slot_point.size());
+  if (!std::isfinite(value)) throw InvalidPoint(slot, "non-finite constraint value");
+  m.check_new_position(p, slot, std::nullopt);
+  if (slot >= PointIndex::kNoId - 1)
+    throw LimitError("local RBF: constraint id " + std::to_string(slot) + " exceeds the 2^32 - 2 ids");
+  auto append = [&m, &p, value] {
+    m.slot_point.push_back(p);
+    m.slot_value.push_back(value);
+    m.slot_alive.push_back(1);
+  };
+  auto pop = [&m] {
+    m.slot_point.pop_back();
+    m.slot_value.pop_back();
+    m.slot_alive.pop_back();
+  };
+  if (!m.tree.root_box().contains(p)) return m.refit_everything(append, pop);
   return m.change(
       std::nullopt, p,
       [&] {
-        m.slot_point.push_back(p);
-        m.slot_value.push_back(value);
-        m.slot_alive.push_back(1);
-        m.ranks.push_back_alive();
+        append();
         m.index.insert(slot, p);
         ++m.live;
         m.nonzero += value != 0;
       },
-      [&] { m.kill_slot(slot); });
+      [&] {
+        m.kill_slot(slot);
+        pop();  // the id is not given out
+      });
 }
 
-ChangedRegion LocalRbf::move_constraint(std::size_t i, const Point3& p) {
+ChangedRegion LocalRbf::move_constraint(ConstraintId id, const Point3& p) {
   require_fitted(fitted());
   Impl& m = *impl_;
-  if (i >= size()) throw InvalidPoint(i, "no such constraint (size " + std::to_string(size()) + ")");
-  const auto slot = static_cast<std::uint32_t>(m.slot_of(i));
-  m.check_new_position(p, i, slot);
+  const std::uint32_t slot = m.slot_of(id);
+  m.check_new_position(p, id, slot);
   const Point3 old = m.slot_point[slot];
-  if (!m.tree.root_box().contains(p)) {
-    Constraints c = constraints();
-    c.points[i] = p;
-    return m.refit_everything(c);
-  }
+  if (!m.tree.root_box().contains(p))
+    return m.refit_everything([&] { m.slot_point[slot] = p; }, [&] { m.slot_point[slot] = old; });
   auto place = [&m, slot](const Point3& at) {
     m.index.erase(slot);
     m.slot_point[slot] = at;
@@ -198,32 +189,26 @@ ChangedRegion LocalRbf::move_constraint(std::size_t i, const Point3& p) {
   return m.change(old, p, [&] { place(p); }, [&] { place(old); });
 }
 
-ChangedRegion LocalRbf::remove_constraint(std::size_t i) {
+ChangedRegion LocalRbf::remove_constraint(ConstraintId id) {
   require_fitted(fitted());
   Impl& m = *impl_;
-  if (i >= size()) throw InvalidPoint(i, "no such constraint (size " + std::to_string(size()) + ")");
+  const std::uint32_t slot = m.slot_of(id);
   if (size() <= 4) throw InvalidArgument("local RBF: removing a constraint would leave fewer than 4");
-  const auto slot = static_cast<std::uint32_t>(m.slot_of(i));
   const double value = m.slot_value[slot];
-  if (value != 0 && m.nonzero == 1) throw InvalidArgument("local RBF: removing constraint " + std::to_string(i) +
+  if (value != 0 && m.nonzero == 1) throw InvalidArgument("local RBF: removing constraint " + std::to_string(id) +
                                                           " would leave only zero values");
   const Point3 old = m.slot_point[slot];
-  ChangedRegion region = m.change(
-      old, std::nullopt,
-      [&] { m.kill_slot(slot); }, [&] { m.revive_slot(slot); });
-  m.compact_if_sparse();
-  return region;
+  return m.change(old, std::nullopt, [&] { m.kill_slot(slot); }, [&] { m.revive_slot(slot); });
 }
 
-ChangedRegion LocalRbf::set_value(std::size_t i, double value) {
+ChangedRegion LocalRbf::set_value(ConstraintId id, double value) {
   require_fitted(fitted());
   Impl& m = *impl_;
-  if (i >= size()) throw InvalidPoint(i, "no such constraint (size " + std::to_string(size()) + ")");
-  if (!std::isfinite(value)) throw InvalidPoint(i, "non-finite constraint value");
-  const auto slot = static_cast<std::uint32_t>(m.slot_of(i));
+  const std::uint32_t slot = m.slot_of(id);
+  if (!std::isfinite(value)) throw InvalidPoint(id, "non-finite constraint value");
   const double old = m.slot_value[slot];
   if (value == 0 && old != 0 && m.nonzero == 1)
-    throw InvalidArgument("local RBF: setting constraint " + std::to_string(i) + " to 0 would leave only zero values");
+    throw InvalidArgument("local RBF: setting constraint " + std::to_string(id) + " to 0 would leave only zero values");
   auto assign = [&m, slot](double from, double to) {
     m.slot_value[slot] = to;
     m.nonzero = m.nonzero - (from != 0) + (to != 0);

@@ -41,28 +41,48 @@ void LocalRbf::Impl::check_duplicates() const {
 }
 
 void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
-  const auto t0 = std::chrono::steady_clock::now();
   if (c.points.size() != c.values.size())
     throw InvalidArgument("local RBF: " + std::to_string(c.points.size()) + " points but " +
                           std::to_string(c.values.size()) + " values");
-  if (c.size() < 4) throw InvalidArgument("local RBF: at least 4 constraints are needed, got " + std::to_string(c.size()));
-  if (c.size() >= PointIndex::kNoId - 1)
-    throw LimitError("local RBF: " + std::to_string(c.size()) + " constraints exceed the 2^32 - 2 ids");
-  std::size_t nz = 0;
-  Box3 box;
-  for (std::size_t i = 0; i < c.size(); ++i) {
-    if (!is_finite(c.points[i])) throw InvalidPoint(i, "non-finite constraint position");
-    if (!std::isfinite(c.values[i])) throw InvalidPoint(i, "non-finite constraint value");
-    nz += c.values[i] != 0;
-    box.extend(c.points[i]);
-  }
-  if (nz == 0) throw InvalidArgument("local RBF: every constraint value is 0 (f would vanish everywhere)");
-  fitted = false;
+  check_slots(c.points, c.values, std::vector<std::uint8_t>(c.size(), 1));
   slot_point = c.points;
   slot_value = c.values;
   slot_alive.assign(c.size(), 1);
-  ranks.reset(c.size());
-  live = c.size();
+  fit_slots(domain);
+}
+
+// The checks of a fit over slots (ids) before anything changes: count, finite data, a nonzero value.
+void LocalRbf::Impl::check_slots(const std::vector<Point3>& points, const std::vector<double>& values,
+                                 const std::vector<std::uint8_t>& alive) {
+  std::size_t n = 0, nz = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) n += alive[i] != 0;
+  if (n < 4) throw InvalidArgument("local RBF: at least 4 constraints are needed, got " + std::to_string(n));
+  if (points.size() >= PointIndex::kNoId - 1)
+    throw LimitError("local RBF: " + std::to_string(points.size()) + " constraint ids exceed the 2^32 - 2 ids");
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!alive[i]) continue;
+    if (!is_finite(points[i])) throw InvalidPoint(i, "non-finite constraint position");
+    if (!std::isfinite(values[i])) throw InvalidPoint(i, "non-finite constraint value");
+    nz += values[i] != 0;
+  }
+  if (nz == 0) throw InvalidArgument("local RBF: every constraint value is 0 (f would vanish everywhere)");
+}
+
+// Fits everything to the live slots, which keep their ids (a fit's, or an edit's refit of the whole).
+void LocalRbf::Impl::fit_slots(const Box3& domain) {
+  const auto t0 = std::chrono::steady_clock::now();
+  check_slots(slot_point, slot_value, slot_alive);
+  std::size_t n = 0, nz = 0;
+  Box3 box;
+  std::vector<PointIndex::Id> ids;  // the live slots, when some are dead
+  for (std::size_t i = 0; i < slot_point.size(); ++i) {
+    if (!slot_alive[i]) continue;
+    ++n;
+    nz += slot_value[i] != 0;
+    box.extend(slot_point[i]);
+  }
+  fitted = false;
+  live = n;
   nonzero = nz;
   cache_valid = false;
   double step_seconds[5] = {0, 0, 0, 0, 0};  // index, duplicates, tree, links, patches
@@ -71,7 +91,17 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
     step_seconds[k] = seconds_since(t_step);
     t_step = std::chrono::steady_clock::now();
   };
-  index.build(slot_point, threads());
+  if (n == slot_point.size()) {
+    index.build(slot_point, threads());
+  } else {
+    std::vector<Point3> points;
+    for (std::size_t i = 0; i < slot_point.size(); ++i)
+      if (slot_alive[i]) {
+        ids.push_back(static_cast<PointIndex::Id>(i));
+        points.push_back(slot_point[i]);
+      }
+    index.build(ids, points, threads());
+  }
   fit_diagonal = box.diagonal();
   end_step(0);
   check_duplicates();
@@ -84,8 +114,8 @@ void LocalRbf::Impl::fit_all(const Constraints& c, const Box3& domain) {
     const Point3 ext = domain.extent();
     reset_root(domain.center(), 0.5 * std::max({ext.x, ext.y, ext.z}));
     const Box3 root = tree.root_box();
-    for (std::size_t i = 0; i < c.size(); ++i)
-      if (!root.contains(c.points[i])) throw InvalidPoint(i, "constraint outside the given domain");
+    for (std::size_t i = 0; i < slot_point.size(); ++i)
+      if (slot_alive[i] && !root.contains(slot_point[i])) throw InvalidPoint(i, "constraint outside the given domain");
   }
   std::vector<std::uint32_t> created;
   t_step = std::chrono::steady_clock::now();
@@ -229,7 +259,7 @@ void LocalRbf::Impl::fill_report() {
   report = LocalFitReport{};
   report.constraints = live;
   std::size_t fitted_terms = 0, rbf_patches = 0;
-  std::size_t bytes = slot_point.size() * (sizeof(Point3) + sizeof(double) + 1 + 8) + index.size() * 40;
+  std::size_t bytes = slot_point.size() * (sizeof(Point3) + sizeof(double) + 1) + index.size() * 40;
   for (std::uint32_t c : tree.leaves()) {
     const Cell& cell = tree.cell(c);
     ++report.patches;

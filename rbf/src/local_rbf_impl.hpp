@@ -5,7 +5,6 @@
 // local_rbf_evaluate.cpp (the partition-of-unity sum), local_rbf_edit.cpp (edits). See docs/local_rbf.md.
 
 #include "vitri/rbf/local_rbf.hpp"
-#include "vitri/core/slot_ranks.hpp"
 
 #include "local_patch.hpp"
 #include "local_tree.hpp"
@@ -52,11 +51,12 @@ struct LocalRbf::Impl {
   LocalFitReport report;
   bool fitted = false;
   local_detail::LocalTree tree;
+  // The constraints by slot; a slot is the constraint's public id (editable_function.hpp): never reused,
+  // a removed one stays dead (33 bytes), so that no id ever changes.
   PointIndex index;  // ids are slots
   std::vector<Point3> slot_point;
   std::vector<double> slot_value;
   std::vector<std::uint8_t> slot_alive;
-  SlotRanks ranks;
   std::size_t live = 0;
   std::size_t nonzero = 0;
   double fit_diagonal = 0;  // bounding-box diagonal of the constraints at the last fit (duplicate tolerance)
@@ -69,8 +69,13 @@ struct LocalRbf::Impl {
   /// True when two constraints at squared distance d2 are (near-)duplicates.
   bool too_close(double d2) const;
 
-  /// Fits everything; the root cube comes from `domain` when not empty, else from the constraints' box.
+  /// Fits everything to `c` (ids 0..n-1); the root cube comes from `domain` when not empty, else from the
+  /// constraints' box.
   void fit_all(const Constraints& c, const Box3& domain);
+  /// Fits everything to the live slots, which keep their ids (an edit that refits the whole).
+  void fit_slots(const Box3& domain);
+  static void check_slots(const std::vector<Point3>& points, const std::vector<double>& values,
+                          const std::vector<std::uint8_t>& alive);
   void check_duplicates() const;
   void reset_root(const Point3& center, double half);
   /// The split rule: c's ball holds more than max_per_patch constraints and c is above max_depth.
@@ -108,12 +113,14 @@ struct LocalRbf::Impl {
   double evaluate(const Point3& x, Point3* grad, std::uint32_t* leaf_hint = nullptr) const;
   double evaluate_inside(const Point3& x, Point3* grad, std::uint32_t* leaf_hint = nullptr) const;
 
-  std::size_t slot_of(std::size_t i) const;
-  void check_new_position(const Point3& p, std::size_t index, std::optional<std::uint32_t> moving) const;
+  /// The slot of a live id. @throws UnknownConstraint.
+  std::uint32_t slot_of(ConstraintId id) const;
+  void check_new_position(const Point3& p, ConstraintId id, std::optional<std::uint32_t> moving) const;
   ChangedRegion change(std::optional<Point3> old_pos, std::optional<Point3> new_pos,
                        const std::function<void()>& apply, const std::function<void()>& undo);
-  ChangedRegion refit_everything(const Constraints& c);
-  void compact_if_sparse();
+  /// An edit outside the root cube: `apply` changes the slots, then everything is refitted with a new
+  /// cube; when that fails, `undo` and a refit on the old cube restore the function.
+  ChangedRegion refit_everything(const std::function<void()>& apply, const std::function<void()>& undo);
   /// Marks a slot dead (its constraint removed) or alive again, keeping the index and counts in step.
   void kill_slot(std::uint32_t slot);
   void revive_slot(std::uint32_t slot);

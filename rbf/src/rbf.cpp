@@ -31,6 +31,26 @@ std::size_t Rbf::size() const {
 const Constraints& Rbf::constraints() const {
   return impl_->cons;
 }
+std::vector<ConstraintId> Rbf::constraint_ids() const {
+  return impl_->ids.ids();
+}
+ConstraintId Rbf::next_id() const {
+  return impl_->ids.next();
+}
+bool Rbf::contains(ConstraintId id) const {
+  return impl_->ids.contains(id);
+}
+Point3 Rbf::point(ConstraintId id) const {
+  return impl_->cons.points[impl_->ids.row(id)];
+}
+double Rbf::value_of(ConstraintId id) const {
+  return impl_->cons.values[impl_->ids.row(id)];
+}
+Box3 Rbf::bounding_box() const {
+  Box3 b;
+  for (const Point3& p : impl_->cons.points) b.extend(p);
+  return b;
+}
 const RbfOptions& Rbf::options() const {
   return impl_->opt;
 }

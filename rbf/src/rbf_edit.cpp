@@ -18,7 +18,7 @@ namespace vitri {
 using rbf_detail::fmt;
 using rbf_detail::kNoSlot;
 
-// Finishes an edit of constraint `index` whose factor update is done. The cheap condition bound is
+// Finishes an edit of constraint `id` whose factor update is done. The cheap condition bound is
 // compared with the one of the last full condition estimate: when it moved by more than a factor
 // kBoundJump either way (a near-duplicate added, or removed), the residual and the condition are
 // measured at once (drift check, refit from scratch if inaccurate), so that the report says what a
@@ -26,7 +26,7 @@ using rbf_detail::kNoSlot;
 // left unmeasured (NaN) until the periodic drift check. When the measured residual is above
 // fail_residual even after a refit, `undo` restores the previous constraints, the function is refitted
 // to them and NumericalError is thrown, as fit() would.
-void Rbf::Impl::after_edit(std::size_t index, const std::function<void()>& undo) {
+void Rbf::Impl::after_edit(ConstraintId id, const std::function<void()>& undo) {
   constexpr double kBoundJump = 100.0;
   ++edits;
   ++edits_since_check;
@@ -47,7 +47,7 @@ void Rbf::Impl::after_edit(std::size_t index, const std::function<void()>& undo)
   factor_from_scratch();
   solve_weights(2);
   fit_residual = rep.relative_residual;
-  throw NumericalError("edit of constraint " + std::to_string(index) + " refused: the RBF fit would fail " +
+  throw NumericalError("edit of constraint " + std::to_string(id) + " refused: the RBF fit would fail " +
                        "(relative residual " + fmt(rel) + " > " + fmt(opt.fail_residual) +
                        ", condition estimate " + fmt(cond) +
                        "): nearly coincident constraints with different values?");
@@ -93,7 +93,7 @@ void Rbf::Impl::move_anchor_by_append(std::size_t i, int k, const Point3& p) {
   basis_row(t, anchor_kernel());
   if (!append_slot(t)) {
     drop_last();
-    throw InvalidPoint(i,
+    throw InvalidPoint(ids.id(i),
                        "moving this constraint makes the RBF system numerically singular (too close to "
                        "other constraints?)");
   }
@@ -102,7 +102,7 @@ void Rbf::Impl::move_anchor_by_append(std::size_t i, int k, const Point3& p) {
     delete_slot(n - 1);  // the last slot: the factor is restored exactly
     drop_last();
     rebuild_slots();
-    throw InvalidPoint(i,
+    throw InvalidPoint(ids.id(i),
                        "moving this constraint there leaves all constraints coplanar: the linear "
                        "polynomial would be undetermined");
   }
@@ -119,18 +119,22 @@ void Rbf::Impl::move_anchor_by_append(std::size_t i, int k, const Point3& p) {
   rebuild_slots();
 }
 
-// ----- edits -----
-void Rbf::add_constraint(const Point3& p, double value) {
+// ----- edits: the public ids are translated to rows here (RowIds), whose maps follow a success -----
+ChangedRegion Rbf::add_constraint(const Point3& p, double value) {
   impl_->require_fitted();
   Impl& m = *impl_;
   const std::size_t i = m.cons.size();
-  m.check_new_point(p, value, i, kNoSlot);
+  const ConstraintId id = m.ids.next();
+  m.check_new_point(p, value, id, kNoSlot);
   if (m.opt.solver == RbfSolver::Cholesky) m.require_room_for_one_more();
   if (m.opt.solver == RbfSolver::FullLu) {
     Constraints c = m.cons;
     c.add(p, value);
+    rbf_detail::RowIds ids = m.ids;  // fit() numbers the rows afresh: the ids are put back
+    ids.append();
     fit(c, m.opt);
-    return;
+    impl_->ids = std::move(ids);
+    return ChangedRegion::whole();
   }
   m.cons.add(p, value);
   const Point3 s = m.scaled(p);
@@ -141,33 +145,38 @@ void Rbf::add_constraint(const Point3& p, double value) {
     m.cons.points.pop_back(), m.cons.values.pop_back();
     m.cx.pop_back(), m.cy.pop_back(), m.cz.pop_back(), m.w.pop_back();
     m.lam.pop_back(), m.aa.pop_back(), m.gg.pop_back();
-    throw InvalidPoint(i,
+    throw InvalidPoint(id,
                        "adding this constraint makes the RBF system numerically singular (too close to "
                        "other constraints?)");
   }
   m.slot_of.push_back(m.n - 1);
-  m.after_edit(i, [&m] { m.cons.points.pop_back(), m.cons.values.pop_back(); });
+  m.after_edit(id, [&m] { m.cons.points.pop_back(), m.cons.values.pop_back(); });
+  m.ids.append();
+  return ChangedRegion::whole();
 }
 
-void Rbf::remove_constraint(std::size_t i) {
+ChangedRegion Rbf::remove_constraint(ConstraintId id) {
   impl_->require_fitted();
   Impl& m = *impl_;
   const std::size_t N = m.cons.size();
-  if (i >= N) throw InvalidPoint(i, "no such constraint (there are " + std::to_string(N) + ")");
+  const std::size_t i = m.ids.row(id);
   if (N <= 4)
-    throw InvalidArgument("cannot remove constraint " + std::to_string(i) +
+    throw InvalidArgument("cannot remove constraint " + std::to_string(id) +
                           ": at least 4 non-coplanar constraints must remain");
   bool nonzero = false;
   for (std::size_t j = 0; j < N && !nonzero; ++j) nonzero = j != i && m.cons.values[j] != 0.0;
   if (!nonzero)
-    throw InvalidArgument("cannot remove constraint " + std::to_string(i) +
+    throw InvalidArgument("cannot remove constraint " + std::to_string(id) +
                           ": all remaining values would be zero");
   if (m.opt.solver == RbfSolver::FullLu) {
     Constraints c = m.cons;
     c.points.erase(c.points.begin() + static_cast<std::ptrdiff_t>(i));
     c.values.erase(c.values.begin() + static_cast<std::ptrdiff_t>(i));
+    rbf_detail::RowIds ids = m.ids;
+    ids.erase_row(i);
     fit(c, m.opt);
-    return;
+    impl_->ids = std::move(ids);
+    return ChangedRegion::whole();
   }
   for (int k = 0; k < 4; ++k)
     if (m.anchor[static_cast<std::size_t>(k)] == i) m.swap_anchor(k);  // throws when coplanar
@@ -182,23 +191,26 @@ void Rbf::remove_constraint(std::size_t i) {
   for (auto& a : m.anchor)
     if (a > i) --a;
   m.rebuild_slots();
-  m.after_edit(i, [&m, i, old_point, old_value] {
+  m.after_edit(id, [&m, i, old_point, old_value] {
     m.cons.points.insert(m.cons.points.begin() + static_cast<std::ptrdiff_t>(i), old_point);
     m.cons.values.insert(m.cons.values.begin() + static_cast<std::ptrdiff_t>(i), old_value);
   });
+  m.ids.erase_row(i);
+  return ChangedRegion::whole();
 }
 
-void Rbf::move_constraint(std::size_t i, const Point3& p) {
+ChangedRegion Rbf::move_constraint(ConstraintId id, const Point3& p) {
   impl_->require_fitted();
   Impl& m = *impl_;
-  const std::size_t N = m.cons.size();
-  if (i >= N) throw InvalidPoint(i, "no such constraint (there are " + std::to_string(N) + ")");
-  m.check_new_point(p, m.cons.values[i], i, i);
+  const std::size_t i = m.ids.row(id);
+  m.check_new_point(p, m.cons.values[i], id, i);
   if (m.opt.solver == RbfSolver::FullLu) {
     Constraints c = m.cons;
     c.points[i] = p;
+    rbf_detail::RowIds ids = m.ids;
     fit(c, m.opt);
-    return;
+    impl_->ids = std::move(ids);
+    return ChangedRegion::whole();
   }
   const Point3 old = m.cons.points[i];
   auto undo = [&m, i, old] { m.cons.points[i] = old; };
@@ -206,8 +218,8 @@ void Rbf::move_constraint(std::size_t i, const Point3& p) {
     if (m.anchor[static_cast<std::size_t>(k)] != i) continue;
     if (m.anchor_replacement(k) == kNoSlot) {  // the other constraints are coplanar
       m.move_anchor_by_append(i, k, p);
-      m.after_edit(i, undo);
-      return;
+      m.after_edit(id, undo);
+      return ChangedRegion::whole();
     }
     m.swap_anchor(k);
   }
@@ -222,35 +234,39 @@ void Rbf::move_constraint(std::size_t i, const Point3& p) {
     m.load_positions();
     m.factor_from_scratch();
     m.solve_weights(2);
-    throw InvalidPoint(i,
+    throw InvalidPoint(id,
                        "moving this constraint makes the RBF system numerically singular (too close to "
                        "other constraints?)");
   }
   m.rebuild_slots();
-  m.after_edit(i, undo);
+  m.after_edit(id, undo);
+  return ChangedRegion::whole();
 }
 
-void Rbf::set_value(std::size_t i, double value) {
+ChangedRegion Rbf::set_value(ConstraintId id, double value) {
   impl_->require_fitted();
   Impl& m = *impl_;
   const std::size_t N = m.cons.size();
-  if (i >= N) throw InvalidPoint(i, "no such constraint (there are " + std::to_string(N) + ")");
-  if (!std::isfinite(value)) throw InvalidPoint(i, "non-finite value (NaN or infinity)");
+  const std::size_t i = m.ids.row(id);
+  if (!std::isfinite(value)) throw InvalidPoint(id, "non-finite value (NaN or infinity)");
   if (value == 0.0) {
     bool nonzero = false;
     for (std::size_t j = 0; j < N && !nonzero; ++j) nonzero = j != i && m.cons.values[j] != 0.0;
     if (!nonzero)
-      throw InvalidArgument("setting value " + std::to_string(i) + " to 0 would make all values zero");
+      throw InvalidArgument("setting value " + std::to_string(id) + " to 0 would make all values zero");
   }
   if (m.opt.solver == RbfSolver::FullLu) {  // a failed refit leaves everything unchanged
     Constraints c = m.cons;
     c.values[i] = value;
+    rbf_detail::RowIds ids = m.ids;
     fit(c, m.opt);
-    return;
+    impl_->ids = std::move(ids);
+    return ChangedRegion::whole();
   }
   const double old = m.cons.values[i];
   m.cons.values[i] = value;
-  m.after_edit(i, [&m, i, old] { m.cons.values[i] = old; });
+  m.after_edit(id, [&m, i, old] { m.cons.values[i] = old; });
+  return ChangedRegion::whole();
 }
 
 bool Rbf::check_drift() {

@@ -138,6 +138,7 @@ const FitReport& Rbf::fit(const Constraints& constraints, const RbfOptions& opti
   rbf_detail::require_memory(rbf_fit_memory_bytes(constraints.size(), options.solver),
                              "the global RBF fit of " + std::to_string(constraints.size()) + " constraints", options);
   fresh->cons = constraints;
+  fresh->ids.reset(constraints.size());
   fresh->setup_scaling(constraints);
   fresh->fit_all();
   fresh->fitted = true;
@@ -149,7 +150,9 @@ void Rbf::refit() {
   impl_->require_fitted();
   Impl& m = *impl_;
   if (m.opt.solver == RbfSolver::FullLu) {
+    rbf_detail::RowIds ids = m.ids;  // fit() numbers the rows afresh
     fit(Constraints(m.cons), m.opt);
+    impl_->ids = std::move(ids);
     return;
   }
   m.factor_from_scratch();

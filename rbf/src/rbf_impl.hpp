@@ -73,11 +73,48 @@ inline Eigen::Vector4d poly_row(const Point3& x) {
   return {1.0, x.x, x.y, x.z};
 }
 
+// The stable ids of the rows (the constraints in cons order) and back: rows shift down on a removal
+// (std::vector::erase), ids never do (editable_function.hpp). A removal renumbers the later rows in
+// O(N), below the O(N^2) of the factor's update.
+class RowIds {
+ public:
+  /// Rows 0..n-1 with ids 0..n-1 (a fit).
+  void reset(std::size_t n) {
+    id_of_row_.resize(n);
+    row_of_id_.resize(n);
+    for (std::size_t r = 0; r < n; ++r) id_of_row_[r] = row_of_id_[r] = r;
+  }
+  bool contains(ConstraintId id) const { return id < row_of_id_.size() && row_of_id_[id] != kNoSlot; }
+  /// Row of a live id. @throws UnknownConstraint.
+  std::size_t row(ConstraintId id) const {
+    if (!contains(id)) throw UnknownConstraint(id, id_of_row_.size());
+    return row_of_id_[id];
+  }
+  ConstraintId id(std::size_t row) const { return id_of_row_[row]; }
+  ConstraintId next() const { return row_of_id_.size(); }
+  /// A new last row under the id next().
+  void append() {
+    row_of_id_.push_back(id_of_row_.size());
+    id_of_row_.push_back(row_of_id_.size() - 1);
+  }
+  void erase_row(std::size_t row) {
+    row_of_id_[id_of_row_[row]] = kNoSlot;
+    id_of_row_.erase(id_of_row_.begin() + static_cast<std::ptrdiff_t>(row));
+    for (std::size_t r = row; r < id_of_row_.size(); ++r) row_of_id_[id_of_row_[r]] = r;
+  }
+  const std::vector<ConstraintId>& ids() const { return id_of_row_; }
+
+ private:
+  std::vector<ConstraintId> id_of_row_;
+  std::vector<std::size_t> row_of_id_;  // kNoSlot for removed ids
+};
+
 }  // namespace rbf_detail
 
 struct Rbf::Impl {
   RbfOptions opt;
-  Constraints cons;  // caller's units
+  Constraints cons;  // caller's units, in row order (= increasing id order)
+  rbf_detail::RowIds ids;  // the stable id of each row
   FitReport rep;
   bool fitted = false;
 
@@ -191,7 +228,7 @@ struct Rbf::Impl {
   void swap_anchor(int k);
 
   // ---------- edits (rbf_edit.cpp) ----------
-  void after_edit(std::size_t index, const std::function<void()>& undo);
+  void after_edit(ConstraintId id, const std::function<void()>& undo);
   bool drift_check(bool estimate_condition);
   void move_anchor_by_append(std::size_t i, int k, const Point3& p);
 };

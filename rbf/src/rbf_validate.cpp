@@ -107,13 +107,13 @@ void Rbf::Impl::check_new_point(const Point3& p, double v, std::size_t index, st
     const double d = distance(cons.points[j], p);
     if (d <= tol_abs) {
       if (d == 0.0 && cons.values[j] != v)
-        throw InvalidPoint(index, "duplicate of constraint " + std::to_string(j) +
+        throw InvalidPoint(index, "duplicate of constraint " + std::to_string(ids.id(j)) +
                                       " with a different value (" + fmt(cons.values[j]) + " vs " + fmt(v) +
                                       ")");
       if (d == 0.0)
         throw InvalidPoint(index,
-                           "duplicate of constraint " + std::to_string(j) + " (same position and value)");
-      throw InvalidPoint(index, "nearly coincides with constraint " + std::to_string(j) + " (distance " +
+                           "duplicate of constraint " + std::to_string(ids.id(j)) + " (same position and value)");
+      throw InvalidPoint(index, "nearly coincides with constraint " + std::to_string(ids.id(j)) + " (distance " +
                                     fmt(d) + " <= tolerance " + fmt(tol_abs) + ")");
     }
   }

@@ -214,7 +214,7 @@ TEST_CASE("vitri mesh: an edit script runs, reports each edit and writes meshes"
   check_mesh(w1);
   check_mesh(w2);
   // One report line per edit, starting with its script line number, with the update times.
-  for (const char* line : {"\n    2 move 3", "\n    3 add 0 0 0.75 0", "\n    6 value 0 -0.8",
+  for (const char* line : {"\n    2 move 3", "\n    3 add (id 25) 0 0 0.75 0", "\n    6 value 0 -0.8",
                            "\n    7 remove 7", "\n    5 write", "\n    8 write"})
     REQUIRE(o.find(line) != std::string::npos);
   REQUIRE(o.find("rbf ms") != std::string::npos);
@@ -437,12 +437,22 @@ TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why o
     REQUIRE(e.find("mesh_bad_edits.txt:1") != std::string::npos);
     REQUIRE(e.find("twist") != std::string::npos);
   }
-  SECTION("constraint index out of range") {
+  SECTION("constraint ids: stable, a removed or unknown one is bad input") {
     const std::string script = kDir + "/mesh_range_edits.txt";
-    std::ofstream(script) << "remove 3\nvalue 25 0.5\n";  // 25 constraints: 0..24
+    // 25 constraints: ids 0..24. After 'remove 3', id 24 is still there (it would have been index 23).
+    std::ofstream(script) << "remove 3\nvalue 24 0.5\nvalue 25 0.5\n";
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + script, o, e) == 1);
+    REQUIRE(e.find("mesh_range_edits.txt:3") != std::string::npos);
+    REQUIRE(e.find("no constraint with id 25") != std::string::npos);
+    std::ofstream(script) << "remove 3\nmove 3 0.1 0.2 0.3\n";  // removed: not renumbered
     REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + script, o, e) == 1);
     REQUIRE(e.find("mesh_range_edits.txt:2") != std::string::npos);
-    REQUIRE(e.find("out of range") != std::string::npos);
+    REQUIRE(e.find("no constraint with id 3") != std::string::npos);
+    std::ofstream(script) << "add 0 0 0.75 0\nremove 25\nadd 0 0 0.7 0\nvalue 26 0.1\nremove 25\n";
+    REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + script, o, e) == 1);
+    INFO(o);
+    REQUIRE(o.find("add (id 26)") != std::string::npos);  // 25 is never given again
+    REQUIRE(e.find("mesh_range_edits.txt:5") != std::string::npos);
   }
   SECTION("missing edit script") {
     REQUIRE(run(in + " -o " + out + " --precision 0.1 --edits " + kDir + "/no_such_script.txt", o, e) == 1);

@@ -262,17 +262,18 @@ TEST_CASE("100 random edits: vertex count stays within 1.5x of a fresh mesh", "[
     std::size_t i = 0;
     do i = 1 + rng() % (n - 1);
     while (std::abs(mesher.constraints().values[i]) >= 0.5);
+    const ConstraintId id = mesher.constraint_ids()[i];  // constraint i of constraints()
     if (kind == 0 || n <= 20) {  // move it a little
       const Point3 p = mesher.constraints().points[i];
-      mesher.move_constraint(i, {p.x + 0.1 * u(rng), p.y + 0.1 * u(rng), p.z + 0.1 * u(rng)});
+      mesher.move_constraint(id, {p.x + 0.1 * u(rng), p.y + 0.1 * u(rng), p.z + 0.1 * u(rng)});
     } else if (kind == 1 && n < 30) {  // add a surface point of the ellipsoid
       const Point3 d{u(rng), u(rng), u(rng)};
       const double len = norm(d) + 1e-3;
       mesher.add_constraint({d.x / len, 0.8 * d.y / len, 0.6 * d.z / len}, 0.0);
     } else if (kind == 2 && n > 20) {
-      mesher.remove_constraint(i);
+      mesher.remove_constraint(id);
     } else {  // nudge its value
-      mesher.set_value(i, 0.02 * u(rng));
+      mesher.set_value(id, 0.02 * u(rng));
     }
   }
   const SurfaceMesh& m = mesher.surface();
@@ -287,17 +288,17 @@ TEST_CASE("100 random edits: vertex count stays within 1.5x of a fresh mesh", "[
   mesher.polygonizer().triangulation().verify_topology();
 }
 
-// Constraint indices shift down on removal; the Mesher keeps the Delaunay vertex of each constraint in
-// stable slots with ranks (O(log n) per removal) and compacts them when dead slots dominate. After more
-// add/remove cycles than a compaction needs, every constraint still owns the Delaunay vertex at its point,
-// and moving constraint i moves that vertex.
-TEST_CASE("constraint indices stay tied to their Delaunay vertices over many removals", "[mesher]") {
+// The Mesher keeps the Delaunay vertex of each constraint by its id (a table, O(1) per edit; ids are never
+// reused). After many add/remove cycles, every constraint still owns the Delaunay vertex at its point,
+// and moving constraint `id` moves that vertex.
+TEST_CASE("constraint ids stay tied to their Delaunay vertices over many removals", "[mesher]") {
   Mesher mesher(small_model());  // no refine(): edits skip refinement, so 2500 of them are cheap
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> u(-0.4, 0.4);
   for (int e = 0; e < 1300; ++e) {
-    mesher.add_constraint({u(rng), u(rng), u(rng)}, -0.2);
-    mesher.remove_constraint(1 + rng() % (mesher.size() - 1));  // anywhere but the center
+    REQUIRE(mesher.add_constraint({u(rng), u(rng), u(rng)}, -0.2) == small_model().size() + std::size_t(e));
+    const std::size_t i = 1 + rng() % (mesher.size() - 1);  // anywhere but the center
+    mesher.remove_constraint(mesher.constraint_ids()[i]);
   }
   const Triangulation& tri = mesher.polygonizer().triangulation();
   const auto seed_at = [&](const Point3& p) {
@@ -308,13 +309,97 @@ TEST_CASE("constraint indices stay tied to their Delaunay vertices over many rem
   };
   REQUIRE(mesher.size() == small_model().size());
   for (std::size_t i = 0; i < mesher.size(); ++i) REQUIRE(seed_at(mesher.constraints().points[i]) == 1);
-  for (std::size_t i = 0; i < mesher.size(); i += 5) {
-    const Point3 old = mesher.constraints().points[i], q = old + Point3{0.01, -0.02, 0.015};
-    mesher.move_constraint(i, q);
+  const std::vector<ConstraintId> ids = mesher.constraint_ids();
+  for (std::size_t i = 0; i < ids.size(); i += 5) {
+    const Point3 old = mesher.constraint_point(ids[i]), q = old + Point3{0.01, -0.02, 0.015};
+    mesher.move_constraint(ids[i], q);
     REQUIRE(seed_at(q) == 1);
     REQUIRE(seed_at(old) == 0);
   }
   tri.verify_topology();
+}
+
+// Stable ids: those of the constraints given are their indices; an add returns the next id; a removal
+// changes no other id; an id is never given out again; a removed or unknown id throws UnknownConstraint
+// naming it, and changes nothing. Edits by id give the mesh of a fresh Mesher of the same constraints.
+TEST_CASE("constraint ids are stable across removals and never reused", "[mesher]") {
+  const double precision = 0.08;
+  const Constraints c = small_model();  // 25 constraints: ids 0..24
+  const FunctionKind kind = GENERATE(FunctionKind::Global, FunctionKind::Local);
+  MesherOptions o;
+  o.function = kind;
+  Mesher mesher(c, o);
+  REQUIRE(mesher.refine(precision));
+  std::vector<ConstraintId> expected(c.size());
+  for (std::size_t i = 0; i < c.size(); ++i) expected[i] = i;
+  REQUIRE(mesher.constraint_ids() == expected);
+
+  mesher.remove_constraint(3);
+  expected.erase(expected.begin() + 3);
+  CHECK(mesher.constraint_ids() == expected);
+  // Id 4 still names the same constraint (with shifting indices it would have become index 3).
+  CHECK(mesher.constraint_point(4) == c.points[4]);
+  CHECK(mesher.constraint_value(4) == c.values[4]);
+  const Point3 moved = c.points[4] + Point3{0.05, 0.0, 0.02};
+  mesher.move_constraint(4, moved);
+  mesher.set_value(10, c.values[10] + 0.05);
+  const ConstraintId added = mesher.add_constraint({0.1, 0.1, 0.55}, 0.0);
+  CHECK(added == 25);  // the next id: 3 is not given again
+  expected.push_back(added);
+  CHECK(mesher.constraint_ids() == expected);
+  CHECK(mesher.has_constraint(added));
+  CHECK_FALSE(mesher.has_constraint(3));
+  mesher.remove_constraint(added);
+  CHECK(mesher.add_constraint({0.1, 0.1, 0.55}, 0.0) == 26);  // 25 is not given again either
+  expected.back() = 26;
+
+  // Unknown ids: a clear error naming the id, nothing changed.
+  const std::size_t before = mesher.stats().polygonizer.vertices;
+  for (const ConstraintId bad : {ConstraintId{3}, ConstraintId{25}, ConstraintId{27}, ConstraintId{1000}}) {
+    INFO("id " << bad);
+    try {
+      mesher.move_constraint(bad, {0, 0, 0});
+      FAIL("no exception");
+    } catch (const UnknownConstraint& e) {
+      CHECK(e.id() == bad);
+      CHECK(e.index() == bad);
+      CHECK_THAT(e.what(), Catch::Contains("id " + std::to_string(bad)));
+    }
+    CHECK_THROWS_AS(mesher.remove_constraint(bad), UnknownConstraint);
+    CHECK_THROWS_AS(mesher.set_value(bad, 0.1), InvalidPoint);
+    CHECK_THROWS_AS(mesher.constraint_point(bad), UnknownConstraint);
+  }
+  CHECK(mesher.stats().polygonizer.vertices == before);
+  CHECK(mesher.constraint_ids() == expected);
+
+  // constraints() lists the current ones in id order: the same set as a fresh fit's, and the same mesh.
+  Constraints now = c;
+  now.points[4] = moved;
+  now.values[10] += 0.05;
+  now.points.erase(now.points.begin() + 3);
+  now.values.erase(now.values.begin() + 3);
+  now.add({0.1, 0.1, 0.55}, 0.0);
+  CHECK(mesher.constraints().points == now.points);
+  CHECK(mesher.constraints().values == now.values);
+  Mesher fresh(now, o);
+  fresh.refine(precision);
+  const SurfaceMesh& m = mesher.surface();
+  require_closed(m);
+  // The edited function is a fresh fit of the current constraints (the local one on the same cube).
+  if (kind == FunctionKind::Local) {
+    LocalRbfOptions same_cube;
+    same_cube.domain = mesher.local_function()->domain();
+    const LocalRbf f(now, same_cube);
+    for (const Point3& p : m.vertices) CHECK(std::abs(f.value(p) - mesher.function().value(p)) <= 1e-12);
+  } else {
+    const Rbf f(now);
+    for (const Point3& p : m.vertices) CHECK(std::abs(f.value(p) - mesher.function().value(p)) <= 1e-8);
+  }
+  CHECK(hausdorff_distance(m, fresh.surface()) <= precision);
+  // restart() keeps the ids.
+  mesher.restart();
+  CHECK(mesher.constraint_ids() == expected);
+  mesher.polygonizer().triangulation().verify_topology();
 }
 
 TEST_CASE("mesher errors", "[mesher]") {
@@ -371,7 +456,7 @@ TEST_CASE("lone zeros: a zero constraint added well outside the surface gets its
       REQUIRE(max_surface_distance(m, mesher.function()) <= 0.1 * precision);
       REQUIRE(mesher.stats().polygonizer.lone_zeros == 0);
       // Kept under edits: moved to the other side, the new surface follows it; removed, it goes away.
-      const std::size_t last = mesher.size() - 1;
+      const ConstraintId last = mesher.constraint_ids().back();
       const Point3 q{0.1, -1.2, 0.8};
       mesher.move_constraint(last, q);
       require_closed(mesher.surface());

@@ -137,7 +137,7 @@ TEST_CASE("LocalRbf: bounding box without the copy; the copy released and rebuil
   CHECK(again.values == before.values);
   f.remove_constraint(0);  // the box follows edits
   vitri::Box3 after;
-  for (std::size_t i = 0; i < f.size(); ++i) after.extend(f.point(i));
+  for (const vitri::ConstraintId id : f.constraint_ids()) after.extend(f.point(id));
   CHECK(f.bounding_box().lo == after.lo);
   CHECK(f.bounding_box().hi == after.hi);
 }
@@ -244,33 +244,39 @@ TEST_CASE("LocalRbf edits equal a fresh fit and stay inside the reported region"
   std::mt19937 rng(31);
   std::uniform_real_distribution<double> u(-1.2, 1.2);
   std::uniform_int_distribution<int> kind(0, 3);
+  std::vector<vitri::ConstraintId> ids = f.constraint_ids();  // of c's constraints, in c's order
   for (int step = 0; step < 40; ++step) {
     f.values(probes.data(), probes.size(), before.data());
     std::uniform_int_distribution<std::size_t> pick(0, c.size() - 1);
     vitri::ChangedRegion region;
     const std::size_t i = pick(rng);
+    const vitri::ConstraintId id = ids[i];
     switch (kind(rng)) {
       case 0: {
         const Point3 p{u(rng), u(rng), 0.3 * u(rng)};
+        ids.push_back(f.next_id());
         region = f.add_constraint(p, 0.02);
         c.add(p, 0.02);
         break;
       }
       case 1: {
         const Point3 p = c.points[i] + Point3{0.05 * u(rng), 0.05 * u(rng), 0.05 * u(rng)};
-        region = f.move_constraint(i, p);
+        region = f.move_constraint(id, p);
         c.points[i] = p;
         break;
       }
       case 2:
-        region = f.remove_constraint(i);
+        region = f.remove_constraint(id);
         c.points.erase(c.points.begin() + static_cast<long>(i));
         c.values.erase(c.values.begin() + static_cast<long>(i));
+        ids.erase(ids.begin() + static_cast<long>(i));
         break;
       default:
-        region = f.set_value(i, c.values[i] + 0.01);
+        region = f.set_value(id, c.values[i] + 0.01);
         c.values[i] += 0.01;
     }
+    REQUIRE(f.constraint_ids() == ids);  // removals changed no other id
+    CHECK_THROWS_AS(f.point(f.next_id()), vitri::UnknownConstraint);
     INFO("step " << step);
     f.validate();
     REQUIRE(f.size() == c.size());
@@ -377,8 +383,8 @@ TEST_CASE("LocalRbf with fewer constraints than a patch wants", "[local_rbf]") {
 }
 
 TEST_CASE("LocalRbf compacts its slots after many removals and stays equal to a fresh fit", "[local_rbf]") {
-  // 5000 constraints added then removed leave more dead slots than live ones (and more than 4096): the
-  // slots are renumbered; the function must not change (fits follow constraint order, not slot numbers).
+  // 5000 constraints added then removed leave more dead slots than live ones: the slots (the ids) stay,
+  // never reused; the function must not change (fits follow id order, whatever the gaps).
   Constraints c = sphere_constraints(150);
   LocalRbf f(c);
   const auto probes = random_points(500, 1.5, 3);
@@ -388,11 +394,13 @@ TEST_CASE("LocalRbf compacts its slots after many removals and stays equal to a 
     const double t = 0.001 * k;
     f.add_constraint({0.3 * std::cos(t * 37), 0.3 * std::sin(t * 37), -0.5 + 0.0002 * k}, -0.2);
   }
-  for (int k = 0; k < 5000; ++k) f.remove_constraint(c.size());
+  for (std::size_t k = 0; k < 5000; ++k) f.remove_constraint(c.size() + k);
   f.validate();
+  CHECK(f.next_id() == c.size() + 5000);
+  CHECK_THROWS_AS(f.remove_constraint(c.size() + 10), vitri::UnknownConstraint);
   REQUIRE(f.constraints().points == c.points);
   f.values(probes.data(), probes.size(), after.data());
   REQUIRE(after == before);
-  f.move_constraint(3, c.points[3] + Point3{0.01, 0, 0});  // edits still work after the renumbering
+  f.move_constraint(3, c.points[3] + Point3{0.01, 0, 0});  // edits still work beside the dead slots
   f.validate();
 }

@@ -45,28 +45,33 @@ TEST_CASE("rbf edits equal a fresh fit", "[rbf][edits]") {
   vitri::RbfOptions opt;
   opt.drift_check_interval = 0;  // no automatic refit: the updates alone must be accurate
   Rbf f(c, opt);
+  std::vector<vitri::ConstraintId> ids = f.constraint_ids();  // of c's constraints, in c's order
   for (int step = 0; step < 60; ++step) {
     const int kind = static_cast<int>(rng() % 4);
     const std::size_t i = rng() % c.size();
     if (kind == 0) {
       const Point3 p{u(rng), u(rng), u(rng)};
       const double v = u(rng);
+      ids.push_back(f.next_id());
       f.add_constraint(p, v);
       c.add(p, v);
     } else if (kind == 1) {
-      f.remove_constraint(i);
+      f.remove_constraint(ids[i]);
       c.points.erase(c.points.begin() + static_cast<std::ptrdiff_t>(i));
       c.values.erase(c.values.begin() + static_cast<std::ptrdiff_t>(i));
+      ids.erase(ids.begin() + static_cast<std::ptrdiff_t>(i));
     } else if (kind == 2) {
       const Point3 p{u(rng), u(rng), u(rng)};
-      f.move_constraint(i, p);
+      f.move_constraint(ids[i], p);
       c.points[i] = p;
     } else {
       const double v = u(rng);
-      f.set_value(i, v);
+      f.set_value(ids[i], v);
       c.values[i] = v;
     }
     REQUIRE(f.size() == c.size());
+    REQUIRE(f.constraint_ids() == ids);  // removals changed no other id
+    REQUIRE(f.point(ids[i % ids.size()]) == c.points[i % ids.size()]);
   }
   CHECK(f.edits_since_fit() == 60);
   CHECK(f.refits_by_edits() == 0);
@@ -94,9 +99,9 @@ TEST_CASE("rbf edits that hit the anchors: removing and moving every constraint 
     c.points[i] = p;
   }
   CHECK(probe_difference(f, Rbf(c), 5) <= 1e-8);
-  // Remove from the front until 10 remain: every original index is removed once.
-  while (c.size() > 10) {
-    f.remove_constraint(0);
+  // Remove from the front until 10 remain: every original id is removed once.
+  for (vitri::ConstraintId id = 0; c.size() > 10; ++id) {
+    f.remove_constraint(id);
     c.points.erase(c.points.begin());
     c.values.erase(c.values.begin());
   }
@@ -110,6 +115,8 @@ TEST_CASE("rbf edit errors leave the function unchanged", "[rbf][edits][errors]"
   Rbf f(c);
   const Rbf before = f;
   CHECK_THROWS_AS(f.remove_constraint(12), vitri::InvalidPoint);
+  CHECK_THROWS_AS(f.remove_constraint(12), vitri::UnknownConstraint);
+  CHECK_THROWS_WITH(f.set_value(40, 1.0), Catch::Contains("id 40"));
   CHECK_THROWS_AS(f.add_constraint(c.points[3], c.values[3] + 1), vitri::InvalidPoint);
   CHECK_THROWS_WITH(f.add_constraint(c.points[3], 0.5), Catch::Contains("constraint 3"));
   CHECK_THROWS_AS(f.add_constraint({std::nan(""), 0, 0}, 0.0), vitri::InvalidPoint);
@@ -173,6 +180,11 @@ TEST_CASE("rbf minimal sets and the FullLu solver's edits", "[rbf][edits]") {
   REQUIRE(f.size() == 4);
   CHECK(g.size() == 4);
   CHECK(probe_difference(f, g, 9) <= 1e-9);
+  // The full-LU refits keep the ids too.
+  const std::vector<vitri::ConstraintId> kept{0, 2, 3, 4};
+  CHECK(f.constraint_ids() == kept);
+  CHECK(g.constraint_ids() == kept);
+  CHECK_THROWS_AS(g.set_value(1, 1.0), vitri::UnknownConstraint);
 }
 
 TEST_CASE("rbf moves of an anchor without a replacement succeed exactly when a fresh fit would",

@@ -10,19 +10,22 @@
 ///   mesher.refine(0.02 * mesher.diagonal());    // absolute precision (circumradius bound)
 ///   Eigen::MatrixXd V, N; Eigen::MatrixXi F;
 ///   mesher.mesh(V, F, N);                       // watertight, CCW seen from outside
-///   mesher.move_constraint(3, {0.1, 0.2, 0.3}); // edits the RBF, updates only what changed
+///   mesher.move_constraint(3, {0.1, 0.2, 0.3}); // constraint id 3 (= index 3 of c); updates what changed
 ///   mesher.mesh(V, F, N);
+///
+/// Constraints are named by stable ids (ConstraintId): those given are 0..n-1 in their order, an add
+/// returns a new one, and a removal changes no other id (see "Dynamic editing" below, docs/mesher.md).
 ///
 /// Precision: the library takes absolute lengths (the circumradius bound of transverse tetrahedra); the
 /// CLI's relative precision is `P * diagonal()`.
 
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
-#include "vitri/core/slot_ranks.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/quality_mesher.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 #include "vitri/rbf/constraints.hpp"
+#include "vitri/rbf/editable_function.hpp"
 #include "vitri/rbf/local_rbf.hpp"
 #include "vitri/rbf/point_index.hpp"
 #include "vitri/rbf/rbf.hpp"
@@ -52,7 +55,7 @@ enum class SurfaceKind {
 enum class FunctionKind {
   Global,  ///< vitri::Rbf: one dense cubic RBF over all constraints (O(N^2) memory, O(N^3) fit, global edits)
   Local,   ///< vitri::LocalRbf: partition of unity of local RBF patches (O(N) memory and fit, local edits)
-  Auto,    ///< Global up to MesherOptions::auto_local_above constraints, Local above
+  Auto,    ///< Global up to MesherOptions::auto_local_above constraints, Local above (choose_function())
 };
 
 /// What the Mesher outputs.
@@ -127,6 +130,13 @@ struct MesherOptions {
   /// Empty: nothing is called.
   std::function<void(const char* phase)> on_phase;
 };
+
+/// The function fitted to `constraints` constraints: `requested`, with Auto resolved to Global up to
+/// `auto_local_above` constraints and Local above. The one place where the Auto rule is written: the
+/// Mesher, Mesher::from_scan, the CLI and the studio all ask it.
+FunctionKind choose_function(FunctionKind requested, std::size_t constraints, std::size_t auto_local_above);
+/// choose_function(options.function, constraints, options.auto_local_above).
+FunctionKind choose_function(std::size_t constraints, const MesherOptions& options);
 
 /// Counters and timings (seconds). `polygonizer` holds the refinement/extraction numbers.
 struct MesherStats {
@@ -235,24 +245,43 @@ class Mesher {
   void set_quality_options(const QualityOptions& quality);
 
   // ---- Dynamic editing: each edit updates the RBF, the Delaunay tree and the mesh -------------------
-  /// Appends the constraint f(p) = value (index size() - 1). @throws as Rbf::add_constraint.
-  std::size_t add_constraint(const Point3& p, double value);
-  /// Moves constraint i to p (keeps its value). @throws as Rbf::move_constraint.
-  void move_constraint(std::size_t i, const Point3& p);
-  /// Removes constraint i; later indices shift down by one. @throws as Rbf::remove_constraint.
-  void remove_constraint(std::size_t i);
-  /// Changes the value of constraint i. @throws as Rbf::set_value.
-  void set_value(std::size_t i, double value);
+  // Constraints are named by stable ids (ConstraintId, an unsigned integer): the constraints given at
+  // construction have ids 0..n-1 in their order (for the builders, the order of docs/mesher.md); each
+  // add returns a new id, one more than the last given out; an id stays valid until its constraint is
+  // removed and is never given out again (also across restart() and rebuilds; restarted_copy() keeps
+  // them); removing a constraint changes no other id. Looking an id up is O(1) (the function's tables:
+  // LocalRbf's slots, Rbf's rows). An id that names no live constraint throws UnknownConstraint (an
+  // InvalidPoint whose index() is the id) and changes nothing; so does every refused edit.
+  /// Adds the constraint f(p) = value. @return its id. @throws as Rbf::add_constraint /
+  /// LocalRbf::add_constraint.
+  ConstraintId add_constraint(const Point3& p, double value);
+  /// Moves constraint `id` to p (keeps its value). @throws UnknownConstraint; as Rbf::move_constraint.
+  void move_constraint(ConstraintId id, const Point3& p);
+  /// Removes constraint `id`; every other id stays valid and unchanged. @throws UnknownConstraint; as
+  /// Rbf::remove_constraint (InvalidArgument when fewer than 4 constraints would remain).
+  void remove_constraint(ConstraintId id);
+  /// Changes the value of constraint `id`. @throws UnknownConstraint; as Rbf::set_value.
+  void set_value(ConstraintId id, double value);
+  /// The ids of the current constraints, in the order of constraints() (increasing). O(N).
+  std::vector<ConstraintId> constraint_ids() const;
+  /// True when `id` names a current constraint. O(1).
+  bool has_constraint(ConstraintId id) const;
+  /// Position and value of constraint `id`. O(1). @throws UnknownConstraint.
+  Point3 constraint_point(ConstraintId id) const;
+  double constraint_value(ConstraintId id) const;
 
   // ---- Queries ----------------------------------------------------------------------------------------
   /// The fitted implicit function (global or local).
   const ImplicitFunction& function() const;
   /// The global function, or nullptr when the Mesher uses the local one.
-  const Rbf* global_function() const { return rbf_.get(); }
+  const Rbf* global_function() const;
   /// The local function, or nullptr when the Mesher uses the global one.
-  const LocalRbf* local_function() const { return local_.get(); }
-  /// Current constraints (for the local function built on demand after edits, O(N)).
+  const LocalRbf* local_function() const;
+  /// Current constraints, in increasing id order (constraint_ids() gives the ids): the order given at
+  /// construction followed by the adds, less the removed ones. For the local function built on demand
+  /// after edits, O(N).
   const Constraints& constraints() const;
+  /// Number of current constraints.
   std::size_t size() const;
   /// Diagonal of the bounding box of the current constraints (the unit of the CLI's precision).
   double diagonal() const;
@@ -270,10 +299,14 @@ class Mesher {
   void build();
   /// build() from the constraints' tetrahedralization made ahead (beside the fit).
   void build(SeedTetrahedralization&& seeds);
-  void after_edit(double rbf_seconds, double t_start, const ChangedRegion* region = nullptr);
+  /// The edit path, written once: `change_function` edits the function (it validates and throws before
+  /// anything changes) and returns the region it changed; an edit that puts a constraint at `moved_to`
+  /// (add, move; null otherwise) outside the domain rebuilds; else `change_vertex` updates the constraint's
+  /// Delaunay vertex and after_edit() the rest.
+  void edit(const std::function<ChangedRegion()>& change_function, const Point3* moved_to,
+            const std::function<void()>& change_vertex);
+  void after_edit(const ChangedRegion& region, double rbf_seconds, double t_start);
   bool rebuild_if_outside(const Point3& p, double t_start, double t_rbf);
-  double value_of(std::size_t i) const;
-  Point3 constraints_point(std::size_t i) const;
   void refine_quality();
   /// from_scan(): mesh_ finished by the scan support (components, open or closed, trimming).
   void finish_scan_surface();
@@ -286,34 +319,13 @@ class Mesher {
   void forget_zero(VertexId v);
 
   MesherOptions options_;
-  std::unique_ptr<Rbf> rbf_;         // the global function, or null; stable address: the polygonizer
-  std::unique_ptr<LocalRbf> local_;  // keeps a reference. Exactly one of the two is set.
+  std::unique_ptr<EditableFunction> function_;  // an Rbf or a LocalRbf; stable address: the polygonizer
+                                               // keeps a reference
   std::unique_ptr<Polygonizer> poly_;
   std::unique_ptr<QualityMesher> quality_;  // quality mode, built by the first refine()
-  /// The Delaunay vertex of each constraint (kNoVertex: its position duplicates another's), by constraint
-  /// index: stable slots and their ranks, so that removing constraint i (later indices shift down) costs
-  /// O(log n), not a shift of the array; compacted when dead slots outnumber live ones (amortized O(1)).
-  class ConstraintVertices {
-   public:
-    void assign(std::vector<VertexId> vertices) {
-      slots_ = std::move(vertices);
-      ranks_.reset(slots_.size());
-      live_ = slots_.size();
-    }
-    VertexId& operator[](std::size_t i) { return slots_[ranks_.select(i)]; }
-    void push_back(VertexId v) {
-      slots_.push_back(v);
-      ranks_.push_back_alive();
-      ++live_;
-    }
-    void erase(std::size_t i);
-
-   private:
-    std::vector<VertexId> slots_;
-    SlotRanks ranks_;
-    std::size_t live_ = 0;
-  };
-  ConstraintVertices vertex_of_;
+  /// The Delaunay vertex of each constraint, by id (kNoVertex: its position duplicates another seed's, or
+  /// the id was removed). 4 bytes per id ever given out.
+  std::vector<VertexId> vertex_of_;
   PointIndex zero_index_;            // on-surface constraints, keyed by their Delaunay vertex (support test)
   double precision_;
   SurfaceMesh mesh_;

@@ -17,6 +17,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
+#include "vitri/rbf/editable_function.hpp"
 #include "vitri/rbf/rbf.hpp"
 
 #include <cstddef>
@@ -60,18 +61,6 @@ struct LocalRbfOptions {
   unsigned threads = 0;
 };
 
-/// Where an edit changed f: f(x) is bitwise unchanged at every x outside every ball (and outside the
-/// domain cube's exterior when `everywhere`). `everywhere` is set when the edit refitted the whole
-/// function (e.g. a constraint moved outside the domain cube).
-struct ChangedRegion {
-  bool everywhere = false;
-  std::vector<Ball> balls;
-  /// True when x may have a different value after the edit.
-  bool contains(const Point3& x) const;
-  /// Bounding box of the balls (the whole space when everywhere; empty box when nothing changed).
-  Box3 bounds() const;
-};
-
 /// What the last fit or edit did.
 struct LocalFitReport {
   std::size_t constraints = 0;    ///< N
@@ -93,10 +82,12 @@ struct LocalFitReport {
   double patches_seconds = 0;
 };
 
-/// The local variational implicit function. Constraint numbering as vitri::Rbf: fit() order, add appends,
-/// remove shifts later indices down by one (like std::vector::erase), move and set_value keep indices.
+/// The local variational implicit function. Constraint ids as vitri::Rbf (EditableFunction,
+/// editable_function.hpp): fit() numbers the constraints 0..N-1, add_constraint() gives next_id(), ids are
+/// never reused and a removal changes no other id. An id is the constraint's storage slot: a removed
+/// constraint's slot stays (33 bytes) so that no id changes.
 /// Thread safety: const members may run concurrently; edits need exclusive access.
-class LocalRbf : public ImplicitFunction {
+class LocalRbf : public EditableFunction {
  public:
   LocalRbf();
   explicit LocalRbf(const Constraints& constraints, const LocalRbfOptions& options = {});
@@ -114,17 +105,23 @@ class LocalRbf : public ImplicitFunction {
   const LocalFitReport& fit(const Constraints& constraints, const LocalRbfOptions& options = {});
 
   bool fitted() const;
-  std::size_t size() const;
-  /// Current constraints in the public numbering (built on demand after edits, O(N), then cached).
-  const Constraints& constraints() const;
+  std::size_t size() const override;
+  /// Current constraints in increasing id order (built on demand after edits, O(N), then cached).
+  const Constraints& constraints() const override;
+  /// Their ids, in the same order. O(N).
+  std::vector<ConstraintId> constraint_ids() const override;
+  /// The id the next add_constraint() gives.
+  ConstraintId next_id() const override;
+  /// True when `id` names a live constraint. O(1).
+  bool contains(ConstraintId id) const override;
   /// Frees the copy that constraints() keeps (32 bytes per constraint; rebuilt by its next call): for
   /// callers that read the constraints once, e.g. the Mesher's seeds.
   void release_constraints_cache() const;
   /// Bounding box of the current constraints, O(N), without building constraints().
-  Box3 bounding_box() const;
-  /// Position and value of constraint i, O(log N). @throws InvalidPoint when i >= size().
-  Point3 point(std::size_t i) const;
-  double value_of(std::size_t i) const;
+  Box3 bounding_box() const override;
+  /// Position and value of constraint `id`, O(1). @throws UnknownConstraint.
+  Point3 point(ConstraintId id) const override;
+  double value_of(ConstraintId id) const override;
   const LocalRbfOptions& options() const;
   const LocalFitReport& report() const;
   /// The octree's root cube (the domain where patches live).
@@ -142,18 +139,18 @@ class LocalRbf : public ImplicitFunction {
   void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const override;
 
   // ----- edits: cost independent of N (amortized), each returns where f changed -----
-  // Errors leave the function unchanged.
-  /// Appends f(p) = value (index size() - 1). @throws InvalidPoint (index size()) for non-finite data or a
+  // Errors leave the function unchanged; they name constraints by id.
+  /// Adds f(p) = value under the id next_id(). @throws InvalidPoint (the new id) for non-finite data or a
   /// near-duplicate of an existing constraint.
-  ChangedRegion add_constraint(const Point3& p, double value);
-  /// Moves constraint i to p. @throws InvalidPoint (i) as add_constraint, or i out of range.
-  ChangedRegion move_constraint(std::size_t i, const Point3& p);
-  /// Removes constraint i (later indices shift down). @throws InvalidPoint for i out of range;
-  /// InvalidArgument when fewer than 4 constraints or only zero values would remain.
-  ChangedRegion remove_constraint(std::size_t i);
-  /// Sets the value of constraint i. @throws InvalidPoint (i) for a non-finite value or i out of range;
-  /// InvalidArgument when every value would be zero.
-  ChangedRegion set_value(std::size_t i, double value);
+  ChangedRegion add_constraint(const Point3& p, double value) override;
+  /// Moves constraint `id` to p. @throws UnknownConstraint; InvalidPoint (id) as add_constraint.
+  ChangedRegion move_constraint(ConstraintId id, const Point3& p) override;
+  /// Removes constraint `id` (no other id changes). @throws UnknownConstraint; InvalidArgument when
+  /// fewer than 4 constraints or only zero values would remain.
+  ChangedRegion remove_constraint(ConstraintId id) override;
+  /// Sets the value of constraint `id`. @throws UnknownConstraint; InvalidPoint (id) for a non-finite
+  /// value; InvalidArgument when every value would be zero.
+  ChangedRegion set_value(ConstraintId id, double value) override;
 
  private:
   struct Impl;

@@ -13,6 +13,7 @@
 
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
+#include "vitri/rbf/editable_function.hpp"
 
 #include <Eigen/Core>
 
@@ -125,14 +126,16 @@ struct FitReport {
 ///   vitri::Rbf f;
 ///   f.fit(constraints);                 // throws on bad input
 ///   double v = f.value({0, 0, 0});
-///   f.add_constraint({1, 2, 3}, 0.0);   // O(N^2)
+///   f.add_constraint({1, 2, 3}, 0.0);   // O(N^2); the new constraint's id is the old next_id()
 ///
-/// Constraint numbering: constraints are numbered 0..size()-1 in the order given to fit(), then
-/// add_constraint() appends (index size()), and remove_constraint(i) erases like std::vector::erase:
-/// constraints after i shift down by one. move_constraint and set_value keep every index.
+/// Constraint ids (EditableFunction, editable_function.hpp): fit() numbers the constraints 0..N-1 in the
+/// order given, add_constraint() gives next_id(), an id is never reused, and remove_constraint(id)
+/// changes no other id. constraints() holds the live constraints in increasing id order (the order of
+/// fit() and the adds: a removal shifts the later ones down by one position, like std::vector::erase).
+/// Every edit changes f everywhere: each returns ChangedRegion::whole().
 ///
 /// Thread safety: the const members (evaluation) may run concurrently; edits need exclusive access.
-class Rbf : public ImplicitFunction {
+class Rbf : public EditableFunction {
  public:
   Rbf();
   /// Shorthand for Rbf r; r.fit(constraints, options).
@@ -159,9 +162,20 @@ class Rbf : public ImplicitFunction {
   /// True after a successful fit().
   bool fitted() const;
   /// Number of constraints N.
-  std::size_t size() const;
-  /// Current constraints, in the numbering described in the class comment.
-  const Constraints& constraints() const;
+  std::size_t size() const override;
+  /// Current constraints, in increasing id order (see the class comment). O(1).
+  const Constraints& constraints() const override;
+  /// Their ids, in the same order. O(N).
+  std::vector<ConstraintId> constraint_ids() const override;
+  /// The id the next add_constraint() gives.
+  ConstraintId next_id() const override;
+  /// True when `id` names a live constraint.
+  bool contains(ConstraintId id) const override;
+  /// Position and value of constraint `id`. @throws UnknownConstraint.
+  Point3 point(ConstraintId id) const override;
+  double value_of(ConstraintId id) const override;
+  /// Bounding box of the constraints. O(N).
+  Box3 bounding_box() const override;
   /// Options of the last fit().
   const RbfOptions& options() const;
   /// Report of the last fit(), refit or drift check.
@@ -177,38 +191,39 @@ class Rbf : public ImplicitFunction {
                         Point3* gradients) const override;
 
   // ----- coefficients, in the caller's units -----
-  /// RBF weights w_j of f (one per constraint, same numbering), for the caller's coordinates.
+  /// RBF weights w_j of f (one per constraint, in the order of constraints()), for the caller's coordinates.
   std::vector<double> weights() const;
   /// Linear part: f(x) = sum_j w_j |x - c_j|^3 + constant + linear . x.
   double polynomial_constant() const;
   Point3 polynomial_linear() const;
 
-  // ----- edits: each O(N^2), keeping the Cholesky factor up to date -----
+  // ----- edits: each O(N^2), keeping the Cholesky factor up to date; each returns ChangedRegion::whole()
   // Every edit also throws NumericalError when the edited set cannot be fitted (relative residual above
   // fail_residual even after a refit from scratch, as fit() would throw); the function is then refitted
-  // to the constraints before the edit. Other errors leave the function exactly unchanged.
-  /// Appends the constraint f(p) = value; it gets index size() - 1.
-  /// @throws InvalidPoint (index size()) for non-finite data or a (near-)duplicate of an existing point.
-  void add_constraint(const Point3& p, double value);
-  /// Removes constraint i; the constraints after it shift down by one (std::vector::erase).
-  /// @throws InvalidPoint when i >= size(); InvalidArgument when fewer than 4 non-coplanar constraints
-  ///         or only zero values would remain (the function is then left unchanged).
-  void remove_constraint(std::size_t i);
-  /// Moves constraint i to p, keeping its value and index. Same errors as add_constraint (index i), and
-  /// InvalidPoint(i) when all constraints would then be coplanar. Succeeds exactly when a fresh fit of the
-  /// moved set would (up to the coplanarity tolerance), also when every other constraint is coplanar
-  /// (e.g. N = 4).
-  void move_constraint(std::size_t i, const Point3& p);
-  /// Sets the value of constraint i. @throws InvalidPoint for a non-finite value or i out of range;
-  /// InvalidArgument when every value would be zero.
-  void set_value(std::size_t i, double value);
+  // to the constraints before the edit. Other errors leave the function exactly unchanged. Errors name
+  // constraints by id.
+  /// Adds the constraint f(p) = value under the id next_id() (last in constraints()).
+  /// @throws InvalidPoint (the new id) for non-finite data or a (near-)duplicate of an existing point.
+  ChangedRegion add_constraint(const Point3& p, double value) override;
+  /// Removes constraint `id`; no other id changes (the later constraints move down one position in
+  /// constraints()). @throws UnknownConstraint; InvalidArgument when fewer than 4 non-coplanar
+  /// constraints or only zero values would remain (the function is then left unchanged).
+  ChangedRegion remove_constraint(ConstraintId id) override;
+  /// Moves constraint `id` to p, keeping its value and id. Same errors as add_constraint (naming `id`),
+  /// UnknownConstraint, and InvalidPoint(id) when all constraints would then be coplanar. Succeeds exactly
+  /// when a fresh fit of the moved set would (up to the coplanarity tolerance), also when every other
+  /// constraint is coplanar (e.g. N = 4).
+  ChangedRegion move_constraint(ConstraintId id, const Point3& p) override;
+  /// Sets the value of constraint `id`. @throws UnknownConstraint; InvalidPoint (id) for a non-finite
+  /// value; InvalidArgument when every value would be zero.
+  ChangedRegion set_value(ConstraintId id, double value) override;
 
   /// Computes the residual of the current weights (O(N^2)); when it exceeds options().warn_residual,
   /// applies iterative refinement and, if still inaccurate, refits from scratch. Updates report().
   /// Called automatically every options().drift_check_interval edits.
   /// @return true when a refit from scratch was needed.
   bool check_drift();
-  /// Refits from scratch from the current constraints (O(N^3)).
+  /// Refits from scratch from the current constraints (O(N^3)); the ids stay.
   void refit();
   /// Number of edits since the last full factorization (fit or refit).
   std::size_t edits_since_fit() const;

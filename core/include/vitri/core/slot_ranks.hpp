@@ -2,8 +2,9 @@
 /// @file slot_ranks.hpp
 /// SlotRanks: a public numbering (0..n-1, later indices shift down on removal) over stable storage slots.
 /// Slots are never reordered; a removed element's slot is marked dead, so element i is the i-th live
-/// slot. A Fenwick tree over the live flags answers both directions in O(log n). Used by the local RBF
-/// (constraint slots) and the Mesher (the Delaunay vertex of each constraint).
+/// slot. A Fenwick tree over the live flags answers both directions in O(log n). The library names
+/// constraints by stable ids (no shifting numbering); the studio uses this for its HTTP API's indices,
+/// positions in the page's list, over the Mesher's constraint ids (apps/studio/session.hpp).
 
 #include <cassert>
 #include <cstddef>

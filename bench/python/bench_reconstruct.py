@@ -9,7 +9,9 @@ The points: --points samples of the model, area-uniform with the faces' normals 
 a binary PLY without faces (oriented points). Both sides do the same work: read that file, reconstruct
 with the default options, write the mesh as binary PLY. Reported per run: the process's wall time
 (interpreter start and imports included for Python), its peak RSS (wait4's ru_maxrss), and for Python the
-time of the reconstruct() call alone. Overhead = Python / CLI - 1 on the medians.
+time of the reconstruct() call alone. Overhead = Python / CLI - 1 on the medians. Also the peak of a Python
+process that only imports vitri and reads the points (the interpreter's own memory and the user's arrays):
+the Python peak less the CLI's and less that baseline is what the binding itself adds.
 """
 import argparse
 import os
@@ -92,6 +94,9 @@ def main():
                 py.append((wall, rss))
                 calls.append(float(out.split()[3]))
             print(f"round {r} {who:3s}: {wall:7.2f} s, peak {rss:7.0f} MB", flush=True)
+    # The interpreter, numpy and the module, and the points read into numpy: what the Python process holds
+    # besides the library's work (its peak over the CLI's, less this, is what the binding adds).
+    _, base, _ = run([sys.executable, "-c", "import sys, vitri; d = vitri.read(sys.argv[1])", src])
     a, b = vitri.read(cli_out), vitri.read(py_out)
     same = np.array_equal(a.faces, b.faces) and np.array_equal(a.vertices, b.vertices)
     cw, pw = statistics.median(w for w, _ in cli), statistics.median(w for w, _ in py)
@@ -102,6 +107,8 @@ def main():
           f"reconstruct() alone {statistics.median(calls):.2f} s")
     print(f"overhead: time {100 * (pw / cw - 1):+.1f}%, peak memory {pm - cm:+.0f} MB ({100 * (pm / cm - 1):+.1f}%); "
           f"same mesh file content: {same}")
+    print(f"Python baseline (interpreter, numpy, vitri, the points read): peak {base:.0f} MB; "
+          f"Python peak - CLI peak - baseline: {pm - cm - base:+.0f} MB")
 
 
 if __name__ == "__main__":

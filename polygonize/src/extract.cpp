@@ -17,9 +17,9 @@ namespace vitri {
 
 namespace {
 
-TrackerInput tracker_input(const Triangulation& tri, const std::vector<double>& values,
+TrackerInput tracker_input(const Triangulation& tri, const VertexMap<double>& values,
                            const std::vector<TetId>& transverse, const ImplicitFunction& f,
-                           const std::vector<Point3>& gradients, const PolygonizerOptions& options) {
+                           const VertexMap<Point3>& gradients, const PolygonizerOptions& options) {
   TrackerInput in{tri, values, transverse, f, {}, options.snap_zero_vertices, options.snap_fraction,
                   options.warm_start_roots};
   // The vertices' gradients are kept current only for the thin-feature test (Polygonizer::grad_).
@@ -61,7 +61,7 @@ const LiveMesh& Polygonizer::live_surface() const { return surface_->mesh(); }
 SurfaceMesh Polygonizer::extract_fresh() {
   evaluate_pending();
   const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, grad_, options_);
-  SurfaceTracker fresh;
+  SurfaceTracker fresh(tri_);
   fresh.update(in);
   return fresh.mesh().to_surface_mesh();
 }

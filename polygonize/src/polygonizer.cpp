@@ -50,6 +50,8 @@ namespace {
 
 using namespace polygonizer_detail;
 
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();  // grad_ of a vertex not evaluated yet
+
 /// The Delaunay tree's options as the polygonizer's options ask (history kept or not, bulk threads).
 TriangulationOptions triangulation_options(const PolygonizerOptions& options) {
   TriangulationOptions t;
@@ -66,7 +68,8 @@ constexpr std::size_t kCreatedSliceMin = std::size_t(1) << 12;   // of classify_
 
 /// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
 /// removal swaps the last element in. @pre x is not listed (on) or listed (off).
-void set_listed(std::vector<std::uint32_t>& list, std::vector<std::uint32_t>& pos, std::uint32_t x, bool on) {
+template <typename PosMap>  // a VertexMap or TetMap of std::uint32_t
+void set_listed(std::vector<std::uint32_t>& list, PosMap& pos, std::uint32_t x, bool on) {
   if (on) {
     pos[x] = static_cast<std::uint32_t>(list.size());
     list.push_back(x);
@@ -180,7 +183,16 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
       options_(options),
       tri_(std::move(seeds.tri)),
       precision_(std::numeric_limits<double>::infinity()),
-      surface_(std::make_unique<SurfaceTracker>()) {
+      values_(tri_, 0.0),
+      kind_(tri_, VertexKind::Refinement),
+      fixed_(tri_, 0),
+      tcount_(tri_, 0),
+      tpos_(tri_, kNotListed, TetRenumbering::Reset),
+      radius_(tri_, 0.0, TetRenumbering::Reset),
+      lpos_(tri_, kNotListed),
+      neck_mark_(tri_, 0),
+      surface_(std::make_unique<SurfaceTracker>(tri_)),
+      grad_(tri_, Point3{kNaN, kNaN, kNaN}) {
   const auto t0 = Clock::now();
   check_options(options_);  // (the closing band was checked by closed_'s initializer)
   if (tri_.keeps_history() != options_.keep_history)
@@ -193,9 +205,8 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
   stats_.init_insert_seconds = seeds.insert_seconds;
   stats_.init_canonical_seconds = seeds.canonical_seconds;
   const auto t2 = Clock::now();
-  grow_vertex_arrays();
   for (VertexId v = 0; v < 8; ++v) {
-    kind_[v] = static_cast<std::uint8_t>(VertexKind::Corner);
+    kind_[v] = VertexKind::Corner;
     pending_.push_back(v);
   }
   seed_vertices_.assign(inserted.size(), kNoVertex);
@@ -205,7 +216,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
   for (std::size_t i = 0; i < inserted.size(); ++i) {
     if (inserted[i].status != InsertStatus::Inserted) continue;
     const VertexId v = inserted[i].vertex;
-    kind_[v] = static_cast<std::uint8_t>(VertexKind::Seed);
+    kind_[v] = VertexKind::Seed;
     seed_vertices_[i] = v;
     if (!seed_values.empty() && !std::isnan(seed_values[i])) {
       set_value(v, seed_values[i]);
@@ -221,33 +232,10 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
   evaluate_pending();
   stats_.init_evaluate_seconds = seconds_since(t2);
   const auto t3 = Clock::now();
-  grow_tet_arrays();
   classify_all();
   settle_zeros({});
   stats_.init_classify_seconds = seconds_since(t3);
   stats_.init_seconds = seeds.insert_seconds + seeds.canonical_seconds + seconds_since(t0);
-}
-
-void Polygonizer::grow_vertex_arrays() {
-  const std::size_t n = tri_.vertex_capacity();
-  if (values_.size() >= n) return;
-  // resize(n) and not to twice the size: std::vector grows its capacity geometrically by itself, and only
-  // the first n elements are written (and so resident).
-  values_.resize(n, 0.0);
-  kind_.resize(n, static_cast<std::uint8_t>(VertexKind::Refinement));
-  fixed_.resize(n, 0);
-  tcount_.resize(n, 0);
-  lpos_.resize(n, kNotListed);
-  neck_mark_.resize(n, 0);
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  grad_.resize(n, Point3{nan, nan, nan});
-}
-
-void Polygonizer::grow_tet_arrays() {
-  const std::size_t n = tri_.tet_capacity();
-  if (tpos_.size() >= n) return;
-  tpos_.resize(n, kNotListed);
-  radius_.resize(n, 0.0);
 }
 
 // Vertices whose evaluation is due: every live vertex without a fixed value, and with
@@ -359,7 +347,7 @@ void Polygonizer::set_transverse(TetId t, bool on) {
       if (--tcount_[u] != 0) continue;
       // The vertex may have become a lone zero (decided after the batch), or garbage.
       if (values_[u] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(u);
-      if (kind_[u] == static_cast<std::uint8_t>(VertexKind::Refinement)) idle_.push_back(u);
+      if (kind_[u] == VertexKind::Refinement) idle_.push_back(u);
     }
   }
 }
@@ -390,7 +378,7 @@ void Polygonizer::set_lonely(VertexId v, bool on) {
   // (collect_garbage() dropped them while they served).
   for (const TetId t : tri_.incident_tetrahedra(v))
     for (const VertexId u : tri_.tet_vertices(t))
-      if (kind_[u] == static_cast<std::uint8_t>(VertexKind::Refinement) && tcount_[u] == 0) idle_.push_back(u);
+      if (kind_[u] == VertexKind::Refinement && tcount_[u] == 0) idle_.push_back(u);
 }
 
 bool Polygonizer::touches_lonely(TetId t) const {
@@ -436,14 +424,13 @@ void Polygonizer::on_killed(const ChangeSet& cs) {
     // edited tetrahedra): drop the per-tetrahedron state; cs.created lists every live tetrahedron and
     // the caller classifies them (O(n), amortized O(1) per edit). Vertex state is kept.
     surface_->note_renumbered();
-    tlist_.clear();
-    std::fill(tpos_.begin(), tpos_.end(), kNotListed);
-    std::fill(tcount_.begin(), tcount_.end(), 0u);
+    tlist_.clear();  // tpos_ and radius_ were reset by the tree (TetRenumbering::Reset)
+    tcount_.fill(0u);
     clear_queue();
     thin_all_ = true;
     idle_.clear();  // every refinement vertex is a candidate again until classified
     for (VertexId v = 8; v < tri_.vertex_capacity(); ++v)
-      if (tri_.is_vertex(v) && kind_[v] == static_cast<std::uint8_t>(VertexKind::Refinement)) idle_.push_back(v);
+      if (tri_.is_vertex(v) && kind_[v] == VertexKind::Refinement) idle_.push_back(v);
     return;
   }
   for (const TetId t : cs.killed) {
@@ -505,7 +492,6 @@ void Polygonizer::classify_all() {
 // this thread, as classify() one tetrahedron after the other would. An id may appear twice (created,
 // killed and reused within the round): both entries see its final tetrahedron, as before.
 void Polygonizer::classify_created(std::vector<TetId>& created) {
-  grow_tet_arrays();
   struct Ahead {
     double radius = 0;  // when transverse
     bool live = false, transverse = false;
@@ -576,9 +562,7 @@ bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, Ve
   InsertResult r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
   if (r.status == InsertStatus::NotInConflict) r = tri_.insert(p, min_distance, &changes_);
   if (r.status != InsertStatus::Inserted) return false;
-  grow_vertex_arrays();
-  grow_tet_arrays();
-  kind_[r.vertex] = static_cast<std::uint8_t>(kind);
+  kind_[r.vertex] = kind;
   if (kind == VertexKind::Refinement) idle_.push_back(r.vertex);  // until a transverse tetrahedron holds it
   fixed_[r.vertex] = 0;
   tcount_[r.vertex] = 0;
@@ -659,10 +643,9 @@ void Polygonizer::sample(double radius) {
                            box.lo.y + ext.y * (static_cast<double>(j) + 0.5) / static_cast<double>(n[1]),
                            box.lo.z + ext.z * (static_cast<double>(k) + 0.5) / static_cast<double>(n[2])});
   const std::vector<InsertResult> res = tri_.insert_points(lattice, 0.0, nullptr);
-  grow_vertex_arrays();
   for (const InsertResult& r : res) {
     if (r.status != InsertStatus::Inserted) continue;  // coincides with a seed
-    kind_[r.vertex] = static_cast<std::uint8_t>(VertexKind::Sampling);
+    kind_[r.vertex] = VertexKind::Sampling;
     pending_.push_back(r.vertex);
     ++stats_.insertions;
   }

@@ -84,7 +84,6 @@ SurfaceTracker::CornerBuckets SurfaceTracker::bucket_corners(const TrackerInput&
                                                              const std::vector<TetId>& tets) {
   const std::size_t n = tets.size();
   const std::size_t nv = in.tri.vertex_capacity();
-  if (!tets.empty() && polygon_of_.size() <= tets.back()) polygon_of_.resize(tets.back() + 1, kNone);
   // Smaller builds run on one thread; the counting rows (4 bytes per vertex and slice) limit the slices.
   const std::size_t slices = std::min(slice_count(in.threads, n, kTrackerSliceMin), kMaxCountingSlices);
   // The cell of each sign pattern (bit i: vertex i negative), and each tetrahedron's pattern (kDead when

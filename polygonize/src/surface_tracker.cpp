@@ -8,6 +8,7 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <functional>
@@ -43,7 +44,6 @@ void SurfaceTracker::note_tet(std::vector<TetId>& list, TetId t) {
 
 // Stamps carry the number of the coming update (epoch_ + 1).
 void SurfaceTracker::note_value(VertexId v) {
-  grow_vertex_arrays(static_cast<std::size_t>(v) + 1);
   if (stamp_[v] == epoch_ + 1) return;
   stamp_[v] = epoch_ + 1;
   touched_.push_back(v);
@@ -55,23 +55,7 @@ void SurfaceTracker::note_moved(VertexId v) {
   moved_stamp_[v] = epoch_ + 1;
 }
 
-std::uint32_t& SurfaceTracker::polygon_of(TetId t) {
-  if (t >= polygon_of_.size()) polygon_of_.resize(t + 1, kNone);  // the capacity grows geometrically
-  return polygon_of_[t];
-}
-
-void SurfaceTracker::grow_vertex_arrays(std::size_t n) {
-  if (collapsed_.size() >= n) return;
-  // resize(n): std::vector grows its capacity geometrically; only the n elements written are resident.
-  collapsed_.resize(n, 0);
-  zero_out_.resize(n, kNone);
-  anchored_.resize(n, 0);
-  stamp_.resize(n, 0);
-  moved_stamp_.resize(n, 0);
-  decide_stamp_.resize(n, 0);
-  snap_at_.resize(n);
-  snap_known_.resize(n, 0);
-}
+std::uint32_t& SurfaceTracker::polygon_of(TetId t) { return polygon_of_[t]; }
 
 std::uint32_t SurfaceTracker::corner_identity(std::uint32_t e) const {
   const VertexId a = edges_[e].anchor;
@@ -81,9 +65,9 @@ std::uint32_t SurfaceTracker::corner_identity(std::uint32_t e) const {
 void SurfaceTracker::update(const TrackerInput& in) {
   report_ = {};
   ++epoch_;
-  grow_vertex_arrays(in.tri.vertex_capacity());
+  assert(collapsed_.size() == in.tri.vertex_capacity() && polygon_of_.size() == in.tri.tet_capacity());
   for (const VertexId v : touched_) snap_known_[v] = 0;
-  if (rebuild_) std::fill(snap_known_.begin(), snap_known_.end(), 0);
+  if (rebuild_) snap_known_.fill(0);
   Work w;
   using Clock = std::chrono::steady_clock;
   auto lap = [t = Clock::now()]() mutable {
@@ -133,10 +117,10 @@ void SurfaceTracker::reset_all(const TrackerInput& in, Work& w) {
   free_edges_.clear();
   polygons_.clear();
   free_polygons_.clear();
-  std::fill(polygon_of_.begin(), polygon_of_.end(), kNone);
-  std::fill(collapsed_.begin(), collapsed_.end(), 0);
-  std::fill(zero_out_.begin(), zero_out_.end(), kNone);
-  std::fill(anchored_.begin(), anchored_.end(), 0);
+  polygon_of_.fill(kNone);
+  collapsed_.fill(0);
+  zero_out_.fill(kNone);
+  anchored_.fill(0);
   owner_.clear();
   num_collapsed_ = num_anchored_ = 0;
   max_edge_ = 0.0;

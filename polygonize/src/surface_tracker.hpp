@@ -23,6 +23,7 @@
 #include "marching.hpp"
 
 #include "vitri/core/implicit.hpp"
+#include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
 
@@ -39,7 +40,7 @@ namespace vitri {
 /// What the tracker reads from its Polygonizer during update().
 struct TrackerInput {
   const Triangulation& tri;
-  const std::vector<double>& values;       ///< per Delaunay vertex
+  const VertexMap<double>& values;         ///< per Delaunay vertex
   const std::vector<TetId>& transverse;    ///< live transverse tetrahedra
   const ImplicitFunction& f;
   marching::RootSettings roots;
@@ -56,7 +57,7 @@ struct TrackerInput {
   bool bulk_full_build = true;
   /// Per Delaunay vertex: f's gradient there where the Polygonizer knows it (NaN: unknown), or null.
   /// The normal of a mesh vertex collapsed onto a zero-valued vertex is read there instead of evaluated.
-  const std::vector<Point3>* gradients = nullptr;
+  const VertexMap<Point3>* gradients = nullptr;
 };
 
 /// Counters of the last update().
@@ -82,6 +83,19 @@ class SurfaceTracker {
   static constexpr std::size_t kLookaheadSlice = std::size_t(1) << 11;
   /// Stars the lookahead walks together (Triangulation::incident_tetrahedra of several vertices).
   static constexpr std::size_t kStarChunk = 64;
+
+  /// A tracker of the tetrahedra of `tri`, whose per-vertex and per-tetrahedron state are property maps
+  /// of `tri` (registered here: a structural change). update() must be given this triangulation.
+  explicit SurfaceTracker(Triangulation& tri)
+      : polygon_of_(tri, kNone, TetRenumbering::Reset),
+        collapsed_(tri, 0),
+        zero_out_(tri, kNone),
+        anchored_(tri, 0),
+        stamp_(tri, 0),
+        moved_stamp_(tri, 0),
+        decide_stamp_(tri, 0),
+        snap_at_(tri),
+        snap_known_(tri, 0) {}
 
   // ---- What changed (called by the Polygonizer as it edits) -----------------------------------------
   // Tetrahedra are listed until the lists outgrow the mesh (a refinement), then the next update sweeps
@@ -244,7 +258,6 @@ class SurfaceTracker {
   void retire_triangles(Work& w);
   bool normal_from_vertex(const TrackerInput& in, std::uint32_t v);
   void refresh_vertices(const TrackerInput& in, Work& w);
-  void grow_vertex_arrays(std::size_t n);
   std::uint32_t& polygon_of(TetId t);
   // Identity of a corner for merging: the edge slot, or kZeroTag | z when collapsed onto z.
   std::uint32_t corner_identity(std::uint32_t e) const;
@@ -265,22 +278,24 @@ class SurfaceTracker {
   std::vector<std::uint32_t> free_edges_;
   std::vector<Polygon> polygons_;
   std::vector<std::uint32_t> free_polygons_;
-  std::vector<std::uint32_t> polygon_of_;  // per TetId: polygon slot or kNone
+  // Property maps of the triangulation (property_map.hpp): sized by it, so never grown here. Reset when it
+  // renumbers its tetrahedra: the next update rebuilds everything then (note_renumbered()).
+  TetMap<std::uint32_t> polygon_of_;  // polygon slot or kNone
   // Per Delaunay vertex: snapping state.
-  std::vector<std::uint8_t> collapsed_;    // its anchored crossings are merged into zero_out_
-  std::vector<std::uint32_t> zero_out_;    // LiveMesh vertex at the Delaunay vertex, or kNone
-  std::vector<std::uint32_t> anchored_;    // number of edges anchored at it
-  std::vector<std::uint32_t> stamp_;       // update number when last touched / moved
-  std::vector<std::uint32_t> moved_stamp_;
-  std::vector<std::uint32_t> decide_stamp_;  // update number when offered for a decision
+  VertexMap<std::uint8_t> collapsed_;     // its anchored crossings are merged into zero_out_
+  VertexMap<std::uint32_t> zero_out_;     // LiveMesh vertex at the Delaunay vertex, or kNone
+  VertexMap<std::uint32_t> anchored_;     // number of edges anchored at it
+  VertexMap<std::uint32_t> stamp_;        // update number when last touched / moved
+  VertexMap<std::uint32_t> moved_stamp_;
+  VertexMap<std::uint32_t> decide_stamp_;  // update number when offered for a decision
   std::uint32_t epoch_ = 1;
   std::size_t num_collapsed_ = 0, num_anchored_ = 0;  // vertices collapsed / with anchored edges
   // Owner of each LiveMesh vertex: an edge slot, or kZeroTag | Delaunay vertex.
   std::vector<std::uint32_t> owner_;
   // Per Delaunay vertex: snap_target() for f(z) != 0, cached when snap_known_[z] (until z's value or
   // position changes; a flat array: the collapse tests read it at every lower collapsed corner).
-  std::vector<Point3> snap_at_;
-  std::vector<std::uint8_t> snap_known_;
+  VertexMap<Point3> snap_at_;
+  VertexMap<std::uint8_t> snap_known_;
   // can_collapse(z) scratch: the star of z (read again by decide_snapping when z's decision changes)
   // and the directed link edges.
   std::vector<TetId> star_;

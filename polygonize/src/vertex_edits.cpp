@@ -25,17 +25,15 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
   changes_.clear();
   InsertResult r = tri_.insert(p, 0.0, &changes_);
   if (r.status != InsertStatus::Inserted) {
-    const auto k = static_cast<VertexKind>(kind_[r.nearest]);
+    const auto k = kind_[r.nearest];
     if (k != VertexKind::Sampling && k != VertexKind::Refinement) return kNoVertex;
     remove_vertex(r.nearest);
     changes_.clear();
     r = tri_.insert(p, 0.0, &changes_);
     if (r.status != InsertStatus::Inserted) return kNoVertex;
   }
-  grow_vertex_arrays();
-  grow_tet_arrays();
   const VertexId v = r.vertex;
-  kind_[v] = static_cast<std::uint8_t>(kind);
+  kind_[v] = kind;
   tcount_[v] = 0;
   if (kind == VertexKind::Refinement) idle_.push_back(v);
   fixed_[v] = value ? 1 : 0;
@@ -66,7 +64,7 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
   InsertResult r = tri_.move(v, p, 0.0, &changes_);
   if (r.status != InsertStatus::Inserted) {
     absorb_renumbering();  // nothing moved, but the tetrahedra may have been renumbered first
-    const auto k = static_cast<VertexKind>(kind_[r.nearest]);
+    const auto k = kind_[r.nearest];
     if (r.nearest == v) return true;  // moved onto itself
     if (k != VertexKind::Sampling && k != VertexKind::Refinement) return false;
     remove_vertex(r.nearest);
@@ -77,7 +75,6 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
       return false;
     }
   }
-  grow_tet_arrays();
   surface_->note_moved(v);
   note_thin_vertex(v);  // its star changed shape
   if (value) {

@@ -111,7 +111,7 @@ void check_state(Polygonizer& poly, Client& client, long long euler) {
 /// anchored crossings.
 struct SphereSamples {
   Triangulation tri{Box3{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}}};
-  std::vector<double> values;
+  VertexMap<double> values{tri, 0.0};  // a property map of tri, as the Polygonizer's (trackers read it)
   std::vector<TetId> transverse;
   SphereSamples(const ImplicitFunction& f, const Point3& c, int n, double offset, int jitter_every,
                 double jitter) {
@@ -125,7 +125,6 @@ struct SphereSamples {
       seeds.push_back(c + (k % 2 == 0 ? 1.0 + offset : 1.0 - offset) * u);
     }
     tri.insert_points(seeds);
-    values.assign(tri.vertex_capacity(), 0.0);
     for (VertexId v = 0; v < tri.vertex_capacity(); ++v)
       if (tri.is_vertex(v)) values[v] = f.value(tri.point(v));
     for (const TetId t : tri.live_tetrahedra()) {
@@ -518,10 +517,10 @@ TEST_CASE("collapse decisions looked ahead on the threads equal those made one a
   // tracker gathers stars and fans ahead on two threads; the same input decided one vertex at a time
   // must give the same mesh, bit for bit.
   const QuadricSphereFunction f({0.1, -0.05, 0.02}, 1.0);
-  const SphereSamples s(f, {0.1, -0.05, 0.02}, 6000, 0.03, 0, 0.0);
+  SphereSamples s(f, {0.1, -0.05, 0.02}, 6000, 0.03, 0, 0.0);  // the trackers register maps with s.tri
   TrackerInput in{s.tri, s.values, s.transverse, f, {}, true, 0.01, false};
   in.threads = 2;
-  SurfaceTracker ahead, one_by_one;
+  SurfaceTracker ahead(s.tri), one_by_one(s.tri);
   ahead.update(in);
   in.snap_lookahead = false;
   one_by_one.update(in);
@@ -579,12 +578,12 @@ TEST_CASE("a full build in bulk passes equals the step-by-step build, ids and bi
   // Every 7th sample slightly off the sphere: its crossings are anchored at a vertex with f != 0 (a
   // Newton target, cached by its collapse test).
   const QuadricSphereFunction f({0.1, -0.05, 0.02}, 1.0);
-  const SphereSamples s(f, {0.1, -0.05, 0.02}, 8000, 0.02, 7, 1e-4);
+  SphereSamples s(f, {0.1, -0.05, 0.02}, 8000, 0.02, 7, 1e-4);  // the trackers register maps with s.tri
   const std::vector<TetId>& transverse = s.transverse;
   TrackerInput in{s.tri, s.values, transverse, f, {}, true, 0.01, false};
   in.threads = 1;
   in.bulk_full_build = false;
-  SurfaceTracker steps;
+  SurfaceTracker steps(s.tri);
   steps.update(in);
   const SurfaceMesh expected = steps.mesh().to_surface_mesh();
   REQUIRE(steps.report().snapped > 1000);
@@ -593,7 +592,7 @@ TEST_CASE("a full build in bulk passes equals the step-by-step build, ids and bi
     INFO(threads << " threads");
     in.threads = threads;
     in.bulk_full_build = true;
-    SurfaceTracker bulk;
+    SurfaceTracker bulk(s.tri);
     bulk.update(in);
     REQUIRE(bulk.report().snapped == steps.report().snapped);
     REQUIRE(bulk.report().offset == steps.report().offset);

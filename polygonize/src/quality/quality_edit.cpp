@@ -206,7 +206,6 @@ void QualityMesher::function_changed(const Box3& region) {
   // Circumcentres inside the region get new values (their tetrahedra are classified again). A facet whose
   // two circumcentres are outside keeps its sign test (f did not change there); it is classified again
   // only when its ball centre, a root of the old f on its Voronoi edge, is inside the region.
-  grow_tet_arrays();
   tri_.for_each_tetrahedron([&](TetId t) {
     if (std::isnan(cvalue_[t])) return;  // not evaluated yet (already pending)
     if (region.contains(ccenter_[t])) {

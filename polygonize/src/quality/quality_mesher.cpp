@@ -27,7 +27,16 @@ namespace vitri {
 
 QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                              const QualityOptions& options)
-    : f_(f), options_(options), tri_(domain), diagonal_(domain.diagonal()) {
+    : f_(f),
+      options_(options),
+      tri_(domain),
+      diagonal_(domain.diagonal()),
+      cvalue_(tri_, std::numeric_limits<double>::quiet_NaN(), TetRenumbering::Reset),
+      ccenter_(tri_, Point3{}, TetRenumbering::Reset),
+      pending_(tri_, 0, TetRenumbering::Reset),
+      rflags_(tri_, 0, TetRenumbering::Reset),
+      on_surface_(tri_, 0),
+      dirty_(tri_, 0) {
   validate(options_);
   for (std::size_t i = 0; i < seeds.size(); ++i)
     if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed is not finite");
@@ -37,7 +46,6 @@ QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, cons
   for (std::size_t i = 0; i < projected.size(); ++i)
     if (ok[i] && inside_domain(projected[i])) kept.push_back(projected[i]);
   const std::vector<InsertResult> inserted = tri_.insert_points(kept, 0.0, nullptr);
-  grow_vertex_arrays();
   for (const InsertResult& r : inserted) {
     if (r.status != InsertStatus::Inserted) continue;
     on_surface_[r.vertex] = 1;
@@ -82,22 +90,6 @@ QualityStats QualityMesher::stats() const {
   return s;
 }
 
-void QualityMesher::grow_tet_arrays() {
-  const std::size_t n = tri_.tet_capacity();
-  if (cvalue_.size() >= n) return;
-  cvalue_.resize(n, std::numeric_limits<double>::quiet_NaN());
-  ccenter_.resize(n);
-  pending_.resize(n, 0);
-  rflags_.resize(n, 0);
-}
-
-void QualityMesher::grow_vertex_arrays() {
-  const std::size_t n = tri_.vertex_capacity();
-  if (on_surface_.size() >= n) return;
-  on_surface_.resize(n, 0);
-  dirty_.resize(n, 0);
-}
-
 void QualityMesher::mark_vertex_dirty(VertexId v) {
   if (dirty_[v]) return;
   dirty_[v] = 1;
@@ -119,11 +111,9 @@ void QualityMesher::forget_all_facets() {
   unprobed_.clear();
   old_facets_.clear();
   edge_probes_.clear();
-  grow_tet_arrays();
-  grow_vertex_arrays();
-  std::fill(cvalue_.begin(), cvalue_.end(), std::numeric_limits<double>::quiet_NaN());
-  std::fill(pending_.begin(), pending_.end(), std::uint8_t(0));
-  std::fill(rflags_.begin(), rflags_.end(), std::uint8_t(0));
+  cvalue_.fill(std::numeric_limits<double>::quiet_NaN());
+  pending_.fill(0);
+  rflags_.fill(0);
   pending_list_.clear();
   tri_.for_each_tetrahedron([this](TetId t) { mark_pending(t); });
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
@@ -133,8 +123,6 @@ void QualityMesher::forget_all_facets() {
 // Applies the change set of one Delaunay operation: facets of killed tetrahedra are forgotten (those on
 // the boundary of the changed region come back with the created tetrahedra, with their new Voronoi edge).
 void QualityMesher::absorb(const ChangeSet& cs) {
-  grow_tet_arrays();
-  grow_vertex_arrays();
   if (cs.renumbered) {
     forget_all_facets();
     return;
@@ -184,7 +172,6 @@ bool QualityMesher::insert_point(const Point3& p, const FacetRecord* facet) {
     ++stats_.rejected;
     return false;
   }
-  grow_vertex_arrays();
   on_surface_[res.vertex] = 1;
   ++stats_.insertions;
   absorb(changes_);

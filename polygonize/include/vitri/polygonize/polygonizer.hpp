@@ -24,6 +24,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
+#include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/box_closure.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
@@ -358,7 +359,7 @@ class Polygonizer {
   double closing_band() const { return closed_ ? closed_->band() : 0.0; }
   /// The stored value at vertex v (f(v) or its fixed value).
   double vertex_value(VertexId v) const { return values_[v]; }
-  VertexKind vertex_kind(VertexId v) const { return static_cast<VertexKind>(kind_[v]); }
+  VertexKind vertex_kind(VertexId v) const { return kind_[v]; }
   /// Delaunay vertex of seed i (kNoVertex when seed i duplicated an earlier one).
   const std::vector<VertexId>& seed_vertices() const { return seed_vertices_; }
   /// Live transverse tetrahedra (unordered).
@@ -397,8 +398,6 @@ class Polygonizer {
   /// After the queue drained: neck checks and their points until none is left (false: cancelled).
   bool settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info);
   bool is_negative_value(VertexId v) const { return values_[v] < 0.0; }  // sign(0) = +
-  void grow_vertex_arrays();
-  void grow_tet_arrays();
   bool needs_evaluation(VertexId v) const;
   void refresh_at(VertexId v);
   void evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out);
@@ -444,19 +443,22 @@ class Polygonizer {
   PolygonizerOptions options_;
   Triangulation tri_;
   double precision_;
-  std::vector<double> values_;          // per vertex id
-  std::vector<std::uint8_t> kind_;      // VertexKind per vertex id
-  std::vector<std::uint8_t> fixed_;     // 1 when values_ is a fixed value (constraint)
-  std::vector<std::uint32_t> tcount_;   // per vertex: incident transverse tetrahedra
-  std::vector<std::uint32_t> tpos_;     // per tet: index in tlist_, or kNotListed
+  // Per-element state: property maps of tri_ (vitri/delaunay/property_map.hpp), grown by tri_ with its
+  // capacities, so declared after it. The per-tetrahedron maps are reset when tri_ renumbers its
+  // tetrahedra (on_killed() drops that state then: TetRenumbering::Reset).
+  VertexMap<double> values_;            // f(v), or its fixed value
+  VertexMap<VertexKind> kind_;          // new ids: Refinement until the inserting code says otherwise
+  VertexMap<std::uint8_t> fixed_;       // 1 when values_ is a fixed value (constraint)
+  VertexMap<std::uint32_t> tcount_;     // incident transverse tetrahedra
+  TetMap<std::uint32_t> tpos_;          // index in tlist_, or kNotListed
   std::vector<TetId> tlist_;            // live transverse tetrahedra
-  std::vector<double> radius_;          // per tet: circumradius, valid while listed or queued
-  std::vector<std::uint32_t> lpos_;     // per vertex: index in lonely_, or kNotListed
+  TetMap<double> radius_;               // circumradius, valid while listed or queued
+  VertexMap<std::uint32_t> lpos_;       // index in lonely_, or kNotListed
   std::vector<VertexId> lonely_;        // lone zeros: value 0, tcount_ 0 (their stars are active)
   std::vector<VertexId> zcheck_;        // zero vertices whose loneliness may have changed (settle_zeros)
   // Necks: vertices of tetrahedra classified since the last check (neck_mark_ 1 while listed).
   std::vector<VertexId> neck_candidates_;
-  std::vector<std::uint8_t> neck_mark_;
+  VertexMap<std::uint8_t> neck_mark_;
   std::vector<VertexId> pending_;       // vertices waiting for their value (batch)
   // During a refinement round with threads: the helper evaluating f at the round's new vertices
   // (values_ahead.hpp), owned by drain_queue() for one round; null otherwise.
@@ -469,7 +471,7 @@ class Polygonizer {
   // The marching-tetrahedra mesh, kept up to date from the changes reported to it (surface_tracker.hpp).
   std::unique_ptr<SurfaceTracker> surface_;
   // Thin features: gradient of f per vertex (NaN when unknown) and the edges waiting for a point.
-  std::vector<Point3> grad_;
+  VertexMap<Point3> grad_;
   struct ThinEdge {
     VertexId a, b;
     TetId t;   // a tetrahedron that had the edge when it was flagged

@@ -25,6 +25,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
+#include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
@@ -184,7 +185,6 @@ class QualityMesher {
   FacetKey key_of(TetId t, int i) const;
   static std::uint64_t edge_key(VertexId a, VertexId b);
   bool inside_domain(const Point3& p) const;  // strictly inside the box
-  void grow_tet_arrays();
   void evaluate_circumcenters(const std::vector<TetId>& tets);
   void classify_pending();
   void collect_brackets(std::vector<Bracket>& brackets);
@@ -210,7 +210,6 @@ class QualityMesher {
   bool insert_point(const Point3& p, const FacetRecord* facet);
   const FacetRecord* current(const QueueItem& item) const;
   void mark_vertex_dirty(VertexId v);
-  void grow_vertex_arrays();
   void absorb(const ChangeSet& cs);
   void mark_pending(TetId t);
   void erase_facet(TetId t, int i);
@@ -224,13 +223,15 @@ class QualityMesher {
   QualityOptions options_;
   Triangulation tri_;
   double diagonal_;
-  std::vector<double> cvalue_;         // per tet: f at its circumcentre (NaN: unknown, +inf: outside box)
-  std::vector<Point3> ccenter_;        // per tet: circumcentre, valid with cvalue_
-  std::vector<std::uint8_t> pending_;  // per tet: its facets wait for classification
-  std::vector<std::uint8_t> rflags_;   // per tet: bit i set when facet i may have a record
+  // Per-element state: property maps of tri_ (vitri/delaunay/property_map.hpp), sized by it. The
+  // per-tetrahedron maps are reset when tri_ renumbers its tetrahedra (absorb() then forgets every facet).
+  TetMap<double> cvalue_;              // f at the circumcentre (NaN: unknown, +inf: outside box)
+  TetMap<Point3> ccenter_;             // circumcentre, valid with cvalue_
+  TetMap<std::uint8_t> pending_;       // its facets wait for classification
+  TetMap<std::uint8_t> rflags_;        // bit i set when facet i may have a record
   std::vector<TetId> pending_list_;
-  std::vector<std::uint8_t> on_surface_;  // per vertex: a seed or ball centre (not a box corner)
-  std::vector<std::uint8_t> dirty_;       // per vertex: star changed since the last topology check
+  VertexMap<std::uint8_t> on_surface_;  // a seed or ball centre (not a box corner)
+  VertexMap<std::uint8_t> dirty_;       // star changed since the last topology check
   std::vector<VertexId> dirty_list_;
   std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
   std::priority_queue<QueueItem> queue_;

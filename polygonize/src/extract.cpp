@@ -39,7 +39,7 @@ Polygonizer::~Polygonizer() = default;
 MeshDelta Polygonizer::update_surface() {
   const auto t0 = std::chrono::steady_clock::now();
   evaluate_pending();
-  const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, grad_, options_);
+  const TrackerInput in = tracker_input(tri_, values_, transverse_.list(), f_, grad_, options_);
   surface_->update(in);
   const TrackerReport& r = surface_->report();
   stats_.function_evaluations += r.evaluations;
@@ -60,7 +60,7 @@ const LiveMesh& Polygonizer::live_surface() const { return surface_->mesh(); }
 
 SurfaceMesh Polygonizer::extract_fresh() {
   evaluate_pending();
-  const TrackerInput in = tracker_input(tri_, values_, tlist_, f_, grad_, options_);
+  const TrackerInput in = tracker_input(tri_, values_, transverse_.list(), f_, grad_, options_);
   SurfaceTracker fresh(tri_);
   fresh.update(in);
   return fresh.mesh().to_surface_mesh();

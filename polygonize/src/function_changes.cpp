@@ -142,7 +142,7 @@ void Polygonizer::reevaluate(const std::vector<VertexId>& ids) {
 
 std::size_t Polygonizer::collect_garbage(double min_fraction, std::size_t max_removals) {
   const auto is_idle = [&](VertexId v) {
-    return tri_.is_vertex(v) && kind_[v] == VertexKind::Refinement && tcount_[v] == 0;
+    return tri_.is_vertex(v) && kind_[v] == VertexKind::Refinement && transverse_.count(v) == 0;
   };
   // Keep the refinement of the stars of lone zeros (they are active; removing would redo it). Such a
   // vertex leaves the list; set_lonely() puts it back when the zero stops being lone.

@@ -53,7 +53,7 @@ std::vector<VertexId> Polygonizer::find_necks() {
   for (const VertexId v : candidates) {
     neck_mark_[v] = 0;
     // A neck has vertices of both signs around it (a transverse tetrahedron); corners have no full link.
-    if (tri_.is_vertex(v) && !tri_.is_corner(v) && tcount_[v] > 0) candidates[kept++] = v;
+    if (tri_.is_vertex(v) && !tri_.is_corner(v) && transverse_.count(v) > 0) candidates[kept++] = v;
   }
   candidates.resize(kept);
   std::sort(candidates.begin(), candidates.end());

@@ -186,8 +186,7 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
       values_(tri_, 0.0),
       kind_(tri_, VertexKind::Refinement),
       fixed_(tri_, 0),
-      tcount_(tri_, 0),
-      tpos_(tri_, kNotListed, TetRenumbering::Reset),
+      transverse_(tri_),
       radius_(tri_, 0.0, TetRenumbering::Reset),
       lpos_(tri_, kNotListed),
       neck_mark_(tri_, 0),
@@ -335,20 +334,17 @@ bool Polygonizer::is_transverse(TetId t) const {
 }
 
 void Polygonizer::set_transverse(TetId t, bool on) {
-  const bool listed = tpos_[t] != kNotListed;
-  if (on == listed) return;
-  const auto v = tri_.tet_vertices(t);
-  set_listed(tlist_, tpos_, t, on);
+  if (on == transverse_.contains(t)) return;
   if (on) {
-    for (const VertexId u : v)
-      if (tcount_[u]++ == 0 && lpos_[u] != kNotListed) set_lonely(u, false);  // no longer a lone zero
+    transverse_.add(t, tri_.tet_vertices(t), [this](VertexId u) {
+      if (lpos_[u] != kNotListed) set_lonely(u, false);  // no longer a lone zero
+    });
   } else {
-    for (const VertexId u : v) {
-      if (--tcount_[u] != 0) continue;
+    transverse_.remove(t, tri_.tet_vertices(t), [this](VertexId u) {
       // The vertex may have become a lone zero (decided after the batch), or garbage.
       if (values_[u] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(u);
       if (kind_[u] == VertexKind::Refinement) idle_.push_back(u);
-    }
+    });
   }
 }
 
@@ -378,7 +374,7 @@ void Polygonizer::set_lonely(VertexId v, bool on) {
   // (collect_garbage() dropped them while they served).
   for (const TetId t : tri_.incident_tetrahedra(v))
     for (const VertexId u : tri_.tet_vertices(t))
-      if (kind_[u] == VertexKind::Refinement && tcount_[u] == 0) idle_.push_back(u);
+      if (kind_[u] == VertexKind::Refinement && transverse_.count(u) == 0) idle_.push_back(u);
 }
 
 bool Polygonizer::touches_lonely(TetId t) const {
@@ -389,7 +385,7 @@ bool Polygonizer::touches_lonely(TetId t) const {
 
 bool Polygonizer::is_active(TetId t) const {
   if (!tri_.is_live(t)) return false;
-  return (t < tpos_.size() && tpos_[t] != kNotListed) || touches_lonely(t);
+  return transverse_.contains(t) || touches_lonely(t);
 }
 
 double Polygonizer::sized_radius(TetId t) const {
@@ -406,7 +402,7 @@ void Polygonizer::push_if_big(TetId t) {
 
 void Polygonizer::settle_zeros(const std::vector<TetId>& created) {
   for (const VertexId u : zcheck_) {
-    const bool lone = tri_.is_vertex(u) && values_[u] == 0.0 && tcount_[u] == 0;
+    const bool lone = tri_.is_vertex(u) && values_[u] == 0.0 && transverse_.count(u) == 0;
     if (lone == (lpos_[u] != kNotListed)) continue;
     set_lonely(u, lone);
     if (lone)
@@ -415,7 +411,7 @@ void Polygonizer::settle_zeros(const std::vector<TetId>& created) {
   zcheck_.clear();
   if (lonely_.empty()) return;
   for (const TetId t : created)
-    if (tri_.is_live(t) && tpos_[t] == kNotListed && touches_lonely(t)) push_if_big(t);
+    if (tri_.is_live(t) && !transverse_.contains(t) && touches_lonely(t)) push_if_big(t);
 }
 
 void Polygonizer::on_killed(const ChangeSet& cs) {
@@ -424,8 +420,7 @@ void Polygonizer::on_killed(const ChangeSet& cs) {
     // edited tetrahedra): drop the per-tetrahedron state; cs.created lists every live tetrahedron and
     // the caller classifies them (O(n), amortized O(1) per edit). Vertex state is kept.
     surface_->note_renumbered();
-    tlist_.clear();  // tpos_ and radius_ were reset by the tree (TetRenumbering::Reset)
-    tcount_.fill(0u);
+    transverse_.clear();  // its positions and radius_ were reset by the tree (TetRenumbering::Reset)
     clear_queue();
     thin_all_ = true;
     idle_.clear();  // every refinement vertex is a candidate again until classified
@@ -435,7 +430,7 @@ void Polygonizer::on_killed(const ChangeSet& cs) {
   }
   for (const TetId t : cs.killed) {
     surface_->note_killed(t);
-    if (t < tpos_.size() && tpos_[t] != kNotListed) set_transverse(t, false);
+    if (transverse_.contains(t)) set_transverse(t, false);
   }
 }
 
@@ -450,7 +445,7 @@ void Polygonizer::absorb_renumbering() {
 void Polygonizer::classify(TetId t, bool requeue) {
   if (!tri_.is_live(t)) return;
   const bool now = is_transverse(t);
-  const bool was = tpos_[t] != kNotListed;
+  const bool was = transverse_.contains(t);
   classify_as(t, requeue, now, now && (!was || requeue) ? sized_radius(t) : 0.0);
 }
 
@@ -458,7 +453,7 @@ void Polygonizer::classify(TetId t, bool requeue) {
 // transverse and newly listed or requeued) were computed by the caller.
 void Polygonizer::classify_as(TetId t, bool requeue, bool now, double radius) {
   if (options_.refine_necks) note_neck_candidates(t);  // its vertices' links changed (necks.cpp)
-  const bool was = tpos_[t] != kNotListed;
+  const bool was = transverse_.contains(t);
   if (now && (!was || requeue)) radius_[t] = radius;
   set_transverse(t, now);
   if (now && (!was || requeue) && radius_[t] > precision_) push(t);
@@ -565,7 +560,7 @@ bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, Ve
   kind_[r.vertex] = kind;
   if (kind == VertexKind::Refinement) idle_.push_back(r.vertex);  // until a transverse tetrahedron holds it
   fixed_[r.vertex] = 0;
-  tcount_[r.vertex] = 0;
+  transverse_.clear_count(r.vertex);
   pending_.push_back(r.vertex);
   if (ahead_) ahead_->offer(r.vertex, tri_.point(r.vertex));  // refused when full: the batch has it
   ++stats_.insertions;
@@ -689,7 +684,7 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
       TetId t;
       if (!pop(t)) break;
       if (!is_active(t) || radius_[t] <= precision) continue;
-      const bool lone_star = tpos_[t] == kNotListed;
+      const bool lone_star = !transverse_.contains(t);
       if (insert_refinement_point(t, dmin, VertexKind::Refinement, created)) {
         ++info.inserted;
         if (lone_star) ++stats_.lone_zero_insertions;
@@ -730,7 +725,7 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   const double dmin = options_.min_distance_fraction * precision;
   if (!resume) {
     clear_queue();
-    for (const TetId t : tlist_)
+    for (const TetId t : transverse_.list())
       if (radius_[t] > precision) push(t);
     for (const VertexId z : lonely_)
       for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
@@ -770,7 +765,7 @@ PolygonizerStats Polygonizer::stats() const {
   PolygonizerStats s = stats_;
   s.vertices = tri_.num_vertices();
   s.tetrahedra = tri_.num_tetrahedra();
-  s.transverse = tlist_.size();
+  s.transverse = transverse_.size();
   s.lone_zeros = lonely_.size();
   return s;
 }

@@ -34,7 +34,7 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
   }
   const VertexId v = r.vertex;
   kind_[v] = kind;
-  tcount_[v] = 0;
+  transverse_.clear_count(v);
   if (kind == VertexKind::Refinement) idle_.push_back(v);
   fixed_[v] = value ? 1 : 0;
   if (value) set_value(v, *value);

@@ -27,6 +27,7 @@
 #include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/box_closure.hpp"
+#include "vitri/polygonize/detail/transverse_set.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
@@ -363,7 +364,7 @@ class Polygonizer {
   /// Delaunay vertex of seed i (kNoVertex when seed i duplicated an earlier one).
   const std::vector<VertexId>& seed_vertices() const { return seed_vertices_; }
   /// Live transverse tetrahedra (unordered).
-  const std::vector<TetId>& transverse_tetrahedra() const { return tlist_; }
+  const std::vector<TetId>& transverse_tetrahedra() const { return transverse_.list(); }
   /// True when tetrahedron t is live and its vertex signs differ (sign(0) = +).
   bool is_transverse(TetId t) const;
   /// True when tetrahedron t is live and refined by refine(): transverse, or incident to a lone zero
@@ -445,16 +446,14 @@ class Polygonizer {
   double precision_;
   // Per-element state: property maps of tri_ (vitri/delaunay/property_map.hpp), grown by tri_ with its
   // capacities, so declared after it. The per-tetrahedron maps are reset when tri_ renumbers its
-  // tetrahedra (on_killed() drops that state then: TetRenumbering::Reset).
+  // tetrahedra (on_killed() drops that state then: TetRenumbering::Reset). transverse_ owns its own maps.
   VertexMap<double> values_;            // f(v), or its fixed value
   VertexMap<VertexKind> kind_;          // new ids: Refinement until the inserting code says otherwise
   VertexMap<std::uint8_t> fixed_;       // 1 when values_ is a fixed value (constraint)
-  VertexMap<std::uint32_t> tcount_;     // incident transverse tetrahedra
-  TetMap<std::uint32_t> tpos_;          // index in tlist_, or kNotListed
-  std::vector<TetId> tlist_;            // live transverse tetrahedra
+  polygonizer_detail::TransverseSet transverse_;  // live transverse tetrahedra, per vertex their count
   TetMap<double> radius_;               // circumradius, valid while listed or queued
   VertexMap<std::uint32_t> lpos_;       // index in lonely_, or kNotListed
-  std::vector<VertexId> lonely_;        // lone zeros: value 0, tcount_ 0 (their stars are active)
+  std::vector<VertexId> lonely_;        // lone zeros: value 0, no transverse tetrahedron (their stars are active)
   std::vector<VertexId> zcheck_;        // zero vertices whose loneliness may have changed (settle_zeros)
   // Necks: vertices of tetrahedra classified since the last check (neck_mark_ 1 while listed).
   std::vector<VertexId> neck_candidates_;

@@ -502,6 +502,53 @@ TEST_CASE("studio api: the page's files are served, three.js missing is a clear 
   CHECK_THAT(e.find("error")->as_string(""), Catch::Contains("/nonexistent-three/build/three.min.js"));
 }
 
+// The session's three numberings (session.hpp): the API's indices shift on a removal, its ids do not (and
+// survive undo), the Mesher's ids are never reused. Index i of constraints() is always constraint i of the
+// Mesher's list, whatever removals, adds and undos came before.
+TEST_CASE("studio session: indices, studio ids and the Mesher's ids stay in step", "[studio][session]") {
+  SessionOptions o = fast_options();
+  o.mesher.function = GENERATE(FunctionKind::Global, FunctionKind::Local);
+  Session session(small_model(), "small", o);
+  const auto check_list = [&] {
+    const std::vector<ConstraintInfo> list = session.constraints();
+    const Constraints& c = session.mesher().constraints();
+    REQUIRE(list.size() == c.size());
+    std::set<std::uint64_t> ids;
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      REQUIRE(list[i].index == i);
+      REQUIRE(list[i].position == c.points[i]);
+      REQUIRE(list[i].value == c.values[i]);
+      ids.insert(list[i].id);
+    }
+    REQUIRE(ids.size() == list.size());
+    return list;
+  };
+  const std::vector<ConstraintInfo> start = check_list();
+  session.remove(3);  // index 4 becomes 3: the same constraint, the same id
+  std::vector<ConstraintInfo> now = check_list();
+  CHECK(now[3].id == start[4].id);
+  CHECK(now[3].position == start[4].position);
+  session.set_value(3, 0.01);  // index 3 now names the constraint that had index 4
+  now = check_list();
+  CHECK(now[3].id == start[4].id);
+  CHECK(now[3].value == 0.01);
+  session.add({0.1, 0.1, 0.5}, 0.0);
+  CHECK(session.mesher().constraint_ids().back() == start.size());  // the Mesher's next id
+  REQUIRE(session.undo());  // the add
+  REQUIRE(session.undo());  // the value
+  REQUIRE(session.undo());  // the removal: constraint 3 comes back last, under its studio id
+  now = check_list();
+  CHECK(now.back().id == start[3].id);
+  CHECK(now.back().position == start[3].position);
+  CHECK(session.mesher().constraint_ids().back() == start.size() + 1);  // a new Mesher id
+  session.move(now.size() - 1, start[3].position + Point3{0.02, 0, 0}, false);
+  now = check_list();
+  CHECK(now.back().id == start[3].id);
+  REQUIRE(session.undo());
+  REQUIRE(session.redo());
+  check_list();
+}
+
 TEST_CASE("studio session: random edits, undo all, redo all", "[studio][session]") {
   Session session(small_model(), "small", fast_options());
   const Constraints original = session.mesher().constraints();

@@ -2,6 +2,7 @@
 // evaluated on (n, 3) arrays with the GIL released, edited in place.
 #include "common.hpp"
 
+#include "vitri/rbf/editable_function.hpp"
 #include "vitri/rbf/local_rbf.hpp"
 #include "vitri/rbf/rbf.hpp"
 
@@ -76,23 +77,38 @@ void bind_common(Cls& cls) {
            [](S& s, py::handle p, double v) {
              const Point3 q = point_arg(p, "point");
              return without_gil(*s.mutex, [&] {
+               const ConstraintId id = s.f->next_id();
                s.f->add_constraint(q, v);
-               return s.f->size() - 1;
+               return id;
              });
            },
            py::arg("point"), py::arg("value"),
-           "Appends the constraint f(point) = value; returns its index (len(f) - 1).")
+           "Adds the constraint f(point) = value; returns its stable id (one more than the last given out).")
       .def("move",
-           [](S& s, std::size_t i, py::handle p) {
+           [](S& s, ConstraintId i, py::handle p) {
              const Point3 q = point_arg(p, "point");
              without_gil(*s.mutex, [&] { s.f->move_constraint(i, q); });
            },
-           py::arg("index"), py::arg("point"), "Moves constraint `index` to `point` (keeps its value).")
-      .def("remove", [](S& s, std::size_t i) { without_gil(*s.mutex, [&] { s.f->remove_constraint(i); }); },
-           py::arg("index"), "Removes constraint `index`; later indices shift down by one.")
+           py::arg("id"), py::arg("point"), "Moves constraint `id` to `point` (keeps its value and id).")
+      .def("remove", [](S& s, ConstraintId i) { without_gil(*s.mutex, [&] { s.f->remove_constraint(i); }); },
+           py::arg("id"), "Removes constraint `id`; every other id stays as it was.")
       .def("set_value",
-           [](S& s, std::size_t i, double v) { without_gil(*s.mutex, [&] { s.f->set_value(i, v); }); },
-           py::arg("index"), py::arg("value"), "Changes the value of constraint `index`.");
+           [](S& s, ConstraintId i, double v) { without_gil(*s.mutex, [&] { s.f->set_value(i, v); }); },
+           py::arg("id"), py::arg("value"), "Changes the value of constraint `id`.")
+      .def("ids",
+           [](S& s) {
+             const std::vector<ConstraintId> ids = without_gil(*s.mutex, [&] { return s.f->constraint_ids(); });
+             return py::array_t<std::uint64_t>(py::ssize_t(ids.size()), ids.data());
+           },
+           "The ids of the live constraints (n,) uint64, increasing: the rows of constraints(). fit() numbers "
+           "the constraints 0..n-1 in the order given; an id is valid until removed, never reused.")
+      .def("__contains__", [](S& s, ConstraintId id) { return s.f->contains(id); }, py::arg("id"))
+      .def("constraint",
+           [](S& s, ConstraintId id) {
+             const auto pv = without_gil(*s.mutex, [&] { return std::make_pair(s.f->point(id), s.f->value_of(id)); });
+             return py::make_tuple(points_out({pv.first}).attr("reshape")(3), pv.second);
+           },
+           py::arg("id"), "(point (3,), value) of constraint `id`. UnknownConstraint if it names none.");
 }
 
 }  // namespace

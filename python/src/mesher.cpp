@@ -13,7 +13,6 @@
 #include <memory>
 #include <optional>
 #include <thread>
-#include <type_traits>
 
 namespace vitri::python {
 namespace {
@@ -286,15 +285,6 @@ py::object mesh_constraints(py::handle points, py::handle values, const py::kwar
 }
 
 // ---- vitri.Mesher -------------------------------------------------------------------------------------------
-/// The type the Mesher's edits name a constraint by: an index (std::size_t) in the library of this
-/// writing, a stable ConstraintId once that lands; the bindings follow whichever the header declares.
-template <class T>
-struct FirstArgument;
-template <class C, class R, class A, class... Rest>
-struct FirstArgument<R (C::*)(A, Rest...)> {
-  using type = std::decay_t<A>;
-};
-using EditId = FirstArgument<decltype(&Mesher::move_constraint)>::type;
 
 struct PyMesher {
   std::unique_ptr<Mesher> mesher;
@@ -506,17 +496,19 @@ Options as reconstruct() (those of point inputs do not apply).)");
              return without_gil(*s.mutex, [&] { return s.mesher->add_constraint(q, value); });
            },
            py::arg("point"), py::arg("value"),
-           "Adds the constraint f(point) = value and updates the mesh; returns its id (its index: len - 1).")
+           "Adds the constraint f(point) = value and updates the mesh; returns its stable id (one more than "
+           "the last id given out; valid until removed, never reused).")
       .def("move",
-           [](PyMesher& s, EditId id, py::handle p) {
+           [](PyMesher& s, ConstraintId id, py::handle p) {
              const Point3 q = point_arg(p, "point");
              without_gil(*s.mutex, [&] { s.mesher->move_constraint(id, q); });
            },
-           py::arg("id"), py::arg("point"), "Moves a constraint (keeps its value) and updates the mesh.")
-      .def("remove", [](PyMesher& s, EditId id) { without_gil(*s.mutex, [&] { s.mesher->remove_constraint(id); }); },
-           py::arg("id"), "Removes a constraint (later indices shift down by one) and updates the mesh.")
+           py::arg("id"), py::arg("point"), "Moves constraint `id` (keeps its value and id) and updates the mesh. UnknownConstraint for an id "
+           "that names no constraint.")
+      .def("remove", [](PyMesher& s, ConstraintId id) { without_gil(*s.mutex, [&] { s.mesher->remove_constraint(id); }); },
+           py::arg("id"), "Removes constraint `id` (every other id stays valid and unchanged) and updates the mesh.")
       .def("set_value",
-           [](PyMesher& s, EditId id, double value) {
+           [](PyMesher& s, ConstraintId id, double value) {
              without_gil(*s.mutex, [&] { s.mesher->set_value(id, value); });
            },
            py::arg("id"), py::arg("value"), "Changes a constraint's value and updates the mesh.")
@@ -532,7 +524,24 @@ Options as reconstruct() (those of point inputs do not apply).)");
            [](PyMesher& s) {
              Constraints c = without_gil(*s.mutex, [&] { return s.mesher->constraints(); });
              return py::make_tuple(points_out(std::move(c.points)), values_out(std::move(c.values)));
-           })
+           },
+           "The current constraints (points (n, 3), values (n,)) in increasing id order (ids()).")
+      .def("ids",
+           [](PyMesher& s) {
+             const std::vector<ConstraintId> ids = without_gil(*s.mutex, [&] { return s.mesher->constraint_ids(); });
+             return py::array_t<std::uint64_t>(py::ssize_t(ids.size()), ids.data());
+           },
+           "The ids of the current constraints (n,) uint64, increasing: the rows of constraints().")
+      .def("__contains__", [](PyMesher& s, ConstraintId id) { return s.mesher->has_constraint(id); }, py::arg("id"),
+           "`id in mesher`: True when id names a current constraint.")
+      .def("constraint",
+           [](PyMesher& s, ConstraintId id) {
+             const auto pv = without_gil(*s.mutex, [&] {
+               return std::make_pair(s.mesher->constraint_point(id), s.mesher->constraint_value(id));
+             });
+             return py::make_tuple(points_out({pv.first}).attr("reshape")(3), pv.second);
+           },
+           py::arg("id"), "(point (3,), value) of constraint `id`. UnknownConstraint if it names none.")
       .def("stats", &stats_of)
       .def("__len__", [](PyMesher& s) { return s.mesher->size(); })
       .def_property_readonly("diagonal", [](PyMesher& s) { return s.mesher->diagonal(); })

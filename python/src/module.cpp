@@ -2,6 +2,7 @@
 // type; the library's parts are bound in functions.cpp, delaunay.cpp, mesher.cpp and io.cpp.
 #include "common.hpp"
 
+#include "vitri/rbf/editable_function.hpp"
 #include "vitri/rbf/normals.hpp"
 
 #include <cmath>
@@ -18,6 +19,7 @@ PyObject* g_invalid_argument = nullptr;
 PyObject* g_invalid_point = nullptr;
 PyObject* g_degenerate = nullptr;
 PyObject* g_orientation = nullptr;
+PyObject* g_unknown = nullptr;
 PyObject* g_parse = nullptr;
 PyObject* g_numerical = nullptr;
 PyObject* g_limit = nullptr;
@@ -45,6 +47,8 @@ void translate(std::exception_ptr p) {
     std::rethrow_exception(p);
   } catch (const OrientationError& e) {
     raise(g_orientation, e.what(), {{"index", py::int_(e.index())}});
+  } catch (const UnknownConstraint& e) {
+    raise(g_unknown, e.what(), {{"index", py::int_(e.index())}, {"id", py::int_(e.id())}});
   } catch (const DegenerateNeighbourhood& e) {
     raise(g_degenerate, e.what(), {{"index", py::int_(e.index())}});
   } catch (const InvalidPoint& e) {
@@ -272,6 +276,8 @@ void bind_errors(py::module_& m) {
                                "A point's neighbours do not define a normal (normal estimation); `index`.");
   g_orientation = new_exception(m, "OrientationError", py::make_tuple(py::handle(g_invalid_point)),
                                 "Normals could not be oriented consistently; `index` names a point.");
+  g_unknown = new_exception(m, "UnknownConstraint", py::make_tuple(py::handle(g_invalid_point)),
+                            "A constraint id that names no live constraint (removed, never given out); `id`.");
   g_parse = new_exception(m, "ParseError", py::make_tuple(error),
                           "A file could not be read or parsed; `file` and `line` (1-based, 0 if unknown).");
   g_numerical = new_exception(m, "NumericalError", py::make_tuple(error),

@@ -11,6 +11,7 @@ def test_hierarchy():
     assert issubclass(vitri.InvalidPoint, vitri.InvalidArgument)
     assert issubclass(vitri.OrientationError, vitri.InvalidPoint)
     assert issubclass(vitri.DegenerateNeighbourhood, vitri.InvalidPoint)
+    assert issubclass(vitri.UnknownConstraint, vitri.InvalidPoint)
     for e in (vitri.ParseError, vitri.NumericalError, vitri.LimitError, vitri.Cancelled):
         assert issubclass(e, vitri.Error) and not issubclass(e, ValueError)
 

@@ -79,3 +79,17 @@ def test_local_smoothing_approximates():
     noisy = vals + np.random.default_rng(4).normal(0, 0.01, len(vals))
     f = vitri.LocalRbf(pts, noisy, smoothing=0.1)
     assert np.max(np.abs(f(pts) - noisy)) > 1e-6  # no longer interpolates
+
+
+@pytest.mark.parametrize("cls", [vitri.Rbf, vitri.LocalRbf])
+def test_stable_ids(cls):
+    pts, vals = sphere_constraints(80)
+    f = cls(pts, vals)
+    f.remove(5)
+    assert 5 not in f and 6 in f and f.ids()[5] == 6
+    f.set_value(6, 0.03)
+    assert f.constraint(6)[1] == 0.03
+    i = f.add([0.0, 0.0, 0.2], -0.6)
+    assert i == len(pts) and f.ids()[-1] == i
+    with pytest.raises(vitri.UnknownConstraint):
+        f.remove(5)

@@ -121,3 +121,32 @@ def test_edit_errors():
         m.add(pts[0], 0.0)  # a duplicate
     with pytest.raises(vitri.InvalidArgument):
         m.refine(-1)
+
+
+def test_stable_constraint_ids():
+    pts, vals = sphere_constraints(60)
+    m = vitri.Mesher(pts, vals)
+    m.refine(0.1, relative=True)
+    assert m.ids().tolist() == list(range(len(pts)))
+    a = m.add([0.0, 0.0, 0.0], -0.5)
+    b = m.add([0.0, 0.0, 0.3], -0.4)
+    assert (a, b) == (len(pts), len(pts) + 1)
+    m.remove(10)
+    assert 10 not in m and 11 in m and a in m
+    p11, v11 = m.constraint(11)  # unchanged by the removal of 10
+    assert np.array_equal(p11, pts[11]) and v11 == vals[11]
+    m.move(b, [0.0, 0.1, 0.3])  # ids, not positions: b is still b after a removal below it
+    assert np.allclose(m.constraint(b)[0], [0.0, 0.1, 0.3])
+    c = m.add([0.05, 0.0, 0.0], -0.5)
+    assert c == len(pts) + 2  # never reused: 10 is not given out again
+    ids = m.ids()
+    assert 10 not in ids.tolist() and len(ids) == len(m)
+    cp, cv = m.constraints()
+    assert np.allclose(cp[list(ids).index(b)], [0.0, 0.1, 0.3])
+    with pytest.raises(vitri.UnknownConstraint) as e:
+        m.move(10, [0, 0, 0])
+    assert e.value.id == 10 and isinstance(e.value, vitri.InvalidPoint)
+    with pytest.raises(vitri.UnknownConstraint):
+        m.set_value(10**9, 0.0)
+    V, F, _ = m.mesh()
+    assert_closed_manifold(V, F)

@@ -34,11 +34,12 @@ Functions:
         A Mesh or (V, F[, N]) to .obj/.off/.ply (PLY binary unless ascii); an object with points and
         values to .xyzv; with points (and normals) to .xyz/.pwn.
 
-Classes: Mesher (refinement, levels, edits, deltas), Rbf and LocalRbf (fit, evaluate, edit), Delaunay
+Classes: Mesher (refinement, levels, edits by stable constraint ids, deltas), Rbf and LocalRbf (fit,
+evaluate, edit by ids), Delaunay
 (the exact dynamic tetrahedralization), Mesh.
 
 Errors: Error > InvalidArgument (also ValueError) > InvalidPoint (.index) > DegenerateNeighbourhood,
-OrientationError; Error > ParseError (.file, .line), NumericalError, LimitError, Cancelled. A wrong
+OrientationError, UnknownConstraint (.id); Error > ParseError (.file, .line), NumericalError, LimitError, Cancelled. A wrong
 dtype is a TypeError. Long calls release the GIL and stop on Ctrl-C (KeyboardInterrupt).
 """
 
@@ -58,6 +59,7 @@ from ._vitri import (
     OrientationError,
     ParseError,
     Rbf,
+    UnknownConstraint,
     mesh_constraints,
     read,
     reconstruct,
@@ -69,5 +71,6 @@ __version__ = _vitri.__version__
 __all__ = [
     "Cancelled", "DegenerateNeighbourhood", "Delaunay", "Error", "InvalidArgument", "InvalidPoint",
     "LimitError", "LocalRbf", "Mesh", "Mesher", "NumericalError", "OrientationError", "ParseError", "Rbf",
+    "UnknownConstraint",
     "mesh_constraints", "read", "reconstruct", "write", "__version__",
 ]

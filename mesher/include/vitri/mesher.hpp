@@ -250,7 +250,8 @@ class Mesher {
   // add returns a new id, one more than the last given out; an id stays valid until its constraint is
   // removed and is never given out again (also across restart() and rebuilds; restarted_copy() keeps
   // them); removing a constraint changes no other id. Looking an id up is O(1) (the function's tables:
-  // LocalRbf's slots, Rbf's rows). An id that names no live constraint throws UnknownConstraint (an
+  // LocalRbf's slots, Rbf's rows; a removal renumbers the global function's later rows in O(N), under
+  // its O(N^2) factor update). An id that names no live constraint throws UnknownConstraint (an
   // InvalidPoint whose index() is the id) and changes nothing; so does every refused edit.
   /// Adds the constraint f(p) = value. @return its id. @throws as Rbf::add_constraint /
   /// LocalRbf::add_constraint.

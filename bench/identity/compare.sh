@@ -42,18 +42,28 @@ cases=(
 )
 if [ "$large" = "--large" ]; then
   if [ ! -f "$out/inputs/elephant-1e6.xyz" ]; then
-    python3 - "$shared/elephant.off" "$out/inputs/elephant-1e6.xyz" <<'PY'
-import sys, numpy as np
-lines = open(sys.argv[1]).read().split()
-assert lines[0] == "OFF"; nv, nf = int(lines[1]), int(lines[2]); k = 4
-V = np.array(lines[k:k + 3 * nv], float).reshape(nv, 3); k += 3 * nv
-F = np.array(lines[k:k + 4 * nf], int).reshape(nf, 4)[:, 1:]
-a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-n = np.cross(b - a, c - a); area = np.linalg.norm(n, axis=1); n /= area[:, None] + 1e-300
-rng = np.random.default_rng(7); t = rng.choice(len(F), 10**6, p=area / area.sum())
-u, v = rng.random(10**6), rng.random(10**6); s = u + v > 1; u[s], v[s] = 1 - u[s], 1 - v[s]
-p = a[t] + u[:, None] * (b[t] - a[t]) + v[:, None] * (c[t] - a[t])
-np.savetxt(sys.argv[2], np.hstack([p, n[t]]), fmt="%.9g")
+    # Pure Python (no numpy on every machine): area-weighted uniform samples of the triangles, with the
+    # face normals, seeded.
+    python3 - "$shared/elephant.off" "$out/inputs/elephant-1e6.xyz" <<'PY' || exit 2
+import random, sys
+tok = open(sys.argv[1]).read().split()
+assert tok[0] == "OFF"; nv, nf = int(tok[1]), int(tok[2]); k = 4
+V = [tuple(float(x) for x in tok[k + 3 * i:k + 3 * i + 3]) for i in range(nv)]; k += 3 * nv
+F = [tuple(int(x) for x in tok[k + 4 * i + 1:k + 4 * i + 4]) for i in range(nf)]
+sub = lambda a, b: (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+cross = lambda a, b: (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+N, A = [], []
+for f in F:
+    n = cross(sub(V[f[1]], V[f[0]]), sub(V[f[2]], V[f[0]])); l = sum(c * c for c in n) ** 0.5
+    A.append(l); N.append(tuple(c / (l + 1e-300) for c in n))
+rng = random.Random(7)
+with open(sys.argv[2], "w") as out:
+    for t in rng.choices(range(nf), weights=A, k=10**6):
+        u, v = rng.random(), rng.random()
+        if u + v > 1: u, v = 1 - u, 1 - v
+        a, b, c = (V[i] for i in F[t]); n = N[t]
+        p = [a[j] + u * (b[j] - a[j]) + v * (c[j] - a[j]) for j in range(3)]
+        out.write("%.9g %.9g %.9g %.9g %.9g %.9g\n" % (p[0], p[1], p[2], n[0], n[1], n[2]))
 PY
   fi
   cases+=("elephant-1e6|$out/inputs/elephant-1e6.xyz|")
@@ -61,6 +71,7 @@ fi
 status=0
 for c in "${cases[@]}"; do
   IFS='|' read -r name input args <<<"$c"
+  if [ ! -f "$input" ]; then printf '%-20s %s\n' "$name" "MISSING INPUT $input"; status=1; continue; fi
   for side in base new; do
     exe=$base; [ $side = new ] && exe=$new
     dir=$out/$side/$name

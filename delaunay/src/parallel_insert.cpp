@@ -37,12 +37,12 @@
 #include "scratch.hpp"
 
 #include "vitri/core/error.hpp"
+#include "vitri/core/parallel.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <exception>
 #include <numeric>
-#include <thread>
 
 #include <time.h>
 
@@ -172,10 +172,7 @@ void Triangulation::bulk_round(Bulk& b, std::size_t lo, std::size_t hi) {
     }
     bulk_partition(b, pending, pass, T);
     for (std::size_t k = 0; k < T; ++k) bulk_give_room(b, b.workers[k], b.workers[k].assigned.size());
-    std::vector<std::thread> threads;
-    for (std::size_t k = 1; k < T; ++k) threads.emplace_back([&, k] { bulk_work(b, b.workers[k]); });
-    bulk_work(b, b.workers[0]);
-    for (std::thread& t : threads) t.join();
+    run_tasks(T, [&](std::size_t k) { bulk_work(b, b.workers[k]); });
     next.clear();
     double slowest = 0;
     for (std::size_t k = 0; k < T; ++k) {

@@ -2,12 +2,11 @@
 #include "scratch.hpp"
 
 #include "vitri/core/bit_spread.hpp"
+#include "vitri/core/parallel.hpp"
 
 #include <algorithm>
-#include <exception>
 #include <numeric>
 #include <random>
-#include <thread>
 
 namespace vitri {
 namespace detail {
@@ -54,20 +53,7 @@ std::uint64_t point_key(const Point3& p, const Box3& box) {
 void parallel_slices(std::size_t n, unsigned threads,
                      const std::function<void(std::size_t, std::size_t)>& fn) {
   const std::size_t T = std::max<std::size_t>(1, std::min<std::size_t>(threads, n));
-  std::vector<std::exception_ptr> errors(T);
-  auto run = [&](std::size_t k) {
-    try {
-      fn(k * n / T, (k + 1) * n / T);
-    } catch (...) {
-      errors[k] = std::current_exception();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (std::size_t k = 1; k < T; ++k) pool.emplace_back(run, k);
-  run(0);
-  for (std::thread& t : pool) t.join();
-  for (const std::exception_ptr& e : errors)
-    if (e) std::rethrow_exception(e);
+  run_slices(n, T, [&](std::size_t, std::size_t lo, std::size_t hi) { fn(lo, hi); });
 }
 
 namespace {

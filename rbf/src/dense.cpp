@@ -1,9 +1,10 @@
 #include "dense.hpp"
 
+#include "vitri/core/parallel.hpp"
+
 #include <algorithm>
 #include <cstdlib>
 #include <string_view>
-#include <thread>
 #include <vector>
 
 namespace vitri::rbf_detail {
@@ -83,10 +84,7 @@ bool cholesky_parallel(double* a, long n, long lda, unsigned threads) {
   const long t = static_cast<long>(std::clamp(threads, 1u, 8u));
   auto at = [&](long i, long j) { return a + i + j * lda; };
   auto run = [&](auto&& task) {  // task(thread index) on t threads (the caller is thread 0)
-    std::vector<std::thread> pool;
-    for (long p = 1; p < t; ++p) pool.emplace_back(task, p);  // none when t == 1
-    task(0L);
-    for (auto& th : pool) th.join();
+    run_tasks(static_cast<std::size_t>(t), [&](std::size_t p) { task(static_cast<long>(p)); });
   };
   for (long k = 0; k < n; k += kBlock) {
     const long kb = std::min(kBlock, n - k);

@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <cassert>
 #include <limits>
-#include <thread>
 #include <utility>
 
 namespace vitri {
@@ -181,22 +180,12 @@ void PointIndex::fill_node_parallel(Forest& f, std::uint32_t index, Entry* first
   right.nodes.reserve(2 * (count / (kBucket / 2) + 1));
   right.buckets.reserve(count);
   right.nodes.emplace_back();
-  std::exception_ptr right_error;
-  std::thread worker([&] {
-    try {
+  run_tasks(2, [&](std::size_t k) {
+    if (k == 0)
+      fill_node_parallel(f, left, first, middle, depth - 1);
+    else
       fill_node_parallel(right, 0, middle, last, depth - 1);
-    } catch (...) {
-      right_error = std::current_exception();
-    }
   });
-  try {
-    fill_node_parallel(f, left, first, middle, depth - 1);
-  } catch (...) {
-    worker.join();
-    throw;
-  }
-  worker.join();
-  if (right_error) std::rethrow_exception(right_error);
   splice(f, left + 1, right);
 }
 

@@ -8,7 +8,6 @@
 #include "parallel.hpp"
 
 #include <algorithm>
-#include <thread>
 #include <vector>
 
 namespace vitri {
@@ -27,17 +26,12 @@ void Rbf::Impl::sums(const double* q, std::size_t m, double* f, double* g) const
     ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), nn, q, static_cast<long>(m), f, g);
     return;
   }
-  std::vector<std::thread> pool;
   const std::size_t chunk = (m + t - 1) / t;
-  for (unsigned k = 0; k < t; ++k) {
+  run_tasks((m + chunk - 1) / chunk, [&](std::size_t k) {
     const std::size_t b = k * chunk, e = std::min(m, b + chunk);
-    if (b >= e) break;
-    pool.emplace_back([&, b, e] {
-      ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), nn, q + 3 * b, static_cast<long>(e - b),
-                   f + b, g ? g + 3 * b : nullptr);
-    });
-  }
-  for (auto& th : pool) th.join();
+    ops.rbf_sums(cx.data(), cy.data(), cz.data(), w.data(), nn, q + 3 * b, static_cast<long>(e - b), f + b,
+                 g ? g + 3 * b : nullptr);
+  });
 }
 
 double Rbf::value(const Point3& p) const {

@@ -1,6 +1,6 @@
-// `vitri render`: draws meshes to a PNG picture with the software renderer (apps/render.hpp).
+// `vitri render`: draws meshes to a PNG picture with the software renderer (vitri/render/render.hpp).
 #include "commands.hpp"
-#include "render.hpp"
+#include "vitri/render/render.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"

@@ -4,7 +4,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/io/io.hpp"
-#include "vitri/polygonize/analytic.hpp"
+#include "vitri/testing/analytic.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/rbf.hpp"

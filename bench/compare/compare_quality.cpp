@@ -22,7 +22,7 @@
 //   --threads   threads of the RBF batch evaluation (default 1: CPU times comparable with CGAL's,
 //               whose evaluations are single calls)
 #include "compare/compare_common.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/quality_mesher.hpp"
 
 #include <cstdio>

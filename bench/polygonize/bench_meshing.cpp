@@ -4,7 +4,7 @@
 
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
-#include "vitri/polygonize/analytic.hpp"
+#include "vitri/testing/analytic.hpp"
 
 #include <cmath>
 #include <string>

@@ -2,7 +2,7 @@
 
 #include "parallel.hpp"
 #include "vitri/core/error.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 #include "vitri/rbf/point_index.hpp"
 #include "vitri/testing/random.hpp"

@@ -3,7 +3,7 @@
 // counts; an edit script runs and reports each edit; bad input exits with 1 and usage errors with 2, each
 // with a message on stderr (the edit line's number for a bad script line).
 #include "vitri/io/io.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include <catch2/catch.hpp>

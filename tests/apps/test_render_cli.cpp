@@ -1,6 +1,6 @@
 // `vitri render`: runs the real binary, decodes the PNG it writes and compares it pixel for pixel with
 // the library's render_mesh() on the same mesh; checks the grid layout and the error reports.
-#include "render.hpp"
+#include "vitri/render/render.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -6,7 +6,7 @@
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 
 #include <algorithm>
 #include <cmath>

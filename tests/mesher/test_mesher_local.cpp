@@ -9,7 +9,7 @@
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/rbf/point_index.hpp"
 

@@ -20,7 +20,7 @@
 #include "support/mesh_checks.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 
 #include <algorithm>
 #include <string>

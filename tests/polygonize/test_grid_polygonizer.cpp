@@ -1,10 +1,10 @@
-// Tests of vitri/polygonize/grid_polygonizer.hpp: the baseline polygonizer gives closed, outward,
+// Tests of vitri/testing/grid_polygonizer.hpp: the baseline polygonizer gives closed, outward,
 // manifold meshes with the right topology on analytic shapes, and its documented defect (coincident
 // vertices where f is exactly 0 at a grid node) is what it says.
-#include "vitri/polygonize/grid_polygonizer.hpp"
+#include "vitri/testing/grid_polygonizer.hpp"
 
 #include "vitri/core/error.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 
 #include <catch2/catch.hpp>
 

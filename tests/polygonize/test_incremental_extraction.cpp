@@ -11,7 +11,7 @@
 #include "support/mesh_checks.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/delaunay/triangulation.hpp"
-#include "vitri/polygonize/analytic.hpp"
+#include "vitri/testing/analytic.hpp"
 #include "vitri/polygonize/live_mesh.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 

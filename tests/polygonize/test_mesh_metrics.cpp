@@ -1,6 +1,6 @@
-// Tests of vitri/polygonize/mesh_metrics.hpp: exact counts on meshes built by hand whose topology is
+// Tests of vitri/testing/mesh_metrics.hpp: exact counts on meshes built by hand whose topology is
 // known (tetrahedron, cube, torus, open box, bowtie, flipped faces, degenerate triangles).
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include "vitri/core/error.hpp"

@@ -5,8 +5,8 @@
 #include "support/mesh_checks.hpp"
 #include "support/surface_metrics.hpp"
 #include "vitri/core/error.hpp"
-#include "vitri/polygonize/analytic.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/analytic.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 

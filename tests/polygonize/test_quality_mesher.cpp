@@ -7,8 +7,8 @@
 
 #include "support/quality_checks.hpp"
 #include "vitri/core/error.hpp"
-#include "vitri/polygonize/analytic.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/analytic.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/quality_mesher.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 

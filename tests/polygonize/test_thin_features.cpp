@@ -5,8 +5,8 @@
 #include "support/surface_metrics.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
-#include "vitri/polygonize/analytic.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/analytic.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 
 #include <cmath>

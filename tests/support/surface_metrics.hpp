@@ -1,6 +1,6 @@
 #pragma once
 // Test support: mesh metrics of a SurfaceMesh (the library's compute_mesh_metrics takes Eigen V, F).
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include <Eigen/Core>

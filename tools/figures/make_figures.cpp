@@ -24,16 +24,16 @@
 // circumcenters of transverse tetrahedra until every one has circumradius <= P_k, with P_1 = kFirstPrecision
 // (0.14) x the diagonal of the constraints' box and P_k = P_{k-1} / 2 (each step continues the previous one).
 
-#include "plot.hpp"
-#include "render.hpp"
+#include "vitri/render/plot.hpp"
+#include "vitri/render/render.hpp"
 
 #include "vitri/core/box.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
-#include "vitri/polygonize/grid_polygonizer.hpp"
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/grid_polygonizer.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 #include "vitri/rbf/constraints.hpp"
@@ -884,7 +884,7 @@ int run(int argc, char** argv) {
         "docs/figures"
      << (ctx.hist_csv.empty() ? std::string() : " --hist " + ctx.hist_csv)
      << "\n```\n\n"
-        "Source: `tools/figures/make_figures.cpp`. Renderer: `apps/render.hpp` (flat shading, headlight, "
+        "Source: `tools/figures/make_figures.cpp`. Renderer: `render/include/vitri/render/render.hpp` (flat shading, headlight, "
         "perspective; front faces blue-grey, back faces red: a hole or a flipped triangle shows red). Times "
         "are wall clock on the machine of the run (see the footer; the RBF's batch evaluation uses the "
         "library's default threads), so they vary from run to run; vertex counts are deterministic.\n\n";

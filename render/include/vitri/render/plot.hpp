@@ -3,7 +3,7 @@
 /// Grouped bar charts as images, for the minimum-angle histograms of the comparison (vitri vs CGAL vs
 /// marching tetrahedra) and similar figures. Uses the Image and text drawing of render.hpp.
 
-#include "render.hpp"
+#include "vitri/render/render.hpp"
 
 #include <string>
 #include <vector>

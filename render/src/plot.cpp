@@ -1,5 +1,5 @@
 // Grouped bar charts (histograms) drawn into an Image.
-#include "plot.hpp"
+#include "vitri/render/plot.hpp"
 
 #include "vitri/core/error.hpp"
 

@@ -22,7 +22,7 @@
 // corner it is reversed; with two inside corners (i, j) the quad (e_ik, e_il, e_jl, e_jk) faces away
 // from them. Even permutations keep the tetrahedron positive, which is what makes the winding right.
 
-#include "vitri/polygonize/grid_polygonizer.hpp"
+#include "vitri/testing/grid_polygonizer.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"

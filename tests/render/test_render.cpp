@@ -1,8 +1,8 @@
-// Tests of apps/render.hpp and apps/plot.hpp: the picture of a sphere is a lit disc of the radius the
+// Tests of vitri/render/render.hpp and vitri/render/plot.hpp: the picture of a sphere is a lit disc of the radius the
 // documented camera framing predicts, the z-buffer keeps the nearest surface, orientation shows in the
 // colour, and the image utilities (text, captions, grids, PNG, histogram plots) do what they say.
-#include "plot.hpp"
-#include "render.hpp"
+#include "vitri/render/plot.hpp"
+#include "vitri/render/render.hpp"
 
 #include "vitri/core/error.hpp"
 

@@ -11,7 +11,7 @@
 // The wireframe is drawn in the same pass: a sample whose screen distance to the nearest edge of its
 // visible triangle is under half the line width takes the wire colour, so only visible edges show.
 
-#include "render.hpp"
+#include "vitri/render/render.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"

@@ -9,7 +9,7 @@
 // exactly with orient2d on the three coordinate planes (a triangle is flat in 3D iff its three
 // projections are), so a mesher's "no zero-area triangle" claim is checked without tolerance.
 
-#include "vitri/polygonize/mesh_metrics.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
 
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"

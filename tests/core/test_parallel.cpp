@@ -84,11 +84,17 @@ TEST_CASE("run_slices, parallel_for and parallel_chunks cover [0, n) exactly onc
       std::vector<int> a(n, 0), b(n, 0), c(n, 0);
       const std::size_t slices = vitri::slice_count(threads, n, 64);
       CHECK(slices >= 1);
+      // Catch's assertions are not thread-safe: each slice records its bounds, checked here afterwards.
+      std::vector<std::size_t> los(slices, n + 1), his(slices, n + 1);
       vitri::run_slices(n, slices, [&](std::size_t s, std::size_t lo, std::size_t hi) {
-        CHECK(lo == s * n / slices);
-        CHECK(hi == (s + 1) * n / slices);
+        los[s] = lo;
+        his[s] = hi;
         for (std::size_t i = lo; i < hi; ++i) ++a[i];
       });
+      for (std::size_t s = 0; s < slices; ++s) {
+        CHECK(los[s] == s * n / slices);
+        CHECK(his[s] == (s + 1) * n / slices);
+      }
       vitri::parallel_for(n, threads, [&](std::size_t i) { ++b[i]; }, 16);
       vitri::parallel_chunks(n, threads, 100, [&](std::size_t lo, std::size_t hi) {
         for (std::size_t i = lo; i < hi; ++i) ++c[i];

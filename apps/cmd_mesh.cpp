@@ -32,7 +32,8 @@ const char* const kUsage =
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z]\n"
-    "                  [--function global|local|auto] [--smoothing S] [--threads N] [--ascii] [-q]\n"
+    "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
+    "                  [--threads N] [--ascii] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -120,6 +121,14 @@ const char* const kUsage =
     "                       to 4000 constraints, local above). See docs/local_rbf.md.\n"
     "  --smoothing S        local function only: regularization of every patch (default 0); for points,\n"
     "                       --smoothing 0 also keeps them where they are (no projection: interpolation)\n"
+    "  --certify            certified levels (docs/certificate.md): enclosures of f and its gradient\n"
+    "                       over every tetrahedron prove it empty or crossed by one disk as marching\n"
+    "                       tetrahedra assumes; the others are refined (circumcenters) down to a floor,\n"
+    "                       --certify-floor x the precision. Each level then prints 'certified' (the\n"
+    "                       mesh is homeomorphic to the zero set in the box) or the count of tetrahedra\n"
+    "                       left uncertified and where the largest is. Costs far more time and vertices on RBF surfaces\n"
+    "                       (docs/benchmarks.md); the local function has no enclosure yet.\n"
+    "  --certify-floor F    the size floor of --certify, a fraction of the precision (default 0.1)\n"
     "  --threads N          threads of the fit, the seeds' insertion and the extraction (default 0:\n"
     "                       every CPU this process may run on, i.e. its affinity mask, so `taskset`\n"
     "                       works too). The mesh is the same file whatever N.\n"
@@ -392,6 +401,13 @@ int run_mesh(const Args& args) {
         return usage_error("--threads needs an integer from 0 (every available CPU) to " +
                            std::to_string(kMaxThreads));
       threads = unsigned(k);
+    } else if (a == "--certify") {
+      options.polygonizer.certify = true;
+    } else if (a == "--certify-floor") {
+      double fl;
+      if (!value(v) || !parse_double(v, fl) || !(fl > 0.0 && fl <= 1.0))
+        return usage_error("--certify-floor needs a fraction of the precision in (0, 1]");
+      options.polygonizer.certify_floor_fraction = fl;
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (a == "--ascii") {
@@ -583,6 +599,20 @@ int run_mesh(const Args& args) {
     if (!quiet)
       std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
                   m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());
+    if (!quiet && options.polygonizer.certify) {
+      const PolygonizerStats& ps = mesher.stats().polygonizer;
+      if (ps.certify_checked == 0 && ps.uncertified > 0)
+        std::printf("      NOT certified: the function gives no enclosures (the local function has none yet, "
+                    "docs/certificate.md); %zu tetrahedra unchecked\n", ps.uncertified);
+      else if (ps.uncertified == 0)
+        std::printf("      certified: %zu tetrahedra checked, %zu points inserted, %.1f ms\n", ps.certify_checked,
+                    ps.certify_insertions, 1e3 * ps.certify_seconds);
+      else
+        std::printf("      NOT certified: %zu tetrahedra left uncertified at the size floor, the largest (radius "
+                    "%.3g) at (%.6g, %.6g, %.6g); %zu checked, %zu points, %.1f ms\n", ps.uncertified,
+                    ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y, ps.uncertified_at.z,
+                    ps.certify_checked, ps.certify_insertions, 1e3 * ps.certify_seconds);
+    }
   }
   if (!quiet) {
     std::printf("\n");

@@ -1,5 +1,6 @@
 #include "vitri/polygonize/box_closure.hpp"
 
+#include "vitri/core/bounds.hpp"
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
@@ -62,6 +63,38 @@ void BoxClosedFunction::values_gradients(const Point3* points, std::size_t n, do
     Point3 g;
     const double w = wall(points[i], &g);
     if (w > values[i]) values[i] = w, gradients[i] = g;
+  }
+}
+
+// The wall band - d(x), d(x) = min over the six face planes of the distance to it: over a box inside the
+// domain, each plane's distance ranges over an interval, d over [min of the lows, min of the highs], and
+// the gradient is the outward normal of a face whose distance may be the smallest (its low end at most
+// the smallest high end): the hull of those normals.
+void BoxClosedFunction::bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const {
+  f_.bounds(boxes, n, out);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Box3& b = boxes[i];
+    double lo[6], hi[6];
+    for (std::size_t k = 0; k < 3; ++k) {
+      // Distances to the low face (x - lo) and to the high face (hi - x); a box outside the domain
+      // gets negative distances, which only make the wall larger: still valid for g there.
+      lo[2 * k] = b.lo[k] - box_.lo[k], hi[2 * k] = b.hi[k] - box_.lo[k];
+      lo[2 * k + 1] = box_.hi[k] - b.hi[k], hi[2 * k + 1] = box_.hi[k] - b.lo[k];
+    }
+    const double d_lo = *std::min_element(lo, lo + 6), d_hi = *std::min_element(hi, hi + 6);
+    FunctionBound w;
+    w.lo = band_ - d_hi;
+    w.hi = band_ - d_lo;
+    w.grad_lo = w.grad_hi = Point3{0.0, 0.0, 0.0};
+    for (std::size_t j = 0; j < 6; ++j) {
+      if (lo[j] > d_hi) continue;  // never the nearest face over this box
+      const std::size_t k = j / 2;
+      if (j % 2 == 0) w.grad_lo[k] = -1.0;
+      else w.grad_hi[k] = 1.0;
+    }
+    const double slack = 1e-12 * (std::abs(band_) + norm(box_.hi - box_.lo));
+    widen_bounds(w, slack, 0.0);
+    out[i] = max_bounds(out[i], w);
   }
 }
 

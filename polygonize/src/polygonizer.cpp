@@ -133,6 +133,8 @@ void check_options(const PolygonizerOptions& options) {
     throw InvalidArgument("PolygonizerOptions::snap_fraction must be in (0, 0.5)");
   if (options.max_root_iterations < 1)
     throw InvalidArgument("PolygonizerOptions::max_root_iterations must be >= 1");
+  if (!(options.certify_floor_fraction > 0.0 && options.certify_floor_fraction <= 1.0))
+    throw InvalidArgument("PolygonizerOptions::certify_floor_fraction must be in (0, 1]");
 }
 
 }  // namespace
@@ -503,6 +505,7 @@ void Polygonizer::classify_created(std::vector<TetId>& created) {
       if (a.transverse) a.radius = sized_radius(t);
     }
   });
+  if (certifying_) certify_new_.insert(certify_new_.end(), created.begin(), created.end());
   for (std::size_t k = 0; k < n; ++k) {
     surface_->note_created(created[k]);
     if (ahead[k].live) classify_as(created[k], false, ahead[k].transverse, ahead[k].radius);
@@ -744,6 +747,7 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   bool completed = drain_queue(dmin, progress, info);
   stats_.neck_seconds = 0;
   if (completed && options_.refine_necks) completed = settle_necks(dmin, progress, info);
+  if (completed && options_.certify) completed = certify_level(dmin, progress, info);
   // Status at the box hull: active tetrahedra with a hull face still larger than the precision (their
   // fallback points were rejected). A hull face has three corners, so these are among the corners' stars.
   std::vector<TetId> hull;

@@ -3,11 +3,24 @@
 /// The implicit-function interface that the polygonizer consumes. Sign convention of the whole
 /// project: f < 0 inside, f > 0 outside, the surface is f = 0.
 
+#include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
 #include <cstddef>
+#include <limits>
 
 namespace vitri {
+
+/// An enclosure of a function and of its gradient over a region (ImplicitFunction::bounds): for every
+/// point x of the region, lo <= f(x) <= hi and grad_lo[k] <= d f / d x_k (x) <= grad_hi[k]; where f is
+/// only Lipschitz (a min or max of smooth functions), every generalized (Clarke) gradient lies in that
+/// box. The default value, infinite everywhere, is a valid enclosure that certifies nothing.
+struct FunctionBound {
+  static constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo = -kInf, hi = kInf;
+  Point3 grad_lo{-kInf, -kInf, -kInf};
+  Point3 grad_hi{kInf, kInf, kInf};
+};
 
 /// A scalar field on R^3 with its gradient. Implementations: the RBF interpolant (vitri::rbf), analytic
 /// shapes (tests, benchmarks). Evaluations must be deterministic and thread-safe for concurrent reads.
@@ -32,6 +45,19 @@ class ImplicitFunction {
   /// threaded kernel (the polygonizer computes all mesh normals with one call).
   virtual void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const {
     for (std::size_t i = 0; i < n; ++i) values[i] = value_gradient(points[i], gradients[i]);
+  }
+
+  /// Whether bounds() gives finite enclosures (an interval extension of f and its gradient). The
+  /// polygonizer's certificate (PolygonizerOptions::certify, docs/certificate.md) needs one: without it
+  /// no tetrahedron that may hold a zero is certified.
+  virtual bool has_bounds() const { return false; }
+
+  /// Batch enclosures: out[i] encloses f and its gradient over boxes[i] (closed, non-empty) for i < n.
+  /// The enclosures must be rigorous (including the rounding of the arithmetic; docs/certificate.md);
+  /// they may be loose. The default leaves every out[i] infinite (valid, certifies nothing).
+  virtual void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const {
+    (void)boxes;
+    for (std::size_t i = 0; i < n; ++i) out[i] = FunctionBound{};
   }
 };
 

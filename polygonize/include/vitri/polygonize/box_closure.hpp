@@ -26,6 +26,11 @@ class BoxClosedFunction : public ImplicitFunction {
   double value_gradient(const Point3& p, Point3& gradient) const override;
   void values(const Point3* points, std::size_t n, double* out) const override;
   void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const override;
+  /// Enclosures of max(f, band - d) from f's (max_bounds); the wall's value is exact over a box (d is
+  /// the distance to the nearest face plane) and its gradient the normals of the faces that may be
+  /// nearest. Available when f has them.
+  bool has_bounds() const override { return f_.has_bounds(); }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override;
 
   const ImplicitFunction& inner() const { return f_; }
   double band() const { return band_; }

@@ -147,6 +147,22 @@ struct PolygonizerOptions {
   /// with every vertex evaluation (about free for the RBF) and one gradient per fixed-value vertex. See
   /// docs/polygonize.md. false: only active tetrahedra are refined (the paper's rule).
   bool refine_thin_features = true;
+  /// Certified mode (docs/certificate.md): after each refine(), every live tetrahedron gets an enclosure
+  /// of f and its gradient over its bounding box (ImplicitFunction::bounds) and is certified *empty* (the
+  /// value interval excludes 0) or *disk* (gradient cone conditions on the tetrahedron, its faces and
+  /// edges: the zero set inside is one disk whose boundary crosses the edges the marching polygon
+  /// crosses, or nothing), else *uncertified*. The circumcenters of uncertified tetrahedra larger than
+  /// certify_floor_fraction x precision are inserted (with the refinement's rules: inside the box, not
+  /// closer than the proximity distance to a vertex) and the new tetrahedra refined and checked, until
+  /// none is left or the floor stops it. stats().uncertified then says whether the level is certified
+  /// (0: the mesh is homeomorphic to the zero set in the domain). A function without bounds
+  /// (has_bounds() false) can certify nothing: nothing is refined and every live tetrahedron is counted
+  /// uncertified. Costs an enclosure per tetrahedron checked (O(N) each for the global RBF) and the points
+  /// inserted (docs/certificate.md). false (default): the paper's sign sampling only.
+  bool certify = false;
+  /// Size floor of the certified mode, a fraction of the precision: uncertified tetrahedra whose
+  /// circumradius is at most this are left (counted in stats().uncertified). In (0, 1].
+  double certify_floor_fraction = 0.1;
   /// Keep the Delaunay tree's history DAG (TriangulationOptions::keep_history): point location by
   /// descent, O(log n) for single insertions and edits, at about 1250 bytes per Delaunay vertex instead
   /// of about 250 for the live mesh alone. false suits a batch run that refines and extracts without
@@ -212,6 +228,18 @@ struct PolygonizerStats {
   double extract_polygons_seconds = 0, extract_placement_seconds = 0, extract_snapping_seconds = 0,
          extract_mesh_seconds = 0;
   double neck_seconds = 0;              ///< of the last refine(): the neck checks and their points
+  /// Certified mode (PolygonizerOptions::certify), the last refine(): tetrahedra whose enclosure was
+  /// computed, points inserted for uncertified tetrahedra, time of the certificate (enclosures, checks,
+  /// and the refinement they caused).
+  std::size_t certify_checked = 0;
+  std::size_t certify_insertions = 0;
+  double certify_seconds = 0;
+  /// After the last refine() in certified mode: live tetrahedra that may hold a zero (value interval
+  /// containing 0) and are not certified, left at the size floor; 0 means the level is certified. The
+  /// place of the largest of them (its circumcenter) and its circumradius (0 when none).
+  std::size_t uncertified = 0;
+  Point3 uncertified_at{0, 0, 0};
+  double uncertified_radius = 0;
   double update_seconds = 0;            ///< last function_changed() call
 };
 
@@ -398,6 +426,9 @@ class Polygonizer {
                                  std::vector<TetId>& created);
   /// After the queue drained: neck checks and their points until none is left (false: cancelled).
   bool settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info);
+  /// Certified mode (certify.cpp): checks every live tetrahedron, refines the uncertified ones above the
+  /// floor and checks the new tetrahedra, until none is left (false: cancelled).
+  bool certify_level(double dmin, const ProgressCallback& progress, RefineProgress& info);
   bool is_negative_value(VertexId v) const { return values_[v] < 0.0; }  // sign(0) = +
   bool needs_evaluation(VertexId v) const;
   void refresh_at(VertexId v);
@@ -484,6 +515,10 @@ class Polygonizer {
   bool thin_all_ = true;                // the lists overflowed (or no refine yet): check everything
   bool queue_valid_ = false;            // the last refine() completed and the queue was kept since
   bool in_refine_ = false;
+  // Certified mode: while certify_level() runs, every tetrahedron classified (created) is listed here,
+  // to be checked next.
+  bool certifying_ = false;
+  std::vector<TetId> certify_new_;
   // Garbage candidates: refinement vertices whose transverse count dropped to 0 (may hold stale or
   // repeated ids; checked when collected).
   std::vector<VertexId> idle_;

@@ -189,6 +189,10 @@ class Rbf : public EditableFunction {
   /// values[i] = f(points[i]) and gradients[i] = grad f(points[i]), i < n, threaded when large.
   void values_gradients(const Point3* points, std::size_t n, double* values,
                         Point3* gradients) const override;
+  /// Enclosures of f and its gradient over boxes (rigorous, rounding included; docs/certificate.md):
+  /// the term-by-term interval sum intersected with a second-order Taylor bound. O(N) per box, threaded.
+  bool has_bounds() const override { return true; }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override;
 
   // ----- coefficients, in the caller's units -----
   /// RBF weights w_j of f (one per constraint, in the order of constraints()), for the caller's coordinates.

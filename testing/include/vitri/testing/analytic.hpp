@@ -4,11 +4,13 @@
 /// exist to test and benchmark the polygonizer independently of the RBF: their zero sets, topology
 /// (Euler characteristic) and distance functions are known exactly.
 
+#include "vitri/core/bounds.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace vitri {
 
@@ -22,6 +24,17 @@ class SphereFunction final : public ImplicitFunction {
     const double n = norm(d);
     gradient = n > 0.0 ? d / n : Point3{0.0, 0.0, 1.0};
     return n - radius_;
+  }
+  /// Enclosures (docs/certificate.md): 1-Lipschitz value; the gradient's Lipschitz constant is
+  /// 1 / (smallest distance to the center over the box).
+  bool has_bounds() const override { return true; }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override {
+    for (std::size_t i = 0; i < n; ++i) {
+      Point3 g;
+      const double v = value_gradient(boxes[i].center(), g);
+      const double near = v + radius_ - box_radius(boxes[i]);
+      out[i] = distance_bound(boxes[i], v, g, near > 0.0 ? 1.0 / near : FunctionBound::kInf);
+    }
   }
   /// Exact distance from p to the zero set.
   double distance_to_surface(const Point3& p) const { return std::abs(value(p)); }
@@ -43,6 +56,17 @@ class QuadricSphereFunction final : public ImplicitFunction {
   double value_gradient(const Point3& p, Point3& gradient) const override {
     gradient = 2.0 * (p - center_);
     return value(p);
+  }
+  /// Enclosures: second-order Taylor with the Hessian 2 I (exact).
+  bool has_bounds() const override { return true; }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override {
+    for (std::size_t i = 0; i < n; ++i) {
+      Point3 g;
+      const double v = value_gradient(boxes[i].center(), g);
+      out[i] = taylor_bound(boxes[i], v, g, 2.0);
+      const double scale = squared_norm(boxes[i].center() - center_) + radius_ * radius_;
+      widen_bounds(out[i], 1e-12 * scale, 1e-12 * std::sqrt(scale));
+    }
   }
   /// Exact distance from p to the zero set.
   double distance_to_surface(const Point3& p) const { return std::abs(norm(p - center_) - radius_); }
@@ -74,6 +98,21 @@ class TorusFunction final : public ImplicitFunction {
       gradient = {0.0, 0.0, 1.0};  // on the axis or on the core circle: any unit vector
     }
     return n - minor_;
+  }
+  /// Enclosures (docs/certificate.md): 1-Lipschitz value; the gradient of the distance s to the core
+  /// circle is Lipschitz with constant max(1 / s, 1 / (R - s)) (the principal curvatures of its level
+  /// tori), over the box's range of s when that stays in (0, R).
+  bool has_bounds() const override { return true; }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override {
+    for (std::size_t i = 0; i < n; ++i) {
+      Point3 g;
+      const double v = value_gradient(boxes[i].center(), g);
+      const double rho = box_radius(boxes[i]);
+      const double s_lo = v + minor_ - rho, s_hi = v + minor_ + rho;
+      const double lipschitz =
+          s_lo > 0.0 && s_hi < major_ ? std::max(1.0 / s_lo, 1.0 / (major_ - s_hi)) : FunctionBound::kInf;
+      out[i] = distance_bound(boxes[i], v, g, lipschitz);
+    }
   }
   /// Exact distance from p to the zero set.
   double distance_to_surface(const Point3& p) const { return std::abs(value(p)); }
@@ -120,6 +159,14 @@ class UnionFunction final : public ImplicitFunction {
     const double vb = b_.value_gradient(p, gb);
     gradient = va <= vb ? ga : gb;
     return std::min(va, vb);
+  }
+  /// Enclosures of min(a, b) from those of a and b (min_bounds).
+  bool has_bounds() const override { return a_.has_bounds() && b_.has_bounds(); }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override {
+    std::vector<FunctionBound> other(n);
+    a_.bounds(boxes, n, out);
+    b_.bounds(boxes, n, other.data());
+    for (std::size_t i = 0; i < n; ++i) out[i] = min_bounds(out[i], other[i]);
   }
 
  private:

@@ -1,0 +1,211 @@
+// The certified mode (PolygonizerOptions::certify, docs/certificate.md): the enclosures of the analytic
+// functions contain sampled values and gradients (property test), certify_cell() on cases with a known
+// answer, and surfaces whose topology sign sampling gets wrong at coarse levels (two spheres almost
+// touching, a thin torus, a small bubble): every certified level has the true components and Euler
+// characteristic, and the fast mode at the same precisions gets at least one level wrong.
+#include <catch2/catch.hpp>
+
+#include "support/surface_metrics.hpp"
+#include "vitri/core/bounds.hpp"
+#include "vitri/testing/analytic.hpp"
+#include "vitri/polygonize/box_closure.hpp"
+#include "vitri/polygonize/certificate.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+
+#include <random>
+#include <string>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+const Box3 kCube{{-1, -1, -1}, {1, 1, 1}};
+// The domain of the meshes: its closing band (a tenth of the side, docs/polygonize.md) clear of the shapes.
+const Box3 kDomain{{-1.4, -1.4, -1.4}, {1.4, 1.4, 1.4}};
+
+// Random boxes of sizes from 1e-3 to 1 in the cube, and `samples` random points in each: f and its
+// gradient there must lie in the enclosure (the gradient where f is differentiable: away from ties of
+// the min and max, which the sampled points almost surely avoid).
+void require_enclosures(const ImplicitFunction& f, std::uint32_t seed, int boxes = 300, int samples = 200) {
+  REQUIRE(f.has_bounds());
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<Box3> bs;
+  for (int i = 0; i < boxes; ++i) {
+    const double size = std::pow(10.0, -3.0 * unit(rng));
+    Box3 b;
+    for (std::size_t k = 0; k < 3; ++k) {
+      b.lo[k] = -1.0 + (2.0 - size) * unit(rng);
+      b.hi[k] = b.lo[k] + size * (0.2 + 0.8 * unit(rng));
+    }
+    bs.push_back(b);
+  }
+  std::vector<FunctionBound> out(bs.size());
+  f.bounds(bs.data(), bs.size(), out.data());
+  std::size_t narrow = 0;  // enclosures that exclude 0 or whose gradient box excludes 0 (not vacuous)
+  for (std::size_t i = 0; i < bs.size(); ++i) {
+    const FunctionBound& e = out[i];
+    if (e.lo > 0 || e.hi < 0) ++narrow;
+    for (int s = 0; s < samples; ++s) {
+      Point3 p;
+      for (std::size_t k = 0; k < 3; ++k) p[k] = bs[i].lo[k] + (bs[i].hi[k] - bs[i].lo[k]) * unit(rng);
+      Point3 g;
+      const double v = f.value_gradient(p, g);
+      INFO("box " << i << " point (" << p.x << ", " << p.y << ", " << p.z << ") f " << v << " in [" << e.lo
+                  << ", " << e.hi << "]");
+      REQUIRE(v >= e.lo);
+      REQUIRE(v <= e.hi);
+      for (std::size_t k = 0; k < 3; ++k) {
+        INFO("gradient " << k << ": " << g[k] << " in [" << e.grad_lo[k] << ", " << e.grad_hi[k] << "]");
+        REQUIRE(g[k] >= e.grad_lo[k]);
+        REQUIRE(g[k] <= e.grad_hi[k]);
+      }
+    }
+  }
+  REQUIRE(narrow > bs.size() / 10);
+}
+
+struct Topology {
+  std::size_t components;
+  long long euler;
+};
+
+Topology topology_of(const SurfaceMesh& m) {
+  const MeshMetrics mm = test::metrics_of(m);
+  return {mm.components, mm.euler_characteristic};
+}
+
+// Levels of detail of f, fast and certified: every certified level (stats().uncertified == 0) has the
+// true topology. Counts the certified levels and the fast levels with a wrong topology.
+struct LevelCounts {
+  std::size_t certified = 0, fast_wrong = 0;
+};
+
+LevelCounts check_levels(const ImplicitFunction& f, Topology truth, const std::vector<double>& precisions) {
+  PolygonizerOptions fast_options;
+  PolygonizerOptions cert_options;
+  cert_options.certify = true;
+  cert_options.certify_floor_fraction = 0.005;
+  Polygonizer fast(f, kDomain, {}, {}, fast_options);
+  Polygonizer cert(f, kDomain, {}, {}, cert_options);
+  LevelCounts counts;
+  for (const double precision : precisions) {
+    REQUIRE(fast.refine(precision));
+    REQUIRE(cert.refine(precision));
+    const Topology tf = topology_of(fast.extract());
+    const SurfaceMesh cm = cert.extract();
+    const Topology tc = topology_of(cm);
+    const PolygonizerStats s = cert.stats();
+    INFO("precision " << precision << ": fast " << tf.components << " component(s), chi " << tf.euler
+                      << "; certified mode " << tc.components << ", chi " << tc.euler << ", " << s.uncertified
+                      << " uncertified (largest r " << s.uncertified_radius << " at " << s.uncertified_at.x << " "
+                      << s.uncertified_at.y << " " << s.uncertified_at.z << "), " << s.certify_insertions
+                      << " points, " << s.vertices << " vs " << fast.stats().vertices << " vertices");
+    REQUIRE(test::metrics_of(cm).closed_manifold());
+    if (s.uncertified == 0) {
+      ++counts.certified;
+      REQUIRE(tc.components == truth.components);
+      REQUIRE(tc.euler == truth.euler);
+    }
+    if (tf.components != truth.components || tf.euler != truth.euler) ++counts.fast_wrong;
+  }
+  return counts;
+}
+
+}  // namespace
+
+TEST_CASE("certificate: enclosures of the analytic functions contain f and its gradient", "[certificate]") {
+  const SphereFunction a({-0.3, 0.1, 0.0}, 0.4);
+  const SphereFunction b({0.4, -0.2, 0.1}, 0.25);
+  const TorusFunction torus({0.1, 0.0, -0.1}, 0.5, 0.1);
+  const QuadricSphereFunction quadric({0.2, 0.2, 0.2}, 0.5);
+  const UnionFunction both(a, torus);
+  const BoxClosedFunction closed(b, kCube, 0.1);
+  require_enclosures(a, 1);
+  require_enclosures(torus, 2);
+  require_enclosures(quadric, 3);
+  require_enclosures(both, 4);
+  require_enclosures(closed, 5);
+}
+
+TEST_CASE("certificate: certify_cell on known cells", "[certificate]") {
+  const std::array<Point3, 4> p{Point3{0, 0, 0}, Point3{1, 0, 0}, Point3{0, 1, 0}, Point3{0, 0, 1}};
+  // A plane f = x + y + z - 0.5 crossing the cell: exact enclosure (gradient (1, 1, 1)).
+  FunctionBound plane;
+  plane.lo = -0.5, plane.hi = 0.5;
+  plane.grad_lo = plane.grad_hi = Point3{1, 1, 1};
+  REQUIRE(certify_cell(p, {-0.5, 0.5, 0.5, 0.5}, plane) == CellCertificate::Disk);
+  // The same values with the gradient's sign unknown: nothing can be said.
+  FunctionBound unknown = plane;
+  unknown.grad_lo = Point3{-1, -1, -1};
+  REQUIRE(certify_cell(p, {-0.5, 0.5, 0.5, 0.5}, unknown) == CellCertificate::Uncertified);
+  // All vertices positive and a value interval containing 0 (figure 5 of the paper: a peak may hide
+  // inside): uncertified unless the cone conditions say the sheet cannot close inside.
+  FunctionBound peak;
+  peak.lo = -0.1, peak.hi = 1.0;
+  peak.grad_lo = Point3{-2, -2, -2}, peak.grad_hi = Point3{2, 2, 2};
+  REQUIRE(certify_cell(p, {0.2, 0.3, 0.3, 0.3}, peak) == CellCertificate::Uncertified);
+  // Positive interval: empty; a vertex value of the other sign contradicts it: not certified.
+  FunctionBound positive = plane;
+  positive.lo = 0.1, positive.hi = 2.0;
+  REQUIRE(certify_cell(p, {0.2, 0.3, 0.3, 0.3}, positive) == CellCertificate::Empty);
+  REQUIRE(certify_cell(p, {-0.2, 0.3, 0.3, 0.3}, positive) == CellCertificate::Uncertified);
+  // A same-sign edge along which f dips: the envelope from the ends must stay positive. Gradient
+  // x-component in [-1, 1] along the edge (0,0,0)-(1,0,0) with end values 0.2 and 0.3: the envelope
+  // reaches 0.2 - 0.45 < 0, so not certified; with end values 1 and 1 it stays above 0.5.
+  FunctionBound dip;
+  dip.lo = -0.1, dip.hi = 1.0;
+  dip.grad_lo = Point3{-1, 2, 2}, dip.grad_hi = Point3{1, 3, 3};
+  REQUIRE(certify_cell(p, {0.2, 0.3, -1.0, -1.0}, dip) == CellCertificate::Uncertified);
+  REQUIRE(certify_cell(p, {1.0, 1.0, -1.0, -1.0}, dip) == CellCertificate::Disk);
+  // A sign-changing edge along which f need not be monotone ((0,1,0)-(0,0,1): <g, d> in [-0.71, 0.71]).
+  REQUIRE(certify_cell(p, {1.0, 1.0, -1.0, 0.5}, dip) == CellCertificate::Uncertified);
+}
+
+TEST_CASE("certificate: a function without enclosures certifies nothing", "[certificate]") {
+  class Plain final : public ImplicitFunction {
+   public:
+    double value(const Point3& p) const override { return norm(p) - 0.5; }
+    double value_gradient(const Point3& p, Point3& g) const override {
+      g = p / norm(p);
+      return value(p);
+    }
+  } f;
+  PolygonizerOptions o;
+  o.certify = true;
+  Polygonizer poly(f, kCube, {}, {}, o);
+  REQUIRE(poly.refine(0.2));
+  REQUIRE(poly.stats().uncertified == poly.stats().tetrahedra);
+  REQUIRE(poly.stats().certify_insertions == 0);
+}
+
+TEST_CASE("certificate: two spheres almost touching", "[certificate]") {
+  // Gap 0.03 between radii 0.45: two components, chi 4.
+  const SphereFunction a({-0.465, 0.02, 0.01}, 0.45);
+  const SphereFunction b({0.465, -0.01, 0.0}, 0.45);
+  const UnionFunction f(a, b);
+  const LevelCounts c = check_levels(f, {2, 4}, {0.4, 0.2, 0.1});
+  CHECK(c.certified == 3);
+  CHECK(c.fast_wrong >= 1);
+}
+
+TEST_CASE("certificate: a thin torus", "[certificate]") {
+  // Minor radius 0.07, far below the sampling lattice's covering radius (0.48): genus 1, chi 0.
+  const TorusFunction f({0.03, -0.02, 0.01}, 0.35, 0.07);
+  const LevelCounts c = check_levels(f, {1, 0}, {0.4, 0.2, 0.1});
+  CHECK(c.certified >= 1);
+  CHECK(c.fast_wrong >= 1);
+}
+
+TEST_CASE("certificate: a small bubble", "[certificate]") {
+  // A sphere of radius 0.05 beside one of radius 0.4: two components, chi 4. Its center is a corner of the
+  // sampling lattice's cells (spacing 0.467), 0.4 from the nearest lattice point: no vertex sees it.
+  const SphereFunction big({-0.3, 0.0, 0.02}, 0.4);
+  const SphereFunction small({0.467, 0.467, 0.467}, 0.02);
+  const UnionFunction f(big, small);
+  const LevelCounts c = check_levels(f, {2, 4}, {0.4, 0.2, 0.1});
+  CHECK(c.certified >= 1);
+  CHECK(c.fast_wrong >= 1);
+}

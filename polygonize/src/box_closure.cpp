@@ -85,12 +85,17 @@ void BoxClosedFunction::bounds(const Box3* boxes, std::size_t n, FunctionBound* 
     FunctionBound w;
     w.lo = band_ - d_hi;
     w.hi = band_ - d_lo;
-    w.grad_lo = w.grad_hi = Point3{0.0, 0.0, 0.0};
+    // The hull of the candidates' normals, component by component (a normal is -e_k or +e_k).
+    const double inf = FunctionBound::kInf;
+    w.grad_lo = Point3{inf, inf, inf};
+    w.grad_hi = Point3{-inf, -inf, -inf};
     for (std::size_t j = 0; j < 6; ++j) {
       if (lo[j] > d_hi) continue;  // never the nearest face over this box
-      const std::size_t k = j / 2;
-      if (j % 2 == 0) w.grad_lo[k] = -1.0;
-      else w.grad_hi[k] = 1.0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const double normal = k != j / 2 ? 0.0 : (j % 2 == 0 ? -1.0 : 1.0);
+        w.grad_lo[k] = std::min(w.grad_lo[k], normal);
+        w.grad_hi[k] = std::max(w.grad_hi[k], normal);
+      }
     }
     const double slack = 1e-12 * (std::abs(band_) + norm(box_.hi - box_.lo));
     widen_bounds(w, slack, 0.0);

@@ -10,6 +10,7 @@
 #include "vitri/mesher.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -22,8 +23,6 @@
 #include <string>
 #include <vector>
 
-#include <unistd.h>
-
 namespace vitri::cli {
 namespace {
 
@@ -32,8 +31,10 @@ const char* const kUsage =
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z]\n"
-    "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
-    "                  [--threads N] [--ascii] [-q]\n"
+    "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]
+"
+    "                  [--threads N] [--memory M] [--ascii] [-q]
+"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -132,6 +133,14 @@ const char* const kUsage =
     "  --threads N          threads of the fit, the seeds' insertion and the extraction (default 0:\n"
     "                       every CPU this process may run on, i.e. its affinity mask, so `taskset`\n"
     "                       works too). The mesh is the same file whatever N.\n"
+    "  --memory M           memory limit of the run: bytes, or with a suffix K, M, G, T (powers of 1024:\n"
+    "                       16G). Default: the machine's available memory (MemAvailable) less a reserve\n"
+    "                       of max(1 GiB, 10% of the physical memory). Checked from the input's size\n"
+    "                       before the large allocations (docs/memory.md): points are thinned evenly to\n"
+    "                       what fits, with a warning (a coarser mesh); the refinement stops at the\n"
+    "                       Delaunay vertices the rest holds (without --precision: a coarser mesh with a\n"
+    "                       warning; with it: an error); an input whose coarsest mesh does not fit is\n"
+    "                       refused (exit 1) naming the sizes.\n"
     "  --ascii              PLY output as text (default: binary little-endian, about half the size and\n"
     "                       several times faster to write; OBJ and OFF are always text)\n"
     "  -q, --quiet          no table, no progress\n"
@@ -253,24 +262,42 @@ constexpr std::size_t kFitProgressConstraints = 1000;
 /// mesh vertices as points (hand.off: 7231 for 1197); 2.5 spacings give 1-1.5x as many (hand 1855,
 /// sphere926 990, 33k samples of man.off 49.6k).
 constexpr double kSpacingFactor = 2.5;
-/// Memory per Delaunay vertex of the whole meshing structure (Delaunay tree, polygonizer arrays, live
-/// mesh, vector growth slack), measured on 10^6 oriented points (docs/benchmarks.md "10^6 points end to
-/// end"): about 1.5 KB in a batch run; with the history kept (a run with --edits) 2.5 KB measured before
-/// the incremental extraction, which adds about 0.4 KB.
-constexpr double kBytesPerVertexBatch = 1600.0;
-constexpr double kBytesPerVertexHistory = 2900.0;
 /// A scan without --precision: at most this many Delaunay vertices per input point (plus the base), about
 /// 2 mesh vertices per input point (docs/scans.md "Budget").
 constexpr std::size_t kScanVerticesPerPoint = 12;
 constexpr std::size_t kScanVerticesBase = 200000;
 
-/// The Delaunay vertex budget of this machine: 80% of the physical memory over the bytes per vertex
-/// (0: unknown, no limit).
-std::size_t vertex_budget(bool keep_history) {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || page <= 0) return 0;
-  const double bytes = 0.8 * static_cast<double>(pages) * static_cast<double>(page);
-  return static_cast<std::size_t>(bytes / (keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch));
+/// The default memory limit of a run: the machine's available memory less a reserve of max(1 GiB, 10% of
+/// the physical memory), never the machine's last gigabyte (0: unknown, no limit).
+std::size_t default_memory_limit() {
+  const double available = static_cast<double>(available_memory_bytes());
+  const double reserve = std::max(double(1ull << 30), 0.1 * static_cast<double>(physical_memory_bytes()));
+  if (available <= 0) return 0;
+  // Under the reserve already: a limit that holds little (a coarser mesh or a clear refusal), not none.
+  return static_cast<std::size_t>(std::max(available - reserve, 0.25 * available));
+}
+
+/// "16G", "512M", "2.5G", "1000000": bytes (suffixes K, M, G, T are powers of 1024; a trailing B or iB
+/// is allowed). False for anything else or a size below 1 byte.
+bool parse_memory(const std::string& s, std::size_t& out) {
+  const char* b = s.c_str();
+  char* e = nullptr;
+  const double v = std::strtod(b, &e);
+  if (e == b || !(v > 0.0) || !std::isfinite(v)) return false;
+  std::string unit = e;
+  for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  if (unit.size() >= 2 && unit.compare(unit.size() - 2, 2, "IB") == 0) unit.resize(unit.size() - 2);
+  else if (unit.size() >= 2 && unit.back() == 'B') unit.pop_back();
+  double scale = 1.0;
+  if (unit == "K") scale = 1024.0;
+  else if (unit == "M") scale = 1024.0 * 1024.0;
+  else if (unit == "G") scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  else if (!unit.empty() && unit != "B") return false;
+  const double bytes = v * scale;
+  if (!(bytes >= 1.0) || bytes > 1e18) return false;
+  out = static_cast<std::size_t>(bytes);
+  return true;
 }
 
 /// mesher.refine(), its LimitError (MesherOptions::max_vertices, set from the machine's memory and, for a
@@ -284,15 +311,17 @@ void refine_within_budget(Mesher& mesher, double precision, bool lenient, bool q
     if (lenient) {
       if (!quiet)
         std::fprintf(stderr, "\nvitri mesh: warning: the refinement reached its budget of %zu Delaunay vertices "
-                     "(the input's size and this machine's memory, docs/scans.md) before the default precision: "
+                     "(the input's size and the memory limit, docs/scans.md, docs/memory.md) before the default "
+                     "precision: "
                      "the mesh is coarser than it, partly (%s)\n", mesher.options().max_vertices, e.what());
       return;
     }
     std::ostringstream what;
-    what << "this machine's memory holds about " << mesher.options().max_vertices
-         << " Delaunay vertices (80% of the physical memory at "
-         << (mesher.options().polygonizer.keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch)
-         << " bytes each) and the refinement needs more: give a coarser --precision (" << e.what() << ")";
+    what << "the memory limit (--memory, else the machine's available memory less a reserve) holds about "
+         << mesher.options().max_vertices << " Delaunay vertices beside the fit (at "
+         << (mesher.options().polygonizer.keep_history ? kMemoryBytesPerVertexHistory : kMemoryBytesPerVertexBatch)
+         << " bytes each, docs/memory.md) and the refinement needs more: give a coarser --precision or a larger "
+            "--memory (" << e.what() << ")";
     throw LimitError(what.str());
   }
 }
@@ -311,6 +340,7 @@ int run_mesh(const Args& args) {
   bool viewpoint_given = false;  // --viewpoint
   PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  // --ascii: text
   unsigned threads = 0;  // --threads: 0 = every available CPU
+  std::size_t memory = 0;  // --memory: 0 = the default limit
   MesherOptions options;
   options.function = FunctionKind::Auto;
   options.constraint_build.offset_spacings = kOffsetSpacings;
@@ -408,6 +438,9 @@ int run_mesh(const Args& args) {
       if (!value(v) || !parse_double(v, fl) || !(fl > 0.0 && fl <= 1.0))
         return usage_error("--certify-floor needs a fraction of the precision in (0, 1]");
       options.polygonizer.certify_floor_fraction = fl;
+    } else if (a == "--memory") {
+      if (!value(v) || !parse_memory(v, memory))
+        return usage_error("--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'");
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;
     } else if (a == "--ascii") {
@@ -454,9 +487,10 @@ int run_mesh(const Args& args) {
   options.rbf.threads = threads;
   options.constraint_build.threads = threads;
   options.constraint_build.normals.threads = threads;
-  // A precision far below the data's spacing would need more memory than the machine has: a LimitError
-  // naming the count instead of an out-of-memory end.
-  options.max_vertices = vertex_budget(options.polygonizer.keep_history);
+  // The memory limit (docs/memory.md), checked from the input's size before the large allocations: a
+  // scan thinned to what fits, the refinement bounded by what the rest holds (a precision far below the
+  // data's spacing: a LimitError naming the count instead of an out-of-memory end).
+  options.max_memory_bytes = memory ? memory : default_memory_limit();
   phases.start("read", "reading " + input);
   Input data = read_input(input);
   // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
@@ -520,6 +554,13 @@ int run_mesh(const Args& args) {
   }
   Mesher& mesher = *built;
   phases.stop();
+  if (mesher.stats().memory_thinned > 0 && !quiet)
+    std::fprintf(stderr, "vitri mesh: warning: the memory limit of %.3g GB (%s) holds the meshing of about %zu of "
+                 "the %zu points: every %zu-th point kept (%zu left out), the mesh is coarser than the data "
+                 "(docs/memory.md)\n", static_cast<double>(options.max_memory_bytes) / 1e9,
+                 memory ? "--memory" : "the machine's available memory less a reserve",
+                 input_points - mesher.stats().memory_thinned, input_points, mesher.stats().memory_stride,
+                 mesher.stats().memory_thinned);
   if (scan_input) {
     const ScanReport& sr = mesher.stats().scan;
     if (!quiet) {

@@ -26,9 +26,11 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <exception>
 #include <limits>
 #include <optional>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <utility>
@@ -40,10 +42,68 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double now_seconds() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
+std::string gigabytes(double bytes) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.3g GB", bytes / 1e9);
+  return buf;
+}
+
+/// Every stride-th entry of v (v itself when stride is 1 or v is empty).
+std::vector<Point3> every(const std::vector<Point3>& v, std::size_t stride) {
+  if (stride <= 1 || v.empty()) return v;
+  std::vector<Point3> out;
+  out.reserve(v.size() / stride + 1);
+  for (std::size_t i = 0; i < v.size(); i += stride) out.push_back(v[i]);
+  return out;
+}
+
 }  // namespace
+
+MemoryPlan plan_memory(std::size_t inputs, std::size_t limit, bool keep_history, bool allow_thinning,
+                       double seeds_per_input) {
+  MemoryPlan plan;
+  plan.points = inputs;
+  if (limit == 0) return plan;
+  const double per_vertex = keep_history ? kMemoryBytesPerVertexHistory : kMemoryBytesPerVertexBatch;
+  const double fixed_per_input = kMemoryBytesPerPoint * seeds_per_input / kMemorySeedsPerPoint;
+  // An input needs its share of the fit and room for its seeds and their first refinement.
+  const double per_input = fixed_per_input + kMemoryRefineFactor * seeds_per_input * per_vertex;
+  const double room = static_cast<double>(limit) - kMemoryBaseBytes;
+  const double fits = room > 0 ? std::floor(room / per_input) : 0.0;
+  if (fits < static_cast<double>(inputs)) {
+    const std::size_t needed = std::min(inputs, kMemoryMinPoints);
+    const double need_bytes = kMemoryBaseBytes + per_input * static_cast<double>(allow_thinning ? needed : inputs);
+    if (!allow_thinning || fits < static_cast<double>(needed)) {
+      std::ostringstream what;
+      what << "the memory limit of " << gigabytes(static_cast<double>(limit)) << " (" << limit
+           << " bytes) holds the meshing of about " << static_cast<std::size_t>(fits) << " of the " << inputs
+           << (allow_thinning ? " input points" : " constraints") << " (about "
+           << static_cast<std::size_t>(per_input) << " bytes each and " << gigabytes(kMemoryBaseBytes)
+           << " of base, docs/memory.md); "
+           << (allow_thinning ? "even the coarsest mesh, of " + std::to_string(needed) + " points, needs "
+                              : "all of them need ")
+           << gigabytes(need_bytes) << ": give a larger memory limit (--memory)"
+           << (allow_thinning ? "" : " or fewer constraints");
+      throw LimitError(what.str());
+    }
+    plan.stride = static_cast<std::size_t>(std::ceil(static_cast<double>(inputs) / fits));
+    plan.points = (inputs + plan.stride - 1) / plan.stride;
+  }
+  plan.fixed_bytes = kMemoryBaseBytes + fixed_per_input * static_cast<double>(plan.points);
+  plan.max_vertices = static_cast<std::size_t>((static_cast<double>(limit) - plan.fixed_bytes) / per_vertex);
+  return plan;
+}
 
 Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
     : options_(options), precision_(std::numeric_limits<double>::infinity()) {
+  // The memory limit, checked before the fit and the seeds allocate anything large.
+  if (options_.max_memory_bytes) {
+    const MemoryPlan plan = plan_memory(constraints.size(), options_.max_memory_bytes,
+                                        options_.polygonizer.keep_history, false, 1.0);
+    options_.max_vertices = options_.max_vertices ? std::min(options_.max_vertices, plan.max_vertices)
+                                                  : plan.max_vertices;
+    if (!options_.rbf.max_memory_bytes) options_.rbf.max_memory_bytes = options_.max_memory_bytes;
+  }
   if (!(options_.box_factor > 1.0) || !std::isfinite(options_.box_factor))
     throw InvalidArgument("MesherOptions::box_factor must be > 1");
   if (!(options_.garbage_fraction >= 0.0) || !std::isfinite(options_.garbage_fraction))
@@ -142,9 +202,29 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
   ScanReport report;
   ScanOptions scan = options.scan;
   if (scan.threads == 0) scan.threads = options.polygonizer.threads;
-  ScanPoints prepared = prepare_scan(points, normals, scan, &report);
-  auto support = std::make_shared<ScanSupport>(prepared, report.resolution, scan.threads);
   MesherOptions o = options;
+  // The memory limit, checked from the input's size before anything large is allocated: the points
+  // thinned evenly to what fits (a coarser mesh), the refinement bounded by what the rest holds.
+  MemoryPlan plan;
+  plan.points = points.size();
+  if (o.max_memory_bytes) {
+    // Seeds per point: the point and its off-surface constraints (one or two sides), about
+    // kMemorySeedsPerPoint when they are spaced out (measured 1.86 at 10^6 points, spacing 1).
+    double seeds = o.constraint_build.sides == OffSurface::Both ? 3.0 : 2.0;
+    if (o.constraint_build.off_surface_spacing > 0) seeds = std::min(seeds, kMemorySeedsPerPoint);
+    plan = plan_memory(points.size(), o.max_memory_bytes, o.polygonizer.keep_history, true, seeds);
+    o.max_vertices = o.max_vertices ? std::min(o.max_vertices, plan.max_vertices) : plan.max_vertices;
+    if (!o.rbf.max_memory_bytes) o.rbf.max_memory_bytes = o.max_memory_bytes;
+    o.max_memory_bytes = 0;  // checked here, on the points; the constructor below need not again
+  }
+  ScanPoints prepared;
+  if (plan.stride > 1) {
+    if (scan.sensors.size() == points.size()) scan.sensors = every(scan.sensors, plan.stride);
+    prepared = prepare_scan(every(points, plan.stride), every(normals, plan.stride), scan, &report);
+  } else {
+    prepared = prepare_scan(points, normals, scan, &report);
+  }
+  auto support = std::make_shared<ScanSupport>(prepared, report.resolution, scan.threads);
   // The sizing field follows the data as they were scanned; an editing session (history kept) moves
   // constraints away from them, so it keeps the uniform precision.
   if (!o.polygonizer.size_scale && !o.polygonizer.keep_history)
@@ -185,6 +265,8 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
   m.scan_ = std::move(support);
   m.stats_.scan = report;
   m.stats_.scan_constraints = built;
+  m.stats_.memory_stride = plan.stride;
+  m.stats_.memory_thinned = points.size() - plan.points;
   return m;
 }
 

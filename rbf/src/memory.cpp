@@ -52,6 +52,18 @@ std::size_t physical_memory_bytes() {
   return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page);
 }
 
+std::size_t available_memory_bytes() {
+  if (std::FILE* f = std::fopen("/proc/meminfo", "r")) {
+    char line[256];
+    unsigned long long kb = 0;
+    bool found = false;
+    while (!found && std::fgets(line, sizeof line, f)) found = std::sscanf(line, "MemAvailable: %llu kB", &kb) == 1;
+    std::fclose(f);
+    if (found) return static_cast<std::size_t>(kb) * 1024;
+  }
+  return physical_memory_bytes();
+}
+
 namespace rbf_detail {
 
 std::size_t saturated_bytes(double bytes) {

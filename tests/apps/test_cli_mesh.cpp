@@ -543,3 +543,40 @@ TEST_CASE("vitri mesh --min-angle --max-distance: quality mode, every angle >= A
     REQUIRE(run(in + " -o " + out + " --precision 0.1 " + bad, o, e) == 2);
   }
 }
+
+TEST_CASE("vitri mesh --memory: a coarser mesh with a warning under a small limit, an error below any mesh",
+          "[cli][mesh][memory]") {
+  // 6000 oriented points on the sphere. docs/memory.md's model (base 64 MB, 1100 bytes per point beside
+  // 2 seeds of 1600 bytes per point) holds about 4000 of them in 84 MiB: every second point is kept, the
+  // check made on the input's size before the scan, the fit and the seeds.
+  const std::string in = write_sphere_points("mesh_memory.pwn", 6000);
+  const std::string full = kDir + "/mesh_memory_full.obj", thin = kDir + "/mesh_memory_thin.obj";
+  std::string o, e;
+  REQUIRE(run(in + " -o " + full, o, e) == 0);
+  CHECK(e.find("memory limit") == std::string::npos);
+  const long full_vertices = check_mesh(full);
+  REQUIRE(run(in + " -o " + thin + " --memory 84M", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("warning: the memory limit") != std::string::npos);
+  CHECK(e.find("3000 of the 6000 points") != std::string::npos);
+  CHECK(e.find("--memory") != std::string::npos);
+  // The preparation saw the thinned points: the check came before it.
+  CHECK(e.find("3000 of 3000 points kept") != std::string::npos);
+  const long thin_vertices = check_mesh(thin);  // closed, outward, a sphere
+  CHECK(thin_vertices < full_vertices);
+  // A limit below the coarsest mesh: exit 1, the sizes named, no mesh.
+  std::remove(thin.c_str());
+  REQUIRE(run(in + " -o " + thin + " --memory 32M", o, e) == 1);
+  CHECK(e.find("memory limit of") != std::string::npos);
+  CHECK(e.find("6000 input points") != std::string::npos);
+  CHECK(e.find("1000 points") != std::string::npos);
+  CHECK(!exists(thin));
+  // A limit that holds every point changes nothing: the same file.
+  REQUIRE(run(in + " -o " + thin + " --memory 16G", o, e) == 0);
+  CHECK(slurp(thin) == slurp(full));
+  for (const char* bad : {"abc", "0", "-5G", "5X", "1e30"}) {
+    INFO(bad);
+    REQUIRE(run(in + " -o " + thin + " --memory " + bad, o, e) == 2);
+    CHECK(e.find("--memory") != std::string::npos);
+  }
+}

@@ -121,6 +121,15 @@ struct MesherOptions {
   /// check runs between refinement rounds, so it may overshoot by a few thousand vertices). The CLI sets
   /// it from the machine's memory (docs/guide.md).
   std::size_t max_vertices = 0;
+  /// Memory limit of the whole run in bytes (0: none, the default). Checked before the large
+  /// allocations, from the input's size (plan_memory(), docs/memory.md): from_scan() thins the points
+  /// evenly to what fits (a coarser mesh; MesherStats::memory_thinned says how many were left out) and
+  /// throws LimitError when even kMemoryMinPoints points do not fit; the constraints' constructors throw
+  /// LimitError when the constraints' fit and tetrahedralization do not fit; max_vertices is lowered to
+  /// the Delaunay vertices the rest holds, and the global function's dense fit is checked against it
+  /// (RbfOptions::max_memory_bytes, when that is 0). The CLI sets it from --memory, else from the
+  /// machine's available memory less a reserve.
+  std::size_t max_memory_bytes = 0;
   /// Called by the constructor when a long phase starts: "fit" (the implicit function) and then
   /// "tetrahedralization" (Delaunay insertion of the constraints, evaluation and classification), so
   /// that a caller can report progress (the CLI does). With the local function the Delaunay insertion
@@ -162,7 +171,43 @@ struct MesherStats {
   bool open = false;
   double unsupported_area = 0;
   std::size_t trimmed_triangles = 0;
+  /// from_scan() under MesherOptions::max_memory_bytes: input points left out to fit the limit (every
+  /// memory_stride-th point kept; 0 and 1 when none was left out).
+  std::size_t memory_thinned = 0;
+  std::size_t memory_stride = 1;
 };
+
+/// Memory model of a run, measured at 10^6 oriented points (docs/memory.md): bytes per input point of
+/// what is not the Delaunay structure (the scan's preparation, the constraints, the local function), the
+/// Delaunay vertices the seeds need per input point, and bytes per Delaunay vertex of the meshing
+/// structure (tree, polygonizer arrays, extraction), without and with the history.
+constexpr double kMemoryBytesPerPoint = 1100.0;
+constexpr double kMemorySeedsPerPoint = 2.0;
+constexpr double kMemoryBytesPerVertexBatch = 1600.0;
+constexpr double kMemoryBytesPerVertexHistory = 2900.0;
+/// Base of a run (code, libraries, small tables), below any input.
+constexpr double kMemoryBaseBytes = 64e6;
+/// The room an input needs: this many Delaunay vertices per seed vertex (1: the seeds with their
+/// extraction, which kMemoryBytesPerVertexBatch includes); an input whose seeds leave less is thinned.
+constexpr double kMemoryRefineFactor = 1.0;
+/// Fewer points than this cannot make a useful mesh: the limit is then refused.
+constexpr std::size_t kMemoryMinPoints = 1000;
+
+/// What fits in a memory limit, decided from the input's size before anything large is allocated.
+struct MemoryPlan {
+  std::size_t points = 0;        ///< input points (or constraints) kept: all of them unless thinned
+  std::size_t stride = 1;        ///< every stride-th input point kept (1: all)
+  std::size_t max_vertices = 0;  ///< Delaunay vertices the limit holds once the fit and the seeds are in
+  double fixed_bytes = 0;        ///< estimated memory of everything but the Delaunay structure
+};
+
+/// The plan for `inputs` input points (seeds_per_input Delaunay seeds each: for points, 1 + the
+/// off-surface sides, kMemorySeedsPerPoint when they are spaced out; 1 for constraints given as such) within `limit` bytes (0: no limit, all kept, no
+/// vertex bound). Thins (stride > 1) when the seeds and the refinement's minimum room do not fit.
+/// @throws LimitError naming the sizes when not even kMemoryMinPoints points (or all inputs, if fewer
+///         and thinning is not allowed) fit.
+MemoryPlan plan_memory(std::size_t inputs, std::size_t limit, bool keep_history, bool allow_thinning = true,
+                       double seeds_per_input = kMemorySeedsPerPoint);
 
 /// Stateful mesher of one variational implicit surface. Not thread-safe. Movable, not copyable.
 class Mesher {

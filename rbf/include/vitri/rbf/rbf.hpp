@@ -94,6 +94,9 @@ std::size_t rbf_fit_memory_bytes(std::size_t n, RbfSolver solver = RbfSolver::Ch
 
 /// Physical memory of the machine in bytes (sysconf; 0 when unknown, then no limit is applied).
 std::size_t physical_memory_bytes();
+/// Memory the machine can still give without swapping, in bytes: MemAvailable of /proc/meminfo (Linux),
+/// else physical_memory_bytes() (0 when neither is known).
+std::size_t available_memory_bytes();
 
 /// What a fit (or the last drift check) measured.
 struct FitReport {

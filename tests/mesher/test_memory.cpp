@@ -1,0 +1,106 @@
+// The memory limit (MesherOptions::max_memory_bytes, plan_memory(), docs/memory.md): decided from the
+// input's size before the large allocations. A limit that holds fewer points than the input thins them
+// evenly (a coarser mesh, said in MesherStats), one that holds no useful mesh is a LimitError naming the
+// sizes, and the refinement is bounded by the Delaunay vertices the rest of the limit holds.
+#include "vitri/mesher.hpp"
+
+#include "vitri/core/error.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+/// n points on the unit sphere (Fibonacci spiral) with their outward normals.
+void sphere(int n, std::vector<Point3>& p, std::vector<Point3>& nrm) {
+  const double golden = 3.14159265358979323846 * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - z * z), phi = golden * i;
+    p.push_back({r * std::cos(phi), r * std::sin(phi), z});
+    nrm.push_back(p.back());
+  }
+}
+
+/// The limit at which plan_memory() holds exactly `points` oriented points (batch run).
+std::size_t limit_for(std::size_t points) {
+  const double per = kMemoryBytesPerPoint + kMemoryRefineFactor * kMemorySeedsPerPoint * kMemoryBytesPerVertexBatch;
+  return static_cast<std::size_t>(kMemoryBaseBytes + per * static_cast<double>(points)) + 1;
+}
+
+}  // namespace
+
+TEST_CASE("plan_memory: all kept within the limit, thinned evenly beyond it, refused below the coarsest mesh",
+          "[mesher][memory]") {
+  const MemoryPlan none = plan_memory(1000000, 0, false);  // no limit
+  CHECK(none.points == 1000000);
+  CHECK(none.stride == 1);
+  CHECK(none.max_vertices == 0);
+
+  const MemoryPlan all = plan_memory(5000, limit_for(5000), false);
+  CHECK(all.points == 5000);
+  CHECK(all.stride == 1);
+  // The refinement's room: at least the seeds' vertices times the refinement factor.
+  CHECK(static_cast<double>(all.max_vertices) >= kMemoryRefineFactor * kMemorySeedsPerPoint * 5000);
+
+  const MemoryPlan half = plan_memory(10000, limit_for(5000), false);
+  CHECK(half.stride == 2);
+  CHECK(half.points == 5000);
+  // With the history each vertex costs more: fewer points fit in the same limit.
+  CHECK(plan_memory(10000, limit_for(5000), true).points < 5000);
+
+  // Not even the coarsest mesh (kMemoryMinPoints points): a LimitError naming the limit and the sizes.
+  try {
+    plan_memory(10000, limit_for(kMemoryMinPoints / 2), false);
+    FAIL("no LimitError");
+  } catch (const LimitError& e) {
+    const std::string what = e.what();
+    INFO(what);
+    CHECK(what.find("memory limit") != std::string::npos);
+    CHECK(what.find("10000 input points") != std::string::npos);
+    CHECK(what.find(std::to_string(kMemoryMinPoints) + " points") != std::string::npos);
+    CHECK(what.find("--memory") != std::string::npos);
+  }
+  // Constraints given as such are not thinned: all of them fit or the limit is refused.
+  CHECK_THROWS_AS(plan_memory(10000, limit_for(4000), false, false, 1.0), LimitError);
+  CHECK(plan_memory(10000, limit_for(10000), false, false, 1.0).points == 10000);
+}
+
+TEST_CASE("Mesher under a memory limit: a scan thinned before its seeds, a coarser closed mesh; refused when "
+          "nothing fits", "[mesher][memory]") {
+  std::vector<Point3> p, n;
+  sphere(4000, p, n);
+  MesherOptions o;
+  o.polygonizer.keep_history = false;
+  o.scan.approximate = false;
+  o.constraint_build.off_surface_spacing = 1.0;  // as the CLI: about kMemorySeedsPerPoint seeds per point
+  Mesher full = Mesher::from_scan(p, n, o);
+  CHECK(full.stats().memory_thinned == 0);
+  CHECK(full.stats().memory_stride == 1);
+  CHECK(full.options().max_vertices == 0);
+
+  o.max_memory_bytes = limit_for(2000);
+  Mesher thin = Mesher::from_scan(p, n, o);
+  // The check ran before the seeds: they were built from every second point.
+  CHECK(thin.stats().memory_stride == 2);
+  CHECK(thin.stats().memory_thinned == 2000);
+  CHECK(thin.stats().scan.input == 2000);
+  CHECK(thin.stats().polygonizer.vertices < full.stats().polygonizer.vertices);
+  // The refinement is bounded by what the rest of the limit holds.
+  CHECK(thin.options().max_vertices > 0);
+  CHECK(thin.options().max_vertices == plan_memory(4000, o.max_memory_bytes, false).max_vertices);
+  thin.refine(0.1 * thin.diagonal());
+  const SurfaceMesh& m = thin.surface();
+  CHECK(m.triangles.size() > 100);
+
+  o.max_memory_bytes = 1 << 20;  // 1 MiB: below the base of any run
+  CHECK_THROWS_AS(Mesher::from_scan(p, n, o), LimitError);
+  // Constraints given as such: all of them or a LimitError before the fit.
+  Constraints c;
+  for (std::size_t i = 0; i < p.size(); ++i) c.add(p[i], 0.0);
+  CHECK_THROWS_AS(Mesher(c, o), LimitError);
+}

@@ -31,10 +31,8 @@ const char* const kUsage =
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z]\n"
-    "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]
-"
-    "                  [--threads N] [--memory M] [--ascii] [-q]
-"
+    "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
+    "                  [--threads N] [--memory M] [--ascii] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"

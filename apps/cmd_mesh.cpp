@@ -39,7 +39,9 @@ const char* const kUsage =
     "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
     "\n"
     "INPUT   .xyzv  constraints 'x y z value' (f < 0 inside, f > 0 outside, 0 on the surface)\n"
-    "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals\n"
+    "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals; a mesh\n"
+    "                with holes or flipped triangles (a warning says so): its surface sampled (vertices,\n"
+    "                at least 20000 points) and meshed as a scan without smoothing (open or closed)\n"
     "        points: .pwn / 6-column .xyz (with normals), 3-column .xyz, .pcd, .ply / .off / .obj\n"
     "                without faces: a scan (docs/scans.md): duplicates and outliers set aside, the\n"
     "                noise measured and absorbed (local quadric projection), normals from the input\n"
@@ -336,6 +338,7 @@ int run_mesh(const Args& args) {
   bool quiet = false;
   bool surface_given = false;  // --surface
   bool viewpoint_given = false;  // --viewpoint
+  bool smoothing_given = false;  // --smoothing
   PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  // --ascii: text
   unsigned threads = 0;  // --threads: 0 = every available CPU
   std::size_t memory = 0;  // --memory: 0 = the default limit
@@ -422,6 +425,7 @@ int run_mesh(const Args& args) {
       if (!value(v) || !parse_double(v, sm) || !(sm >= 0.0) || !std::isfinite(sm))
         return usage_error("--smoothing needs a number >= 0");
       options.local.smoothing = sm;
+      smoothing_given = true;
       options.scan.approximate = sm > 0.0;  // 0: interpolate the points as they are
     } else if (a == "--threads") {
       std::size_t k = 0;
@@ -491,8 +495,34 @@ int run_mesh(const Args& args) {
   options.max_memory_bytes = memory ? memory : default_memory_limit();
   phases.start("read", "reading " + input);
   Input data = read_input(input);
+  // A mesh that bounds no volume (a hole, an open sheet, flipped or non-manifold triangles) has no inside
+  // to interpolate: its surface goes through the scan path as points instead of being refused (docs/guide.md).
+  if (data.kind == InputKind::Mesh) {
+    MeshDefects defects;
+    try {
+      defects = mesh_defects(data.mesh.V, data.mesh.F);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(input + ": " + e.what());
+    }
+    if (!defects.closed()) {
+      MeshSamples samples = mesh_surface_samples(data.mesh.V, data.mesh.F);
+      std::fprintf(stderr,
+                   "vitri mesh: warning: %s: %zu boundary edges, %zu edges repeated in one direction: not a closed "
+                   "mesh; its surface is meshed as a scan of %zu points%s (docs/scans.md)\n",
+                   input.c_str(), defects.boundary_edges, defects.repeated_edges, samples.points.size(),
+                   samples.normals.empty() ? " without normals (not consistently oriented)" : " with its normals");
+      data.kind = samples.normals.empty() ? InputKind::Points : InputKind::OrientedPoints;
+      data.points.points = std::move(samples.points);
+      data.points.normals = std::move(samples.normals);
+      data.mesh = TriangleMesh{};
+      // A model's surface is exact: interpolated as it is (no projection, no outlier) unless --smoothing
+      // asks for an approximation.
+      if (!smoothing_given) options.scan.approximate = false;
+      options.scan.remove_outliers = false;
+    }
+  }
   // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
-  // orientation, open or closed. Constraints (.xyzv) and meshes are interpolated as they are.
+  // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
   const bool scan_input = data.kind == InputKind::Points || data.kind == InputKind::OrientedPoints;
   if (surface_given && !scan_input && options.surface != SurfaceKind::Closed)
     std::fprintf(stderr, "vitri mesh: warning: --surface applies to point inputs; %s gives a closed surface\n",

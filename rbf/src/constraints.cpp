@@ -26,6 +26,7 @@
 #include <cmath>
 #include <cstdint>
 #include <numeric>
+#include <random>
 #include <string>
 #include <unordered_map>
 #include <utility>
@@ -276,7 +277,18 @@ Constraints constraints_from_points(const std::vector<Point3>& points, const Con
                                           report);
 }
 
-Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+std::string MeshDefects::describe() const {
+  if (repeated_edges)
+    return "mesh is not a consistently oriented closed manifold: edge (" + std::to_string(repeated_a) + ", " +
+           std::to_string(repeated_b) + ") is used twice in the same direction (flipped triangle or non-manifold edge)";
+  if (boundary_edges)
+    return "mesh has a boundary: edge (" + std::to_string(boundary_a) + ", " + std::to_string(boundary_b) +
+           ") belongs to a single triangle (" + std::to_string(boundary_edges) +
+           " boundary edges); the inside is undefined: close the mesh or give oriented points";
+  return "closed, consistently oriented mesh";
+}
+
+MeshDefects mesh_defects(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   if (V.cols() != 3 || F.cols() != 3) throw InvalidArgument("mesh: V and F must have 3 columns");
   if (F.rows() == 0) throw InvalidArgument("mesh has no triangle");
   const auto nv = V.rows();
@@ -289,7 +301,9 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
     if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2))
       throw InvalidArgument("mesh triangle " + std::to_string(f) + " repeats a vertex");
   }
-  // Every undirected edge must be used by exactly two triangles, once in each direction.
+  // Every undirected edge of a closed oriented manifold is used by exactly two triangles, once in each
+  // direction.
+  MeshDefects d;
   std::unordered_map<std::uint64_t, int> directed;
   auto key = [](int a, int b) {
     return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
@@ -297,29 +311,30 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
   for (Eigen::Index f = 0; f < F.rows(); ++f)
     for (int k = 0; k < 3; ++k) {
       const int a = F(f, k), b = F(f, (k + 1) % 3);
-      if (++directed[key(a, b)] > 1)
-        throw InvalidArgument("mesh is not a consistently oriented closed manifold: edge (" +
-                              std::to_string(a) + ", " + std::to_string(b) +
-                              ") is used twice in the same direction (flipped triangle or "
-                              "non-manifold edge)");
+      if (++directed[key(a, b)] == 2) {
+        if (d.repeated_edges == 0) d.repeated_a = a, d.repeated_b = b;
+        ++d.repeated_edges;
+      }
     }
-  std::size_t boundary = 0;
-  int ba = -1, bb = -1;
   for (const auto& [k, count] : directed) {
     (void)count;
     const int a = static_cast<int>(k >> 32), b = static_cast<int>(k & 0xffffffffULL);
     if (!directed.count(key(b, a))) {
-      if (boundary == 0 || std::make_pair(std::min(a, b), std::max(a, b)) < std::make_pair(ba, bb))
-        ba = std::min(a, b), bb = std::max(a, b);
-      ++boundary;
+      if (d.boundary_edges == 0 ||
+          std::make_pair(std::min(a, b), std::max(a, b)) < std::make_pair(d.boundary_a, d.boundary_b))
+        d.boundary_a = std::min(a, b), d.boundary_b = std::max(a, b);
+      ++d.boundary_edges;
     }
   }
-  if (boundary)
-    throw InvalidArgument(
-        "mesh has a boundary: edge (" + std::to_string(ba) + ", " + std::to_string(bb) +
-        ") belongs to a single triangle (" + std::to_string(boundary) +
-        " boundary edges); the inside is undefined: close the mesh or give oriented points");
-  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(nv, 3);
+  return d;
+}
+
+namespace {
+
+/// Area-weighted vertex normals (twice the areas), flipped when the signed volume is negative (triangles
+/// wound inwards), so that they point outwards; `flip` receives the sign applied (+1 or -1).
+Eigen::MatrixXd area_weighted_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double* flip = nullptr) {
+  Eigen::MatrixXd N = Eigen::MatrixXd::Zero(V.rows(), 3);
   double volume6 = 0;
   for (Eigen::Index f = 0; f < F.rows(); ++f) {
     const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
@@ -327,8 +342,74 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
     for (int k = 0; k < 3; ++k) N.row(F(f, k)) += n.transpose();
     volume6 += a.dot(b.cross(c));
   }
-  if (volume6 < 0) N = -N;  // triangles wound inwards: flip so that normals point outwards
+  if (volume6 < 0) N = -N;
+  if (flip) *flip = volume6 < 0 ? -1.0 : 1.0;
   return N;
+}
+
+}  // namespace
+
+MeshSamples mesh_surface_samples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, std::size_t min_points) {
+  const MeshDefects defects = mesh_defects(V, F);
+  const bool oriented = defects.oriented();
+  double flip = 1.0;
+  const Eigen::MatrixXd N = area_weighted_normals(V, F, &flip);
+  std::vector<bool> used(static_cast<std::size_t>(V.rows()), false);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(F(f, k))] = true;
+  MeshSamples out;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) {
+    if (!used[static_cast<std::size_t>(i)]) continue;
+    if (!V.row(i).allFinite())
+      throw InvalidPoint(static_cast<std::size_t>(i), "mesh vertex with a non-finite coordinate");
+    const Point3 n{N(i, 0), N(i, 1), N(i, 2)};
+    if (oriented && !(norm(n) > 0 && is_finite(n))) continue;  // a vertex of degenerate triangles only
+    out.points.push_back({V(i, 0), V(i, 1), V(i, 2)});
+    if (oriented) out.normals.push_back(n / norm(n));
+  }
+  // Samples inside the triangles, in proportion to their area: a triangle larger than 4 x the median
+  // area gets one per 4 median areas (at most 4 x the vertices in all), and a mesh of fewer than
+  // `min_points` vertices gets the difference spread over its area (stochastic rounding, seeded).
+  std::vector<double> areas(static_cast<std::size_t>(F.rows()));
+  double total_area = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    total_area += areas[static_cast<std::size_t>(f)] = 0.5 * (b - a).cross(c - a).norm();
+  }
+  if (!(total_area > 0) || !std::isfinite(total_area)) return out;
+  std::vector<double> sorted = areas;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double unit = 4.0 * sorted[sorted.size() / 2];
+  double wanted = 0;
+  if (unit > 0)
+    for (double a : areas) wanted += std::floor(a / unit);
+  const double cap = 4.0 * static_cast<double>(out.points.size());
+  const double scale = wanted > cap ? cap / wanted : 1.0;
+  const double spread = out.points.size() < min_points ? static_cast<double>(min_points - out.points.size()) : 0.0;
+  std::mt19937_64 rng(0x5eed5a3b1e5ULL);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const double area = areas[static_cast<std::size_t>(f)];
+    const double large = unit > 0 ? std::floor(area / unit) * scale : 0.0;
+    const auto count = static_cast<std::size_t>(std::floor(large + spread * area / total_area + uniform(rng)));
+    if (count == 0) continue;
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Eigen::Vector3d n = flip * (b - a).cross(c - a).normalized();
+    for (std::size_t s = 0; s < count; ++s) {
+      double u = uniform(rng), v = uniform(rng);
+      if (u + v > 1) u = 1 - u, v = 1 - v;  // uniform on the triangle
+      const Eigen::Vector3d p = a + u * (b - a) + v * (c - a);
+      out.points.push_back({p.x(), p.y(), p.z()});
+      if (oriented) out.normals.push_back({n.x(), n.y(), n.z()});
+    }
+  }
+  return out;
+}
+
+Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
+  const MeshDefects defects = mesh_defects(V, F);
+  if (!defects.closed()) throw InvalidArgument(defects.describe());
+  return area_weighted_normals(V, F);
 }
 
 Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,

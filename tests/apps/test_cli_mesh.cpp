@@ -9,6 +9,7 @@
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -382,6 +383,69 @@ TEST_CASE("vitri mesh: unoriented points that cannot be oriented, and a fit too 
     CHECK(e.find("GB") != std::string::npos);
     CHECK(e.find("--function local") != std::string::npos);
     CHECK(e.find("bad_alloc") == std::string::npos);
+  }
+}
+
+TEST_CASE("vitri mesh: a mesh with holes is meshed as a scan of its surface, with a warning", "[cli][mesh]") {
+  // A sphere of radius 1 (a latitude-longitude mesh of 18 rings) with the rings below `kept` left out: a
+  // boundary loop at z = cos(kept / 18 pi). A small hole is closed (--surface auto: the data surround
+  // the body), a hemisphere stays open where the data end.
+  const auto open_sphere = [](int kept, const std::string& path) {
+    const double pi = 3.14159265358979323846;
+    const int rings = 18, sectors = 36;
+    std::vector<std::array<double, 3>> v;
+    for (int i = 0; i <= kept; ++i)
+      for (int j = 0; j < sectors; ++j) {
+        const double theta = pi * i / rings, phi = 2 * pi * j / sectors;
+        v.push_back({std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)});
+      }
+    std::vector<std::array<int, 3>> f;
+    for (int i = 0; i < kept; ++i)
+      for (int j = 0; j < sectors; ++j) {
+        const int a = i * sectors + j, b = i * sectors + (j + 1) % sectors, c = a + sectors, d = b + sectors;
+        if (i > 0) f.push_back({a, c, b});  // counter-clockwise seen from outside (the pole's ring: one point)
+        f.push_back({b, c, d});
+      }
+    std::ofstream o(path);
+    o.precision(17);
+    o << "OFF\n" << v.size() << ' ' << f.size() << " 0\n";
+    for (const auto& p : v) o << p[0] << ' ' << p[1] << ' ' << p[2] << '\n';
+    for (const auto& t : f) o << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  };
+  const auto on_sphere_above = [](const TriangleMesh& m, double z) {
+    double worst = 0;
+    for (Eigen::Index i = 0; i < m.V.rows(); ++i)
+      if (m.V(i, 2) > z) worst = std::max(worst, std::abs(m.V.row(i).norm() - 1.0));
+    return worst;
+  };
+  std::string o, e;
+  SECTION("a cap of 12% of the area missing: closed") {
+    const std::string in = kDir + "/mesh_capped_sphere.off", out = kDir + "/mesh_capped_sphere.ply";
+    open_sphere(14, in);
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(e);
+    CHECK(e.find("not a closed mesh") != std::string::npos);
+    CHECK(e.find("boundary edges") != std::string::npos);
+    CHECK(e.find("surface: closed") != std::string::npos);
+    const TriangleMesh m = read_mesh(out);
+    const MeshMetrics mm = compute_mesh_metrics(m.V, m.F);
+    CHECK(mm.closed_manifold());
+    CHECK(mm.euler_characteristic == 2);
+    CHECK(on_sphere_above(m, -0.7) < 0.02);  // where the input has its surface
+  }
+  SECTION("a hemisphere: open where the data end") {
+    const std::string in = kDir + "/mesh_hemisphere.off", out = kDir + "/mesh_hemisphere.ply";
+    open_sphere(9, in);
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(e);
+    CHECK(e.find("not a closed mesh") != std::string::npos);
+    CHECK(e.find("surface: open") != std::string::npos);
+    const TriangleMesh m = read_mesh(out);
+    REQUIRE(m.F.rows() > 100);
+    CHECK(on_sphere_above(m, -1.0) < 0.02);
+    double lowest = 1;
+    for (Eigen::Index i = 0; i < m.V.rows(); ++i) lowest = std::min(lowest, m.V(i, 2));
+    CHECK(lowest > -0.2);  // the equator is z = 0: nothing far below it
   }
 }
 

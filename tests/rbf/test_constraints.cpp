@@ -145,6 +145,59 @@ TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary an
                     Catch::Contains("boundary") && Catch::Contains("edge ("));
 }
 
+TEST_CASE("mesh defects counted without throwing; surface samples of an open mesh lie on its triangles",
+          "[rbf][constraints]") {
+  Eigen::MatrixXd V(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  Eigen::MatrixXi F(4, 3);
+  F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  CHECK(mesh_defects(V, F).closed());
+  const MeshDefects open = mesh_defects(V, F.topRows(3));  // one face missing: a triangular hole
+  CHECK_FALSE(open.closed());
+  CHECK(open.oriented());
+  CHECK(open.boundary_edges == 3);
+  CHECK(open.repeated_edges == 0);
+  CHECK(open.boundary_a == 1);
+  CHECK(open.boundary_b == 2);
+  // describe() is the message closed_mesh_vertex_normals throws.
+  CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, F.topRows(3)), open.describe());
+  Eigen::MatrixXi H = F;
+  H.row(0) << 0, 1, 2;  // flipped
+  const MeshDefects flipped = mesh_defects(V, H);
+  CHECK_FALSE(flipped.oriented());
+  CHECK(flipped.repeated_edges == 3);  // its three edges each meet a neighbour in the same direction
+  CHECK_THROWS_WITH(closed_mesh_vertex_normals(V, H), flipped.describe());
+  Eigen::MatrixXi bad = F;
+  bad(2, 1) = 7;
+  CHECK_THROWS_WITH(mesh_defects(V, bad), Catch::Contains("triangle 2") && Catch::Contains("out of range"));
+
+  // Samples: every vertex, then at least min_points in all, each on one of the triangles, with the outward
+  // normal of the tetrahedron's face it lies on; the same samples on a second call.
+  const Eigen::MatrixXi G = F.topRows(3);
+  const MeshSamples s = mesh_surface_samples(V, G, 500);
+  REQUIRE(s.normals.size() == s.points.size());
+  CHECK(s.points.size() >= 495);  // stochastic rounding: the expected count is 500
+  CHECK(s.points.size() <= 510);
+  const MeshSamples again = mesh_surface_samples(V, G, 500);
+  REQUIRE(again.points.size() == s.points.size());
+  for (std::size_t i = 0; i < s.points.size(); ++i) CHECK(again.points[i] == s.points[i]);
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const Point3 p = s.points[i], n = s.normals[i];
+    CHECK(std::abs(norm(n) - 1.0) < 1e-9);
+    // The open tetrahedron's faces: x = 0, y = 0, z = 0 (outward normals -x, -y, -z).
+    const bool on_x = std::abs(p.x) < 1e-12, on_y = std::abs(p.y) < 1e-12, on_z = std::abs(p.z) < 1e-12;
+    CHECK((on_x || on_y || on_z));
+    CHECK(p.x + p.y + p.z <= 1.0 + 1e-12);
+    if (on_x && !on_y && !on_z) CHECK(n.x < -0.99);
+    if (on_y && !on_x && !on_z) CHECK(n.y < -0.99);
+    if (on_z && !on_x && !on_y) CHECK(n.z < -0.99);
+  }
+  // Not consistently oriented: points without normals (the scan path orients them).
+  const MeshSamples u = mesh_surface_samples(V, H, 100);
+  CHECK(u.normals.empty());
+  CHECK(u.points.size() >= 95);
+}
+
 TEST_CASE("rbf on real models: ~0 on the surface, < 0 inside, > 0 outside", "[rbf][data]") {
   const std::string name =
       GENERATE(std::string("hand.off"), std::string("bunny.off"), std::string("cactus.off"));

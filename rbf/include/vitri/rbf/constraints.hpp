@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace vitri {
@@ -111,6 +112,47 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
 ///         consistent, InvalidArgument for too few points.
 Constraints constraints_from_points(const std::vector<Point3>& points, const ConstraintBuildOptions& options = {},
                                    ConstraintBuildReport* report = nullptr);
+
+/// What keeps a triangle mesh from being a closed, consistently oriented 2-manifold (the input that
+/// closed_mesh_vertex_normals() and constraints_from_mesh() need). Counts are of directed edges.
+struct MeshDefects {
+  /// Edges used by one triangle only (a hole or an open sheet).
+  std::size_t boundary_edges = 0;
+  /// Directed edges used twice in the same direction: a flipped triangle or a non-manifold edge.
+  std::size_t repeated_edges = 0;
+  /// The first repeated edge in the order of F (a, b as F has them); -1 when none.
+  int repeated_a = -1, repeated_b = -1;
+  /// The smallest boundary edge (min, max); -1 when none.
+  int boundary_a = -1, boundary_b = -1;
+  /// No defect: the mesh bounds a volume.
+  bool closed() const { return boundary_edges == 0 && repeated_edges == 0; }
+  /// Consistently oriented (no repeated edge), perhaps with a boundary.
+  bool oriented() const { return repeated_edges == 0; }
+  /// One line naming the defects and an offending edge, as closed_mesh_vertex_normals() throws it.
+  std::string describe() const;
+};
+
+/// The defects of a triangle mesh (V #V x 3, F #F x 3), without throwing for them.
+/// @throws InvalidArgument for what is not a triangle mesh at all: columns other than 3, no triangle, a
+///         triangle with an out-of-range or repeated vertex index (named).
+MeshDefects mesh_defects(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F);
+
+/// Points and normals on a triangle mesh that need not be closed (a scan's mesh, a model with holes), for
+/// the scan path (prepare_scan, Mesher::from_scan): every referenced vertex, plus uniform samples inside
+/// the triangles: one per 4 median triangle areas in the triangles larger than that (so that a mesh of a
+/// few large triangles still gives a dense sample; at most 4 x the vertex count), and, for a mesh of
+/// fewer than `min_points` vertices, the difference spread over the area (a coarse model becomes a dense
+/// sample of its facets). Seeded: the same mesh gives the same samples. Normals: area-weighted
+/// vertex normals and the triangles' own for their samples, outward when the signed volume is positive
+/// as for a closed mesh; empty when the mesh is not consistently oriented (then the scan path orients).
+/// Unreferenced vertices and vertices with a zero normal are left out.
+/// @throws as mesh_defects(); InvalidPoint (row of V) for a non-finite coordinate of a referenced vertex.
+struct MeshSamples {
+  std::vector<Point3> points;
+  std::vector<Point3> normals;  ///< empty, or one per point
+};
+MeshSamples mesh_surface_samples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                 std::size_t min_points = 20000);
 
 /// Area-weighted vertex normals of a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3),
 /// oriented outwards: when the signed volume is negative (triangles wound inwards) every normal is

@@ -53,6 +53,14 @@ Check check_vertices(const Rbf& f, const Eigen::MatrixXd& V, const Eigen::Matrix
   return c;
 }
 
+/// The tetrahedron (0, 0, 0), (1, 0, 0), (0, 1, 0), (0, 0, 1), its faces counter-clockwise from outside.
+void unit_tetrahedron(Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+  V.resize(4, 3);
+  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  F.resize(4, 3);
+  F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+}
+
 }  // namespace
 
 TEST_CASE("constraints from oriented points: values, offsets, subsampling", "[rbf][constraints]") {
@@ -107,10 +115,9 @@ TEST_CASE("constraints: a thin slab shrinks the offset instead of crossing to th
 
 TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary and non-manifold refused",
           "[rbf][constraints]") {
-  Eigen::MatrixXd V(4, 3);
-  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  Eigen::MatrixXi F(4, 3);
-  F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_tetrahedron(V, F);
   const Eigen::MatrixXd N = closed_mesh_vertex_normals(V, F);
   CHECK(N(3, 2) > 0);
   CHECK(N(0, 0) < 0);
@@ -147,10 +154,9 @@ TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary an
 
 TEST_CASE("mesh defects counted without throwing; surface samples of an open mesh lie on its triangles",
           "[rbf][constraints]") {
-  Eigen::MatrixXd V(4, 3);
-  V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1;
-  Eigen::MatrixXi F(4, 3);
-  F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_tetrahedron(V, F);
   CHECK(mesh_defects(V, F).closed());
   const MeshDefects open = mesh_defects(V, F.topRows(3));  // one face missing: a triangular hole
   CHECK_FALSE(open.closed());

@@ -484,11 +484,8 @@ int run_mesh(const Args& args) {
   options.polygonizer.keep_history = !script.empty();
   // Then the seeds go in on `threads` cores: the same mesh, bit for bit, as one thread (canonical ids).
   // The fit, the constraints' construction and the normals give the same result on any thread count.
-  options.polygonizer.threads = threads;
-  options.local.threads = threads;
-  options.rbf.threads = threads;
-  options.constraint_build.threads = threads;
-  options.constraint_build.normals.threads = threads;
+  options.threads = threads;
+  options = with_threads_applied(options);  // the constraints are built here, before the Mesher
   // The memory limit (docs/memory.md), checked from the input's size before the large allocations: a
   // scan thinned to what fits, the refinement bounded by what the rest holds (a precision far below the
   // data's spacing: a LimitError naming the count instead of an out-of-memory end).

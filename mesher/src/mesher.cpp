@@ -95,7 +95,7 @@ MemoryPlan plan_memory(std::size_t inputs, std::size_t limit, bool keep_history,
 }
 
 Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
-    : options_(options), precision_(std::numeric_limits<double>::infinity()) {
+    : options_(with_threads_applied(options)), precision_(std::numeric_limits<double>::infinity()) {
   // The memory limit, checked before the fit and the seeds allocate anything large.
   if (options_.max_memory_bytes) {
     const MemoryPlan plan = plan_memory(constraints.size(), options_.max_memory_bytes,
@@ -188,17 +188,26 @@ Point3 Mesher::constraint_point(ConstraintId id) const { return function_->point
 
 double Mesher::constraint_value(ConstraintId id) const { return function_->value_of(id); }
 
+MesherOptions with_threads_applied(MesherOptions o) {
+  if (o.threads == 0) return o;
+  o.polygonizer.threads = o.local.threads = o.rbf.threads = o.threads;
+  o.constraint_build.threads = o.constraint_build.normals.threads = o.scan.threads = o.threads;
+  return o;
+}
+
 Mesher Mesher::from_oriented_points(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                                    const MesherOptions& options) {
-  return Mesher(constraints_from_oriented_points(points, normals, options.constraint_build), options);
+  const ConstraintBuildOptions build = with_threads_applied(options).constraint_build;
+  return Mesher(constraints_from_oriented_points(points, normals, build), options);
 }
 
 Mesher Mesher::from_points(const std::vector<Point3>& points, const MesherOptions& options) {
-  return Mesher(constraints_from_points(points, options.constraint_build), options);
+  return Mesher(constraints_from_points(points, with_threads_applied(options).constraint_build), options);
 }
 
 Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
-                         const MesherOptions& options) {
+                         const MesherOptions& given) {
+  const MesherOptions options = with_threads_applied(given);
   ScanReport report;
   ScanOptions scan = options.scan;
   if (scan.threads == 0) scan.threads = options.polygonizer.threads;
@@ -271,7 +280,7 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
 }
 
 Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options) {
-  return Mesher(constraints_from_mesh(V, F, options.constraint_build), options);
+  return Mesher(constraints_from_mesh(V, F, with_threads_applied(options).constraint_build), options);
 }
 
 Mesher::Mesher(Mesher&&) noexcept = default;
@@ -310,7 +319,7 @@ void Mesher::build(SeedTetrahedralization&& seeds) {
 }
 
 Mesher::Mesher(const Rbf& function, const MesherOptions& options)
-    : options_(options), function_(std::make_unique<Rbf>(function)),
+    : options_(with_threads_applied(options)), function_(std::make_unique<Rbf>(function)),
       precision_(std::numeric_limits<double>::infinity()) {
   build();
 }
@@ -585,12 +594,14 @@ void mesh_points(const Constraints& constraints, double precision, Eigen::Matrix
 }
 
 SurfaceMesh mesh_points(const std::vector<Point3>& points, double precision, const MesherOptions& options) {
-  return mesh_points(constraints_from_points(points, options.constraint_build), precision, options);
+  const ConstraintBuildOptions build = with_threads_applied(options).constraint_build;
+  return mesh_points(constraints_from_points(points, build), precision, options);
 }
 
 SurfaceMesh mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& normals, double precision,
                         const MesherOptions& options) {
-  return mesh_points(constraints_from_oriented_points(points, normals, options.constraint_build), precision,
+  const ConstraintBuildOptions build = with_threads_applied(options).constraint_build;
+  return mesh_points(constraints_from_oriented_points(points, normals, build), precision,
                      options);
 }
 
@@ -601,7 +612,8 @@ void mesh_points(const std::vector<Point3>& points, const std::vector<Point3>& n
 
 SurfaceMesh mesh_points(const Eigen::MatrixXd& in_V, const Eigen::MatrixXi& in_F, double precision,
                         const MesherOptions& options) {
-  return mesh_points(constraints_from_mesh(in_V, in_F, options.constraint_build), precision, options);
+  const ConstraintBuildOptions build = with_threads_applied(options).constraint_build;
+  return mesh_points(constraints_from_mesh(in_V, in_F, build), precision, options);
 }
 
 void mesh_points(const Eigen::MatrixXd& in_V, const Eigen::MatrixXi& in_F, double precision, Eigen::MatrixXd& V,

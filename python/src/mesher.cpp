@@ -143,11 +143,8 @@ Options parse_options(const py::kwargs& kw, const char* fn, bool one_call) {
       throw py::type_error(std::string(fn) + "() got an unexpected keyword argument '" + key + "'");
     }
   }
-  m.polygonizer.threads = threads;
-  m.local.threads = threads;
-  m.rbf.threads = threads;
-  m.constraint_build.threads = threads;
-  m.constraint_build.normals.threads = threads;
+  m.threads = threads;
+  m = with_threads_applied(m);
   return o;
 }
 

@@ -69,6 +69,12 @@ enum class MeshMode {
 
 /// Options of the Mesher.
 struct MesherOptions {
+  /// Threads of every phase: the constraints and normals, the scan preparation, the fit, the Delaunay
+  /// insertion, the refinement and the extraction. Non-zero: that many everywhere (it overrides
+  /// polygonizer.threads, local.threads, rbf.threads, constraint_build.threads,
+  /// constraint_build.normals.threads and scan.threads); 0 (default): each phase's own field decides
+  /// (their default, 0, is every CPU this process may run on). No result depends on it.
+  unsigned threads = 0;
   /// The implicit function. The library default stays Global (the paper's function); the CLI's is Auto.
   FunctionKind function = FunctionKind::Global;
   /// Auto: the largest constraint count fitted with the global function. By fit time the two cross at
@@ -139,6 +145,10 @@ struct MesherOptions {
   /// Empty: nothing is called.
   std::function<void(const char* phase)> on_phase;
 };
+
+/// `options` with MesherOptions::threads written into every phase's own field (when non-zero): what the
+/// Mesher and mesh_points() apply to the options they are given.
+MesherOptions with_threads_applied(MesherOptions options);
 
 /// The function fitted to `constraints` constraints: `requested`, with Auto resolved to Global up to
 /// `auto_local_above` constraints and Local above. The one place where the Auto rule is written: the

@@ -8,6 +8,7 @@
 #include "vitri/rbf/rbf.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <iostream>
@@ -53,6 +54,8 @@ int run_eval(const Args& args) {
   std::string input, query;
   ConstraintBuildOptions opt;
   opt.offset_spacings = kOffsetSpacings;  // the constraints of vitri mesh
+  ScanOptions scan;  // points are read as vitri mesh reads them (docs/scans.md)
+  bool viewpoint_given = false;
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> const std::string& {
@@ -70,7 +73,16 @@ int run_eval(const Args& args) {
     else if (a == "--seed")
       opt.seed = parse_unsigned<std::uint64_t>(a, value());
     else if (a == "--neighbours")
-      opt.normals.k = parse_unsigned<std::size_t>(a, value());
+      scan.k = parse_unsigned<std::size_t>(a, value());
+    else if (a == "--viewpoint") {
+      double xyz[3];
+      for (double& x : xyz) {
+        x = parse_number(a, value());
+        if (!std::isfinite(x)) throw InvalidArgument(a + " needs three finite numbers X Y Z");
+      }
+      scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
+      viewpoint_given = true;
+    }
     else if (!a.empty() && a[0] == '-') {
       std::cerr << "vitri eval: unknown option '" << a << "'\n";
       return 2;
@@ -85,7 +97,11 @@ int run_eval(const Args& args) {
     std::cerr << "usage: vitri eval INPUT --at QUERY.xyz (try vitri eval --help)\n";
     return 2;
   }
-  const Constraints c = constraints_of(read_input(input), input, opt);
+  ScanFit fit;
+  Input data = read_input(input);
+  const bool scan_input = is_scan(data);
+  const Constraints c = constraints_of(std::move(data), input, opt, nullptr, scan, &fit);
+  if (scan_input) std::cerr << describe_scan(fit, viewpoint_given) << "\n";
   Rbf f(c);
   if (f.report().warning) std::cerr << "vitri eval: warning: " << f.report().message << "\n";
   const OrientedPoints q = read_points(query);
@@ -99,24 +115,28 @@ int run_eval(const Args& args) {
 
 const char* eval_usage() {
   return "usage: vitri eval INPUT --at QUERY.xyz [--offset F] [--max-constraints N] [--seed S]\n"
-         "                  [--neighbours K]\n"
+         "                  [--neighbours K] [--viewpoint X Y Z]\n"
          "\n"
          "Fits the variational implicit function of INPUT and prints 'f gx gy gz' (value and gradient, "
          "%.17g)\n"
          "for each point of QUERY.xyz (3 or 6 columns; only positions are used), one line per point.\n"
          "f < 0 inside, f > 0 outside.\n"
          "\n"
-         "INPUT: constraints .xyzv (x y z value), oriented points .pwn / 6-column .xyz, or a closed mesh\n"
-         "       .off / .obj / .ply (vertex normals area-weighted, oriented outwards), or points without\n"
-         "       normals (3-column .xyz, a .ply / .off without faces): normals estimated from the K nearest\n"
-         "       neighbours and oriented consistently (docs/normals.md).\n"
+         "INPUT: constraints .xyzv (x y z value), a closed mesh .off / .obj / .ply (vertex normals\n"
+         "       area-weighted, oriented outwards), or points with or\n"
+         "       without normals (.xyz, .pwn, .pcd, a .ply / .off without faces): read as vitri mesh reads a\n"
+         "       scan (docs/scans.md): duplicates and outliers set aside, noise absorbed, normals estimated\n"
+         "       or checked and oriented (the viewpoint: --viewpoint, PCD VIEWPOINT, NAME.viewpoint beside\n"
+         "       the input) without refusing; what was set aside is printed on stderr.\n"
          "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal "
          "(default: 2 x the median spacing of the points, at most 0.01)\n"
          "  --max-constraints N  subsample points / vertices to at most N constraints (0: all; else at\n"
          "                       least the 3 constraints made per point)\n"
          "  --seed S             seed of the subsampling (1)\n"
-         "  --neighbours K       neighbours per point for the normals of unoriented points (10; more for\n"
-         "                       noisy points)\n";
+         "  --neighbours K       neighbours per point of a scan's noise estimate, projection and normals\n"
+         "                       (default: chosen from the data, 16 to 64)\n"
+         "  --viewpoint X Y Z    points: the sensor's position; normals are oriented toward it (checked\n"
+         "                       against the data). Default: the input's (PCD VIEWPOINT, NAME.viewpoint)\n";
 }
 
 }  // namespace vitri::cli

@@ -520,7 +520,7 @@ int run_mesh(const Args& args) {
   }
   // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
   // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
-  const bool scan_input = data.kind == InputKind::Points || data.kind == InputKind::OrientedPoints;
+  const bool scan_input = is_scan(data);
   if (surface_given && !scan_input && options.surface != SurfaceKind::Closed)
     std::fprintf(stderr, "vitri mesh: warning: --surface applies to point inputs; %s gives a closed surface\n",
                  input.c_str());
@@ -538,24 +538,17 @@ int run_mesh(const Args& args) {
   std::unique_ptr<Mesher> built;
   if (scan_input) {
     input_points = data.points.points.size();
-    if (!options.scan.viewpoint && data.points.viewpoint) options.scan.viewpoint = data.points.viewpoint;
-    if (data.points.has_sensors()) options.scan.sensors = std::move(data.points.sensors);
-    if (!quiet && options.scan.viewpoint)
-      std::fprintf(stderr, "viewpoint %g %g %g (%s)\n", options.scan.viewpoint->x, options.scan.viewpoint->y,
-                   options.scan.viewpoint->z, viewpoint_given ? "--viewpoint" : "from the input");
     // The default budget follows the input (docs/scans.md): a coarser mesh with a warning beyond it.
     if (default_precision) {
       const std::size_t by_input = kScanVerticesPerPoint * input_points + kScanVerticesBase;
       options.max_vertices = options.max_vertices ? std::min(options.max_vertices, by_input) : by_input;
     }
     phases.start("scan", "preparing " + std::to_string(input_points) + " scanned points");
-    try {
-      built = std::make_unique<Mesher>(Mesher::from_scan(data.points.points, data.points.normals, options));
-    } catch (const InvalidPoint& e) {  // say which file (the message names the point)
-      throw InvalidPoint(e.index(), input + ": " + e.what());
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(input + ": " + e.what());
-    }
+    ScanFit fit = scan_of(data, input, options);
+    options.scan.viewpoint = fit.options.scan.viewpoint;
+    if (!quiet && options.scan.viewpoint)
+      std::fprintf(stderr, "%s\n", viewpoint_line(options.scan, viewpoint_given).c_str());
+    built = std::make_unique<Mesher>(Mesher::from_scan(std::move(fit)));
     data = Input{};
   } else {
     phases.start("constraints");
@@ -625,6 +618,8 @@ int run_mesh(const Args& args) {
     if (options.mode == MeshMode::Quality) {
       QualityOptions q = options.quality;
       q.max_size = relative_size * diag;
+      // The same budget as the refinement (a scan's follows its size): a coarser mesh with a warning.
+      if (options.max_vertices) q.max_vertices = std::max<std::size_t>(9, std::min(q.max_vertices, options.max_vertices));
       if (!distances.empty()) q.max_distance = distances[std::min(k, distances.size() - 1)] * diag;
       mesher.set_quality_options(q);
     }
@@ -644,6 +639,11 @@ int run_mesh(const Args& args) {
     if (reported) std::fprintf(stderr, "\n");
     const double refine_ms = ms_since(t0);
     if (!quiet) print_neck_split(mesher.stats().polygonizer);
+    if (!quiet && options.mode == MeshMode::Quality) {
+      const QualityStats qs = mesher.stats().quality;
+      std::fprintf(stderr, "  quality: %zu Delaunay vertices, %zu inserted (%zu for the topology), %zu rejected\n",
+                   qs.vertices, qs.insertions, qs.topology_insertions, qs.rejected);
+    }
     phases.start("extraction");
     const auto t1 = Clock::now();
     const SurfaceMesh& m = mesher.surface();

@@ -25,14 +25,17 @@ namespace {
 
 const char* const kUsage =
     "usage: vitri studio [INPUT] [--port N] [--host ADDR] [--precision P] [--function F]\n"
-    "                    [--offset D] [--sides both|inside|outside] [--drag-levels K] [--no-socket]\n"
+    "                    [--offset D] [--sides both|inside|outside] [--neighbours K]\n"
+    "                    [--viewpoint X Y Z] [--drag-levels K] [--no-socket]\n"
     "\n"
     "Starts the interactive modeler: a local web server; open the printed address in a browser. Click\n"
     "the surface to add a constraint, shift+click / alt+click for an outside / inside one, drag a\n"
     "constraint to move it; undo, redo, delete, change a value, precision slider, open a file, save the\n"
     "constraints (.xyzv), export the mesh (OBJ, PLY, OFF). The page and its HTTP/JSON API: docs/studio.md.\n"
     "\n"
-    "INPUT             any input of vitri mesh (.xyzv, .pwn, .xyz with normals, .off, .obj, .ply);\n"
+    "INPUT             any input of vitri mesh (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply); points (with\n"
+    "                  or without normals) are read as vitri mesh reads a scan (docs/scans.md: outliers\n"
+    "                  set aside, normals oriented without refusing; the report on stderr);\n"
     "                  without it, a blob of 25 constraints\n"
     "  --port N        TCP port (default 8080; 0: any free port)\n"
     "  --host ADDR     address to bind (default 127.0.0.1, this machine only; 0.0.0.0 exposes the\n"
@@ -45,7 +48,10 @@ const char* const kUsage =
     "  --drag-levels K with the global function, edits are shown first on a preview K halvings\n"
     "                  coarser than the target (default 1; 0: every edit at the target) above\n"
     "                  5000 triangles; the target mesh follows in the next idle step\n"
-    "  --offset D, --sides S   as vitri mesh, for oriented points and meshes\n"
+    "  --offset D, --sides S   as vitri mesh, for points and meshes\n"
+    "  --neighbours K  as vitri mesh: neighbours per point of a scan (default: from the data)\n"
+    "  --viewpoint X Y Z  as vitri mesh: the sensor's position for INPUT's points (default: the\n"
+    "                  input's: PCD VIEWPOINT, NAME.viewpoint beside it)\n"
     "  --no-socket     HTTP only: no WebSocket beside it (by default the page sends its requests\n"
     "                  over a WebSocket on a second, free port of the same host: faster updates)\n"
     "\n"
@@ -76,6 +82,8 @@ Constraints default_blob() {
 
 struct StudioArgs {
   std::string input;
+  ScanOptions scan;              // --neighbours; --viewpoint for INPUT only
+  bool viewpoint_given = false;
   studio::SessionOptions session;
   studio::ServerOptions server;
 };
@@ -90,7 +98,7 @@ std::string parse_args(const Args& args, StudioArgs& out) {
     const std::string v = has_value ? args[i + 1] : std::string();
     double d = 0;
     if (a == "--port" || a == "--host" || a == "--precision" || a == "--function" || a == "--offset" ||
-        a == "--sides" || a == "--drag-levels") {
+        a == "--sides" || a == "--drag-levels" || a == "--neighbours") {
       if (!has_value) return a + " needs a value";
       ++i;
     }
@@ -123,6 +131,17 @@ std::string parse_args(const Args& args, StudioArgs& out) {
         out.session.mesher.constraint_build.sides = OffSurface::Outside;
       else
         return "--sides must be both, inside or outside, got '" + v + "'";
+    } else if (a == "--neighbours") {
+      if (!parse_number(v, d) || d < 0 || d > 1e6 || d != std::floor(d)) return "--neighbours needs a count, got " + v;
+      out.scan.k = static_cast<std::size_t>(d);
+    } else if (a == "--viewpoint") {
+      double xyz[3];
+      for (double& x : xyz) {
+        if (i + 1 >= args.size() || !parse_number(args[i + 1], x)) return "--viewpoint needs three finite numbers X Y Z";
+        ++i;
+      }
+      out.scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
+      out.viewpoint_given = true;
     } else if (a == "--no-socket") {
       out.server.socket = false;
     } else if (!a.empty() && a[0] == '-') {
@@ -150,11 +169,21 @@ int run_studio(const Args& args) {
   const std::string bad = parse_args(args, sa);
   if (!bad.empty()) return usage_error(bad);
   const ConstraintBuildOptions& build = sa.session.mesher.constraint_build;
-  Constraints constraints =
-      sa.input.empty() ? default_blob() : constraints_of(read_input(sa.input), sa.input, build);
+  Constraints constraints;
+  if (sa.input.empty()) {
+    constraints = default_blob();
+  } else {
+    Input in = read_input(sa.input);
+    const bool points = is_scan(in);
+    ScanFit fit;
+    constraints = constraints_of(std::move(in), sa.input, build, nullptr, sa.scan, &fit);
+    if (points) std::fprintf(stderr, "%s\n", describe_scan(fit, sa.viewpoint_given).c_str());
+  }
   std::fprintf(stderr, "fitting %zu constraints...\n", constraints.size());
   studio::Session session(std::move(constraints), sa.input.empty() ? "blob" : sa.input, sa.session);
-  studio::Api api(session, build);
+  ScanOptions upload_scan = sa.scan;  // uploads: the file's viewpoint or the request's
+  upload_scan.viewpoint.reset();
+  studio::Api api(session, build, upload_scan);
   studio::Server server(api, sa.server);
   // Ctrl-C / SIGTERM: a thread waits for them and stops the server (no work inside a signal handler).
   sigset_t stop_signals;

@@ -2,13 +2,45 @@
 
 #include "vitri/core/error.hpp"
 
+#include <cstdio>
 #include <optional>
 #include <utility>
 
 namespace vitri::cli {
 
+bool is_scan(const Input& in) { return in.kind == InputKind::Points || in.kind == InputKind::OrientedPoints; }
+
+ScanFit scan_of(Input& in, const std::string& name, const MesherOptions& options) {
+  MesherOptions o = options;
+  if (!o.scan.viewpoint && in.points.viewpoint) o.scan.viewpoint = in.points.viewpoint;
+  if (in.points.has_sensors()) o.scan.sensors = std::move(in.points.sensors);
+  const std::vector<Point3> points = std::move(in.points.points);
+  const std::vector<Point3> normals = std::move(in.points.normals);
+  in = Input{};
+  try {
+    return prepare_scan_fit(points, normals, o);
+  } catch (const InvalidPoint& e) {  // say which file (the message names the point)
+    throw InvalidPoint(e.index(), name + ": " + e.what());
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(name + ": " + e.what());
+  }
+}
+
+std::string viewpoint_line(const ScanOptions& scan, bool given) {
+  if (!scan.viewpoint) return {};
+  char line[200];
+  std::snprintf(line, sizeof line, "viewpoint %g %g %g (%s)", scan.viewpoint->x, scan.viewpoint->y,
+                scan.viewpoint->z, given ? "--viewpoint" : "from the input");
+  return line;
+}
+
+std::string describe_scan(const ScanFit& fit, bool given) {
+  const std::string v = viewpoint_line(fit.options.scan, given);
+  return (v.empty() ? v : v + "\n") + describe(fit.report);
+}
+
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
-                           ConstraintBuildReport* report) {
+                           ConstraintBuildReport* report, const ScanOptions& scan, ScanFit* fit) {
   switch (in.kind) {
     case InputKind::Constraints: {
       Constraints c;
@@ -16,16 +48,26 @@ Constraints constraints_of(Input in, const std::string& name, const ConstraintBu
       c.values = std::move(in.constraints.values);
       return c;
     }
-    case InputKind::OrientedPoints:
-      return constraints_from_oriented_points(in.points.points, in.points.normals, build, report);
     case InputKind::Mesh:
       return constraints_from_mesh(in.mesh.V, in.mesh.F, build, report);
-    case InputKind::Points:
-      try {
-        return constraints_from_points(in.points.points, build, report);
-      } catch (const InvalidArgument& e) {  // say which file (the message names the point)
-        throw InvalidArgument(name + ": points without normals: " + e.what());
+    case InputKind::OrientedPoints:
+    case InputKind::Points: {
+      MesherOptions o;
+      o.constraint_build = build;
+      o.scan = scan;
+      // The constraints as `build` says: prepare_scan_fit applies the off-surface spacing with the local
+      // function only.
+      o.function = build.off_surface_spacing > 0 ? FunctionKind::Local : FunctionKind::Global;
+      ScanFit f = scan_of(in, name, o);
+      if (report) *report = f.built;
+      Constraints c = std::move(f.constraints);
+      if (fit) {
+        f.constraints = Constraints{};
+        f.prepared = ScanPoints{};
+        *fit = std::move(f);
       }
+      return c;
+    }
   }
   throw InvalidArgument(name + ": unsupported input");
 }

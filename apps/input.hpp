@@ -20,15 +20,35 @@ constexpr double kOffsetSpacings = 2.0;
 /// docs/benchmarks.md "Off-surface spacing".
 constexpr double kOffSurfaceSpacing = 1.0;
 
-/// The constraints of an input: as read (.xyzv), or built from oriented points, unoriented points (normals
-/// estimated and oriented, build.normals) or a closed mesh exactly as Mesher::from_oriented_points /
-/// from_points / from_mesh build them (surface points first, then the off-surface constraints; see
-/// constraints_from_oriented_points). `name` is used in messages.
-/// @throws InvalidArgument where the normals of unoriented points cannot be oriented (names the file and
-/// the point); as constraints_from_mesh / _oriented_points.
-/// `report`, when given, receives what the builder merged (left zero for .xyzv constraints).
+/// True for the inputs read as scans (points with or without normals: .xyz, .pwn, .pcd, PLY/OFF/OBJ
+/// without faces; docs/scans.md). Constraints (.xyzv) and meshes are interpolated as they are.
+bool is_scan(const Input& in);
+
+/// Points in, scan prepared: the one way `vitri mesh`, `vitri eval` and the studio read points
+/// (prepare_scan_fit with `options`: duplicates and outliers set aside, noise, orientation that never
+/// refuses, the normal constraints). The sensor: options.scan.viewpoint when set (--viewpoint), else the
+/// input's own (PCD VIEWPOINT, NAME.viewpoint beside the file); per-point sensors (PLY vx vy vz) from the
+/// input. `in` must be a scan (is_scan); its points are moved out. The result's options.scan.viewpoint is
+/// the viewpoint used. @throws InvalidPoint / InvalidArgument as prepare_scan, the message naming `name`.
+ScanFit scan_of(Input& in, const std::string& name, const MesherOptions& options);
+
+/// "viewpoint X Y Z (from the input)" (or "(--viewpoint)" when `given`); empty without a viewpoint.
+std::string viewpoint_line(const ScanOptions& scan, bool given);
+
+/// The viewpoint line and the scan's report (describe()) for people, as `vitri mesh` prints them:
+/// "viewpoint X Y Z (from the input)\n<describe(report)>". `given`: the viewpoint came from --viewpoint.
+std::string describe_scan(const ScanFit& fit, bool given);
+
+/// The constraints of an input: as read (.xyzv), built from a closed mesh as Mesher::from_mesh builds
+/// them, or for points (with or without normals) through the scan path of scan_of() with `scan` (so
+/// that every command reads points as `vitri mesh` does; the constraints follow `build`: the off-surface
+/// spacing only when it is set). `name` is used in messages.
+/// @throws as scan_of; as constraints_from_mesh.
+/// `report`, when given, receives what the builder merged (left zero for .xyzv constraints); `fit`, when
+/// given, receives the scan's report and the viewpoint used (its constraints and points left empty).
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
-                           ConstraintBuildReport* report = nullptr);
+                           ConstraintBuildReport* report = nullptr, const ScanOptions& scan = {},
+                           ScanFit* fit = nullptr);
 
 /// constraints_of() for a run whose function may be FunctionKind::Auto, as `vitri mesh` builds them:
 /// build.off_surface_spacing serves the local function only. Auto is resolved here, on the number of

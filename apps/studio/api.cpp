@@ -186,7 +186,8 @@ ApiResponse error_response(int status, const std::string& what) {
   return r;
 }
 
-Api::Api(Session& session, const ConstraintBuildOptions& build) : session_(session), build_(build) {
+Api::Api(Session& session, const ConstraintBuildOptions& build, const ScanOptions& scan)
+    : session_(session), build_(build), scan_(scan) {
   const char* tmp = std::getenv("TMPDIR");
   std::string pattern = std::string(tmp && *tmp ? tmp : "/tmp") + "/vitri-studio-XXXXXX";
   if (!mkdtemp(pattern.data())) throw Error("studio: cannot create a private temporary directory");
@@ -385,13 +386,32 @@ ApiResponse Api::load(const ApiRequest& r) {
   const std::string name = param(r, "name");
   if (name.empty() || name.size() > 200) throw BadRequest("\"name\" (the uploaded file's name) is required");
   const std::string ext = file_extension(name);
-  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "off" && ext != "obj" && ext != "ply")
-    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .off, .obj, .ply)");
+  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "pcd" && ext != "off" && ext != "obj" && ext != "ply")
+    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply)");
   if (r.body.empty()) throw BadRequest(name + ": empty file");
+  // Points are read as vitri mesh reads a scan; "viewpoint=X,Y,Z" plays its --viewpoint (else the
+  // file's own, a PCD VIEWPOINT).
+  ScanOptions scan = scan_;
+  const std::string viewpoint = param(r, "viewpoint");
+  if (!viewpoint.empty()) {
+    double xyz[3];
+    const char* at = viewpoint.c_str();
+    for (int k = 0; k < 3; ++k) {
+      char* end = nullptr;
+      xyz[k] = std::strtod(at, &end);
+      if (end == at || !std::isfinite(xyz[k]) || *end != (k < 2 ? ',' : '\0'))
+        throw BadRequest("\"viewpoint\" must be three finite numbers X,Y,Z, got '" + viewpoint + "'");
+      at = end + (k < 2);
+    }
+    scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
+  }
   // Parsed from memory: the server never opens a path a client names.
-  Constraints c = cli::constraints_of(parse_input(r.body, name), name, build_);
+  Input in = parse_input(r.body, name);
+  const bool points = cli::is_scan(in);
+  ScanFit fit;
+  Constraints c = cli::constraints_of(std::move(in), name, build_, nullptr, scan, &fit);
   session_.load(std::move(c), name);
-  return json_response(stats_json());
+  return json_response(stats_json(points ? "\"scan\":" + json_quote(cli::describe_scan(fit, !viewpoint.empty())) : ""));
 }
 
 ApiResponse Api::export_file(const ApiRequest& r) {

@@ -42,8 +42,10 @@ ApiResponse error_response(int status, const std::string& what);
 /// gives way to a waiting edit (it stops between insertions and resumes on the next refine request).
 class Api {
  public:
-  /// `build` turns an uploaded mesh or oriented points into constraints (vitri mesh's --offset, --sides).
-  Api(Session& session, const ConstraintBuildOptions& build = {});
+  /// `build` turns an uploaded mesh or points into constraints (vitri mesh's --offset, --sides); uploaded
+  /// points are read as vitri mesh reads a scan, with `scan` (its k; the viewpoint is the file's or the
+  /// request's, docs/studio.md).
+  Api(Session& session, const ConstraintBuildOptions& build = {}, const ScanOptions& scan = {});
   ~Api();
   Api(const Api&) = delete;
   Api& operator=(const Api&) = delete;
@@ -71,6 +73,7 @@ class Api {
 
   Session& session_;
   ConstraintBuildOptions build_;
+  ScanOptions scan_;
   std::mutex mutex_;
   std::atomic<int> waiting_{0};
   std::atomic<int> socket_port_{0};  // requests waiting for the mutex (a refinement step yields to them)

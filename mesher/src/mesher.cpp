@@ -205,13 +205,14 @@ Mesher Mesher::from_points(const std::vector<Point3>& points, const MesherOption
   return Mesher(constraints_from_points(points, with_threads_applied(options).constraint_build), options);
 }
 
-Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                          const MesherOptions& given) {
   const MesherOptions options = with_threads_applied(given);
-  ScanReport report;
+  ScanFit fit;
   ScanOptions scan = options.scan;
   if (scan.threads == 0) scan.threads = options.polygonizer.threads;
-  MesherOptions o = options;
+  MesherOptions& o = fit.options;
+  o = options;
   // The memory limit, checked from the input's size before anything large is allocated: the points
   // thinned evenly to what fits (a coarser mesh), the refinement bounded by what the rest holds.
   MemoryPlan plan;
@@ -226,18 +227,16 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
     if (!o.rbf.max_memory_bytes) o.rbf.max_memory_bytes = o.max_memory_bytes;
     o.max_memory_bytes = 0;  // checked here, on the points; the constructor below need not again
   }
-  ScanPoints prepared;
+  fit.memory_stride = plan.stride;
+  fit.memory_thinned = points.size() - plan.points;
   if (plan.stride > 1) {
     if (scan.sensors.size() == points.size()) scan.sensors = every(scan.sensors, plan.stride);
-    prepared = prepare_scan(every(points, plan.stride), every(normals, plan.stride), scan, &report);
+    fit.prepared = prepare_scan(every(points, plan.stride), every(normals, plan.stride), scan, &fit.report);
   } else {
-    prepared = prepare_scan(points, normals, scan, &report);
+    fit.prepared = prepare_scan(points, normals, scan, &fit.report);
   }
-  auto support = std::make_shared<ScanSupport>(prepared, report.resolution, scan.threads);
-  // The sizing field follows the data as they were scanned; an editing session (history kept) moves
-  // constraints away from them, so it keeps the uniform precision.
-  if (!o.polygonizer.size_scale && !o.polygonizer.keep_history)
-    o.polygonizer.size_scale = [support](const Point3& x) { return support->size_scale(x); };
+  const ScanReport& report = fit.report;
+  const ScanPoints& prepared = fit.prepared;
   // The function: Auto decided on the constraint count without the off-surface spacing (which serves the
   // local function only), as the CLI always did.
   // The off-surface distance must clear what noise the projection left: at least 3 x the measured noise
@@ -255,27 +254,43 @@ Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Po
     o.constraint_build.offset_spacings = 0;
   }
   ConstraintBuildOptions build = o.constraint_build;
-  ConstraintBuildReport built;
-  Constraints c;
+  Constraints& c = fit.constraints;
   if (choose_function(prepared.points.size(), o) == FunctionKind::Local) o.function = FunctionKind::Local;
   if (o.function != FunctionKind::Local) {
     build.off_surface_spacing = 0.0;
-    c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &built);
+    c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &fit.built);
     if (o.function == FunctionKind::Auto) {
       o.function = choose_function(c.size(), o);
       if (o.function == FunctionKind::Local && o.constraint_build.off_surface_spacing > 0)
-        c = constraints_from_oriented_points(prepared.points, prepared.normals, o.constraint_build, &built);
+        c = constraints_from_oriented_points(prepared.points, prepared.normals, o.constraint_build, &fit.built);
     }
   } else {
-    c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &built);
+    c = constraints_from_oriented_points(prepared.points, prepared.normals, build, &fit.built);
   }
-  prepared = ScanPoints{};
-  Mesher m(c, o);
+  return fit;
+}
+
+Mesher Mesher::from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                         const MesherOptions& options) {
+  return from_scan(prepare_scan_fit(points, normals, options));
+}
+
+Mesher Mesher::from_scan(ScanFit fit) {
+  MesherOptions& o = fit.options;
+  ScanOptions scan = o.scan;
+  if (scan.threads == 0) scan.threads = o.polygonizer.threads;
+  auto support = std::make_shared<ScanSupport>(fit.prepared, fit.report.resolution, scan.threads);
+  fit.prepared = ScanPoints{};
+  // The sizing field follows the data as they were scanned; an editing session (history kept) moves
+  // constraints away from them, so it keeps the uniform precision.
+  if (!o.polygonizer.size_scale && !o.polygonizer.keep_history)
+    o.polygonizer.size_scale = [support](const Point3& x) { return support->size_scale(x); };
+  Mesher m(fit.constraints, o);
   m.scan_ = std::move(support);
-  m.stats_.scan = report;
-  m.stats_.scan_constraints = built;
-  m.stats_.memory_stride = plan.stride;
-  m.stats_.memory_thinned = points.size() - plan.points;
+  m.stats_.scan = fit.report;
+  m.stats_.scan_constraints = fit.built;
+  m.stats_.memory_stride = fit.memory_stride;
+  m.stats_.memory_thinned = fit.memory_thinned;
   return m;
 }
 
@@ -313,6 +328,8 @@ void Mesher::build(SeedTetrahedralization&& seeds) {
     }
   zero_index_.build(zero_ids, zero_points, options_.polygonizer.threads);
   quality_.reset();
+  quality_region_ = nullptr;
+  quality_topology_radius_ = 0;
   mesh_valid_ = false;
   if (const LocalRbf* local = local_function())
     local->release_constraints_cache();  // read once here; 32 bytes per constraint freed
@@ -371,11 +388,45 @@ bool Mesher::refine(double precision, const ProgressCallback& progress) {
 // continues it with the current criteria.
 void Mesher::refine_quality() {
   if (options_.mode != MeshMode::Quality || !std::isfinite(precision_)) return;
+  QualityOptions q = options_.quality;
   if (!quality_) {
-    const std::vector<Point3> seeds = QualityMesher::seeds_from_mesh(poly_->extract(), precision_);
-    quality_ = std::make_unique<QualityMesher>(function(), poly_->triangulation().box(), seeds, options_.quality);
+    SurfaceMesh fast = poly_->extract();
+    // A scan left open (docs/scans.md): only the surface near the data is refined (and seeded); the
+    // rest of the closed zero set, the sheets along the domain box and their creases included, is
+    // trimmed away (by whole triangles, finish_scan_surface) and refining it only cost vertices.
+    if (scan_) {
+      bool open = options_.surface == SurfaceKind::Open;
+      if (options_.surface == SurfaceKind::Auto) {
+        ScanFinishReport r;
+        scan_->finish(fast, precision_, SurfaceKind::Auto, options_.polygonizer.keep_history, &r);
+        open = r.open;
+      }
+      if (open) {
+        // The topology is followed down to a quarter of the precision, not below (the fold where the
+        // closed zero set turns back, bubbles of noise): the trimming's fan splits keep the result a
+        // 2-manifold where a star stays pinched.
+        quality_topology_radius_ = 0.25 * precision_;
+        // Beyond the reach: a kept triangle may have corners snapped onto the cut, up to an edge out.
+        const std::shared_ptr<ScanSupport> support = scan_;
+        const double p = precision_;
+        quality_region_ = [support, p](const Point3& x) {
+          double d = 0;
+          const double reach = support->reach(x, p, &d);
+          return d <= 2 * (reach + p);
+        };
+      }
+    }
+    std::vector<Point3> seeds = QualityMesher::seeds_from_mesh(fast, precision_);
+    if (quality_region_)
+      seeds.erase(std::remove_if(seeds.begin(), seeds.end(), [&](const Point3& x) { return !quality_region_(x); }),
+                  seeds.end());
+    q.refine_where = quality_region_;
+    q.min_topology_radius = quality_topology_radius_;
+    quality_ = std::make_unique<QualityMesher>(function(), poly_->triangulation().box(), seeds, q);
   } else {
-    quality_->set_options(options_.quality);
+    q.refine_where = quality_region_;
+    q.min_topology_radius = quality_topology_radius_;
+    quality_->set_options(q);
   }
   quality_->refine();
   mesh_valid_ = false;
@@ -466,7 +517,9 @@ const SurfaceMesh& Mesher::surface() {
 void Mesher::finish_scan_surface() {
   if (!scan_ || !std::isfinite(precision_)) return;
   ScanFinishReport r;
-  mesh_ = scan_->finish(std::move(mesh_), precision_, options_.surface, options_.polygonizer.keep_history, &r);
+  // The quality mode's mesh is trimmed by whole triangles: its angles hold up to the boundary.
+  mesh_ = scan_->finish(std::move(mesh_), precision_, options_.surface, options_.polygonizer.keep_history, &r,
+                        quality_ != nullptr);
   stats_.scan_small_components = r.small_components;
   stats_.open = r.open;
   stats_.unsupported_area = r.unsupported_area;

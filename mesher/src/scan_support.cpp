@@ -63,8 +63,18 @@ double ScanSupport::size_scale(const Point3& x) const {
   return sparse * (d <= reach ? 1.0 : d / reach);
 }
 
+double ScanSupport::reach(const Point3& x, double precision, double* distance_out) const {
+  double h = 0;
+  const double d = distance(x, &h);
+  if (distance_out) *distance_out = d;
+  // Sparse regions reach farther, but never beyond kReachResolutions (the "far from the data" of a
+  // user's check is in the data's median spacing), unless the precision itself is coarser.
+  return std::min(std::max(kReachSpacings * h, kReachPrecision * precision),
+                  std::max(kReachResolutions * resolution_, precision));
+}
+
 SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing,
-                                ScanFinishReport* report) {
+                                ScanFinishReport* report, bool whole_triangles) {
   ScanFinishReport rep;
   const std::size_t nv = mesh.vertices.size();
   std::vector<double> s(nv, 0.0);  // distance to the data minus the reach: <= 0 supported
@@ -72,13 +82,9 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   // to cut the lip where an open scan's zero set turns back: the partial cuts left more small boundary
   // loops at the rim, 3 -> 5-8 on a single view of a sphere cap.)
   for (std::size_t v = 0; v < nv; ++v) {
-    double h = 0;
-    const double d = distance(mesh.vertices[v], &h);
-    // Sparse regions reach farther, but never beyond kReachResolutions (the "far from the data" of a
-    // user's check is in the data's median spacing), unless the precision itself is coarser.
-    const double reach = std::min(std::max(kReachSpacings * h, kReachPrecision * precision),
-                                  std::max(kReachResolutions * resolution_, precision));
-    s[v] = d - reach;
+    double d = 0;
+    const double r = reach(mesh.vertices[v], precision, &d);
+    s[v] = d - r;
   }
   // Components through shared vertices: area and support.
   std::vector<std::uint32_t> root(nv);
@@ -153,7 +159,9 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
     // Clipped along the zero level of s (marching triangles on the surface, trim_mesh): a clean open
     // 2-manifold whose boundary follows where the data end, not the mesh's edges.
     TrimReport trim;
-    mesh = trim_mesh(mesh, s, TrimOptions{}, &trim);
+    TrimOptions to;
+    if (whole_triangles) to.snap = 0.5;
+    mesh = trim_mesh(mesh, s, to, &trim);
     rep.trimmed_triangles = trim.removed_triangles + trim.clipped_triangles;
     rep.small_components += trim.removed_components;
   } else if (rep.small_components) {

@@ -40,7 +40,14 @@ class ScanSupport {
   /// and keeps it), trims an open one. Returns the finished mesh.
   /// `editing`: an editing session (constraints moved away from the scan): components are not judged by
   /// the scan's data (the Mesher's own support filter, on the current zero constraints, still applies).
-  SurfaceMesh finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing, ScanFinishReport* report);
+  /// `whole_triangles`: an open mesh is trimmed by whole triangles (TrimOptions::snap 0.5: the cut runs
+  /// along edges, every triangle kept as it was; the quality mode's angles hold up to the boundary).
+  SurfaceMesh finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing, ScanFinishReport* report,
+                     bool whole_triangles = false);
+
+  /// The reach of the data at x: a mesh vertex within it of a point is supported (finish()); sets the
+  /// distance from x to the data in `distance` when given.
+  double reach(const Point3& x, double precision, double* distance = nullptr) const;
 
   /// The decision of Auto, once made.
   std::optional<bool> decided_open() const { return decided_open_; }

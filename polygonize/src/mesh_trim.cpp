@@ -185,6 +185,10 @@ class Trimmer {
         const double f = crossing_fraction(n, p);
         // Near an end, the cut passes through that end. f <= 0 and f >= 1 (underflow, rounding) snap
         // whatever the option: a crossing must not coincide with a vertex.
+        if (snap >= 0.5) {  // every crossing onto its nearer end: triangles kept whole or dropped
+          snapped[f <= 0.5 ? n : p] = 1;
+          continue;
+        }
         if (f < snap || f <= 0.0) snapped[n] = 1;
         if (f > 1.0 - snap || f >= 1.0) snapped[p] = 1;
       }
@@ -541,8 +545,8 @@ SurfaceMesh trim_mesh(const SurfaceMesh& mesh, const std::vector<double>& s, con
   if (!mesh.normals.empty() && mesh.normals.size() != nv)
     throw InvalidArgument("trim_mesh: " + std::to_string(mesh.normals.size()) + " normals for " +
                           std::to_string(nv) + " vertices (expected none or one per vertex)");
-  if (!(options.snap >= 0.0 && options.snap < 0.5))
-    throw InvalidArgument("trim_mesh: snap must be in [0, 0.5), got " + std::to_string(options.snap));
+  if (!(options.snap >= 0.0 && options.snap <= 0.5))
+    throw InvalidArgument("trim_mesh: snap must be in [0, 0.5], got " + std::to_string(options.snap));
   if (!(options.min_component_area_fraction >= 0.0 && options.min_component_area_fraction <= 1.0))
     throw InvalidArgument("trim_mesh: min_component_area_fraction must be in [0, 1], got " +
                           std::to_string(options.min_component_area_fraction));

@@ -7,6 +7,7 @@
 
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
+#include "vitri/rbf/constraints.hpp"
 
 #include <httplib.h>
 #include <catch2/catch.hpp>
@@ -193,6 +194,52 @@ TEST_CASE("studio api: refine, precision, export, load", "[studio][api]") {
   CHECK(r.get("/api/mesh?format=json&since=5").find("full")->as_bool(""));
 }
 
+TEST_CASE("studio api: uploaded points are read as vitri mesh reads a scan (.xyz without normals, .pcd)",
+          "[studio][api][scan]") {
+  // 800 points on the unit sphere with noise of 0.15 (about 1.5 spacings), no normals: the strict
+  // orientation (constraints_from_points, what the studio used) refuses them; the scan path does not.
+  std::vector<Point3> pts;
+  std::mt19937 rng(5);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  const int n = 800;
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - (2.0 * i + 1) / n, r = std::sqrt(1 - z * z), a = 2.399963 * i;
+    const double k = 1 + 0.15 * gauss(rng);
+    pts.push_back({k * r * std::cos(a), k * r * std::sin(a), k * z});
+  }
+  CHECK_THROWS_AS(vitri::constraints_from_points(pts), vitri::InvalidArgument);
+  std::string xyz, pcd = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH " +
+                         std::to_string(n) + "\nHEIGHT 1\nVIEWPOINT 0 0 20 1 0 0 0\nPOINTS " + std::to_string(n) +
+                         "\nDATA ascii\n";
+  char line[128];
+  for (const Point3& p : pts) {
+    std::snprintf(line, sizeof line, "%.17g %.17g %.17g\n", p.x, p.y, p.z);
+    xyz += line;
+    pcd += line;
+  }
+  Running r;
+  for (const char* name : {"noisy.xyz", "noisy.pcd"}) {
+    INFO(name);
+    const Json s = r.check(r.client.Post((std::string("/api/load?name=") + name).c_str(), name[6] == 'x' ? xyz : pcd,
+                                         "application/octet-stream"),
+                           200);
+    CHECK(s.find("name")->as_string("") == name);
+    const std::string note = s.find("scan")->as_string("scan");
+    CHECK(note.find("outliers set aside") != std::string::npos);  // the report of vitri mesh's scan line
+    if (name[6] == 'p') CHECK(note.find("viewpoint 0 0 20 (from the input)") != std::string::npos);
+    CHECK(number(s, "constraints") > 3 * 400);  // normal constraints of the points kept
+    r.post("/api/refine", R"({"all": true})");
+    const auto e = r.client.Get("/api/export?format=off");
+    REQUIRE(e);
+    const TriangleMesh tm = parse_input(e->body, "x.off").mesh;
+    CHECK(tm.F.rows() > 100);
+  }
+  // A viewpoint with the upload ("viewpoint=X,Y,Z", as --viewpoint), and a bad one.
+  const Json s = r.check(r.client.Post("/api/load?name=noisy.xyz&viewpoint=0,0,20", xyz, "application/octet-stream"), 200);
+  CHECK(s.find("scan")->as_string("scan").find("viewpoint 0 0 20 (--viewpoint)") != std::string::npos);
+  r.check(r.client.Post("/api/load?name=noisy.xyz&viewpoint=0,0", xyz, "application/octet-stream"), 400);
+}
+
 TEST_CASE("studio api: an edit's answer carries the mesh delta when asked (one round trip)", "[studio][api]") {
   Running r;
   // A client holding the mesh through binary deltas: triangle id -> 9 floats.
@@ -305,7 +352,7 @@ TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[
       {"/api/load?name=bad.xyzv", "0 0 zero 0\n", 400, "bad.xyzv"},
       {"/api/load?name=empty.off", "", 400, "empty"},
       {"/api/load?name=open.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 400, "boundary"},
-      {"/api/load?name=flat.xyz", "0 0 0\n1 0 0\n0 1 0\n", 400, "normals"},
+      {"/api/load?name=flat.xyz", "0 0 0\n1 0 0\n0 1 0\n", 400, "no surface"},
   };
   for (const Bad& b : bad) {
     INFO(b.path << " " << b.body);

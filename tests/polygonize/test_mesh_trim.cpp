@@ -10,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -407,7 +408,7 @@ TEST_CASE("mesh_trim: random fields always give a clean oriented 2-manifold with
     }));
     for (std::size_t f = 0; f < fields.size(); ++f) {
       CAPTURE(f);
-      for (const double snap : {0.0, 0.1, 0.3}) {
+      for (const double snap : {0.0, 0.1, 0.3, 0.5}) {
         CAPTURE(snap);
         TrimOptions options;
         options.snap = snap;
@@ -419,6 +420,19 @@ TEST_CASE("mesh_trim: random fields always give a clean oriented 2-manifold with
         const SurfaceMesh out = trim_mesh(sphere, fields[f], options, &rep);
         check_result(sphere, fields[f], out, rep, options);
         CHECK(rep.kept_triangles + rep.clipped_triangles + rep.removed_triangles == sphere.triangles.size());
+        if (snap == 0.5) {  // whole triangles: none clipped, no new vertex, every triangle an input one
+          CHECK(rep.clipped_triangles == 0);
+          CHECK(rep.crossing_vertices == 0);
+          std::set<std::array<std::array<double, 3>, 3>> input;
+          auto corners = [](const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t) {
+            std::array<std::array<double, 3>, 3> c;
+            for (std::size_t k = 0; k < 3; ++k) c[k] = {m.vertices[t[k]].x, m.vertices[t[k]].y, m.vertices[t[k]].z};
+            std::sort(c.begin(), c.end());
+            return c;
+          };
+          for (const auto& t : sphere.triangles) input.insert(corners(sphere, t));
+          for (const auto& t : out.triangles) CHECK(input.count(corners(out, t)) == 1);
+        }
         total.snapped_vertices += rep.snapped_vertices;
         total.dangling_triangles += rep.dangling_triangles;
         total.nonmanifold_fixed += rep.nonmanifold_fixed;
@@ -509,7 +523,7 @@ TEST_CASE("mesh_trim: bad input is rejected with the culprit named", "[mesh_trim
   CHECK_THROWS_AS(trim_mesh(sphere, s), vitri::InvalidPoint);
   s[7] = -1.0;
   TrimOptions bad;
-  bad.snap = 0.5;
+  bad.snap = 0.51;
   CHECK_THROWS_AS(trim_mesh(sphere, s, bad), vitri::InvalidArgument);
   bad.snap = 0.1;
   bad.min_component_area_fraction = -1.0;

@@ -352,7 +352,9 @@ class Studio {
   async load(file) {
     const bytes = await file.arrayBuffer();
     await this.queue(async () => {
-      await api.request('POST', '/api/load?name=' + encodeURIComponent(file.name), bytes);
+      const loaded = await (await api.request('POST', '/api/load?name=' + encodeURIComponent(file.name), bytes)).json();
+      // Points are read as a scan: what was set aside and how the normals were oriented.
+      document.getElementById('scan-note').textContent = loaded.scan || '';
       await this.reload();
       this.frameModel();
       this.scheduleRefine();

@@ -219,6 +219,27 @@ struct MemoryPlan {
 MemoryPlan plan_memory(std::size_t inputs, std::size_t limit, bool keep_history, bool allow_thinning = true,
                        double seeds_per_input = kMemorySeedsPerPoint);
 
+/// Scanned points prepared for the fit: the first half of Mesher::from_scan (docs/scans.md), and what
+/// every entry point reading points uses (vitri mesh, eval, studio), so that they read points alike.
+struct ScanFit {
+  Constraints constraints;       ///< the normal constraints of the prepared points
+  ScanPoints prepared;           ///< the prepared points (the data the mesh follows)
+  ScanReport report;             ///< what prepare_scan() measured and set aside
+  ConstraintBuildReport built;   ///< what the constraints' builder merged, the off-surface distance
+  MesherOptions options;         ///< the options given, with the off-surface distance and function chosen
+  /// Under MesherOptions::max_memory_bytes: every memory_stride-th input point kept, memory_thinned left out.
+  std::size_t memory_stride = 1;
+  std::size_t memory_thinned = 0;
+};
+
+/// prepare_scan() with options.scan (its threads from options.polygonizer's when 0), then the normal
+/// constraints of the prepared points: off-surface distance max(offset_spacings x the spacing, 3 x the
+/// noise) (at most offset x the diagonal), the function chosen as options.function says; under
+/// options.max_memory_bytes the points thinned evenly to what fits first (as from_scan).
+/// @throws as prepare_scan (only for inputs with no surface).
+ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Point3>& normals,
+                         const MesherOptions& options = {});
+
 /// Stateful mesher of one variational implicit surface. Not thread-safe. Movable, not copyable.
 class Mesher {
  public:
@@ -246,6 +267,8 @@ class Mesher {
   /// @throws as prepare_scan (only for inputs with no surface) and Mesher::Mesher.
   static Mesher from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                           const MesherOptions& options = {});
+  /// from_scan() on points already prepared by prepare_scan_fit() (its constraints, options and data).
+  static Mesher from_scan(ScanFit fit);
   /// Normal constraints from a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3;
   /// constraints_from_mesh), then as above. @throws InvalidArgument for an open or non-manifold mesh.
   static Mesher from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options = {});
@@ -379,6 +402,8 @@ class Mesher {
                                                // keeps a reference
   std::unique_ptr<Polygonizer> poly_;
   std::unique_ptr<QualityMesher> quality_;  // quality mode, built by the first refine()
+  std::function<bool(const Point3&)> quality_region_;  // a scan left open: where quality_ refines
+  double quality_topology_radius_ = 0;                 // a scan left open: QualityOptions::min_topology_radius
   /// The Delaunay vertex of each constraint, by id (kNoVertex: its position duplicates another seed's, or
   /// the id was removed). 4 bytes per id ever given out.
   std::vector<VertexId> vertex_of_;

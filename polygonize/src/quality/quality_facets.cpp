@@ -299,7 +299,7 @@ void QualityMesher::probe_pending() {
 
 bool QualityMesher::needs_probes(const FacetRecord& r) const {
   return r.probe_distance == kNotProbed && options_.distance_probes > 0 &&
-         std::isfinite(options_.max_distance);
+         std::isfinite(options_.max_distance) && (!options_.refine_where || options_.refine_where(r.center));
 }
 
 // The first-order distance |f| / |grad f| at the probes of the facets `keys` (one batch): the points of
@@ -410,6 +410,8 @@ bool QualityMesher::is_bad(const FacetRecord& r) const {
 }
 
 void QualityMesher::push(const FacetKey& key, const FacetRecord& r, bool topology) {
+  if (options_.refine_where && !options_.refine_where(r.center)) return;  // outside the refined region
+  if (topology && r.radius < options_.min_topology_radius) return;         // thinner than asked for
   queue_.push({r.radius, key, r.stamp, topology});
 }
 

@@ -31,8 +31,10 @@ namespace vitri {
 struct TrimOptions {
   /// A crossing within `snap` x the edge's length of one of its ends is snapped onto that end (nothing
   /// moves: the end is treated as lying on the cut, s = 0, and none of its edges gets a crossing). So
-  /// every new vertex lies in [snap, 1 - snap] of its edge and no sliver or tiny edge appears. In [0, 0.5);
-  /// 0 keeps every crossing where it falls (only crossings exactly at an end snap).
+  /// every new vertex lies in [snap, 1 - snap] of its edge and no sliver or tiny edge appears. In [0, 0.5];
+  /// 0 keeps every crossing where it falls (only crossings exactly at an end snap); 0.5 snaps every
+  /// crossing onto its nearer end (the one with the smaller |s|; the kept one at a tie), so no triangle is
+  /// clipped: each is kept whole or dropped, its shape (angles) unchanged, and the cut runs along edges.
   double snap = 0.1;
   /// An open component of the result (one with a boundary edge) with fewer triangles than this is removed.
   /// The default removes islands of a few mesh cells (a wiggle of s around 0 beside the main part).

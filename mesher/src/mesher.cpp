@@ -253,6 +253,9 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
     o.constraint_build.offset = std::max(spaced, 3 * report.noise) / box.diagonal();
     o.constraint_build.offset_spacings = 0;
   }
+  // Thin parts are told by the normals: the prepared points keep what noise the projection left, and
+  // same-sheet neighbours within D of p +- D n must not halve D (docs/scans.md).
+  o.constraint_build.thin_opposite_only = true;
   ConstraintBuildOptions build = o.constraint_build;
   Constraints& c = fit.constraints;
   if (choose_function(prepared.points.size(), o) == FunctionKind::Local) o.function = FunctionKind::Local;

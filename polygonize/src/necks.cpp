@@ -33,6 +33,9 @@ namespace {
 constexpr std::size_t kNeckSliceMin = std::size_t(1) << 12;
 // Candidates whose stars are walked together (Triangulation::incident_tetrahedra of several vertices).
 constexpr std::size_t kNeckChunk = 64;
+// Necks with no tetrahedron above the proximity distance d are refined again with d halved, down to
+// d / kNeckDepth.
+constexpr double kNeckDepth = 16.0;
 
 }  // namespace
 
@@ -120,10 +123,15 @@ bool Polygonizer::settle_necks(double dmin, const ProgressCallback& progress, Re
   stats_.necks_left = 0;
   for (;;) {
     const std::vector<VertexId> necks = find_necks();
-    const std::size_t inserted = insert_neck_points(necks, dmin, created);
+    std::size_t inserted = 0;
+    // A neck whose tetrahedra are all below d is a feature of f narrower than d (a saddle of noisy data
+    // pinching the zero set) or a real tube: the star is refined again at d / 2, d / 4, ... down to
+    // d / kNeckDepth before it is left (the packing bound then holds with that distance).
+    for (double d = dmin; inserted == 0 && !necks.empty() && d >= dmin / kNeckDepth; d *= 0.5)
+      inserted = insert_neck_points(necks, d, created);
     if (inserted == 0) {
-      // Left as they are (no tetrahedron of theirs above d): checked again by the next refine(), whose
-      // precision, hence d, may be smaller.
+      // Left as they are (no tetrahedron of theirs above d / kNeckDepth): checked again by the next
+      // refine(), whose precision, hence d, may be smaller.
       stats_.necks_left = necks.size();
       for (const VertexId v : necks) note_neck_vertex(v);
       break;

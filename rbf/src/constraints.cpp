@@ -105,13 +105,24 @@ double spacing_median(const PointIndex& index, const std::vector<Point3>& points
 /// Each point is independent: the queries run on the threads (PointIndex is const-queryable).
 std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                                         const std::vector<std::size_t>& keep, const PointIndex& surface,
-                                        double d0, double tol, const ConstraintBuildOptions& opt) {
+                                        const std::vector<Point3>& surface_normals, double d0, double tol,
+                                        const ConstraintBuildOptions& opt) {
   std::vector<double> offsets(2 * keep.size(), 0.0);
   // Queries in the index's spatial order: consecutive queries visit the same kd-tree leaves.
   std::vector<Point3> kept_points(keep.size());
   for (std::size_t k = 0; k < keep.size(); ++k) kept_points[k] = points[keep[k]];
   const std::vector<std::size_t> order = detail::spatial_order(kept_points);
   rbf_detail::parallel_chunks(keep.size(), opt.threads, 4096, [&](std::size_t b, std::size_t e) {
+    std::vector<PointIndex::Id> near;
+    // Surface points that contradict p + d n within the ball: every one, or (thin_opposite_only) those
+    // whose normal is more than 60 degrees from n.
+    auto contradicted = [&](const Point3& q, double r, const Point3& n) {
+      if (!opt.thin_opposite_only) return surface.count_ball(q, r * r, 0) > 0;
+      surface.ball(q, r * r, near);
+      for (const PointIndex::Id j : near)
+        if (dot(surface_normals[j], n) < 0.5) return true;
+      return false;
+    };
     for (std::size_t o = b; o < e; ++o) {
       const std::size_t k = order[o], i = keep[k];
       const Point3 n = normals[i] / norm(normals[i]);
@@ -123,7 +134,7 @@ std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const
           const Point3 q = points[i] + (side * d) * n;
           // Too close to another surface point: the constraint would contradict that part of the surface.
           // (p_i itself lies at distance d, outside the strict ball.)
-          if (surface.count_ball(q, (0.999 * d) * (0.999 * d), 0) == 0) {
+          if (!contradicted(q, 0.999 * d, n)) {
             offsets[2 * k + static_cast<std::size_t>(s)] = side * d;
             break;
           }
@@ -239,12 +250,19 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   std::vector<std::size_t> keep = merged_surface_points(points, tol, opt.threads, rep);
   // Index over all merged surface points, not only the subsample: thin parts are judged on the data.
   // Built in spatial order (ids are not used): a leaf's points share cache lines.
-  std::vector<Point3> surf(keep.size());
+  std::vector<Point3> surf(keep.size()), surf_normals;
   {
     std::vector<Point3> merged(keep.size());
     for (std::size_t k = 0; k < keep.size(); ++k) merged[k] = points[keep[k]];
     const std::vector<std::size_t> order = detail::spatial_order(merged);
     for (std::size_t k = 0; k < order.size(); ++k) surf[k] = merged[order[k]];
+    if (opt.thin_opposite_only) {  // unit normals in the index's order
+      surf_normals.resize(keep.size());
+      for (std::size_t k = 0; k < order.size(); ++k) {
+        const Point3& m = normals[keep[order[k]]];
+        surf_normals[k] = m / norm(m);
+      }
+    }
   }
   const PointIndex surface(surf, opt.threads);
   // The merge tolerance above stays measured on the box grown by the largest d.
@@ -253,7 +271,7 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   rep.offset = d;
   rep.median_spacing = spacing;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
-  std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, d, tol, opt);
+  std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, surf_normals, d, tol, opt);
   if (opt.off_surface_spacing > 0)
     rep.spaced_out = space_off_surface(offsets, points, keep, d, opt.off_surface_spacing, opt);
   Constraints c;

@@ -113,6 +113,55 @@ TEST_CASE("constraints: a thin slab shrinks the offset instead of crossing to th
   }
 }
 
+TEST_CASE("constraints: thin_opposite_only keeps the full offset on a noisy sheet, still halves on a thin slab",
+          "[rbf][constraints]") {
+  // A 30x30 grid of spacing 0.1 in z = 0 whose heights alternate +-0.04 (noise left by a projection),
+  // normals +z; d = 2 median spacings (0.26). p + d n lies within d of the raised neighbours of a lowered point:
+  // the plain thin-part test halves d there, the normal-aware one does not (same sheet).
+  std::vector<Point3> p, n;
+  for (int i = 0; i < 30; ++i)
+    for (int j = 0; j < 30; ++j) {
+      p.push_back({i * 0.1, j * 0.1, ((i + j) % 2 ? 0.04 : -0.04)});
+      n.push_back({0, 0, 1});
+    }
+  ConstraintBuildOptions o;
+  o.offset = 0.1;  // of the diagonal: not the cap here
+  o.offset_spacings = 2.0;
+  auto full_offsets = [&](const std::vector<Point3>& pts, const std::vector<Point3>& nrm, double& d) {
+    ConstraintBuildReport rep;
+    const Constraints c = constraints_from_oriented_points(pts, nrm, o, &rep);
+    d = rep.offset;
+    std::size_t full = 0, off = 0;
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (c.values[i] != 0) ++off, full += std::abs(std::abs(c.values[i]) - d) < 1e-12 * d;
+    return std::make_pair(full, off);
+  };
+  double d = 0;
+  o.thin_opposite_only = false;
+  const auto plain = full_offsets(p, n, d);
+  CHECK(d > 2 * 0.08);  // d clears the noise (2 x 0.04) on both sides
+  CHECK(plain.first <= plain.second / 2);  // one side of every point halved by the plain test
+  o.thin_opposite_only = true;
+  const auto aware = full_offsets(p, n, d);
+  CHECK(aware.second == 2 * p.size());
+  CHECK(aware.first == aware.second);
+  // The thin slab of the test above (0.02 apart, opposite normals): halved either way.
+  std::vector<Point3> q, m;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      q.push_back({i * 0.25, j * 0.25, 0.0}), m.push_back({0, 0, -1});
+      q.push_back({i * 0.25, j * 0.25, 0.02}), m.push_back({0, 0, 1});
+    }
+  ConstraintBuildOptions slab;
+  slab.thin_opposite_only = true;
+  const Constraints c = constraints_from_oriented_points(q, m, slab);
+  for (std::size_t i = 0; i < c.size(); ++i) {
+    if (c.values[i] >= 0) continue;
+    CHECK(c.points[i].z > 0.0);
+    CHECK(c.points[i].z < 0.02);
+  }
+}
+
 TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary and non-manifold refused",
           "[rbf][constraints]") {
   Eigen::MatrixXd V;

@@ -37,6 +37,13 @@ struct ConstraintBuildOptions {
   /// between the samples (measured in docs/benchmarks.md "Off-surface distance": 2 spacings give a mesh
   /// closer to the true model, the right genus where 0.01 failed, and much less refinement).
   double offset_spacings = 0.0;
+  /// When true, the thin-part test of `offset` counts only the surface points whose normal is more than
+  /// 60 degrees from the point's own (the other side of a thin part, the other face of a crease):
+  /// neighbours of the same sheet that noise left above or below the point's tangent plane then do not
+  /// halve d. On noisy data every neighbourhood has such points within d of p +- d n, and halving d there
+  /// puts the off-surface constraints inside the noise, where those of neighbouring points cross (tunnels
+  /// and handles). false (the library's default) counts every point; Mesher::from_scan sets it.
+  bool thin_opposite_only = false;
   /// Off-surface constraints per point; see OffSurface.
   OffSurface sides = OffSurface::Both;
   /// When > 0, only some surface points get off-surface constraints, about off_surface_spacing x d

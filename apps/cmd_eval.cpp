@@ -4,7 +4,9 @@
 #include "input.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
+#include "vitri/mesher.hpp"
 #include "vitri/rbf/constraints.hpp"
+#include "vitri/rbf/local_rbf.hpp"
 #include "vitri/rbf/rbf.hpp"
 
 #include <charconv>
@@ -13,6 +15,7 @@
 #include <cstdio>
 #include <iostream>
 #include <limits>
+#include <memory>
 #include <string>
 #include <system_error>
 #include <type_traits>
@@ -56,6 +59,7 @@ int run_eval(const Args& args) {
   opt.offset_spacings = kOffsetSpacings;  // the constraints of vitri mesh
   ScanOptions scan;  // points are read as vitri mesh reads them (docs/scans.md)
   bool viewpoint_given = false;
+  FunctionKind function = FunctionKind::Auto;  // as vitri mesh chooses it
   for (std::size_t i = 0; i < args.size(); ++i) {
     const std::string& a = args[i];
     auto value = [&]() -> const std::string& {
@@ -72,6 +76,13 @@ int run_eval(const Args& args) {
       opt.max_constraints = parse_unsigned<std::size_t>(a, value());
     else if (a == "--seed")
       opt.seed = parse_unsigned<std::uint64_t>(a, value());
+    else if (a == "--function") {
+      const std::string& v = value();
+      if (v == "auto") function = FunctionKind::Auto;
+      else if (v == "global") function = FunctionKind::Global;
+      else if (v == "local") function = FunctionKind::Local;
+      else throw InvalidArgument("--function: '" + v + "' is not auto, global or local");
+    }
     else if (a == "--neighbours")
       scan.k = parse_unsigned<std::size_t>(a, value());
     else if (a == "--viewpoint") {
@@ -97,27 +108,51 @@ int run_eval(const Args& args) {
     std::cerr << "usage: vitri eval INPUT --at QUERY.xyz (try vitri eval --help)\n";
     return 2;
   }
-  ScanFit fit;
+  // The function vitri mesh would mesh: the same constraints (the off-surface spacing with the local
+  // function only), the same Auto rule (choose_function), the same fit options.
+  MesherOptions mo;
+  mo.function = function;
+  mo.constraint_build = opt;
+  mo.constraint_build.off_surface_spacing = kOffSurfaceSpacing;
   Input data = read_input(input);
-  const bool scan_input = is_scan(data);
-  const Constraints c = constraints_of(std::move(data), input, opt, nullptr, scan, &fit);
-  if (scan_input) std::cerr << describe_scan(fit, viewpoint_given) << "\n";
-  Rbf f(c);
-  if (f.report().warning) std::cerr << "vitri eval: warning: " << f.report().message << "\n";
+  Constraints c;
+  if (is_scan(data)) {
+    mo.scan = scan;
+    ScanFit fit = scan_of(data, input, mo);
+    std::cerr << describe_scan(fit, viewpoint_given) << "\n";
+    c = std::move(fit.constraints);
+    mo = fit.options;
+    mo.function = choose_function(c.size(), mo);  // resolved by the scan path already
+  } else {
+    ConstraintBuildReport merged;
+    c = constraints_for_function(std::move(data), input, mo.constraint_build, mo.function, mo.auto_local_above,
+                                 merged);
+  }
+  std::unique_ptr<ImplicitFunction> f;
+  if (mo.function == FunctionKind::Local) {
+    auto local = std::make_unique<LocalRbf>();
+    local->fit(c, mo.local);
+    f = std::move(local);
+  } else {
+    auto global = std::make_unique<Rbf>();
+    global->fit(c, mo.rbf);
+    if (global->report().warning) std::cerr << "vitri eval: warning: " << global->report().message << "\n";
+    f = std::move(global);
+  }
   const OrientedPoints q = read_points(query);
   std::vector<double> v(q.points.size());
   std::vector<Point3> g(q.points.size());
-  f.values_gradients(q.points.data(), q.points.size(), v.data(), g.data());
+  f->values_gradients(q.points.data(), q.points.size(), v.data(), g.data());
   for (std::size_t i = 0; i < v.size(); ++i)
     std::printf("%.17g %.17g %.17g %.17g\n", v[i], g[i].x, g[i].y, g[i].z);
   return std::fflush(stdout) == 0 ? 0 : 1;
 }
 
 const char* eval_usage() {
-  return "usage: vitri eval INPUT --at QUERY.xyz [--offset F] [--max-constraints N] [--seed S]\n"
-         "                  [--neighbours K] [--viewpoint X Y Z]\n"
+  return "usage: vitri eval INPUT --at QUERY.xyz [--function auto|global|local] [--offset F]\n"
+         "                  [--max-constraints N] [--seed S] [--neighbours K] [--viewpoint X Y Z]\n"
          "\n"
-         "Fits the variational implicit function of INPUT and prints 'f gx gy gz' (value and gradient, "
+         "Fits the variational implicit function of INPUT (the one vitri mesh meshes) and prints 'f gx gy gz' (value and gradient, "
          "%.17g)\n"
          "for each point of QUERY.xyz (3 or 6 columns; only positions are used), one line per point.\n"
          "f < 0 inside, f > 0 outside.\n"
@@ -128,6 +163,8 @@ const char* eval_usage() {
          "       scan (docs/scans.md): duplicates and outliers set aside, noise absorbed, normals estimated\n"
          "       or checked and oriented (the viewpoint: --viewpoint, PCD VIEWPOINT, NAME.viewpoint beside\n"
          "       the input) without refusing; what was set aside is printed on stderr.\n"
+         "  --function KIND      auto (default: global up to 4000 constraints, local above, as vitri\n"
+         "                       mesh), global (the paper's cubic RBF) or local (partition of unity)\n"
          "  --offset F           off-surface constraint distance, fraction of the bounding-box diagonal "
          "(default: 2 x the median spacing of the points, at most 0.01)\n"
          "  --max-constraints N  subsample points / vertices to at most N constraints (0: all; else at\n"

@@ -194,6 +194,11 @@ TEST_CASE("vitri eval reads points as vitri mesh does: an unoriented noisy cloud
   CHECK(r[2][0] > 0);  // outside, on three sides
   CHECK(r[3][0] > 0);
   CHECK(r[4][0] > 0);
+  // The function vitri mesh meshes: with all its off-surface constraints the cloud needs more than 4000,
+  // so Auto gives the local function, as vitri mesh says ("local fit") on the same file.
+  std::string local_out;
+  REQUIRE(run(points + " --function local --at " + query, local_out, err) == 0);
+  CHECK(local_out == out);
 }
 
 TEST_CASE("vitri eval refuses inputs without an inside (too few unoriented points, open mesh) and bad option values", "[cli][eval][errors]") {
@@ -229,6 +234,9 @@ TEST_CASE("vitri eval refuses inputs without an inside (too few unoriented point
     CHECK(err.find("not a non-negative integer") != std::string::npos);
     CHECK(out.empty());
   }
+  CHECK(run(mesh + " --function cubic --at " + query, out, err) == 1);
+  CHECK(err.find("--function: 'cubic' is not auto, global or local") != std::string::npos);
+  CHECK(out.empty());
   CHECK(run(mesh + " --seed 99999999999999999999999 --at " + query, out, err) == 1);
   CHECK(err.find("too large") != std::string::npos);
   CHECK(run(mesh + " --max-constraints 2 --at " + query, out, err) == 1);

@@ -413,6 +413,81 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   return changed;
 }
 
+/// Misregistered layers: the overlap of two views registered a little apart gives two sheets of the
+/// same surface, with normals of the same sign, a few spacings apart; the offsets of one (+-D along
+/// its normal) then contradict the other's, and the interpolant folds between them (handles, blobs).
+/// Two sheets of one orientation so close are never both right: the space between them would be
+/// outside for one and inside for the other (unless a sheet of the opposite orientation lies between,
+/// a thin part). For each point, the points in a cylinder around its normal line (radius 2 h, half-height
+/// 4 h, h its local spacing, at least 0.7 x the scan's median), of its orientation (normals within 60
+/// degrees) and nearer than half the nearest opposite point along the line: when their heights along
+/// the line (its own, 0, included) split into two clusters of at least a quarter of them each, by a
+/// gap wider than h / 2 and than twice either cluster's spread (two layers, not one noisy or curved
+/// sheet), the point moves along its normal by the mean height (to the layers' middle, weighted by
+/// their densities). Returns the number of points moved; `shift` receives each move (0 elsewhere).
+constexpr std::size_t kMergeNeighbours = 96;
+
+std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>& n, const PointIndex& index,
+                         const Neighbours& nb, unsigned threads, std::vector<double>& shift) {
+  shift.assign(p.size(), 0.0);
+  // The overlap of two layers is denser than either: its local spacing is up to half a layer's, so the
+  // cylinder's scale has a floor of 0.7 x the scan's median local spacing.
+  std::vector<double> spacing(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) spacing[i] = local_spacing(nb, i);
+  const double floor = 0.7 * median(spacing);
+  rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Id> near;
+    std::vector<double> same, keep;
+    for (std::size_t i = b; i < e; ++i) {
+      const double h = std::max(spacing[i], floor);
+      const double rc = 2.0 * h, half = 4.0 * h;
+      // The cylinder's points among the nearest 96 (a ball would hold thousands where a sparse point
+      // borders a dense region: room scans): about 3.9 h in an overlap of two layers, 5.5 h on one.
+      index.nearest(p[i], kMergeNeighbours, near);
+      same.clear();
+      double opposite = 2 * half;  // |t| of the nearest opposite point along the line (none: 2 half)
+      for (const Id j : near) {
+        if (j == i) continue;
+        const Point3 v = p[j] - p[i];
+        const double t = dot(v, n[i]);
+        if (dot(v, v) - t * t > rc * rc || std::abs(t) > half) continue;
+        const double c = dot(n[j], n[i]);
+        if (c < -0.5) opposite = std::min(opposite, std::abs(t));
+        else if (c > 0.5) same.push_back(t);
+      }
+      // Two layers: the heights, sorted (the point's own, 0, included), split by their widest gap into
+      // two clusters of at least a quarter of them each, the gap wider than half a spacing and than
+      // twice either cluster's spread (one noisy or curved sheet spreads its heights without such a gap).
+      keep.assign(1, 0.0);
+      for (const double t : same)
+        if (std::abs(t) < 0.5 * opposite) keep.push_back(t);
+      const std::size_t m = keep.size();
+      if (m < 8) continue;
+      std::sort(keep.begin(), keep.end());
+      const std::size_t lo_min = std::max<std::size_t>(3, m / 4);
+      std::size_t cut = 0;
+      double gap = 0;
+      for (std::size_t c = lo_min; c + lo_min <= m; ++c)
+        if (keep[c] - keep[c - 1] > gap) gap = keep[c] - keep[c - 1], cut = c;
+      if (cut == 0 || !(gap > 0.5 * h)) continue;
+      auto spread = [&](std::size_t from, std::size_t to) {
+        double mean = 0, var = 0;
+        for (std::size_t c = from; c < to; ++c) mean += keep[c];
+        mean /= static_cast<double>(to - from);
+        for (std::size_t c = from; c < to; ++c) var += (keep[c] - mean) * (keep[c] - mean);
+        return std::sqrt(var / static_cast<double>(to - from));
+      };
+      if (!(gap > 2 * std::max(spread(0, cut), spread(cut, m)))) continue;
+      double sum = 0;
+      for (const double t : keep) sum += t;
+      shift[i] = sum / static_cast<double>(m);
+    }
+  });
+  std::size_t moved = 0;
+  for (const double d : shift) moved += d != 0.0;
+  return moved;
+}
+
 }  // namespace
 
 ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Point3>& normals,
@@ -537,10 +612,26 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   if (collinear == p.size())
     throw InvalidArgument("no surface: every neighbourhood of the " + std::to_string(p.size()) +
                           " points is collinear (the points lie on a line)");
+  // The noise per region: each point's residual is one neighbourhood's (itself noisy); the median over the
+  // neighbourhood (the point included) is the region's. ScanReport::noise is the median over the points.
+  std::vector<double> region_noise(p.size()), region_nn(p.size());
   {
     std::vector<double> noise(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) noise[i] = fit[i].noise;
     rep.noise = median(noise);
+    rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+      std::vector<double> a, c;
+      for (std::size_t i = b; i < e; ++i) {
+        a.assign(1, noise[i]);
+        c.assign(1, nb.d(i, 0));
+        for (std::size_t j = 0; j < nb.k; ++j) {
+          a.push_back(noise[nb.at(i, j)]);
+          c.push_back(nb.d(nb.at(i, j), 0));
+        }
+        region_noise[i] = median(a);
+        region_nn[i] = median(c);
+      }
+    });
   }
 
   std::vector<Point3> n(p.size());
@@ -635,6 +726,13 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     if (flips == 0) break;
   }
 
+  // Misregistered layers merged (merge_layers), before the projection smooths what is left.
+  if (options.approximate) {
+    std::vector<double> shift;
+    rep.merged = merge_layers(p, n, index, nb, threads, shift);
+    for (std::size_t i = 0; i < p.size(); ++i) p[i] = p[i] + shift[i] * n[i];
+  }
+
   // Approximation: the projection onto the local quadrics of each point's own side (twice where the data
   // are noisy: the second fit sees the smoother points), once the normals are oriented; the normals are
   // then those of the quadrics at the projected points, with the signs decided.
@@ -643,12 +741,21 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     std::vector<double> nearest(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) nearest[i] = nb.d(i, 0);
     const double scale = median(nearest);  // the spacing
-    const int passes = rep.noise > 0.5 * scale ? 3 : rep.noise > 0.1 * scale ? 2 : 1;
+    // Passes per region: a point is projected again where its region's noise is large against the
+    // spacing (a second pass above 0.1 spacings, a third above 0.5), clean regions once.
+    auto passes_at = [&](std::size_t i) {
+      const double noise = std::max(region_noise[i], rep.noise), spacing = scale;
+      return noise > 0.5 * spacing ? 3 : noise > 0.1 * spacing ? 2 : 1;
+    };
+    int passes = 1;
+    for (std::size_t i = 0; i < p.size(); ++i) passes = std::max(passes, passes_at(i));
     for (int pass = 0; pass < passes; ++pass) {
       rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) fit[i] = fit_neighbourhood(p, nb, i, &n);
+        for (std::size_t i = b; i < e; ++i)
+          if (pass < passes_at(i)) fit[i] = fit_neighbourhood(p, nb, i, &n);
       });
-      for (std::size_t i = 0; i < p.size(); ++i) p[i] = fit[i].projected;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (pass < passes_at(i)) p[i] = fit[i].projected;
     }
     rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
       for (std::size_t i = b; i < e; ++i) fit[i] = fit_neighbourhood(p, nb, i, &n);
@@ -670,19 +777,41 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // detail finer than the resolution, and clusters of them closer than that only make the interpolant
   // fold between them (small handles at the default precision). A Poisson-disk subset (input order) at
   // half the resolution keeps one point per such cluster.
+  //
+  // Per region: the resolution of point i is max(its region's spacing, 2 x its region's noise) and the
+  // rule applies where that exceeds 1.2 x the region's spacing (a noisy part of a cleaner scan, the
+  // overlap of misregistered views, whose two layers give their neighbourhoods' quadrics a residual of
+  // about half their distance); where the whole scan is that noisy, the scan's resolution as before.
   std::vector<char> kept(p.size(), 1);
-  const bool thin = options.approximate && rep.resolution > 1.2 * rep.spacing;
-  if (thin) {
+  std::vector<double> radius(p.size(), 0.0);  // of the Poisson disk; 0: not thinned
+  const bool thin_all = options.approximate && rep.resolution > 1.2 * rep.spacing;
+  if (thin_all) {
     std::vector<std::size_t> visit(p.size());
     std::iota(visit.begin(), visit.end(), std::size_t(0));
     kept = rbf_detail::spaced_subset(p, visit, 0.5 * rep.resolution);
+    std::fill(radius.begin(), radius.end(), 0.5 * rep.resolution);
+  } else if (options.approximate) {
+    // Greedy in input order over each point's neighbours (the Poisson disk of radius
+    // 0.5 x resolution_i is within its k nearest: resolution_i is a few spacings at most where k grew
+    // with the noise); a point whose disk holds a point kept before it is left out.
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      const double res = std::max(region_nn[i], 2 * region_noise[i]);
+      if (res > 1.2 * region_nn[i]) radius[i] = 0.5 * res;
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (radius[i] == 0) continue;
+      for (std::size_t c = 0; c < nb.k && kept[i]; ++c) {
+        const Id j = nb.at(i, c);
+        if (j < i && kept[j] && norm(p[j] - p[i]) < radius[i]) kept[i] = 0;
+      }
+    }
   }
   ScanPoints out;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (!kept[i]) continue;
     out.points.push_back(p[i]);
     out.normals.push_back(n[i]);
-    out.spacing.push_back(thin ? std::max(local[i], 0.5 * rep.resolution) : local[i]);
+    out.spacing.push_back(std::max(local[i], radius[i]));
   }
   rep.thinned = p.size() - out.points.size();
   rep.kept = out.points.size();
@@ -702,6 +831,7 @@ std::string describe(const ScanReport& r) {
     << r.outliers << " outliers set aside); " << r.k << " neighbours; spacing " << r.spacing << ", noise "
     << r.noise << " (" << (r.spacing > 0 ? r.noise / r.spacing : 0) << " spacings), points moved by "
     << r.moved << " (median)";
+  if (r.merged) s << ", " << r.merged << " moved to the middle of misregistered layers";
   if (r.thinned) s << ", " << r.thinned << " thinned to the resolution " << r.resolution;
   s << "; normals from " << source;
   if (r.repaired) s << ", " << r.repaired << " given normals repaired";

@@ -73,6 +73,92 @@ TEST_CASE("prepare_scan: noise of one spacing is measured and absorbed, normals 
   for (const double h : s.spacing) CHECK(h > 0);
 }
 
+TEST_CASE("prepare_scan: misregistered layers are merged to their middle; a thin part's two sheets are not",
+          "[scan]") {
+  // A clean unit sphere (6000 points, spacing about 0.046) and, over its cap z > 0.6, a second view
+  // registered 2.5 spacings outward: two sheets of one orientation, 0.115 apart.
+  const std::size_t n = 6000;
+  const double spacing = std::sqrt(4 * kPi / static_cast<double>(n)), gap = 2.5 * spacing;
+  std::vector<Point3> p = noisy_sphere(n, 0.0, 3);
+  const std::vector<Point3> view = noisy_sphere(n, 0.0, 4);
+  Gauss g(5);
+  for (std::size_t i = 0; i < view.size(); ++i)  // the second view: another sample of the cap
+    if (view[i].z > 0.6) {
+      const double a = 0.3 * spacing * g(), b = 0.3 * spacing * g();
+      const Point3 q = view[i] + Point3{a, b, 0};
+      p.push_back(q * ((1 + gap) / vitri::norm(q)));
+    }
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.merged > 0);
+  // In the cap (away from its rim), the prepared points lie near the layers' middle, not on either
+  // layer: no radius within gap / 4 of 1 or of 1 + gap.
+  std::size_t cap = 0, near_layer = 0;
+  for (const Point3& q : s.points) {
+    const double rad = vitri::norm(q);
+    if (q.z / rad < 0.7) continue;
+    ++cap;
+    near_layer += std::abs(rad - 1) < gap / 4 || std::abs(rad - 1 - gap) < gap / 4;
+  }
+  CHECK(cap > 500);
+  CHECK(near_layer < cap / 10);
+  // Away from the cap, nothing was moved: the sphere elsewhere keeps its radius.
+  for (const Point3& q : s.points)
+    if (q.z / vitri::norm(q) < 0.4) CHECK(std::abs(vitri::norm(q) - 1) < 0.1 * spacing);
+  CHECK(outward(s.points, s.normals) >= s.points.size() * 995 / 1000);
+
+  // A thin slab (two parallel squares 2 spacings apart, normals opposite: outward) keeps both sheets.
+  std::vector<Point3> slab;
+  const double h = 0.05;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j)
+      for (const double z : {-h, h}) slab.push_back({i * 0.05 + 0.01 * (j % 2), j * 0.05, z});
+  std::vector<Point3> normals;
+  for (const Point3& q : slab) normals.push_back({0, 0, q.z > 0 ? 1.0 : -1.0});
+  vitri::ScanReport rs;
+  const vitri::ScanPoints ss = vitri::prepare_scan(slab, normals, {}, &rs);
+  INFO(vitri::describe(rs));
+  // Away from the rim (where a neighbourhood holds both sheets and no side wall), no point moved toward
+  // the other sheet.
+  std::size_t inner = 0, moved_inward = 0;
+  for (const Point3& q : ss.points) {
+    if (q.x < 0.4 || q.x > 1.55 || q.y < 0.4 || q.y > 1.55) continue;
+    ++inner;
+    moved_inward += std::abs(q.z) < 0.9 * h;
+  }
+  CHECK(inner > 1000);
+  CHECK(moved_inward == 0);
+}
+
+TEST_CASE("prepare_scan: a noisy part of a clean scan is thinned to its own resolution, the rest kept",
+          "[scan]") {
+  // A unit sphere, 8000 points; noise of 1.5 spacings on the half x > 0 only: the scan's median noise
+  // stays low (no thinning of the whole scan), the noisy half is thinned, the clean half kept whole.
+  const std::size_t n = 8000;
+  const double spacing = std::sqrt(4 * kPi / static_cast<double>(n));
+  std::vector<Point3> p = noisy_sphere(n, 0.0, 11);
+  Gauss g(12);
+  std::size_t clean = 0;
+  for (Point3& q : p) {
+    if (q.x > 0) q = q * (1 + 1.5 * spacing * g());
+    else clean += q.x < -0.2;
+  }
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.thinned > 0);
+  std::size_t kept_clean = 0, kept_noisy = 0, noisy = 0;
+  for (const Point3& q : p) noisy += q.x > 0.2;
+  for (const Point3& q : s.points) {
+    kept_clean += q.x < -0.2;
+    kept_noisy += q.x > 0.2;
+  }
+  CHECK(kept_clean >= clean * 99 / 100);
+  CHECK(kept_noisy < noisy * 95 / 100);  // about 10% thinned there (2896 of 3200 kept when written)
+  CHECK(outward(s.points, s.normals) >= s.points.size() * 99 / 100);
+}
+
 TEST_CASE("prepare_scan: outliers in the box get no vote, the surface keeps its points", "[scan]") {
   std::vector<Point3> p = noisy_sphere(3000, 0.0, 3);
   Gauss g(11);

@@ -59,6 +59,9 @@ struct ScanReport {
   /// Points left out after the projection because a kept one lay within half the resolution (only
   /// where the resolution exceeds 1.5 spacings: noise larger than the spacing; ScanOptions::approximate).
   std::size_t thinned = 0;
+  /// Points moved to the middle of two misregistered layers (sheets of one orientation a few spacings
+  /// apart: docs/scans.md) before the projection.
+  std::size_t merged = 0;
   std::size_t k = 0;           ///< neighbours per point used
   /// The median distance from a returned point to its nearest other one.
   double spacing = 0;

@@ -1,0 +1,176 @@
+#!/usr/bin/python3
+"""Topology under noise: `vitri mesh IN.xyz -o OUT.obj` with the CLI's defaults on noisy samples whose
+truth is known (docs/scans.md, Limits: "Topology under noise").
+
+Cases (generated here, seeded, numpy only):
+  sphere-n{1,2}-s{seed}  6000 points on the unit sphere (Fibonacci lattice), isotropic Gaussian noise of
+                         1 or 2 spacings of the clean sample; truth: chi 2, 1 component
+  MODEL-n{1,2}           30,000 area-uniform samples of ../shared/data/MODEL.off, noise 1 or 2 spacings;
+                         truth: the model's own chi (from its file)
+  MODEL-misreg           the same sample, 20% of it (x above the 80th percentile) duplicated by a second
+                         sample shifted 2 spacings along +x (a misregistered overlap)
+For each: Euler characteristic chi = V - E + F of the output (vertices used by triangles), components,
+boundary loops, seconds. Prints a markdown table. Usage:
+  python3 bench/scans/noise_topology.py [--vitri build-release/apps/vitri] [--models bunny] [--seeds 4]
+"""
+import argparse
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+SHARED = Path(os.environ.get("VITRI_SHARED_DATA", ROOT.parent / "shared" / "data"))
+
+
+def read_off(path):
+    tok = Path(path).read_text().split()
+    assert tok[0] == "OFF"
+    nv, nf = int(tok[1]), int(tok[2])
+    v = np.array(tok[4:4 + 3 * nv], dtype=float).reshape(nv, 3)
+    f, at = [], 4 + 3 * nv
+    for _ in range(nf):
+        k = int(tok[at])
+        poly = [int(x) for x in tok[at + 1:at + 1 + k]]
+        f.extend([poly[0], poly[i], poly[i + 1]] for i in range(1, k - 1))
+        at += 1 + k
+    return v, np.array(f, dtype=np.int64)
+
+
+def read_obj(path):
+    v, f = [], []
+    for line in Path(path).read_text().splitlines():
+        if line.startswith("v "):
+            v.append([float(x) for x in line.split()[1:4]])
+        elif line.startswith("f "):
+            f.append([int(x.split("/")[0]) - 1 for x in line.split()[1:4]])
+    return np.array(v).reshape(-1, 3), np.array(f, dtype=np.int64).reshape(-1, 3)
+
+
+def topology(f):
+    """chi, components, boundary loops of a triangle list (vertices counted where triangles use them)."""
+    if len(f) == 0:
+        return 0, 0, 0
+    used = np.unique(f)
+    edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    uniq, count = np.unique(edges, axis=0, return_counts=True)
+    chi = len(used) - len(uniq) + len(f)
+    parent = {int(u): int(u) for u in used}
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b in uniq:
+        ra, rb = find(int(a)), find(int(b))
+        if ra != rb:
+            parent[ra] = rb
+    comps = len({find(int(u)) for u in used})
+    border = uniq[count == 1]
+    bparent = {int(u): int(u) for u in np.unique(border)}
+
+    def bfind(a):
+        while bparent[a] != a:
+            bparent[a] = bparent[bparent[a]]
+            a = bparent[a]
+        return a
+
+    for a, b in border:
+        ra, rb = bfind(int(a)), bfind(int(b))
+        if ra != rb:
+            bparent[ra] = rb
+    loops = len({bfind(u) for u in bparent})
+    return chi, comps, loops
+
+
+def area_samples(v, f, n, rng):
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    tri = rng.choice(len(f), size=n, p=area / area.sum())
+    r1, r2 = rng.random(n), rng.random(n)
+    s = np.sqrt(r1)
+    return (1 - s)[:, None] * a[tri] + (s * (1 - r2))[:, None] * b[tri] + (s * r2)[:, None] * c[tri], area.sum()
+
+
+def cases(models, seeds):
+    out = []
+    for noise in (1, 2):
+        for seed in range(1, seeds + 1):
+            out.append((f"sphere-n{noise}-s{seed}", "sphere", noise, seed, 2))
+    for m in models:
+        v, f = read_off(SHARED / f"{m}.off")
+        chi, _, _ = topology(f)
+        for noise in (1, 2):
+            out.append((f"{m}-n{noise}", m, noise, 1, chi))
+        out.append((f"{m}-misreg", m, "misreg", 1, chi))
+    return out
+
+
+def generate(name, model, noise, seed, work):
+    rng = np.random.default_rng(seed)
+    if model == "sphere":
+        n = 6000
+        i = np.arange(n)
+        z = 1 - (2 * i + 1) / n
+        r = np.sqrt(1 - z * z)
+        a = 2.399963229728653 * i
+        p = np.stack([r * np.cos(a), r * np.sin(a), z], axis=1)
+        spacing = np.sqrt(4 * np.pi / n)
+    else:
+        v, f = read_off(SHARED / f"{model}.off")
+        p, area = area_samples(v, f, 30000, rng)
+        spacing = np.sqrt(area / len(p))
+    if noise == "misreg":
+        cut = np.quantile(p[:, 0], 0.8)
+        extra = p[p[:, 0] > cut].copy()
+        extra += rng.normal(scale=0.05 * spacing, size=extra.shape)
+        extra[:, 0] += 2 * spacing
+        p = np.concatenate([p, extra])
+    else:
+        p = p + rng.normal(scale=noise * spacing, size=p.shape)
+    path = work / f"{name}.xyz"
+    np.savetxt(path, p, fmt="%.9g")
+    return path
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--vitri", default=str(ROOT / "build-release" / "apps" / "vitri"))
+    ap.add_argument("--work", default="/tmp/vitri-noise-topology")
+    ap.add_argument("--models", default="bunny")
+    ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--only", default=None, help="comma-separated prefixes of case names")
+    ap.add_argument("--extra", default="", help="more CLI options, e.g. '--threads 1'")
+    a = ap.parse_args()
+    work = Path(a.work)
+    work.mkdir(parents=True, exist_ok=True)
+    models = [m for m in a.models.split(",") if m]
+    print("| case | truth chi | chi | components | loops | noise line | s |")
+    print("|---|---|---|---|---|---|---|")
+    for name, model, noise, seed, truth in cases(models, a.seeds):
+        if a.only and not any(name.startswith(x) for x in a.only.split(",")):
+            continue
+        xyz = generate(name, model, noise, seed, work)
+        obj = work / f"{name}.obj"
+        t0 = time.time()
+        r = subprocess.run([a.vitri, "mesh", str(xyz), "-o", str(obj)] + a.extra.split(),
+                           capture_output=True, text=True)
+        dt = time.time() - t0
+        scan = next((l for l in r.stderr.splitlines() if l.startswith("scan:")), "")
+        noise_part = scan.split("spacing ")[-1].split(", points")[0] if scan else ""
+        if r.returncode != 0:
+            print(f"| {name} | {truth} | exit {r.returncode} | | | {r.stderr.strip()[-120:]} | {dt:.1f} |")
+            continue
+        _, f = read_obj(obj)
+        chi, comps, loops = topology(f)
+        print(f"| {name} | {truth} | {chi} | {comps} | {loops} | {noise_part} | {dt:.1f} |", flush=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -51,6 +51,23 @@ def read_obj(path):
     return np.array(v).reshape(-1, 3), np.array(f, dtype=np.int64).reshape(-1, 3)
 
 
+def count_classes(pairs, items):
+    """Connected classes of `items` under the pairs (union-find)."""
+    parent = {int(u): int(u) for u in items}
+
+    def find(a):
+        while parent[a] != a:
+            parent[a] = parent[parent[a]]
+            a = parent[a]
+        return a
+
+    for a, b in pairs:
+        ra, rb = find(int(a)), find(int(b))
+        if ra != rb:
+            parent[ra] = rb
+    return len({find(u) for u in parent})
+
+
 def topology(f):
     """chi, components, boundary loops of a triangle list (vertices counted where triangles use them)."""
     if len(f) == 0:
@@ -59,34 +76,8 @@ def topology(f):
     edges = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
     uniq, count = np.unique(edges, axis=0, return_counts=True)
     chi = len(used) - len(uniq) + len(f)
-    parent = {int(u): int(u) for u in used}
-
-    def find(a):
-        while parent[a] != a:
-            parent[a] = parent[parent[a]]
-            a = parent[a]
-        return a
-
-    for a, b in uniq:
-        ra, rb = find(int(a)), find(int(b))
-        if ra != rb:
-            parent[ra] = rb
-    comps = len({find(int(u)) for u in used})
     border = uniq[count == 1]
-    bparent = {int(u): int(u) for u in np.unique(border)}
-
-    def bfind(a):
-        while bparent[a] != a:
-            bparent[a] = bparent[bparent[a]]
-            a = bparent[a]
-        return a
-
-    for a, b in border:
-        ra, rb = bfind(int(a)), bfind(int(b))
-        if ra != rb:
-            bparent[ra] = rb
-    loops = len({bfind(u) for u in bparent})
-    return chi, comps, loops
+    return chi, count_classes(uniq, used), count_classes(border, np.unique(border))
 
 
 def area_samples(v, f, n, rng):

@@ -260,45 +260,13 @@ constexpr std::size_t kFitProgressConstraints = 1000;
 /// Default precision = this x the median spacing of the surface points: marching tetrahedra puts a mesh
 /// vertex on every crossed Delaunay edge, so a circumradius bound of one spacing gives about 6x as many
 /// mesh vertices as points (hand.off: 7231 for 1197); 2.5 spacings give 1-1.5x as many (hand 1855,
-/// sphere926 990, 33k samples of man.off 49.6k).
-constexpr double kSpacingFactor = 2.5;
+/// sphere926 990, 33k samples of man.off 49.6k). The run defaults are the library's (shared with Python).
+constexpr double kSpacingFactor = run_defaults::spacing_factor;
 /// A scan without --precision: at most this many Delaunay vertices per input point (plus the base), about
 /// 2 mesh vertices per input point (docs/scans.md "Budget").
-constexpr std::size_t kScanVerticesPerPoint = 12;
-constexpr std::size_t kScanVerticesBase = 200000;
+constexpr std::size_t kScanVerticesPerPoint = run_defaults::scan_vertices_per_point;
+constexpr std::size_t kScanVerticesBase = run_defaults::scan_vertices_base;
 
-/// The default memory limit of a run: the machine's available memory less a reserve of max(1 GiB, 10% of
-/// the physical memory), never the machine's last gigabyte (0: unknown, no limit).
-std::size_t default_memory_limit() {
-  const double available = static_cast<double>(available_memory_bytes());
-  const double reserve = std::max(double(1ull << 30), 0.1 * static_cast<double>(physical_memory_bytes()));
-  if (available <= 0) return 0;
-  // Under the reserve already: a limit that holds little (a coarser mesh or a clear refusal), not none.
-  return static_cast<std::size_t>(std::max(available - reserve, 0.25 * available));
-}
-
-/// "16G", "512M", "2.5G", "1000000": bytes (suffixes K, M, G, T are powers of 1024; a trailing B or iB
-/// is allowed). False for anything else or a size below 1 byte.
-bool parse_memory(const std::string& s, std::size_t& out) {
-  const char* b = s.c_str();
-  char* e = nullptr;
-  const double v = std::strtod(b, &e);
-  if (e == b || !(v > 0.0) || !std::isfinite(v)) return false;
-  std::string unit = e;
-  for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
-  if (unit.size() >= 2 && unit.compare(unit.size() - 2, 2, "IB") == 0) unit.resize(unit.size() - 2);
-  else if (unit.size() >= 2 && unit.back() == 'B') unit.pop_back();
-  double scale = 1.0;
-  if (unit == "K") scale = 1024.0;
-  else if (unit == "M") scale = 1024.0 * 1024.0;
-  else if (unit == "G") scale = 1024.0 * 1024.0 * 1024.0;
-  else if (unit == "T") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
-  else if (!unit.empty() && unit != "B") return false;
-  const double bytes = v * scale;
-  if (!(bytes >= 1.0) || bytes > 1e18) return false;
-  out = static_cast<std::size_t>(bytes);
-  return true;
-}
 
 /// mesher.refine(), its LimitError (MesherOptions::max_vertices, set from the machine's memory and, for a
 /// scan without --precision, from the input's size) said in the CLI's terms. Without an explicit
@@ -441,7 +409,7 @@ int run_mesh(const Args& args) {
         return usage_error("--certify-floor needs a fraction of the precision in (0, 1]");
       options.polygonizer.certify_floor_fraction = fl;
     } else if (a == "--memory") {
-      if (!value(v) || !parse_memory(v, memory))
+      if (!value(v) || !parse_memory_size(v, memory))
         return usage_error("--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'");
     } else if (a == "-q" || a == "--quiet") {
       quiet = true;

@@ -13,12 +13,12 @@ namespace vitri::cli {
 /// The commands' default off-surface distance for points and meshes: 2 median spacings of the points,
 /// at most the library's 0.01 x diagonal (ConstraintBuildOptions::offset_spacings; --offset D gives
 /// D x diagonal instead). Measured in docs/benchmarks.md "Off-surface distance".
-constexpr double kOffsetSpacings = 2.0;
+constexpr double kOffsetSpacings = run_defaults::offset_spacings;
 
 /// `vitri mesh`'s default spacing of the off-surface constraints with the local function, in off-surface
 /// distances (ConstraintBuildOptions::off_surface_spacing; --off-surface-spacing S). Measured in
 /// docs/benchmarks.md "Off-surface spacing".
-constexpr double kOffSurfaceSpacing = 1.0;
+constexpr double kOffSurfaceSpacing = run_defaults::off_surface_spacing;
 
 /// True for the inputs read as scans (points with or without normals: .xyz, .pwn, .pcd, PLY/OFF/OBJ
 /// without faces; docs/scans.md). Constraints (.xyzv) and meshes are interpolated as they are.

@@ -26,6 +26,8 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
+#include <cctype>
 #include <cstdio>
 #include <exception>
 #include <limits>
@@ -187,6 +189,35 @@ bool Mesher::has_constraint(ConstraintId id) const { return function_->contains(
 Point3 Mesher::constraint_point(ConstraintId id) const { return function_->point(id); }
 
 double Mesher::constraint_value(ConstraintId id) const { return function_->value_of(id); }
+
+std::size_t default_memory_limit() {
+  const double available = static_cast<double>(available_memory_bytes());
+  const double reserve = std::max(double(1ull << 30), 0.1 * static_cast<double>(physical_memory_bytes()));
+  if (available <= 0) return 0;
+  // Under the reserve already: a limit that holds little (a coarser mesh or a clear refusal), not none.
+  return static_cast<std::size_t>(std::max(available - reserve, 0.25 * available));
+}
+
+bool parse_memory_size(const std::string& s, std::size_t& out) {
+  const char* b = s.c_str();
+  char* e = nullptr;
+  const double v = std::strtod(b, &e);
+  if (e == b || !(v > 0.0) || !std::isfinite(v)) return false;
+  std::string unit = e;
+  for (char& c : unit) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  if (unit.size() >= 2 && unit.compare(unit.size() - 2, 2, "IB") == 0) unit.resize(unit.size() - 2);
+  else if (unit.size() >= 2 && unit.back() == 'B') unit.pop_back();
+  double scale = 1.0;
+  if (unit == "K") scale = 1024.0;
+  else if (unit == "M") scale = 1024.0 * 1024.0;
+  else if (unit == "G") scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  else if (!unit.empty() && unit != "B") return false;
+  const double bytes = v * scale;
+  if (!(bytes >= 1.0) || bytes > 1e18) return false;
+  out = static_cast<std::size_t>(bytes);
+  return true;
+}
 
 MesherOptions with_threads_applied(MesherOptions o) {
   if (o.threads == 0) return o;

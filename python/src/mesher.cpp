@@ -5,7 +5,6 @@
 
 #include "vitri/mesher.hpp"
 
-#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -17,22 +16,9 @@
 namespace vitri::python {
 namespace {
 
-// The CLI's defaults (apps/input.hpp, apps/cmd_mesh.cpp), kept equal to them: test_reconstruct compares
-// the meshes of both.
-constexpr double kOffsetSpacings = 2.0;     // off-surface distance: 2 median spacings (capped)
-constexpr double kOffSurfaceSpacing = 1.0;  // local function: off-surface constraints 1 distance apart
-constexpr double kSpacingFactor = 2.5;      // default precision: 2.5 x the data's spacing / resolution
-constexpr double kBytesPerVertexBatch = 1600.0;
-constexpr double kBytesPerVertexHistory = 2900.0;
-constexpr std::size_t kScanVerticesPerPoint = 12;
-constexpr std::size_t kScanVerticesBase = 200000;
-
-std::size_t vertex_budget(bool keep_history) {
-  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
-  if (pages <= 0 || page <= 0) return 0;
-  const double bytes = 0.8 * static_cast<double>(pages) * static_cast<double>(page);
-  return static_cast<std::size_t>(bytes / (keep_history ? kBytesPerVertexHistory : kBytesPerVertexBatch));
-}
+// The CLI's defaults are the library's (vitri::run_defaults, default_memory_limit() in mesher.hpp):
+// test_reconstruct compares the meshes of both.
+using namespace run_defaults;
 
 /// The keyword options of reconstruct(), mesh_constraints() and Mesher (the CLI's options by name).
 struct Options {
@@ -75,8 +61,8 @@ Options parse_options(const py::kwargs& kw, const char* fn, bool one_call) {
   Options o;
   MesherOptions& m = o.mesher;
   m.function = FunctionKind::Auto;
-  m.constraint_build.offset_spacings = kOffsetSpacings;
-  m.constraint_build.off_surface_spacing = kOffSurfaceSpacing;
+  m.constraint_build.offset_spacings = offset_spacings;
+  m.constraint_build.off_surface_spacing = off_surface_spacing;
   unsigned threads = 0;
   for (auto item : kw) {
     const std::string key = py::str(item.first);
@@ -136,6 +122,22 @@ Options parse_options(const py::kwargs& kw, const char* fn, bool one_call) {
       threads = unsigned(t);
     } else if (key == "max_vertices") {
       m.max_vertices = v.cast<std::size_t>();
+    } else if (key == "memory") {  // bytes, or a size as the CLI's --memory takes it ("16G")
+      std::size_t bytes = 0;
+      if (py::isinstance<py::str>(v)) {
+        if (!parse_memory_size(py::str(v), bytes))
+          throw InvalidArgument("memory: a size such as 16G, 512M or a number of bytes, got '" +
+                                std::string(py::str(v)) + "'");
+      } else {
+        const long long b = v.cast<long long>();
+        if (b < 1) throw InvalidArgument("memory: a positive number of bytes, got " + std::to_string(b));
+        bytes = static_cast<std::size_t>(b);
+      }
+      m.max_memory_bytes = bytes;
+    } else if (key == "certify") {
+      m.polygonizer.certify = v.cast<bool>();
+    } else if (key == "certify_floor") {
+      m.polygonizer.certify_floor_fraction = number(v, "certify_floor", 0.0, 1.0, true);
     } else if (key == "progress") {
       if (!PyCallable_Check(v.ptr())) throw py::type_error("progress: expected a callable");
       o.progress = py::reinterpret_borrow<py::object>(v);
@@ -241,12 +243,10 @@ py::object reconstruct(py::handle points, py::handle normals, const py::kwargs& 
   const bool default_precision = o.precisions.empty();
   MesherOptions& m = o.mesher;
   m.polygonizer.keep_history = false;  // a batch run, as the CLI without --edits
-  if (!m.max_vertices) {
-    m.max_vertices = vertex_budget(false);
-    if (default_precision) {
-      const std::size_t by_input = kScanVerticesPerPoint * pts.size() + kScanVerticesBase;
-      m.max_vertices = m.max_vertices ? std::min(m.max_vertices, by_input) : by_input;
-    }
+  if (!m.max_memory_bytes) m.max_memory_bytes = default_memory_limit();  // the CLI's limit (docs/memory.md)
+  if (default_precision) {
+    const std::size_t by_input = scan_vertices_per_point * pts.size() + scan_vertices_base;
+    m.max_vertices = m.max_vertices ? std::min(m.max_vertices, by_input) : by_input;
   }
   const bool lenient = default_precision;
   return one_call(o, lenient, [&](Progress& progress) {
@@ -255,7 +255,7 @@ py::object reconstruct(py::handle points, py::handle normals, const py::kwargs& 
     pts = {};
     nrm = {};
     if (default_precision)
-      o.precisions.push_back(kSpacingFactor * mesher->stats().scan.resolution / mesher->diagonal());
+      o.precisions.push_back(spacing_factor * mesher->stats().scan.resolution / mesher->diagonal());
     return mesher;
   });
 }
@@ -267,13 +267,13 @@ py::object mesh_constraints(py::handle points, py::handle values, const py::kwar
   c.values = values_arg(values, "values", c.points.size());
   MesherOptions& m = o.mesher;
   m.polygonizer.keep_history = false;
-  if (!m.max_vertices) m.max_vertices = vertex_budget(false);
+  if (!m.max_memory_bytes) m.max_memory_bytes = default_memory_limit();
   return one_call(o, false, [&](Progress& progress) {
     if (o.precisions.empty()) {
       progress.phase("precision");
       Box3 box;
       for (const Point3& p : c.points) box.extend(p);
-      o.precisions.push_back(kSpacingFactor * median_spacing(c) / box.diagonal());
+      o.precisions.push_back(spacing_factor * median_spacing(c) / box.diagonal());
     }
     auto mesher = std::make_unique<Mesher>(c, o.mesher);
     c = Constraints{};
@@ -295,7 +295,7 @@ PyMesher build(const py::kwargs& kw, const char* fn, Make&& make) {
   PyMesher out;
   out.options = parse_options(kw, fn, false);
   MesherOptions& m = out.options.mesher;
-  if (!m.max_vertices) m.max_vertices = vertex_budget(true);
+  if (!m.max_memory_bytes) m.max_memory_bytes = default_memory_limit();
   Progress progress(out.options.progress);
   // The Mesher keeps a copy of its options, phase callback included: it reaches this call's Progress
   // through a slot emptied when the call ends (a later rebuild of the Mesher reports to nobody).
@@ -344,6 +344,10 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_outliers"] = s.scan.outliers;
   d["scan_resolution"] = s.scan.resolution;
   d["scan_noise"] = s.scan.noise;
+  d["scan_thinned"] = s.scan.thinned;  // points thinned to the resolution (whole scan or noisy regions)
+  d["scan_merged"] = s.scan.merged;    // points moved to the middle of misregistered layers
+  d["memory_thinned"] = s.memory_thinned;  // input points left out to fit the memory limit
+  d["uncertified"] = s.polygonizer.uncertified;  // certify: tetrahedra left uncertified (0: certified)
   d["precision"] = precision;
   d["diagonal"] = diagonal;
   return d;
@@ -388,7 +392,8 @@ points: (n, 3) float64/float32; normals: None or (n, 3). Options (the CLI's, by 
   function: 'global' | 'local' | 'auto' (default);  smoothing: local function regularization (0)
   threads: 0 = every available CPU;  surface: 'closed' | 'open' | 'auto';  viewpoint: (x, y, z)
   min_angle, max_distance, max_size: the quality mode;  offset, sides, off_surface_spacing, neighbours
-  max_vertices: LimitError beyond it
+  max_vertices: LimitError beyond it;  memory: bytes or '16G' (default: the machine's available
+    memory less a reserve, docs/memory.md);  certify, certify_floor: certified levels (docs/certificate.md)
   progress: progress(phase, vertices, queued) -> bool | None; False cancels (vitri.Cancelled)
 Raises InvalidArgument/InvalidPoint (ValueError) for bad arrays, TypeError for a wrong dtype or an
 unknown option, KeyboardInterrupt on Ctrl-C.)");
@@ -409,7 +414,7 @@ Options as reconstruct() (those of point inputs do not apply).)");
           py::arg("points"), py::arg("values"),
           "Mesher(points, values, **options): fits the function through f(points[i]) = values[i] (f < 0 "
           "inside) and tetrahedralizes the constraints. Options: function, smoothing, threads, min_angle, "
-          "max_distance, max_size, max_vertices, progress (see reconstruct). Then refine() and mesh().")
+          "max_distance, max_size, max_vertices, memory, certify, certify_floor, progress (see reconstruct). Then refine() and mesh().")
       .def_static("from_oriented_points",
                   [](py::handle points, py::handle normals, const py::kwargs& kw) {
                     std::vector<Point3> p = points_arg(points, "points"), n = points_arg(normals, "normals");

@@ -22,6 +22,9 @@ Functions:
           offset, sides, off_surface_spacing, neighbours      the normal constraints (docs/guide.md)
           surface         'closed', 'open' or 'auto' (default);   viewpoint   the sensor's (x, y, z)
           max_vertices    a limit on the Delaunay vertices (LimitError beyond it)
+          memory          bytes or '16G': the run's memory limit, checked before the large allocations
+                          (default: the machine's available memory less a reserve; docs/memory.md)
+          certify, certify_floor   certified levels (docs/certificate.md), as --certify
           progress        progress(phase: str, vertices: int, queued: int) -> bool | None; False cancels
                           (vitri.Cancelled); an exception raised there reaches the caller.
     mesh_constraints(points, values, **options) -> Mesh

@@ -53,6 +53,8 @@ def reconstruct(points: ArrayLike, normals: Optional[ArrayLike] = None, *,
                 max_size: Optional[float] = None, offset: Optional[float] = None, sides: str = "both",
                 off_surface_spacing: float = 1.0, neighbours: Optional[int] = None, surface: str = "auto",
                 viewpoint: Optional[ArrayLike] = None, max_vertices: Optional[int] = None,
+                memory: Union[int, str, None] = None, certify: bool = False,
+                certify_floor: float = 0.1,
                 progress: Optional[ProgressCallback] = None) -> Union[Mesh, List[Mesh]]:
     """A scan meshed as ``vitri mesh`` meshes a point file; a list of meshes when precision (or
     max_distance) is a sequence (levels of detail, coarse to fine)."""
@@ -60,7 +62,8 @@ def mesh_constraints(points: ArrayLike, values: ArrayLike, *,
                      precision: Union[float, Sequence[float], None] = None, function: str = "auto",
                      smoothing: float = 0.0, threads: int = 0, min_angle: Optional[float] = None,
                      max_distance: Union[float, Sequence[float], None] = None, max_size: Optional[float] = None,
-                     max_vertices: Optional[int] = None,
+                     max_vertices: Optional[int] = None, memory: Union[int, str, None] = None,
+                     certify: bool = False, certify_floor: float = 0.1,
                      progress: Optional[ProgressCallback] = None) -> Union[Mesh, List[Mesh]]:
     """The surface f = 0 of the function through f(points[i]) = values[i] (f < 0 inside)."""
 def read(path: str) -> Union[Mesh, SimpleNamespace]:

@@ -150,6 +150,33 @@ struct MesherOptions {
 /// Mesher and mesh_points() apply to the options they are given.
 MesherOptions with_threads_applied(MesherOptions options);
 
+/// The defaults of a batch run as `vitri mesh` and the Python `vitri.reconstruct` make it, written once
+/// for both (the options' own defaults above stay the library's).
+namespace run_defaults {
+/// Off-surface distance for points and meshes: 2 median spacings of the points, at most the library's
+/// 0.01 x diagonal (ConstraintBuildOptions::offset_spacings; docs/benchmarks.md "Off-surface distance").
+inline constexpr double offset_spacings = 2.0;
+/// The local function's off-surface constraints 1 off-surface distance apart
+/// (ConstraintBuildOptions::off_surface_spacing; docs/benchmarks.md "Off-surface spacing").
+inline constexpr double off_surface_spacing = 1.0;
+/// Without a precision: 2.5 x the median spacing of the surface points (constraints, meshes) or the
+/// scan's resolution (ScanReport::resolution): about as many mesh vertices as points.
+inline constexpr double spacing_factor = 2.5;
+/// A scan without a precision: at most 12 Delaunay vertices per input point plus 200,000, about 2 mesh
+/// vertices per input point (docs/scans.md "Budget"); beyond it a coarser mesh with a warning.
+inline constexpr std::size_t scan_vertices_per_point = 12;
+inline constexpr std::size_t scan_vertices_base = 200000;
+}  // namespace run_defaults
+
+/// The memory limit of a run when none is given (MesherOptions::max_memory_bytes, docs/memory.md): the
+/// machine's available memory less a reserve of max(1 GiB, 10% of the physical memory), never the
+/// machine's last gigabyte; 0 when the machine's memory is unknown (no limit).
+std::size_t default_memory_limit();
+
+/// A memory size as users write it: "16G", "512M", "2.5G", "1000000" (bytes; K, M, G, T are powers of
+/// 1024; a trailing B or iB is allowed). False for anything else or a size below 1 byte.
+bool parse_memory_size(const std::string& text, std::size_t& bytes);
+
 /// The function fitted to `constraints` constraints: `requested`, with Auto resolved to Global up to
 /// `auto_local_above` constraints and Local above. The one place where the Auto rule is written: the
 /// Mesher, Mesher::from_scan, the CLI and the studio all ask it.

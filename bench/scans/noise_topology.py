@@ -7,8 +7,8 @@ Cases (generated here, seeded, numpy only):
                          1 or 2 spacings of the clean sample; truth: chi 2, 1 component
   MODEL-n{1,2}           30,000 area-uniform samples of ../shared/data/MODEL.off, noise 1 or 2 spacings;
                          truth: the model's own chi (from its file)
-  MODEL-misreg           the same sample, 20% of it (x above the 80th percentile) duplicated by a second
-                         sample shifted 2 spacings along +x (a misregistered overlap)
+  MODEL-misreg           the same sample and a second sample of the 20% of largest x, shifted 2 spacings
+                         along +x (a misregistered overlap); MODEL-misreg-noisy: both with noise of 0.5
 For each: Euler characteristic chi = V - E + F of the output (vertices used by triangles), components,
 boundary loops, seconds. Prints a markdown table. Usage:
   python3 bench/scans/noise_topology.py [--vitri build-release/apps/vitri] [--models bunny] [--seeds 4]
@@ -100,6 +100,7 @@ def cases(models, seeds):
         for noise in (1, 2):
             out.append((f"{m}-n{noise}", m, noise, 1, chi))
         out.append((f"{m}-misreg", m, "misreg", 1, chi))
+        out.append((f"{m}-misreg-noisy", m, "misreg-noisy", 1, chi))
     return out
 
 
@@ -117,12 +118,16 @@ def generate(name, model, noise, seed, work):
         v, f = read_off(SHARED / f"{model}.off")
         p, area = area_samples(v, f, 30000, rng)
         spacing = np.sqrt(area / len(p))
-    if noise == "misreg":
+    if noise in ("misreg", "misreg-noisy"):
+        # A second view of the 20% of largest x (another sample of it), registered 2 spacings off along
+        # +x; misreg-noisy: both views with noise of half a spacing.
+        q, _ = area_samples(v, f, 30000, rng)
         cut = np.quantile(p[:, 0], 0.8)
-        extra = p[p[:, 0] > cut].copy()
-        extra += rng.normal(scale=0.05 * spacing, size=extra.shape)
+        extra = q[q[:, 0] > cut].copy()
         extra[:, 0] += 2 * spacing
         p = np.concatenate([p, extra])
+        if noise == "misreg-noisy":
+            p = p + rng.normal(scale=0.5 * spacing, size=p.shape)
     else:
         p = p + rng.normal(scale=noise * spacing, size=p.shape)
     path = work / f"{name}.xyz"

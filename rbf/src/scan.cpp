@@ -728,9 +728,13 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
 
   // Misregistered layers merged (merge_layers), before the projection smooths what is left.
   if (options.approximate) {
-    std::vector<double> shift;
-    rep.merged = merge_layers(p, n, index, nb, threads, shift);
-    for (std::size_t i = 0; i < p.size(); ++i) p[i] = p[i] + shift[i] * n[i];
+    std::vector<double> shift, total(p.size(), 0.0);
+    for (int pass = 0; pass < 2; ++pass) {
+      if (pass > 0) index = PointIndex(p, threads);
+      if (merge_layers(p, n, index, nb, threads, shift) == 0) break;
+      for (std::size_t i = 0; i < p.size(); ++i) p[i] = p[i] + shift[i] * n[i], total[i] += shift[i];
+    }
+    for (const double t : total) rep.merged += t != 0.0;
   }
 
   // Approximation: the projection onto the local quadrics of each point's own side (twice where the data

@@ -171,7 +171,7 @@ const char* eval_usage() {
          "                       least the 3 constraints made per point)\n"
          "  --seed S             seed of the subsampling (1)\n"
          "  --neighbours K       neighbours per point of a scan's noise estimate, projection and normals\n"
-         "                       (default: chosen from the data, 16 to 64)\n"
+         "                       (default: chosen from the data, 16 to 96)\n"
          "  --viewpoint X Y Z    points: the sensor's position; normals are oriented toward it (checked\n"
          "                       against the data). Default: the input's (PCD VIEWPOINT, NAME.viewpoint)\n";
 }

@@ -110,7 +110,7 @@ const char* const kUsage =
     "                       the true surface (docs/guide.md). The global function (and --function auto's choice,\n"
     "                       made on the count without it) always has them at every point.\n"
     "  --neighbours K       neighbours per point of a scan's noise estimate, projection and normals\n"
-    "                       (default: from the data, 16 to 64; at least 6)\n"
+    "                       (default: from the data, 16 to 96; at least 6)\n"
     "  --surface S          points: closed (the zero set), open (trimmed to the data: a surface with\n"
     "                       boundary where the data end) or auto (default: open when over a fifth of the\n"
     "                       closed surface's area is away from the data, e.g. a single view)\n"

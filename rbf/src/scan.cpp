@@ -426,6 +426,8 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
 /// sheet), the point moves along its normal by the mean height (to the layers' middle, weighted by
 /// their densities). Returns the number of points moved; `shift` receives each move (0 elsewhere).
 constexpr std::size_t kMergeNeighbours = 96;
+/// The widest neighbourhood the noise can ask for (ScanOptions::k = 0).
+constexpr std::size_t kMaxNeighbours = 96;
 
 std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>& n, const PointIndex& index,
                          const Neighbours& nb, unsigned threads, std::vector<double>& shift) {
@@ -561,7 +563,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     }
     const double rho = median(ratio), noise_small = median(small);
     const double want = 16.0 * (rho / 0.06) * (rho / 0.06);
-    std::size_t k2 = clamp_k(static_cast<std::size_t>(std::min(64.0, std::max(16.0, std::ceil(want)))));
+    std::size_t k2 = clamp_k(static_cast<std::size_t>(std::min(double(kMaxNeighbours), std::max(16.0, std::ceil(want)))));
     if (k2 < 48 && p.size() > 64) {
       const std::size_t k3 = clamp_k(48);
       Neighbours wide = nearest_neighbours(p, index, k3, threads);

@@ -22,7 +22,7 @@ namespace vitri {
 /// Options of prepare_scan().
 struct ScanOptions {
   /// Neighbours per point for the noise estimate, the tangent planes and the projection; 0 (default):
-  /// chosen from the data, 16 to 64, larger where the noise is large against the neighbourhood (the
+  /// chosen from the data, 16 to 96, larger where the noise is large against the neighbourhood (the
   /// neighbourhood must be several times wider than the noise to see a surface). At least 6 otherwise.
   std::size_t k = 0;
   /// Approximate instead of interpolate: every point is moved onto the weighted least-squares quadric

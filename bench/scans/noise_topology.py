@@ -9,6 +9,7 @@ Cases (generated here, seeded, numpy only):
                          truth: the model's own chi (from its file)
   MODEL-misreg           the same sample and a second sample of the 20% of largest x, shifted 2 spacings
                          along +x (a misregistered overlap); MODEL-misreg-noisy: both with noise of 0.5
+  MODEL-density10        the sample, one point in 10 kept on the half x < median (10x density change)
 For each: Euler characteristic chi = V - E + F of the output (vertices used by triangles), components,
 boundary loops, seconds. Prints a markdown table. Usage:
   python3 bench/scans/noise_topology.py [--vitri build-release/apps/vitri] [--models bunny] [--seeds 4]
@@ -101,6 +102,7 @@ def cases(models, seeds):
             out.append((f"{m}-n{noise}", m, noise, 1, chi))
         out.append((f"{m}-misreg", m, "misreg", 1, chi))
         out.append((f"{m}-misreg-noisy", m, "misreg-noisy", 1, chi))
+        out.append((f"{m}-density10", m, "density10", 1, chi))
     return out
 
 
@@ -118,7 +120,12 @@ def generate(name, model, noise, seed, work):
         v, f = read_off(SHARED / f"{model}.off")
         p, area = area_samples(v, f, 30000, rng)
         spacing = np.sqrt(area / len(p))
-    if noise in ("misreg", "misreg-noisy"):
+    if noise == "density10":
+        # Uneven density: the half x < median keeps one point in 10 (a 10x density change across a plane).
+        mid = np.median(p[:, 0])
+        keep = (p[:, 0] >= mid) | (rng.random(len(p)) < 0.1)
+        p = p[keep]
+    elif noise in ("misreg", "misreg-noisy"):
         # A second view of the 20% of largest x (another sample of it), registered 2 spacings off along
         # +x; misreg-noisy: both views with noise of half a spacing.
         q, _ = area_samples(v, f, 30000, rng)

@@ -413,6 +413,11 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   return changed;
 }
 
+/// Neighbours examined per point by merge_layers().
+constexpr std::size_t kMergeNeighbours = 96;
+/// The widest neighbourhood the noise can ask for (ScanOptions::k = 0).
+constexpr std::size_t kMaxNeighbours = 96;
+
 /// Misregistered layers: the overlap of two views registered a little apart gives two sheets of the
 /// same surface, with normals of the same sign, a few spacings apart; the offsets of one (+-D along
 /// its normal) then contradict the other's, and the interpolant folds between them (handles, blobs).
@@ -425,10 +430,6 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
 /// gap wider than h / 2 and than twice either cluster's spread (two layers, not one noisy or curved
 /// sheet), the point moves along its normal by the mean height (to the layers' middle, weighted by
 /// their densities). Returns the number of points moved; `shift` receives each move (0 elsewhere).
-constexpr std::size_t kMergeNeighbours = 96;
-/// The widest neighbourhood the noise can ask for (ScanOptions::k = 0).
-constexpr std::size_t kMaxNeighbours = 96;
-
 std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>& n, const PointIndex& index,
                          const Neighbours& nb, unsigned threads, std::vector<double>& shift) {
   shift.assign(p.size(), 0.0);
@@ -747,11 +748,12 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     std::vector<double> nearest(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) nearest[i] = nb.d(i, 0);
     const double scale = median(nearest);  // the spacing
-    // Passes per region: a point is projected again where its region's noise is large against the
-    // spacing (a second pass above 0.1 spacings, a third above 0.5), clean regions once.
+    // Passes: a second where the noise exceeds 0.1 spacings, a third above 0.5, the noise being the
+    // larger of the scan's median and the point's region's (a noisy region gets more passes than the
+    // scan as a whole, never fewer).
     auto passes_at = [&](std::size_t i) {
-      const double noise = std::max(region_noise[i], rep.noise), spacing = scale;
-      return noise > 0.5 * spacing ? 3 : noise > 0.1 * spacing ? 2 : 1;
+      const double noise = std::max(region_noise[i], rep.noise);
+      return noise > 0.5 * scale ? 3 : noise > 0.1 * scale ? 2 : 1;
     };
     int passes = 1;
     for (std::size_t i = 0; i < p.size(); ++i) passes = std::max(passes, passes_at(i));
@@ -800,10 +802,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     // Greedy in input order over each point's neighbours (the Poisson disk of radius
     // 0.5 x resolution_i is within its k nearest: resolution_i is a few spacings at most where k grew
     // with the noise); a point whose disk holds a point kept before it is left out.
-    for (std::size_t i = 0; i < p.size(); ++i) {
-      const double res = std::max(region_nn[i], 2 * region_noise[i]);
-      if (res > 1.2 * region_nn[i]) radius[i] = 0.5 * res;
-    }
+    for (std::size_t i = 0; i < p.size(); ++i)  // resolution_i = 2 x noise_i above 1.2 x spacing_i
+      if (region_noise[i] > 0.6 * region_nn[i]) radius[i] = region_noise[i];
     for (std::size_t i = 0; i < p.size(); ++i) {
       if (radius[i] == 0) continue;
       for (std::size_t c = 0; c < nb.k && kept[i]; ++c) {

@@ -11,7 +11,8 @@ Cases (generated here, seeded, numpy only):
                          along +x (a misregistered overlap); MODEL-misreg-noisy: both with noise of 0.5
   MODEL-density10        the sample, one point in 10 kept on the half x < median (10x density change)
 For each: Euler characteristic chi = V - E + F of the output (vertices used by triangles), components,
-boundary loops, seconds. Prints a markdown table. Usage:
+boundary loops, the percentage of the output's area farther than 10 median input spacings from every input
+point ("away": blobs and sheets where there is no data), seconds. Prints a markdown table. Usage:
   python3 bench/scans/noise_topology.py [--vitri build-release/apps/vitri] [--models bunny] [--seeds 4]
 """
 import argparse
@@ -90,6 +91,22 @@ def area_samples(v, f, n, rng):
     return (1 - s)[:, None] * a[tri] + (s * (1 - r2))[:, None] * b[tri] + (s * r2)[:, None] * c[tri], area.sum()
 
 
+def away_fraction(v, f, points, rng, spacings=10.0, n=20000):
+    """Fraction of the output's area farther than `spacings` median input spacings from every input point
+    (issue 38's measure of blobs and sheets away from the data). Uses Open3D's k-d tree."""
+    import open3d as o3d
+    points = np.ascontiguousarray(points, dtype=float)
+    cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
+    tree = o3d.geometry.KDTreeFlann(cloud)
+    def nearest(q):
+        return np.sqrt(tree.search_knn_vector_3d(np.array(q, dtype=float), 2)[2][-1])
+    step = np.median([nearest(points[i]) for i in rng.choice(len(points), size=min(2000, len(points)),
+                                                                  replace=False)])
+    s, _ = area_samples(v, f, n, rng)
+    d = np.array([np.sqrt(tree.search_knn_vector_3d(np.array(q, dtype=float), 1)[2][0]) for q in s])
+    return float(np.mean(d > spacings * step))
+
+
 def cases(models, seeds):
     out = []
     for noise in (1, 2):
@@ -154,8 +171,8 @@ def main():
     work = Path(a.work)
     work.mkdir(parents=True, exist_ok=True)
     models = [m for m in a.models.split(",") if m]
-    print("| case | truth chi | chi | components | loops | noise line | s |")
-    print("|---|---|---|---|---|---|---|")
+    print("| case | truth chi | chi | components | loops | away % | noise line | s |")
+    print("|---|---|---|---|---|---|---|---|")
     for name, model, noise, seed, truth in cases(models, a.seeds):
         if a.only and not any(name.startswith(x) for x in a.only.split(",")):
             continue
@@ -170,9 +187,11 @@ def main():
         if r.returncode != 0:
             print(f"| {name} | {truth} | exit {r.returncode} | | | {r.stderr.strip()[-120:]} | {dt:.1f} |")
             continue
-        _, f = read_obj(obj)
+        v, f = read_obj(obj)
         chi, comps, loops = topology(f)
-        print(f"| {name} | {truth} | {chi} | {comps} | {loops} | {noise_part} | {dt:.1f} |", flush=True)
+        away = 100 * away_fraction(v, f, np.loadtxt(xyz)[:, :3], np.random.default_rng(7))
+        print(f"| {name} | {truth} | {chi} | {comps} | {loops} | {away:.1f} | {noise_part} | {dt:.1f} |",
+              flush=True)
 
 
 if __name__ == "__main__":

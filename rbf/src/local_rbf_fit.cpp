@@ -234,16 +234,54 @@ void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s, std::uint32_t ball
     s.values.push_back(slot_value[id]);
   }
   const double inv = 1.0 / cell.radius;
+  cell.far_settled = false;
   if (far) {
     fit_linear_patch(cell.center, inv, s.points, s.values, cell.coef);
     cell.terms = 0;
+    if (opt.far_side) settle_far_patch(cell, s.d2.empty() ? cell.radius : std::sqrt(s.d2.front()));
     return;
   }
-  if (!fit_rbf_patch(cell.center, inv, s.points, s.values, opt.smoothing, cell.coef, s.patch))
-    throw NumericalError("local RBF: the patch at " + format_point(cell.center) + " (radius " +
-                         std::to_string(cell.radius) + ", " + std::to_string(s.points.size()) +
-                         " constraints) has no positive definite system: near-duplicate constraints?");
-  cell.terms = static_cast<std::uint32_t>(s.points.size());
+  auto fit_patch = [&] {
+    if (!fit_rbf_patch(cell.center, inv, s.points, s.values, opt.smoothing, cell.coef, s.patch))
+      throw NumericalError("local RBF: the patch at " + format_point(cell.center) + " (radius " +
+                           std::to_string(cell.radius) + ", " + std::to_string(s.points.size()) +
+                           " constraints) has no positive definite system: near-duplicate constraints?");
+    cell.terms = static_cast<std::uint32_t>(s.points.size());
+  };
+  fit_patch();
+  // A patch whose centre lies in empty space, at least half its radius from every constraint (beside a
+  // thin part, at the edge of the data), extrapolates its constraints' values over that space as a far
+  // patch does: where its value at the centre disagrees with far_side's answer there, it is fitted again
+  // with one more point, its centre, at the answer x the distance to the nearest constraint (it still
+  // interpolates its constraints).
+  if (opt.far_side) {
+    double nearest2 = std::numeric_limits<double>::infinity();
+    for (const Point3& q : s.points) nearest2 = std::min(nearest2, squared_norm(q - cell.center));
+    if (nearest2 > 0.25 * r2) {
+      const int side = opt.far_side(cell.center);
+      if (side != 0 && side * patch_value(cell.coef.data(), cell.terms, Point3{0, 0, 0}, nullptr) < 0) {
+        s.points.push_back(cell.center);
+        s.values.push_back(side * std::sqrt(nearest2));
+        fit_patch();
+        cell.far_settled = true;
+      }
+    }
+  }
+}
+
+// The plane a0 + a . u (u = (x - centre) / R) takes, over the support |u| < 1, values down to a0 - |a| and
+// up to a0 + |a|: it keeps the far side's answer everywhere there when side x a0 - |a| >= 0. Otherwise
+// the patch becomes the constant answer x the distance to the nearest constraint (an estimate of the
+// distance to the surface, of the off-surface values' scale).
+void LocalRbf::Impl::settle_far_patch(Cell& cell, double nearest) const {
+  const int side = opt.far_side(cell.center);
+  if (side == 0) return;
+  const double a0 = cell.coef[0];
+  const double slope = std::sqrt(cell.coef[1] * cell.coef[1] + cell.coef[2] * cell.coef[2] +
+                                 cell.coef[3] * cell.coef[3]);
+  if (side * a0 - slope >= 0) return;
+  cell.coef = {side * nearest, 0.0, 0.0, 0.0};
+  cell.far_settled = true;
 }
 
 void LocalRbf::Impl::fit_leaves(const std::vector<std::uint32_t>& leaves,
@@ -265,6 +303,7 @@ void LocalRbf::Impl::fill_report() {
     ++report.patches;
     report.depth = std::max(report.depth, cell.depth);
     if (cell.terms == 0) ++report.far_patches;
+    if (cell.far_settled) ++report.far_settled;
     else ++rbf_patches;
     fitted_terms += cell.terms;
     report.max_fitted = std::max<std::size_t>(report.max_fitted, cell.terms);

@@ -94,6 +94,9 @@ struct LocalRbf::Impl {
   /// A ball count of kUnknownCount: fit_leaf finds the fit set without it (one more query for dense balls).
   static constexpr std::uint32_t kUnknownCount = 0xffffffffu;
   void fit_leaf(std::uint32_t c, local_detail::FitScratch& s, std::uint32_t ball_count = kUnknownCount);
+  /// A far patch (fitted as a plane) against LocalRbfOptions::far_side: made constant where the plane
+  /// disagrees with it inside the support. `nearest`: distance from the centre to the nearest constraint.
+  void settle_far_patch(local_detail::Cell& cell, double nearest) const;
   /// Fits `leaves`; `ball_counts`, when given, holds each cell's ball count (refine_levels').
   void fit_leaves(const std::vector<std::uint32_t>& leaves, const std::vector<std::uint32_t>* ball_counts = nullptr);
   /// `created`: the new leaves; `every_leaf`: they are all the tree's leaves (a full fit).

@@ -44,6 +44,7 @@ struct Cell {
   std::uint32_t first_child = kNone;
   int depth = 0;
   bool alive = false;
+  bool far_settled = false;  ///< a far patch made constant by LocalRbfOptions::far_side
   // The patch of a leaf.
   double radius = 0;      ///< support radius R
   double fit_r2 = 0;      ///< an edit at q touches the patch iff |q - center|^2 <= fit_r2

@@ -378,3 +378,40 @@ TEST_CASE("an open scan gives a closed mesh, closed by the domain box", "[mesher
     REQUIRE(test::metrics_of(open.surface()).boundary_edges > 0);
   }
 }
+
+// The scan path's far field (docs/scans.md, "Far from the data"): a scan of an object gets the winding
+// number's answers for the local function's far patches, a single view does not (its far field lies behind
+// it and is trimmed with the open surface).
+TEST_CASE("prepare_scan_fit: the winding number's far side for objects, not for single views", "[mesher][scan]") {
+  std::vector<Point3> sphere, sphere_n, cap, cap_n;
+  const int n = 6000;
+  for (int i = 0; i < n; ++i) {
+    const double z = 1 - (2 * i + 1.0) / n, r = std::sqrt(1 - z * z), phi = i * 3.14159265358979 * (3 - std::sqrt(5.0));
+    const Point3 u{r * std::cos(phi), r * std::sin(phi), z};
+    sphere.push_back(u);
+    sphere_n.push_back(u);
+    if (z > 0.3) {
+      cap.push_back(u);
+      cap_n.push_back(u);
+    }
+  }
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  o.constraint_build.offset_spacings = 2;
+  o.polygonizer.threads = 2;
+  const ScanFit object = prepare_scan_fit(sphere, sphere_n, o);
+  CHECK(object.far_jump > 0.5);
+  CHECK(std::abs(object.far_level / object.far_jump - 0.5) < 0.1);
+  REQUIRE(object.options.local.far_side);
+  CHECK(object.options.local.far_side(Point3{0, 0, 0}) == -1);
+  CHECK(object.options.local.far_side(Point3{3, 0, 0}) == 1);
+  const ScanFit view = prepare_scan_fit(cap, cap_n, o);
+  CHECK(view.far_level < 0.35 * view.far_jump);
+  CHECK(!view.options.local.far_side);
+  // The global function has no far patches: nothing set.
+  o.function = FunctionKind::Global;
+  const ScanFit global = prepare_scan_fit(std::vector<Point3>(sphere.begin(), sphere.begin() + 800),
+                                          std::vector<Point3>(sphere_n.begin(), sphere_n.begin() + 800), o);
+  CHECK(!global.options.local.far_side);
+  CHECK(global.far_jump == 0);
+}

@@ -257,6 +257,9 @@ struct ScanFit {
   /// Under MesherOptions::max_memory_bytes: every memory_stride-th input point kept, memory_thinned left out.
   std::size_t memory_stride = 1;
   std::size_t memory_thinned = 0;
+  /// The winding number's calibration for the local function's far patches (WindingSides: level and
+  /// jump; both 0 when not set, e.g. with the global function).
+  double far_level = 0, far_jump = 0;
 };
 
 /// prepare_scan() with options.scan (its threads from options.polygonizer's when 0), then the normal

@@ -21,6 +21,7 @@
 #include "vitri/rbf/rbf.hpp"
 
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <vector>
 
@@ -56,6 +57,16 @@ struct LocalRbfOptions {
   double duplicate_tolerance = 1e-6;
   /// Deepest octree level (root 0). Cells at this level are never split, whatever their count.
   int max_depth = 20;
+  /// Inside or outside away from the constraints, for the *far* patches (no constraint in their support;
+  /// each is a least-squares plane through the nearest constraints' values). When set, it is asked at
+  /// every far patch's centre and answers -1 (inside), +1 (outside) or 0 (no opinion); a far patch whose
+  /// plane takes the other sign somewhere in its support becomes the constant answer x the distance from
+  /// its centre to the nearest constraint. Without it (empty, the default) the planes extrapolate the
+  /// nearest off-surface values: where those are inconsistent (a noisy thin part, a misregistered
+  /// overlap) the zero set crosses far patches and the function gets sheets and blobs far from the data.
+  /// Mesher::from_scan sets it from the scan's winding number (vitri::WindingNumber, docs/scans.md).
+  /// Called from the fit's threads (it must be thread-safe), and by edits for the patches they refit.
+  std::function<int(const Point3&)> far_side;
   /// Threads of the fit (over patches) and of the batch evaluation: 0 = every available CPU
   /// (vitri::available_cpus).
   unsigned threads = 0;
@@ -66,6 +77,7 @@ struct LocalFitReport {
   std::size_t constraints = 0;    ///< N
   std::size_t patches = 0;        ///< leaf cells (one patch each)
   std::size_t far_patches = 0;    ///< of which patches with no constraint in their support (linear)
+  std::size_t far_settled = 0;    ///< of which made constant by LocalRbfOptions::far_side
   std::size_t max_fitted = 0;     ///< largest number of constraints fitted by one patch
   double mean_fitted = 0;         ///< mean number of constraints fitted by an RBF patch
   int depth = 0;                  ///< deepest leaf level

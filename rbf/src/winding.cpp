@@ -1,5 +1,5 @@
-// vitri::WindingNumber: the octree (built by splitting index ranges at the node's centre, octant by
-// octant) and the Barnes-Hut evaluation.
+// vitri::WindingNumber: the octree (each node's range split by octant around its box's centre, a counting
+// sort) and the Barnes-Hut evaluation; WindingSides, its calibration on the samples.
 #include "vitri/rbf/winding.hpp"
 
 #include "vitri/core/box.hpp"
@@ -7,7 +7,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 
 namespace vitri {
 
@@ -71,30 +70,33 @@ void WindingNumber::build(std::uint32_t node, int depth) {
   nodes_[node].child = 0;
   nodes_[node].children = 0;
   if (count <= kLeafSize || depth >= kMaxDepth || !(box.diagonal() > 0)) return;
-  // The permutation moves the three per-sample arrays together: sort an index range, then apply it.
+  // A counting sort by octant moves the three per-sample arrays together (stable: the input order is
+  // kept within an octant, so the tree does not depend on anything but the input).
   const Point3 mid = (box.lo + box.hi) * 0.5;
-  std::vector<std::uint32_t> order(count);
-  std::iota(order.begin(), order.end(), first);
-  auto octant = [&](std::uint32_t i) {
-    return (points_[i].x >= mid.x ? 1 : 0) | (points_[i].y >= mid.y ? 2 : 0) | (points_[i].z >= mid.z ? 4 : 0);
-  };
-  std::stable_sort(order.begin(), order.end(), [&](std::uint32_t a, std::uint32_t b) { return octant(a) < octant(b); });
+  std::vector<std::uint8_t> octant(count);
+  std::uint32_t starts[9] = {0};
+  for (std::uint32_t k = 0; k < count; ++k) {
+    const Point3& q = points_[first + k];
+    octant[k] = static_cast<std::uint8_t>((q.x >= mid.x ? 1 : 0) | (q.y >= mid.y ? 2 : 0) | (q.z >= mid.z ? 4 : 0));
+    ++starts[octant[k] + 1];
+  }
+  for (int k = 0; k < 8; ++k) starts[k + 1] += starts[k];
   {
+    std::uint32_t at[8];
+    std::copy(starts, starts + 8, at);
     std::vector<Point3> p(count), w(count);
     std::vector<double> a(count);
     for (std::uint32_t k = 0; k < count; ++k) {
-      p[k] = points_[order[k]];
-      w[k] = weighted_[order[k]];
-      a[k] = areas_[order[k]];
+      const std::uint32_t to = at[octant[k]]++;
+      p[to] = points_[first + k];
+      w[to] = weighted_[first + k];
+      a[to] = areas_[first + k];
     }
     std::copy(p.begin(), p.end(), points_.begin() + first);
     std::copy(w.begin(), w.end(), weighted_.begin() + first);
     std::copy(a.begin(), a.end(), areas_.begin() + first);
   }
   // Children: one node per non-empty octant, contiguous.
-  std::uint32_t starts[9] = {0};
-  for (std::uint32_t i = first; i < first + count; ++i) ++starts[octant(i) + 1];
-  for (int k = 0; k < 8; ++k) starts[k + 1] += starts[k];
   const auto child = static_cast<std::uint32_t>(nodes_.size());
   std::uint32_t made = 0;
   for (int k = 0; k < 8; ++k) {

@@ -16,9 +16,11 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -294,23 +296,57 @@ void refine_within_budget(Mesher& mesher, double precision, bool lenient, bool q
   }
 }
 
-}  // namespace
+// `vitri mesh` runs in three stages, each handing the next a named struct: parse (the arguments,
+// checked, into a MeshCommand: nothing read yet), plan (the options resolved, the input read, the
+// function fitted and the levels decided: a MeshPlan) and run (the levels refined and written, the
+// edits replayed). run_mesh() calls them in turn.
 
-const char* mesh_usage() { return kUsage; }
-
-int run_mesh(const Args& args) {
-  std::string input, output, edits;
+/// What the user asked of `vitri mesh`: the arguments as given and checked, before any file is read.
+struct MeshCommand {
+  std::string input;   ///< INPUT
+  std::string output;  ///< -o OUT (.obj, .ply or .off)
+  std::string edits;   ///< --edits SCRIPT; empty: no script
+  /// --precision per level, relative to the diagonal, strictly decreasing; empty: the data's resolution.
   std::vector<double> precisions;
-  std::vector<double> distances;  // quality mode: --max-distance per level (relative)
-  double relative_size = std::numeric_limits<double>::infinity();  // quality mode: --max-size
-  bool quiet = false;
-  bool surface_given = false;  // --surface
-  bool viewpoint_given = false;  // --viewpoint
-  bool smoothing_given = false;  // --smoothing
-  PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  // --ascii: text
-  unsigned threads = 0;  // --threads: 0 = every available CPU
-  std::size_t memory = 0;  // --memory: 0 = the default limit
+  /// Quality mode: --max-distance per level, relative to the diagonal, strictly decreasing.
+  std::vector<double> distances;
+  double relative_size = std::numeric_limits<double>::infinity();  ///< quality mode: --max-size (relative)
+  bool quiet = false;            ///< -q: no table, no progress
+  bool surface_given = false;    ///< --surface (warned about when the input is no scan)
+  bool viewpoint_given = false;  ///< --viewpoint (the viewpoint line says where the viewpoint came from)
+  bool smoothing_given = false;  ///< --smoothing (else a mesh meshed as a scan is interpolated)
+  PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  ///< --ascii: text
+  unsigned threads = 0;    ///< --threads: 0 = every available CPU
+  std::size_t memory = 0;  ///< --memory: 0 = the default limit
+  /// The CLI's defaults and what the flags set over them (quality mode, off-surface constraints, scan,
+  /// surface, function, smoothing, certificate). Threads, memory and history are the plan's to resolve.
   MesherOptions options;
+};
+
+/// The checks that need every argument: input and output given, levels from coarse to fine, an output
+/// format we write. Returns the usage error, or an empty string.
+std::string check_mesh_command(const MeshCommand& c) {
+  if (c.input.empty()) return "no input file";
+  if (c.output.empty()) return "no output file (-o OUT.obj)";
+  for (const auto* list : {&c.precisions, &c.distances})
+    for (std::size_t k = 1; k < list->size(); ++k)
+      if (!((*list)[k] < (*list)[k - 1])) {
+        std::ostringstream what;
+        what << (list == &c.precisions ? "--precision" : "--max-distance")
+             << " values must go from coarse to fine (strictly decreasing): level " << k - 1 << " is "
+             << (*list)[k - 1] << ", level " << k << " is " << (*list)[k];
+        return what.str();
+      }
+  const std::string ext = file_extension(c.output);
+  if (ext != "obj" && ext != "ply" && ext != "off")
+    return "output must end in .obj, .ply or .off, got '" + c.output + "'";
+  return {};
+}
+
+/// Stage 1, parse: the arguments of `vitri mesh` into `c` (as cmd_studio's parse_args). Returns the
+/// usage error (the first one met, for run_mesh to print with exit status 2), or an empty string.
+std::string parse_mesh_args(const Args& args, MeshCommand& c) {
+  MesherOptions& options = c.options;
   options.function = FunctionKind::Auto;
   options.constraint_build.offset_spacings = kOffsetSpacings;
   options.constraint_build.off_surface_spacing = kOffSurfaceSpacing;  // with the local function only
@@ -323,389 +359,473 @@ int run_mesh(const Args& args) {
     };
     std::string v;
     if (a == "-o" || a == "--output") {
-      if (!value(output)) return usage_error("-o needs a path");
+      if (!value(c.output)) return "-o needs a path";
     } else if (a == "--precision") {
       double p;
-      if (!value(v) || !parse_double(v, p)) return usage_error("--precision needs a number");
-      if (!(p > 0.0) || !std::isfinite(p)) return usage_error("--precision must be positive and finite, got " + v);
-      precisions.push_back(p);
+      if (!value(v) || !parse_double(v, p)) return "--precision needs a number";
+      if (!(p > 0.0) || !std::isfinite(p)) return "--precision must be positive and finite, got " + v;
+      c.precisions.push_back(p);
     } else if (a == "--min-angle") {
       double d;
       if (!value(v) || !parse_double(v, d) || !(d >= 0.0 && d <= 30.0))
-        return usage_error("--min-angle needs a number of degrees in [0, 30]");
+        return "--min-angle needs a number of degrees in [0, 30]";
       options.mode = MeshMode::Quality;
       options.quality.min_angle_degrees = d;
     } else if (a == "--max-distance" || a == "--max-size") {
       double d;
       if (!value(v) || !parse_double(v, d) || !(d > 0.0) || !std::isfinite(d))
-        return usage_error(a + " needs a positive number");
+        return a + " needs a positive number";
       options.mode = MeshMode::Quality;
-      if (a == "--max-size") relative_size = d;
-      else distances.push_back(d);
+      if (a == "--max-size") c.relative_size = d;
+      else c.distances.push_back(d);
     } else if (a == "--edits") {
-      if (!value(edits)) return usage_error("--edits needs a path");
+      if (!value(c.edits)) return "--edits needs a path";
     } else if (a == "--offset") {
       double d;
       if (!value(v) || !parse_double(v, d) || !(d > 0.0) || !std::isfinite(d))
-        return usage_error("--offset needs a positive number");
+        return "--offset needs a positive number";
       options.constraint_build.offset = d;
       options.constraint_build.offset_spacings = 0.0;
     } else if (a == "--sides") {
-      if (!value(v)) return usage_error("--sides needs both, inside or outside");
+      if (!value(v)) return "--sides needs both, inside or outside";
       if (v == "both") options.constraint_build.sides = OffSurface::Both;
       else if (v == "inside") options.constraint_build.sides = OffSurface::Inside;
       else if (v == "outside") options.constraint_build.sides = OffSurface::Outside;
-      else return usage_error("--sides must be both, inside or outside, got '" + v + "'");
+      else return "--sides must be both, inside or outside, got '" + v + "'";
     } else if (a == "--off-surface-spacing") {
       double sp;
       if (!value(v) || !parse_double(v, sp) || !(sp >= 0.0) || !std::isfinite(sp))
-        return usage_error("--off-surface-spacing needs a number >= 0");
+        return "--off-surface-spacing needs a number >= 0";
       options.constraint_build.off_surface_spacing = sp;
     } else if (a == "--neighbours") {
       std::size_t k = 0;
-      if (!value(v) || !parse_index(v, k) || k < 6) return usage_error("--neighbours needs an integer >= 6");
+      if (!value(v) || !parse_index(v, k) || k < 6) return "--neighbours needs an integer >= 6";
       options.constraint_build.normals.k = k;
       options.scan.k = k;
     } else if (a == "--surface") {
-      if (!value(v)) return usage_error("--surface needs closed, open or auto");
+      if (!value(v)) return "--surface needs closed, open or auto";
       if (v == "closed") options.surface = SurfaceKind::Closed;
       else if (v == "open") options.surface = SurfaceKind::Open;
       else if (v == "auto") options.surface = SurfaceKind::Auto;
-      else return usage_error("--surface must be closed, open or auto, got '" + v + "'");
-      surface_given = true;
+      else return "--surface must be closed, open or auto, got '" + v + "'";
+      c.surface_given = true;
     } else if (a == "--viewpoint") {
       double xyz[3];
-      for (double& c : xyz) {
+      for (double& x : xyz) {
         std::string w;
-        if (!value(w) || !parse_double(w, c) || !std::isfinite(c))
-          return usage_error("--viewpoint needs three finite numbers X Y Z");
+        if (!value(w) || !parse_double(w, x) || !std::isfinite(x))
+          return "--viewpoint needs three finite numbers X Y Z";
       }
       options.scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
-      viewpoint_given = true;
+      c.viewpoint_given = true;
     } else if (a == "--function") {
-      if (!value(v)) return usage_error("--function needs global, local or auto");
+      if (!value(v)) return "--function needs global, local or auto";
       if (v == "global") options.function = FunctionKind::Global;
       else if (v == "local") options.function = FunctionKind::Local;
       else if (v == "auto") options.function = FunctionKind::Auto;
-      else return usage_error("--function must be global, local or auto, got '" + v + "'");
+      else return "--function must be global, local or auto, got '" + v + "'";
     } else if (a == "--smoothing") {
       double sm;
       if (!value(v) || !parse_double(v, sm) || !(sm >= 0.0) || !std::isfinite(sm))
-        return usage_error("--smoothing needs a number >= 0");
+        return "--smoothing needs a number >= 0";
       options.local.smoothing = sm;
-      smoothing_given = true;
+      c.smoothing_given = true;
       options.scan.approximate = sm > 0.0;  // 0: interpolate the points as they are
     } else if (a == "--threads") {
       std::size_t k = 0;
       if (!value(v) || !parse_index(v, k) || k > kMaxThreads)
-        return usage_error("--threads needs an integer from 0 (every available CPU) to " +
-                           std::to_string(kMaxThreads));
-      threads = unsigned(k);
+        return "--threads needs an integer from 0 (every available CPU) to " + std::to_string(kMaxThreads);
+      c.threads = unsigned(k);
     } else if (a == "--certify") {
       options.polygonizer.certify = true;
     } else if (a == "--certify-floor") {
       double fl;
       if (!value(v) || !parse_double(v, fl) || !(fl > 0.0 && fl <= 1.0))
-        return usage_error("--certify-floor needs a fraction of the precision in (0, 1]");
+        return "--certify-floor needs a fraction of the precision in (0, 1]";
       options.polygonizer.certify_floor_fraction = fl;
     } else if (a == "--memory") {
-      if (!value(v) || !parse_memory_size(v, memory))
-        return usage_error("--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'");
+      if (!value(v) || !parse_memory_size(v, c.memory))
+        return "--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'";
     } else if (a == "-q" || a == "--quiet") {
-      quiet = true;
+      c.quiet = true;
     } else if (a == "--ascii") {
-      ply = PlyEncoding::Ascii;
+      c.ply = PlyEncoding::Ascii;
     } else if (!a.empty() && a[0] == '-') {
-      return usage_error("unknown option '" + a + "'");
-    } else if (input.empty()) {
-      input = a;
+      return "unknown option '" + a + "'";
+    } else if (c.input.empty()) {
+      c.input = a;
     } else {
-      return usage_error("more than one input ('" + input + "', '" + a + "')");
+      return "more than one input ('" + c.input + "', '" + a + "')";
     }
   }
-  if (input.empty()) return usage_error("no input file");
-  if (output.empty()) return usage_error("no output file (-o OUT.obj)");
-  for (const auto* list : {&precisions, &distances})
-    for (std::size_t k = 1; k < list->size(); ++k)
-      if (!((*list)[k] < (*list)[k - 1])) {
-        std::ostringstream what;
-        what << (list == &precisions ? "--precision" : "--max-distance")
-             << " values must go from coarse to fine (strictly decreasing): level " << k - 1 << " is "
-             << (*list)[k - 1] << ", level " << k << " is " << (*list)[k];
-        return usage_error(what.str());
-      }
-  const bool default_precision = precisions.empty();
-  const std::string ext = file_extension(output);
-  if (ext != "obj" && ext != "ply" && ext != "off")
-    return usage_error("output must end in .obj, .ply or .off, got '" + output + "'");
-  // Read the edit script up front so that a bad script fails before the long work.
-  std::vector<std::string> script;
-  if (!edits.empty()) {
-    std::ifstream in(edits);
-    if (!in) throw ParseError(edits, 0, "cannot open file");
-    for (std::string line; std::getline(in, line);) script.push_back(line);
-  }
+  return check_mesh_command(c);
+}
 
-  PhaseTimes phases(quiet);
-  // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
-  // memory (docs/mesher.md "Batch runs and memory").
-  options.polygonizer.keep_history = !script.empty();
-  // Then the seeds go in on `threads` cores: the same mesh, bit for bit, as one thread (canonical ids).
-  // The fit, the constraints' construction and the normals give the same result on any thread count.
-  options.threads = threads;
-  options = with_threads_applied(options);  // the constraints are built here, before the Mesher
-  // The memory limit (docs/memory.md), checked from the input's size before the large allocations: a
-  // scan thinned to what fits, the refinement bounded by what the rest holds (a precision far below the
-  // data's spacing: a LimitError naming the count instead of an out-of-memory end).
-  options.max_memory_bytes = memory ? memory : default_memory_limit();
-  phases.start("read", "reading " + input);
-  Input data = read_input(input);
-  // A mesh that bounds no volume (a hole, an open sheet, flipped or non-manifold triangles) has no inside
-  // to interpolate: its surface goes through the scan path as points instead of being refused (docs/guide.md).
-  if (data.kind == InputKind::Mesh) {
-    MeshDefects defects;
-    try {
-      defects = mesh_defects(data.mesh.V, data.mesh.F);
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(input + ": " + e.what());
-    }
-    if (!defects.closed()) {
-      MeshSamples samples = mesh_surface_samples(data.mesh.V, data.mesh.F);
-      std::fprintf(stderr,
-                   "vitri mesh: warning: %s: %zu boundary edges, %zu edges repeated in one direction: not a closed "
-                   "mesh; its surface is meshed as a scan of %zu points%s (docs/scans.md)\n",
-                   input.c_str(), defects.boundary_edges, defects.repeated_edges, samples.points.size(),
-                   samples.normals.empty() ? " without normals (not consistently oriented)" : " with its normals");
-      data.kind = samples.normals.empty() ? InputKind::Points : InputKind::OrientedPoints;
-      data.points.points = std::move(samples.points);
-      data.points.normals = std::move(samples.normals);
-      data.mesh = TriangleMesh{};
-      // A model's surface is exact: interpolated as it is (no projection, no outlier) unless --smoothing
-      // asks for an approximation.
-      if (!smoothing_given) options.scan.approximate = false;
-      options.scan.remove_outliers = false;
-    }
+/// The lines of the edit script at `path` (none when `path` is empty).
+/// @throws ParseError when the file cannot be opened.
+std::vector<std::string> read_edit_script(const std::string& path) {
+  std::vector<std::string> script;
+  if (path.empty()) return script;
+  std::ifstream in(path);
+  if (!in) throw ParseError(path, 0, "cannot open file");
+  for (std::string line; std::getline(in, line);) script.push_back(line);
+  return script;
+}
+
+/// One level of detail of the plan.
+struct MeshLevel {
+  double precision = 0;  ///< relative to the diagonal (the table's column)
+  /// Quality mode: the level's --max-distance, relative to the diagonal; none: QualityOptions' default.
+  std::optional<double> max_distance;
+  std::string path;  ///< where the level's mesh is written
+};
+
+/// What `vitri mesh` runs: the options resolved from the command and the input, the fitted Mesher, the
+/// levels and the edits.
+struct MeshPlan {
+  /// The command's options with what the plan resolved: threads, memory limit, history (kept for an
+  /// edit script only), the function (auto resolved on the constraints' count), a scan's viewpoint and
+  /// vertex budget, a mesh meshed as a scan interpolated.
+  MesherOptions options;
+  bool scan_input = false;         ///< the input went through the scan path (docs/scans.md)
+  std::size_t input_points = 0;    ///< a scan's points as read (the memory warning counts against them)
+  /// No --precision: the levels use the data's resolution, and the refinement's vertex budget gives a
+  /// coarser mesh with a warning instead of an error.
+  bool default_precision = false;
+  /// The fitted function and its initial tetrahedralization, ready to refine. The fit belongs to the
+  /// plan: a scan's default precision is the resolution its preparation measured.
+  std::unique_ptr<Mesher> mesher;
+  double diagonal = 0;             ///< mesher->diagonal(): the unit of the relative sizes
+  std::vector<MeshLevel> levels;   ///< coarse to fine, each continuing the previous one
+  std::vector<std::string> script; ///< the --edits script's lines, replayed after the last level
+};
+
+/// A mesh that bounds no volume (a hole, an open sheet, flipped or non-manifold triangles) has no inside
+/// to interpolate: its surface goes through the scan path as points instead of being refused
+/// (docs/guide.md). Such a mesh in `data` becomes those points, with a warning; any other input is left.
+void open_mesh_as_points(Input& data, const MeshCommand& c, MesherOptions& options) {
+  if (data.kind != InputKind::Mesh) return;
+  MeshDefects defects;
+  try {
+    defects = mesh_defects(data.mesh.V, data.mesh.F);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(c.input + ": " + e.what());
   }
-  // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
-  // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
-  const bool scan_input = is_scan(data);
-  if (surface_given && !scan_input && options.surface != SurfaceKind::Closed)
-    std::fprintf(stderr, "vitri mesh: warning: --surface applies to point inputs; %s gives a closed surface\n",
-                 input.c_str());
-  std::size_t input_points = 0;
-  std::size_t announced_constraints = 0;
-  options.on_phase = [&](const char* phase) {
+  if (defects.closed()) return;
+  MeshSamples samples = mesh_surface_samples(data.mesh.V, data.mesh.F);
+  std::fprintf(stderr,
+               "vitri mesh: warning: %s: %zu boundary edges, %zu edges repeated in one direction: not a closed "
+               "mesh; its surface is meshed as a scan of %zu points%s (docs/scans.md)\n",
+               c.input.c_str(), defects.boundary_edges, defects.repeated_edges, samples.points.size(),
+               samples.normals.empty() ? " without normals (not consistently oriented)" : " with its normals");
+  data.kind = samples.normals.empty() ? InputKind::Points : InputKind::OrientedPoints;
+  data.points.points = std::move(samples.points);
+  data.points.normals = std::move(samples.normals);
+  data.mesh = TriangleMesh{};
+  // A model's surface is exact: interpolated as it is (no projection, no outlier) unless --smoothing
+  // asks for an approximation.
+  if (!c.smoothing_given) options.scan.approximate = false;
+  options.scan.remove_outliers = false;
+}
+
+/// MesherOptions::on_phase of the run: every phase announced as it starts; the fit with its count of
+/// `constraints` from kFitProgressConstraints on (a scan's count is not known before: 0).
+std::function<void(const char*)> phase_announcer(PhaseTimes& phases, std::size_t constraints, bool scan) {
+  return [&phases, constraints, scan](const char* phase) {
     const std::string name = phase;
     if (name != "fit" && name != "fit+seeds") return phases.start(name);
     const std::string beside = name == "fit" ? "" : ", their Delaunay tetrahedralization beside it";
-    phases.start(name, announced_constraints >= kFitProgressConstraints
-                           ? "fitting the implicit function to " + std::to_string(announced_constraints) +
-                                 " constraints" + beside
-                           : scan_input ? "fitting the implicit function" + beside : name);
+    phases.start(name, constraints >= kFitProgressConstraints
+                           ? "fitting the implicit function to " + std::to_string(constraints) + " constraints" +
+                                 beside
+                           : scan ? "fitting the implicit function" + beside : name);
   };
-  std::unique_ptr<Mesher> built;
-  if (scan_input) {
-    input_points = data.points.points.size();
-    // The default budget follows the input (docs/scans.md): a coarser mesh with a warning beyond it.
-    if (default_precision) {
-      const std::size_t by_input = kScanVerticesPerPoint * input_points + kScanVerticesBase;
-      options.max_vertices = options.max_vertices ? std::min(options.max_vertices, by_input) : by_input;
-    }
-    phases.start("scan", "preparing " + std::to_string(input_points) + " scanned points");
-    ScanFit fit = scan_of(data, input, options);
-    options.scan.viewpoint = fit.options.scan.viewpoint;
-    if (!quiet && options.scan.viewpoint)
-      std::fprintf(stderr, "%s\n", viewpoint_line(options.scan, viewpoint_given).c_str());
-    built = std::make_unique<Mesher>(Mesher::from_scan(std::move(fit)));
-    data = Input{};
-  } else {
-    phases.start("constraints");
-    ConstraintBuildReport merged;
-    Constraints constraints = constraints_for_function(std::move(data), input, options.constraint_build,
-                                                       options.function, options.auto_local_above, merged);
-    if (!quiet) print_build_report(merged, options.constraint_build);
-    if (default_precision) {
-      // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
-      phases.start("precision", "median spacing");
-      Box3 box;
-      for (const Point3& p : constraints.points) box.extend(p);
-      // Measured already when the builder's off-surface distance followed the data (the same estimate).
-      const double spacing = merged.median_spacing > 0 ? merged.median_spacing : median_spacing(constraints);
-      precisions.push_back(kSpacingFactor * spacing / box.diagonal());
-      if (!quiet) std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", precisions[0]);
-    }
-    announced_constraints = constraints.size();
-    built = std::make_unique<Mesher>(constraints, options);
-    constraints = Constraints{};  // the Mesher has its own copy: 32 bytes per constraint freed for the rest
+}
+
+/// Scanned points (with or without normals) through the scan path (docs/scans.md): noise, outliers,
+/// orientation, open or closed; then the fit. Sets the plan's input points, vertex budget and viewpoint.
+std::unique_ptr<Mesher> fit_scan(Input data, const MeshCommand& c, MeshPlan& plan, PhaseTimes& phases) {
+  MesherOptions& options = plan.options;
+  plan.input_points = data.points.points.size();
+  // The default budget follows the input (docs/scans.md): a coarser mesh with a warning beyond it.
+  if (plan.default_precision) {
+    const std::size_t by_input = kScanVerticesPerPoint * plan.input_points + kScanVerticesBase;
+    options.max_vertices = options.max_vertices ? std::min(options.max_vertices, by_input) : by_input;
   }
-  Mesher& mesher = *built;
+  options.on_phase = phase_announcer(phases, 0, true);
+  phases.start("scan", "preparing " + std::to_string(plan.input_points) + " scanned points");
+  ScanFit fit = scan_of(data, c.input, options);
+  options.scan.viewpoint = fit.options.scan.viewpoint;
+  if (!c.quiet && options.scan.viewpoint)
+    std::fprintf(stderr, "%s\n", viewpoint_line(options.scan, c.viewpoint_given).c_str());
+  return std::make_unique<Mesher>(Mesher::from_scan(std::move(fit)));
+}
+
+/// Constraints (.xyzv) and closed meshes, interpolated as they are: the constraints built (the function
+/// chosen on their count), without --precision the data's resolution in `data_precision`, then the fit.
+std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPlan& plan,
+                                        double& data_precision, PhaseTimes& phases) {
+  MesherOptions& options = plan.options;
+  phases.start("constraints");
+  ConstraintBuildReport merged;
+  Constraints constraints = constraints_for_function(std::move(data), c.input, options.constraint_build,
+                                                     options.function, options.auto_local_above, merged);
+  if (!c.quiet) print_build_report(merged, options.constraint_build);
+  if (plan.default_precision) {
+    // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
+    phases.start("precision", "median spacing");
+    Box3 box;
+    for (const Point3& p : constraints.points) box.extend(p);
+    // Measured already when the builder's off-surface distance followed the data (the same estimate).
+    const double spacing = merged.median_spacing > 0 ? merged.median_spacing : median_spacing(constraints);
+    data_precision = kSpacingFactor * spacing / box.diagonal();
+    if (!c.quiet)
+      std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", data_precision);
+  }
+  options.on_phase = phase_announcer(phases, constraints.size(), false);
+  // The constraints are freed on return: the Mesher has its own copy, 32 bytes per constraint for the rest.
+  return std::make_unique<Mesher>(constraints, options);
+}
+
+/// The memory limit's thinning of a scan (stderr): the mesh is coarser than the data.
+void warn_memory_thinned(const MeshCommand& c, const MeshPlan& plan) {
+  const MesherStats& st = plan.mesher->stats();
+  std::fprintf(stderr, "vitri mesh: warning: the memory limit of %.3g GB (%s) holds the meshing of about %zu of "
+               "the %zu points: every %zu-th point kept (%zu left out), the mesh is coarser than the data "
+               "(docs/memory.md)\n", static_cast<double>(plan.options.max_memory_bytes) / 1e9,
+               c.memory ? "--memory" : "the machine's available memory less a reserve",
+               plan.input_points - st.memory_thinned, plan.input_points, st.memory_stride, st.memory_thinned);
+}
+
+/// The levels of detail: level k takes the k-th --precision and --max-distance, a shorter list repeating
+/// its last value; without --precision, `data_precision`. One level goes to OUT, several to OUT-k.
+std::vector<MeshLevel> plan_levels(const MeshCommand& c, double data_precision) {
+  const std::vector<double> precisions =
+      c.precisions.empty() ? std::vector<double>{data_precision} : c.precisions;
+  std::vector<MeshLevel> levels(std::max(precisions.size(), c.distances.size()));
+  for (std::size_t k = 0; k < levels.size(); ++k) {
+    levels[k].precision = precisions[std::min(k, precisions.size() - 1)];
+    if (!c.distances.empty()) levels[k].max_distance = c.distances[std::min(k, c.distances.size() - 1)];
+    levels[k].path = levels.size() == 1 ? c.output : level_path(c.output, k);
+  }
+  return levels;
+}
+
+/// Stage 2, plan: the options resolved, the input read and fitted (a mesh that bounds no volume as
+/// points), the levels decided; what the fit did reported on stderr.
+MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseTimes& phases) {
+  MeshPlan plan;
+  plan.script = std::move(script);
+  plan.default_precision = c.precisions.empty();
+  MesherOptions& options = plan.options;
+  options = c.options;
+  // A batch run (no edit script) drops the Delaunay history: an equivalent mesh in well under half the
+  // memory (docs/mesher.md "Batch runs and memory").
+  options.polygonizer.keep_history = !plan.script.empty();
+  // Then the seeds go in on `threads` cores: the same mesh, bit for bit, as one thread (canonical ids).
+  // The fit, the constraints' construction and the normals give the same result on any thread count.
+  options.threads = c.threads;
+  options = with_threads_applied(options);  // the constraints are built here, before the Mesher
+  // The memory limit (docs/memory.md), checked from the input's size before the large allocations: a
+  // scan thinned to what fits, the refinement bounded by what the rest holds (a precision far below the
+  // data's spacing: a LimitError naming the count instead of an out-of-memory end). Taken before the
+  // input is read, from the memory available then.
+  options.max_memory_bytes = c.memory ? c.memory : default_memory_limit();
+  phases.start("read", "reading " + c.input);
+  Input data = read_input(c.input);
+  open_mesh_as_points(data, c, options);
+  // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
+  // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
+  plan.scan_input = is_scan(data);
+  if (c.surface_given && !plan.scan_input && options.surface != SurfaceKind::Closed)
+    std::fprintf(stderr, "vitri mesh: warning: --surface applies to point inputs; %s gives a closed surface\n",
+                 c.input.c_str());
+  double data_precision = 0;  // without --precision: the data's resolution, relative to the diagonal
+  plan.mesher = plan.scan_input ? fit_scan(std::move(data), c, plan, phases)
+                                : fit_constraints(std::move(data), c, plan, data_precision, phases);
+  const Mesher& mesher = *plan.mesher;
   phases.stop();
-  if (mesher.stats().memory_thinned > 0 && !quiet)
-    std::fprintf(stderr, "vitri mesh: warning: the memory limit of %.3g GB (%s) holds the meshing of about %zu of "
-                 "the %zu points: every %zu-th point kept (%zu left out), the mesh is coarser than the data "
-                 "(docs/memory.md)\n", static_cast<double>(options.max_memory_bytes) / 1e9,
-                 memory ? "--memory" : "the machine's available memory less a reserve",
-                 input_points - mesher.stats().memory_thinned, input_points, mesher.stats().memory_stride,
-                 mesher.stats().memory_thinned);
-  if (scan_input) {
+  if (mesher.stats().memory_thinned > 0 && !c.quiet) warn_memory_thinned(c, plan);
+  if (plan.scan_input) {
     const ScanReport& sr = mesher.stats().scan;
-    if (!quiet) {
+    if (!c.quiet) {
       std::fprintf(stderr, "%s\n", describe(sr).c_str());
       print_build_report(mesher.stats().scan_constraints, options.constraint_build);
     }
-    if (default_precision) {
+    if (plan.default_precision) {
       // The resolution the data resolve, not the raw spacing of noisy points (docs/scans.md).
-      precisions.push_back(kSpacingFactor * sr.resolution / mesher.diagonal());
-      if (!quiet)
+      data_precision = kSpacingFactor * sr.resolution / mesher.diagonal();
+      if (!c.quiet)
         std::fprintf(stderr, "no --precision: using the data's resolution (%.4g: spacing and noise), %.4g\n",
-                     sr.resolution, precisions[0]);
+                     sr.resolution, data_precision);
     }
   }
-  const bool announce_fit = mesher.size() >= kFitProgressConstraints;
-  if (announce_fit && !quiet) {
+  if (mesher.size() >= kFitProgressConstraints && !c.quiet) {
     std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
     if (const LocalRbf* local = mesher.local_function()) print_fit_split(local->report());
     print_init_split(mesher.stats().polygonizer);
   }
-  const std::size_t levels = std::max(precisions.size(), distances.size());
-  const double diag = mesher.diagonal();
-  const double build_ms = 1e3 * phases.elapsed();
-  if (!quiet) {
-    // Each step's own time; with the local function the seeds' insertion ran beside the fit.
-    const MesherStats st = mesher.stats();
-    std::printf("%s: %zu constraints, diagonal %.6g; %s fit %.0f ms, initial tetrahedralization %.0f ms%s\n",
-                input.c_str(), mesher.size(), diag, mesher.local_function() ? "local" : "global",
-                1e3 * st.fit_seconds, 1e3 * st.polygonizer.init_seconds,
-                mesher.local_function() ? " (its insertion beside the fit)" : "");
-    std::printf("%5s %10s %9s %10s %11s %11s %10s\n", "level", "precision", "vertices", "triangles", "refine ms",
-                "extract ms", "total ms");
-  }
-  double total_ms = build_ms;
-  for (std::size_t k = 0; k < levels; ++k) {
-    const double precision = precisions[std::min(k, precisions.size() - 1)];
-    if (options.mode == MeshMode::Quality) {
-      QualityOptions q = options.quality;
-      q.max_size = relative_size * diag;
-      // The same budget as the refinement (a scan's follows its size): a coarser mesh with a warning.
-      if (options.max_vertices) q.max_vertices = std::max<std::size_t>(9, std::min(q.max_vertices, options.max_vertices));
-      if (!distances.empty()) q.max_distance = distances[std::min(k, distances.size() - 1)] * diag;
-      mesher.set_quality_options(q);
-    }
-    phases.start("refinement", "refining level " + std::to_string(k));
-    const auto t0 = Clock::now();
-    auto last_report = Clock::now();
-    bool reported = false;
-    refine_within_budget(mesher, precision * diag, default_precision, quiet, [&](const RefineProgress& p) {
-      if (!quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
-        std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
-                     p.queued);
-        last_report = Clock::now();
-        reported = true;
-      }
-      return true;
-    });
-    if (reported) std::fprintf(stderr, "\n");
-    const double refine_ms = ms_since(t0);
-    if (!quiet) print_neck_split(mesher.stats().polygonizer);
-    if (!quiet && options.mode == MeshMode::Quality) {
-      const QualityStats qs = mesher.stats().quality;
-      std::fprintf(stderr, "  quality: %zu Delaunay vertices, %zu inserted (%zu for the topology), %zu rejected\n",
-                   qs.vertices, qs.insertions, qs.topology_insertions, qs.rejected);
-    }
-    phases.start("extraction");
-    const auto t1 = Clock::now();
-    const SurfaceMesh& m = mesher.surface();
-    const double extract_ms = ms_since(t1);
-    if (!quiet) print_extraction_split(mesher.stats().polygonizer, extract_ms);
-    total_ms += refine_ms + extract_ms;
-    const std::string path = levels == 1 ? output : level_path(output, k);
-    phases.start("writing", "writing " + path);
-    write_current(mesher, path, ply);
-    phases.stop();
-    if (!quiet && scan_input) {
-      const MesherStats st = mesher.stats();
-      std::fprintf(stderr, "surface: %s (%.1f%% of the closed surface's area away from the data%s); %zu small or "
-                   "unsupported components dropped%s\n", st.open ? "open, trimmed to the data" : "closed",
-                   100 * st.unsupported_area,
-                   options.surface == SurfaceKind::Auto ? ", --surface auto" : "", st.scan_small_components,
-                   st.open ? (", " + std::to_string(st.trimmed_triangles) + " triangles trimmed").c_str() : "");
-    }
-    if (!quiet)
-      std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, precision, m.vertices.size(),
-                  m.triangles.size(), refine_ms, extract_ms, total_ms, path.c_str());
-    if (!quiet && options.polygonizer.certify) {
-      const PolygonizerStats& ps = mesher.stats().polygonizer;
-      if (ps.certify_checked == 0 && ps.uncertified > 0)
-        std::printf("      NOT certified: the function gives no enclosures (the local function has none yet, "
-                    "docs/certificate.md); %zu tetrahedra unchecked\n", ps.uncertified);
-      else if (ps.uncertified == 0)
-        std::printf("      certified: %zu tetrahedra checked, %zu points inserted, %.1f ms\n", ps.certify_checked,
-                    ps.certify_insertions, 1e3 * ps.certify_seconds);
-      else
-        std::printf("      NOT certified: %zu tetrahedra left uncertified at the size floor, the largest (radius "
-                    "%.3g) at (%.6g, %.6g, %.6g); %zu checked, %zu points, %.1f ms\n", ps.uncertified,
-                    ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y, ps.uncertified_at.z,
-                    ps.certify_checked, ps.certify_insertions, 1e3 * ps.certify_seconds);
-    }
-  }
-  if (!quiet) {
-    std::printf("\n");
-    phases.print(stdout);
-  }
+  plan.levels = plan_levels(c, data_precision);
+  plan.diagonal = mesher.diagonal();
+  return plan;
+}
 
-  if (!script.empty() && !quiet)
+/// The quality mode's options of one level: --max-size and the level's --max-distance in absolute units,
+/// and the refinement's vertex budget.
+QualityOptions level_quality(const MeshCommand& c, const MeshPlan& plan, const MeshLevel& level) {
+  const MesherOptions& options = plan.options;
+  QualityOptions q = options.quality;
+  q.max_size = c.relative_size * plan.diagonal;
+  // The same budget as the refinement (a scan's follows its size): a coarser mesh with a warning.
+  if (options.max_vertices) q.max_vertices = std::max<std::size_t>(9, std::min(q.max_vertices, options.max_vertices));
+  if (level.max_distance) q.max_distance = *level.max_distance * plan.diagonal;
+  return q;
+}
+
+/// What a scan's surface became (stderr): open or closed, and the components dropped.
+void print_scan_surface(const MesherStats& st, SurfaceKind surface) {
+  std::fprintf(stderr, "surface: %s (%.1f%% of the closed surface's area away from the data%s); %zu small or "
+               "unsupported components dropped%s\n", st.open ? "open, trimmed to the data" : "closed",
+               100 * st.unsupported_area,
+               surface == SurfaceKind::Auto ? ", --surface auto" : "", st.scan_small_components,
+               st.open ? (", " + std::to_string(st.trimmed_triangles) + " triangles trimmed").c_str() : "");
+}
+
+/// --certify: whether the level's mesh is certified, else what is left (stdout, below its row).
+void print_certificate(const PolygonizerStats& ps) {
+  if (ps.certify_checked == 0 && ps.uncertified > 0)
+    std::printf("      NOT certified: the function gives no enclosures (the local function has none yet, "
+                "docs/certificate.md); %zu tetrahedra unchecked\n", ps.uncertified);
+  else if (ps.uncertified == 0)
+    std::printf("      certified: %zu tetrahedra checked, %zu points inserted, %.1f ms\n", ps.certify_checked,
+                ps.certify_insertions, 1e3 * ps.certify_seconds);
+  else
+    std::printf("      NOT certified: %zu tetrahedra left uncertified at the size floor, the largest (radius "
+                "%.3g) at (%.6g, %.6g, %.6g); %zu checked, %zu points, %.1f ms\n", ps.uncertified,
+                ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y, ps.uncertified_at.z,
+                ps.certify_checked, ps.certify_insertions, 1e3 * ps.certify_seconds);
+}
+
+/// Level k of the plan refined (within the vertex budget), extracted and written, its row printed.
+/// Returns the running total of the table, `total_ms` plus the level's refinement and extraction.
+double run_level(const MeshCommand& c, MeshPlan& plan, std::size_t k, double total_ms, PhaseTimes& phases) {
+  Mesher& mesher = *plan.mesher;
+  const MesherOptions& options = plan.options;
+  const MeshLevel& level = plan.levels[k];
+  if (options.mode == MeshMode::Quality) mesher.set_quality_options(level_quality(c, plan, level));
+  phases.start("refinement", "refining level " + std::to_string(k));
+  const auto t0 = Clock::now();
+  auto last_report = Clock::now();
+  bool reported = false;
+  auto progress = [&](const RefineProgress& p) {
+    if (!c.quiet && std::chrono::duration<double>(Clock::now() - last_report).count() > 1.0) {
+      std::fprintf(stderr, "\r  level %zu: %zu Delaunay vertices, %zu tetrahedra queued...", k, p.vertices,
+                   p.queued);
+      last_report = Clock::now();
+      reported = true;
+    }
+    return true;
+  };
+  refine_within_budget(mesher, level.precision * plan.diagonal, plan.default_precision, c.quiet, progress);
+  if (reported) std::fprintf(stderr, "\n");
+  const double refine_ms = ms_since(t0);
+  if (!c.quiet) print_neck_split(mesher.stats().polygonizer);
+  if (!c.quiet && options.mode == MeshMode::Quality) {
+    const QualityStats qs = mesher.stats().quality;
+    std::fprintf(stderr, "  quality: %zu Delaunay vertices, %zu inserted (%zu for the topology), %zu rejected\n",
+                 qs.vertices, qs.insertions, qs.topology_insertions, qs.rejected);
+  }
+  phases.start("extraction");
+  const auto t1 = Clock::now();
+  const SurfaceMesh& m = mesher.surface();
+  const double extract_ms = ms_since(t1);
+  if (!c.quiet) print_extraction_split(mesher.stats().polygonizer, extract_ms);
+  total_ms += refine_ms + extract_ms;
+  phases.start("writing", "writing " + level.path);
+  write_current(mesher, level.path, c.ply);
+  phases.stop();
+  if (!c.quiet && plan.scan_input) print_scan_surface(mesher.stats(), options.surface);
+  if (!c.quiet)
+    std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, level.precision, m.vertices.size(),
+                m.triangles.size(), refine_ms, extract_ms, total_ms, level.path.c_str());
+  if (!c.quiet && options.polygonizer.certify) print_certificate(mesher.stats().polygonizer);
+  return total_ms;
+}
+
+/// The tokens of an edit line, up to a '#' comment.
+std::vector<std::string> edit_tokens(const std::string& line) {
+  std::istringstream in(line);
+  std::vector<std::string> tok;
+  for (std::string t; in >> t;) {
+    if (t[0] == '#') break;
+    tok.push_back(t);
+  }
+  return tok;
+}
+
+/// Applies one edit (add, move, remove or value; usage above) to `mesher`. Returns "(id N)" for an add,
+/// the id it got, else an empty string. @throws ParseError naming `script`:`line` for a malformed edit or
+/// an id that names no constraint; as the Mesher's edits.
+std::string apply_edit(Mesher& mesher, const std::vector<std::string>& tok, const std::string& script,
+                       std::size_t line) {
+  auto bad = [&](const std::string& what) { return ParseError(script, line, what); };
+  double x[4];
+  std::size_t idx = 0;
+  const std::string& op = tok[0];
+  // Constraints are named by their stable ids (Mesher::add_constraint and the others; help above).
+  auto known = [&](const std::string& text) {
+    if (!mesher.has_constraint(idx))
+      throw bad("no constraint with id " + text + " (never given, or removed; ids do not shift)");
+  };
+  if (op == "add") {
+    if (tok.size() != 5 || !parse_double(tok[1], x[0]) || !parse_double(tok[2], x[1]) ||
+        !parse_double(tok[3], x[2]) || !parse_double(tok[4], x[3]))
+      throw bad("expected 'add X Y Z V'");
+    return "(id " + std::to_string(mesher.add_constraint({x[0], x[1], x[2]}, x[3])) + ")";
+  }
+  if (op == "move") {
+    if (tok.size() != 5 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]) ||
+        !parse_double(tok[3], x[1]) || !parse_double(tok[4], x[2]))
+      throw bad("expected 'move I X Y Z'");
+    known(tok[1]);
+    mesher.move_constraint(idx, {x[0], x[1], x[2]});
+  } else if (op == "remove") {
+    if (tok.size() != 2 || !parse_index(tok[1], idx)) throw bad("expected 'remove I'");
+    known(tok[1]);
+    mesher.remove_constraint(idx);
+  } else if (op == "value") {
+    if (tok.size() != 3 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]))
+      throw bad("expected 'value I V'");
+    known(tok[1]);
+    mesher.set_value(idx, x[0]);
+  } else {
+    throw bad("unknown edit '" + op + "' (add, move, remove, value, write)");
+  }
+  return {};
+}
+
+/// --edits: the plan's script replayed on the last level's mesh, a row per edit with its update times;
+/// `write PATH` writes the current mesh. Any error names the script's line (ParseError).
+void replay_edits(const MeshCommand& c, MeshPlan& plan) {
+  Mesher& mesher = *plan.mesher;
+  const std::vector<std::string>& script = plan.script;
+  if (!script.empty() && !c.quiet)
     std::printf("\n%5s %-28s %9s %10s %9s %9s %11s %9s\n", "line", "edit", "vertices", "triangles", "rbf ms",
                 "refine ms", "extract ms", "total ms");
   for (std::size_t ln = 0; ln < script.size(); ++ln) {
-    std::istringstream in(script[ln]);
-    std::vector<std::string> tok;
-    for (std::string t; in >> t;) {
-      if (t[0] == '#') break;
-      tok.push_back(t);
-    }
+    const std::vector<std::string> tok = edit_tokens(script[ln]);
     if (tok.empty()) continue;
     const std::size_t line = ln + 1;
-    auto bad = [&](const std::string& what) { return ParseError(edits, line, what); };
-    double x[4];
-    std::size_t idx = 0;
     const std::string& op = tok[0];
     try {
       if (op == "write") {
-        if (tok.size() != 2) throw bad("expected 'write PATH'");
-        write_current(mesher, tok[1], ply);
-        if (!quiet) std::printf("%5zu %-28s -> %s\n", line, "write", tok[1].c_str());
+        if (tok.size() != 2) throw ParseError(c.edits, line, "expected 'write PATH'");
+        write_current(mesher, tok[1], c.ply);
+        if (!c.quiet) std::printf("%5zu %-28s -> %s\n", line, "write", tok[1].c_str());
         continue;
       }
       const auto t0 = Clock::now();
-      // Constraints are named by their stable ids (Mesher::add_constraint and the others; help above).
-      auto known = [&](const std::string& text) {
-        if (!mesher.has_constraint(idx))
-          throw bad("no constraint with id " + text + " (never given, or removed; ids do not shift)");
-      };
-      std::string added;  // "(id N)" of an add, for its row
-      if (op == "add") {
-        if (tok.size() != 5 || !parse_double(tok[1], x[0]) || !parse_double(tok[2], x[1]) ||
-            !parse_double(tok[3], x[2]) || !parse_double(tok[4], x[3]))
-          throw bad("expected 'add X Y Z V'");
-        added = "(id " + std::to_string(mesher.add_constraint({x[0], x[1], x[2]}, x[3])) + ")";
-      } else if (op == "move") {
-        if (tok.size() != 5 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]) ||
-            !parse_double(tok[3], x[1]) || !parse_double(tok[4], x[2]))
-          throw bad("expected 'move I X Y Z'");
-        known(tok[1]);
-        mesher.move_constraint(idx, {x[0], x[1], x[2]});
-      } else if (op == "remove") {
-        if (tok.size() != 2 || !parse_index(tok[1], idx)) throw bad("expected 'remove I'");
-        known(tok[1]);
-        mesher.remove_constraint(idx);
-      } else if (op == "value") {
-        if (tok.size() != 3 || !parse_index(tok[1], idx) || !parse_double(tok[2], x[0]))
-          throw bad("expected 'value I V'");
-        known(tok[1]);
-        mesher.set_value(idx, x[0]);
-      } else {
-        throw bad("unknown edit '" + op + "' (add, move, remove, value, write)");
-      }
+      const std::string added = apply_edit(mesher, tok, c.edits, line);  // "(id N)" of an add, for its row
       const double edit_ms = ms_since(t0);
       const auto t1 = Clock::now();
       const SurfaceMesh& m = mesher.surface();
@@ -714,16 +834,54 @@ int run_mesh(const Args& args) {
       std::string text = added.empty() ? op : op + " " + added;
       for (std::size_t k = 1; k < tok.size(); ++k) text += " " + tok[k];
       if (text.size() > 28) text = text.substr(0, 25) + "...";
-      if (!quiet)
+      if (!c.quiet)
         std::printf("%5zu %-28s %9zu %10zu %9.1f %9.1f %11.1f %9.1f\n", line, text.c_str(), m.vertices.size(),
                     m.triangles.size(), s.edit_rbf_seconds * 1e3, edit_ms - s.edit_rbf_seconds * 1e3, extract_ms,
                     edit_ms + extract_ms);
     } catch (const ParseError&) {
       throw;
     } catch (const Error& e) {
-      throw ParseError(edits, line, e.what());
+      throw ParseError(c.edits, line, e.what());
     }
   }
+}
+
+/// Stage 3, run: the plan's levels refined, extracted and written (the table, then the phases' times),
+/// then its edit script replayed.
+void run_mesh_plan(const MeshCommand& c, MeshPlan& plan, PhaseTimes& phases) {
+  const Mesher& mesher = *plan.mesher;
+  const double build_ms = 1e3 * phases.elapsed();
+  if (!c.quiet) {
+    // Each step's own time; with the local function the seeds' insertion ran beside the fit.
+    const MesherStats st = mesher.stats();
+    std::printf("%s: %zu constraints, diagonal %.6g; %s fit %.0f ms, initial tetrahedralization %.0f ms%s\n",
+                c.input.c_str(), mesher.size(), plan.diagonal, mesher.local_function() ? "local" : "global",
+                1e3 * st.fit_seconds, 1e3 * st.polygonizer.init_seconds,
+                mesher.local_function() ? " (its insertion beside the fit)" : "");
+    std::printf("%5s %10s %9s %10s %11s %11s %10s\n", "level", "precision", "vertices", "triangles", "refine ms",
+                "extract ms", "total ms");
+  }
+  double total_ms = build_ms;
+  for (std::size_t k = 0; k < plan.levels.size(); ++k) total_ms = run_level(c, plan, k, total_ms, phases);
+  if (!c.quiet) {
+    std::printf("\n");
+    phases.print(stdout);
+  }
+  replay_edits(c, plan);
+}
+
+}  // namespace
+
+const char* mesh_usage() { return kUsage; }
+
+int run_mesh(const Args& args) {
+  MeshCommand command;
+  if (const std::string bad = parse_mesh_args(args, command); !bad.empty()) return usage_error(bad);
+  // Read the edit script up front so that a bad script fails before the long work.
+  std::vector<std::string> script = read_edit_script(command.edits);
+  PhaseTimes phases(command.quiet);  // the plan's and the run's phases, announced and timed
+  MeshPlan plan = plan_mesh(command, std::move(script), phases);
+  run_mesh_plan(command, plan, phases);
   // Every output file is closed (write_mesh), every line printed: the Mesher, the constraints and the
   // meshes are left to the system (freeing them block by block took 0.5 s at 10^6 points).
   exit_without_teardown(0);

@@ -237,6 +237,19 @@ void print_fit_split(const LocalFitReport& r) {
                1e3 * r.patches_seconds, r.patches, r.mean_fitted, r.max_fitted);
 }
 
+/// The scan's far field (stderr; docs/scans.md, "Far from the data"): whether the winding number tells the
+/// local function's far patches inside from outside, and how many it settled.
+void print_far_field(const Mesher& mesher) {
+  const MesherStats& s = mesher.stats();
+  const LocalRbf* local = mesher.local_function();
+  if (s.far_side && local)
+    std::fprintf(stderr, "far field: the winding number (level %.2f of its jump %.2f: an object) settled %zu of %zu "
+                 "patches\n", s.far_level, s.far_jump, local->report().far_settled, local->report().patches);
+  else
+    std::fprintf(stderr, "far field: the nearest data's planes (winding number level %.2f of its jump %.2f: a "
+                 "single view or a scene seen from inside)\n", s.far_level, s.far_jump);
+}
+
 /// What the constraint builder merged and left out (stderr).
 void print_build_report(const ConstraintBuildReport& merged, const ConstraintBuildOptions& build) {
   if (merged.merged_points + merged.merged_off_surface > 0)
@@ -660,6 +673,7 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
                      sr.resolution, data_precision);
     }
   }
+  if (plan.scan_input && mesher.stats().far_jump > 0 && !c.quiet) print_far_field(mesher);
   if (mesher.size() >= kFitProgressConstraints && !c.quiet) {
     std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
     if (const LocalRbf* local = mesher.local_function()) print_fit_split(local->report());

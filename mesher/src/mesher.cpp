@@ -347,6 +347,9 @@ Mesher Mesher::from_scan(ScanFit fit) {
   m.stats_.scan_constraints = fit.built;
   m.stats_.memory_stride = fit.memory_stride;
   m.stats_.memory_thinned = fit.memory_thinned;
+  m.stats_.far_level = fit.far_level;
+  m.stats_.far_jump = fit.far_jump;
+  m.stats_.far_side = static_cast<bool>(o.local.far_side);
   return m;
 }
 

@@ -174,6 +174,7 @@ TEST_CASE("vitri mesh, scan defaults: a noisy sphere with outliers gives one clo
   REQUIRE(run(in + " -o " + out, o, e) == 0);
   INFO(o << e);
   CHECK(e.find("outliers set aside") != std::string::npos);
+  CHECK(e.find("far field: the winding number") != std::string::npos);  // an object (docs/scans.md)
   CHECK(e.find("surface: closed") != std::string::npos);
   const Shape s = shape_of(out);
   CHECK(s.components == 1);
@@ -241,6 +242,7 @@ TEST_CASE("vitri mesh, scan defaults: a single view with its viewpoint is left o
   INFO(o << e);
   CHECK(e.find("viewpoint 0 0 5 (from the input)") != std::string::npos);
   CHECK(e.find("normals from the viewpoint") != std::string::npos);
+  CHECK(e.find("far field: the nearest data's planes") != std::string::npos);  // a single view
   CHECK(e.find("surface: open") != std::string::npos);
   const Shape s = shape_of(out);
   CHECK(s.components == 1);

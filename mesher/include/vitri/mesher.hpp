@@ -212,6 +212,10 @@ struct MesherStats {
   /// memory_stride-th point kept; 0 and 1 when none was left out).
   std::size_t memory_thinned = 0;
   std::size_t memory_stride = 1;
+  /// from_scan() with the local function: the winding number's calibration (ScanFit::far_level and
+  /// far_jump; 0 when not measured) and whether its far side was given to the fit (a scan of an object).
+  double far_level = 0, far_jump = 0;
+  bool far_side = false;
 };
 
 /// Memory model of a run, measured at 10^6 oriented points (docs/memory.md): bytes per input point of

@@ -5,7 +5,7 @@ truth is known (docs/scans.md, Limits: "Topology under noise").
 Cases (generated here, seeded, numpy only):
   sphere-n{1,2}-s{seed}  6000 points on the unit sphere (Fibonacci lattice), isotropic Gaussian noise of
                          1 or 2 spacings of the clean sample; truth: chi 2, 1 component
-  MODEL-n{1,2}           30,000 area-uniform samples of ../shared/data/MODEL.off, noise 1 or 2 spacings;
+  MODEL-n{0,1,2}         30,000 area-uniform samples of ../shared/data/MODEL.off, noise 0, 1 or 2 spacings;
                          truth: the model's own chi (from its file)
   MODEL-misreg           the same sample and a second sample of the 20% of largest x, shifted 2 spacings
                          along +x (a misregistered overlap); MODEL-misreg-noisy: both with noise of 0.5
@@ -95,7 +95,7 @@ def away_fraction(v, f, points, rng, spacings=10.0, n=20000):
     """Fraction of the output's area farther than `spacings` median input spacings from every input point
     (issue 38's measure of blobs and sheets away from the data). Uses Open3D's k-d tree."""
     import open3d as o3d
-    points = np.ascontiguousarray(points, dtype=float)
+    points = np.ascontiguousarray(np.unique(points, axis=0), dtype=float)  # duplicates: spacing 0
     cloud = o3d.geometry.PointCloud(o3d.utility.Vector3dVector(points))
     tree = o3d.geometry.KDTreeFlann(cloud)
     def nearest(q):
@@ -115,7 +115,7 @@ def cases(models, seeds):
     for m in models:
         v, f = read_off(SHARED / f"{m}.off")
         chi, _, _ = topology(f)
-        for noise in (1, 2):
+        for noise in (0, 1, 2):
             out.append((f"{m}-n{noise}", m, noise, 1, chi))
         out.append((f"{m}-misreg", m, "misreg", 1, chi))
         out.append((f"{m}-misreg-noisy", m, "misreg-noisy", 1, chi))

@@ -366,3 +366,114 @@ TEST_CASE("vitri mesh, scan defaults: a PCD file with its VIEWPOINT", "[cli][sca
   CHECK(s.components == 1);
   CHECK(s.nonmanifold_edges == 0);
 }
+
+namespace {
+
+/// n area-uniform samples of the triangle mesh `path` (seeded), the mean spacing sqrt(area / n) in
+/// `spacing`.
+std::vector<Point3> sample_mesh(const std::string& path, std::size_t n, std::uint64_t seed, double& spacing) {
+  const vitri::TriangleMesh m = vitri::read_mesh(path);
+  std::vector<double> cumulative;
+  double area = 0;
+  auto corner = [&](long t, int c) {
+    const long v = m.F(t, c);
+    return Point3{m.V(v, 0), m.V(v, 1), m.V(v, 2)};
+  };
+  for (long t = 0; t < m.F.rows(); ++t) {
+    area += 0.5 * vitri::norm(vitri::cross(corner(t, 1) - corner(t, 0), corner(t, 2) - corner(t, 0)));
+    cumulative.push_back(area);
+  }
+  Gauss g(seed);
+  std::vector<Point3> p;
+  for (std::size_t i = 0; i < n; ++i) {
+    const long t = std::lower_bound(cumulative.begin(), cumulative.end(), g.uniform() * area) - cumulative.begin();
+    const double s = std::sqrt(g.uniform()), r = g.uniform();
+    p.push_back(corner(t, 0) * (1 - s) + corner(t, 1) * (s * (1 - r)) + corner(t, 2) * (s * r));
+  }
+  spacing = std::sqrt(area / static_cast<double>(n));
+  return p;
+}
+
+/// Share of the output's area farther than `limit` from every input point (20,000 area samples).
+double area_away(const Shape& s, const std::vector<Point3>& input, double limit) {
+  const vitri::PointIndex index(input);
+  std::vector<double> cumulative;
+  double area = 0;
+  for (const auto& t : s.f) {
+    const Point3 &a = s.v[static_cast<std::size_t>(t[0])], &b = s.v[static_cast<std::size_t>(t[1])],
+                 &c = s.v[static_cast<std::size_t>(t[2])];
+    area += 0.5 * vitri::norm(vitri::cross(b - a, c - a));
+    cumulative.push_back(area);
+  }
+  Gauss g(11);
+  std::vector<vitri::PointIndex::Id> ids;
+  std::vector<double> d2;
+  std::size_t away = 0;
+  const std::size_t samples = 20000;
+  for (std::size_t i = 0; i < samples; ++i) {
+    const auto t = s.f[static_cast<std::size_t>(
+        std::lower_bound(cumulative.begin(), cumulative.end(), g.uniform() * area) - cumulative.begin())];
+    const double u = std::sqrt(g.uniform()), r = g.uniform();
+    const Point3 q = s.v[static_cast<std::size_t>(t[0])] * (1 - u) + s.v[static_cast<std::size_t>(t[1])] * (u * (1 - r)) +
+                     s.v[static_cast<std::size_t>(t[2])] * (u * r);
+    index.nearest(q, 1, ids, &d2);
+    away += std::sqrt(d2[0]) > limit;
+  }
+  return static_cast<double>(away) / static_cast<double>(samples);
+}
+
+void write_xyz(const std::string& path, const std::vector<Point3>& p) {
+  std::ofstream f(path);
+  f.precision(17);
+  for (const Point3& q : p) f << q.x << ' ' << q.y << ' ' << q.z << '\n';
+}
+
+}  // namespace
+
+// The far field of noisy and misregistered samples of a closed model (docs/scans.md, "Far from the data"):
+// without the winding number's far side, the noisy sample below keeps 4.4% of its area farther than 10
+// spacings from the data (a sheet by the ears; bench/scans/noise_topology.py's bunny-n1 came out open,
+// 32% of its closed surface away). The misregistered sample holds without it too (its sweep twin had a
+// blob below the tail, 13% away): it guards the layers' merge and the far side together.
+TEST_CASE("vitri mesh, scan defaults: noisy and misregistered samples of a closed model, nothing far from the data",
+          "[.][slow][cli][scan]") {
+  double spacing = 0;
+  const std::vector<Point3> clean = sample_mesh(kData + "/bunny.off", 30000, 1, spacing);
+  SECTION("Gaussian noise of one spacing") {
+    Gauss g(2);
+    std::vector<Point3> p;
+    for (const Point3& q : clean) p.push_back(q + Point3{g(), g(), g()} * spacing);
+    const std::string in = kDir + "/scan_bunny_noisy.xyz", out = kDir + "/scan_bunny_noisy.ply";
+    write_xyz(in, p);
+    std::string o, e;
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(o << e);
+    CHECK(e.find("far field: the winding number") != std::string::npos);
+    CHECK(e.find("surface: closed") != std::string::npos);
+    const Shape s = shape_of(out);
+    CHECK(s.components == 1);
+    CHECK(s.boundary_edges == 0);
+    CHECK(area_away(s, p, 10 * median_nn(p)) < 0.01);
+  }
+  SECTION("a second view of the 20% of largest x, 2 spacings off") {
+    double unused = 0;
+    const std::vector<Point3> second = sample_mesh(kData + "/bunny.off", 30000, 3, unused);
+    std::vector<double> xs;
+    for (const Point3& q : clean) xs.push_back(q.x);
+    std::nth_element(xs.begin(), xs.begin() + static_cast<long>(xs.size() * 8 / 10), xs.end());
+    const double cut = xs[xs.size() * 8 / 10];
+    std::vector<Point3> p = clean;
+    for (const Point3& q : second)
+      if (q.x > cut) p.push_back(q + Point3{2 * spacing, 0, 0});
+    const std::string in = kDir + "/scan_bunny_misreg.xyz", out = kDir + "/scan_bunny_misreg.ply";
+    write_xyz(in, p);
+    std::string o, e;
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(o << e);
+    CHECK(e.find("surface: closed") != std::string::npos);
+    const Shape s = shape_of(out);
+    CHECK(s.components == 1);
+    CHECK(s.boundary_edges == 0);
+    CHECK(area_away(s, p, 10 * median_nn(p)) < 0.01);
+  }
+}

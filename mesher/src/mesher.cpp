@@ -320,7 +320,10 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
     auto sides = std::make_shared<const WindingSides>(prepared.points, prepared.normals, areas, fit.built.offset);
     fit.far_level = sides->level();
     fit.far_jump = sides->jump();
-    if (sides->level() > kEnclosingLevel * sides->jump())
+    // An editing session (history kept) keeps the planes, as it keeps the uniform precision: edits move
+    // constraints away from the scan, whose winding number would then answer for a shape that is gone
+    // (a patch inside a new bump told "outside" would open a hole in it).
+    if (sides->level() > kEnclosingLevel * sides->jump() && !o.polygonizer.keep_history)
       o.local.far_side = [sides](const Point3& x) { return (*sides)(x); };
   }
   return fit;

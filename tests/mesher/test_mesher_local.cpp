@@ -381,7 +381,7 @@ TEST_CASE("an open scan gives a closed mesh, closed by the domain box", "[mesher
 
 // The scan path's far field (docs/scans.md, "Far from the data"): a scan of an object gets the winding
 // number's answers for the local function's far patches, a single view does not (its far field lies behind
-// it and is trimmed with the open surface).
+// it and is trimmed with the open surface), nor an editing session.
 TEST_CASE("prepare_scan_fit: the winding number's far side for objects, not for single views", "[mesher][scan]") {
   std::vector<Point3> sphere, sphere_n, cap, cap_n;
   const int n = 6000;
@@ -399,12 +399,19 @@ TEST_CASE("prepare_scan_fit: the winding number's far side for objects, not for 
   o.function = FunctionKind::Local;
   o.constraint_build.offset_spacings = 2;
   o.polygonizer.threads = 2;
+  o.polygonizer.keep_history = false;  // a batch run, as the CLI's without --edits
   const ScanFit object = prepare_scan_fit(sphere, sphere_n, o);
   CHECK(object.far_jump > 0.5);
   CHECK(std::abs(object.far_level / object.far_jump - 0.5) < 0.1);
   REQUIRE(object.options.local.far_side);
   CHECK(object.options.local.far_side(Point3{0, 0, 0}) == -1);
   CHECK(object.options.local.far_side(Point3{3, 0, 0}) == 1);
+  // An editing session keeps the planes (its edits move constraints away from the scan).
+  o.polygonizer.keep_history = true;
+  const ScanFit editing = prepare_scan_fit(sphere, sphere_n, o);
+  CHECK(editing.far_jump > 0.5);
+  CHECK(!editing.options.local.far_side);
+  o.polygonizer.keep_history = false;
   const ScanFit view = prepare_scan_fit(cap, cap_n, o);
   CHECK(view.far_level < 0.35 * view.far_jump);
   CHECK(!view.options.local.far_side);

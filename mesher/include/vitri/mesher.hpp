@@ -298,6 +298,8 @@ class Mesher {
   /// them otherwise), normal constraints of the prepared points, then as above; the refinement is coarse
   /// far from the data, and surface() drops components the data do not support or resolve and, for an
   /// open surface (options.surface), trims the mesh to the data. stats().scan says what was set aside.
+  /// With the local function, a scan of an object and no history kept (a batch run), the far patches take
+  /// their sign from the scan's winding number (WindingSides; stats().far_side, docs/scans.md).
   /// @throws as prepare_scan (only for inputs with no surface) and Mesher::Mesher.
   static Mesher from_scan(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                           const MesherOptions& options = {});

@@ -3,6 +3,7 @@
 // necks have settled.
 #include "vitri/polygonize/certificate.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 
 #include "polygonizer_internal.hpp"
 #include "slices.hpp"
@@ -114,7 +115,7 @@ CellCertificate certify_cell(const std::array<Point3, 4>& p, const std::array<do
   return CellCertificate::Disk;
 }
 
-bool Polygonizer::certify_level(double dmin, const ProgressCallback& progress, RefineProgress& info) {
+bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const auto t0 = Clock::now();
   const double floor = options_.certify_floor_fraction * precision_;
   // A circumcenter of a tetrahedron of circumradius R > floor is at least R from every vertex: it passes.

@@ -10,6 +10,7 @@
 // edge), so no triangle degenerates. The tracker recomputes only what the Polygonizer's changes reach.
 #include "surface_tracker.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 
 #include <chrono>
 
@@ -22,7 +23,7 @@ TrackerInput tracker_input(const Triangulation& tri, const VertexMap<double>& va
                            const VertexMap<Point3>& gradients, const PolygonizerOptions& options) {
   TrackerInput in{tri, values, transverse, f, {}, options.snap_zero_vertices, options.snap_fraction,
                   options.warm_start_roots};
-  // The vertices' gradients are kept current only for the thin-feature test (Polygonizer::grad_).
+  // The vertices' gradients are kept current only for the thin-feature test (Polygonizer::Impl::grad_).
   if (options.refine_thin_features) in.gradients = &gradients;
   in.roots.root_finding = options.placement == VertexPlacement::RootFinding;
   in.roots.tolerance = options.root_tolerance;
@@ -34,9 +35,7 @@ TrackerInput tracker_input(const Triangulation& tri, const VertexMap<double>& va
 
 }  // namespace
 
-Polygonizer::~Polygonizer() = default;
-
-MeshDelta Polygonizer::update_surface() {
+MeshDelta Polygonizer::Impl::update_surface() {
   const auto t0 = std::chrono::steady_clock::now();
   evaluate_pending();
   const TrackerInput in = tracker_input(tri_, values_, transverse_.list(), f_, grad_, options_);
@@ -56,9 +55,9 @@ MeshDelta Polygonizer::update_surface() {
   return delta;
 }
 
-const LiveMesh& Polygonizer::live_surface() const { return surface_->mesh(); }
+const LiveMesh& Polygonizer::Impl::live_surface() const { return surface_->mesh(); }
 
-SurfaceMesh Polygonizer::extract_fresh() {
+SurfaceMesh Polygonizer::Impl::extract_fresh() {
   evaluate_pending();
   const TrackerInput in = tracker_input(tri_, values_, transverse_.list(), f_, grad_, options_);
   SurfaceTracker fresh(tri_);
@@ -66,7 +65,7 @@ SurfaceMesh Polygonizer::extract_fresh() {
   return fresh.mesh().to_surface_mesh();
 }
 
-SurfaceMesh Polygonizer::extract() {
+SurfaceMesh Polygonizer::Impl::extract() {
   const auto t0 = std::chrono::steady_clock::now();
   update_surface();
   SurfaceMesh mesh = surface_->mesh().to_surface_mesh();

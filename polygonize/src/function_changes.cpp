@@ -13,6 +13,7 @@
 // transverse count of one dropping to 0), checked when collected: no scan of the vertices.
 #include "polygonizer_internal.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 #include "surface_tracker.hpp"
 
 #include <algorithm>
@@ -24,9 +25,9 @@ namespace vitri {
 using namespace polygonizer_detail;
 
 
-void Polygonizer::function_changed() { function_changed([](const Point3&) { return true; }); }
+void Polygonizer::Impl::function_changed() { function_changed([](const Point3&) { return true; }); }
 
-void Polygonizer::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
+void Polygonizer::Impl::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
   const auto t0 = Clock::now();
   std::vector<VertexId> ids;
   const std::size_t cap = tri_.vertex_capacity();
@@ -36,7 +37,7 @@ void Polygonizer::function_changed(const std::function<bool(const Point3&)>& may
   stats_.update_seconds = seconds_since(t0);
 }
 
-void Polygonizer::function_changed(const std::vector<Ball>& changed) {
+void Polygonizer::Impl::function_changed(const std::vector<Ball>& changed) {
   const auto t0 = Clock::now();
   std::vector<VertexId> ids = vertices_near(changed, crossing_reach());
   ids.erase(std::remove_if(ids.begin(), ids.end(), [&](VertexId v) { return !needs_evaluation(v); }), ids.end());
@@ -44,11 +45,11 @@ void Polygonizer::function_changed(const std::vector<Ball>& changed) {
   stats_.update_seconds = seconds_since(t0);
 }
 
-double Polygonizer::crossing_reach() const { return surface_->max_edge_length(); }
+double Polygonizer::Impl::crossing_reach() const { return surface_->max_edge_length(); }
 
 // Live vertices within `pad` of a ball, sorted. One walk from the tetrahedra holding the balls' centers
 // (clamped into the domain), entering a tetrahedron when its bounding box meets a dilated ball.
-std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls, double pad) {
+std::vector<VertexId> Polygonizer::Impl::vertices_near(const std::vector<Ball>& balls, double pad) {
   std::vector<Ball> grown;
   const Box3& box = tri_.box();
   for (const Ball& b : balls) {
@@ -109,7 +110,7 @@ std::vector<VertexId> Polygonizer::vertices_near(const std::vector<Ball>& balls,
   return out;
 }
 
-void Polygonizer::VisitMarks::begin(std::size_t capacity) {
+void Polygonizer::Impl::VisitMarks::begin(std::size_t capacity) {
   if (stamp.size() < capacity) stamp.resize(capacity + capacity / 2, 0);
   if (++epoch == 0) {  // wrapped: old stamps could match again
     std::fill(stamp.begin(), stamp.end(), 0);
@@ -119,7 +120,7 @@ void Polygonizer::VisitMarks::begin(std::size_t capacity) {
 
 // New values at `ids` (one batch), then the tetrahedra around vertices whose sign flipped are
 // reclassified; the thin-feature test of the next refine() sees every vertex whose value changed.
-void Polygonizer::reevaluate(const std::vector<VertexId>& ids) {
+void Polygonizer::Impl::reevaluate(const std::vector<VertexId>& ids) {
   std::vector<double> out;
   evaluate_at(ids, out);
   std::vector<TetId> touched;
@@ -140,7 +141,7 @@ void Polygonizer::reevaluate(const std::vector<VertexId>& ids) {
   settle_zeros({});
 }
 
-std::size_t Polygonizer::collect_garbage(double min_fraction, std::size_t max_removals) {
+std::size_t Polygonizer::Impl::collect_garbage(double min_fraction, std::size_t max_removals) {
   const auto is_idle = [&](VertexId v) {
     return tri_.is_vertex(v) && kind_[v] == VertexKind::Refinement && transverse_.count(v) == 0;
   };

@@ -20,6 +20,7 @@
 #include "polygonizer_internal.hpp"
 #include "slices.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 
 #include <algorithm>
 
@@ -39,17 +40,17 @@ constexpr double kNeckDepth = 16.0;
 
 }  // namespace
 
-void Polygonizer::note_neck_vertex(VertexId v) {
+void Polygonizer::Impl::note_neck_vertex(VertexId v) {
   if (neck_mark_[v]) return;
   neck_mark_[v] = 1;
   neck_candidates_.push_back(v);
 }
 
-void Polygonizer::note_neck_candidates(TetId t) {
+void Polygonizer::Impl::note_neck_candidates(TetId t) {
   for (const VertexId u : tri_.tet_vertices(t)) note_neck_vertex(u);
 }
 
-std::vector<VertexId> Polygonizer::find_necks() {
+std::vector<VertexId> Polygonizer::Impl::find_necks() {
   std::vector<VertexId> candidates;
   candidates.swap(neck_candidates_);
   std::size_t kept = 0;
@@ -102,7 +103,7 @@ std::vector<VertexId> Polygonizer::find_necks() {
   return necks;
 }
 
-std::size_t Polygonizer::insert_neck_points(const std::vector<VertexId>& necks, double dmin,
+std::size_t Polygonizer::Impl::insert_neck_points(const std::vector<VertexId>& necks, double dmin,
                                             std::vector<TetId>& created) {
   std::size_t inserted = 0;
   std::vector<TetId> star;
@@ -116,7 +117,7 @@ std::size_t Polygonizer::insert_neck_points(const std::vector<VertexId>& necks, 
   return inserted;
 }
 
-bool Polygonizer::settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info) {
+bool Polygonizer::Impl::settle_necks(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const auto t0 = Clock::now();
   std::vector<TetId> created;
   bool completed = true;

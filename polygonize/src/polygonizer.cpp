@@ -27,6 +27,7 @@
 // (function_changes.cpp), necks (necks.cpp), extraction (extract.cpp over surface_tracker.hpp), the
 // closing function of close_at_box (box_closure.cpp).
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 
 #include "polygonizer_internal.hpp"
 #include "slices.hpp"
@@ -178,6 +179,10 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, const Box3& domain, const st
 
 Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& seeds,
                          const std::vector<double>& seed_values, const PolygonizerOptions& options)
+    : impl_(std::make_unique<Impl>(f, std::move(seeds), seed_values, options)) {}
+
+Polygonizer::Impl::Impl(const ImplicitFunction& f, SeedTetrahedralization&& seeds,
+                        const std::vector<double>& seed_values, const PolygonizerOptions& options)
     : closed_(options.close_at_box
                   ? std::make_unique<BoxClosedFunction>(f, seeds.domain, box_band(seeds.domain, options))
                   : nullptr),
@@ -241,18 +246,18 @@ Polygonizer::Polygonizer(const ImplicitFunction& f, SeedTetrahedralization&& see
 
 // Vertices whose evaluation is due: every live vertex without a fixed value, and with
 // refine_thin_features also the fixed ones, for their gradient.
-bool Polygonizer::needs_evaluation(VertexId v) const {
+bool Polygonizer::Impl::needs_evaluation(VertexId v) const {
   return tri_.is_vertex(v) && (!fixed_[v] || options_.refine_thin_features);
 }
 
 // f at the vertices `ids` into `out`, in one batch call; with refine_thin_features the gradients come
 // with the values (about the cost of the values alone for the RBF) and are stored in grad_.
-void Polygonizer::evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
+void Polygonizer::Impl::evaluate_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
   compute_at(ids, out);
   check_values(ids, out);
 }
 
-void Polygonizer::compute_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
+void Polygonizer::Impl::compute_at(const std::vector<VertexId>& ids, std::vector<double>& out) {
   std::vector<Point3> pts(ids.size());
   for (std::size_t i = 0; i < ids.size(); ++i) pts[i] = tri_.point(ids[i]);
   out.resize(ids.size());
@@ -267,7 +272,7 @@ void Polygonizer::compute_at(const std::vector<VertexId>& ids, std::vector<doubl
   stats_.vertex_evaluations += ids.size();
 }
 
-void Polygonizer::check_values(const std::vector<VertexId>& ids, const std::vector<double>& out) const {
+void Polygonizer::Impl::check_values(const std::vector<VertexId>& ids, const std::vector<double>& out) const {
   for (std::size_t i = 0; i < ids.size(); ++i)
     if (!fixed_[ids[i]] && std::isnan(out[i]))
       throw NumericalError("implicit function returned NaN at " + describe(tri_.point(ids[i])));
@@ -276,7 +281,7 @@ void Polygonizer::check_values(const std::vector<VertexId>& ids, const std::vect
 // evaluate_at() when a helper evaluated a round's new vertices (values_ahead.hpp): its results for the
 // vertices it was given (in the order of `ids`, at the points they still have), the others in one batch,
 // the same checks after. The same values, gradients and counts as evaluate_at(ids).
-void Polygonizer::values_from_ahead(const std::vector<VertexId>& ids, std::vector<double>& out) {
+void Polygonizer::Impl::values_from_ahead(const std::vector<VertexId>& ids, std::vector<double>& out) {
   polygonizer_detail::ValuesAhead& ahead = *ahead_;
   ahead.finish();
   out.resize(ids.size());
@@ -306,13 +311,13 @@ void Polygonizer::values_from_ahead(const std::vector<VertexId>& ids, std::vecto
 // After an edit put v where it is (or gave it a fixed value): its value when it has none of its own,
 // and with refine_thin_features its gradient at the new position in every case (the thin-feature test
 // and the normals of the mesh vertices collapsed onto it read grad_).
-void Polygonizer::refresh_at(VertexId v) {
+void Polygonizer::Impl::refresh_at(VertexId v) {
   if (!needs_evaluation(v)) return;
   pending_.push_back(v);
   evaluate_pending();
 }
 
-void Polygonizer::evaluate_pending() {
+void Polygonizer::Impl::evaluate_pending() {
   if (pending_.empty()) return;
   std::vector<VertexId> ids;
   ids.reserve(pending_.size());
@@ -328,14 +333,14 @@ void Polygonizer::evaluate_pending() {
     if (!fixed_[ids[i]]) set_value(ids[i], out[i]);
 }
 
-bool Polygonizer::is_transverse(TetId t) const {
+bool Polygonizer::Impl::is_transverse(TetId t) const {
   if (!tri_.is_live(t)) return false;
   const auto v = tri_.tet_vertices(t);
   const bool n0 = is_negative(values_[v[0]]);
   return is_negative(values_[v[1]]) != n0 || is_negative(values_[v[2]]) != n0 || is_negative(values_[v[3]]) != n0;
 }
 
-void Polygonizer::set_transverse(TetId t, bool on) {
+void Polygonizer::Impl::set_transverse(TetId t, bool on) {
   if (on == transverse_.contains(t)) return;
   if (on) {
     transverse_.add(t, tri_.tet_vertices(t), [this](VertexId u) {
@@ -361,14 +366,14 @@ void Polygonizer::set_transverse(TetId t, bool on) {
 // transverse count of a zero vertex dropping to 0 (set_transverse), tetrahedra created around a lone zero
 // (settle_zeros); no scan.
 
-void Polygonizer::set_value(VertexId v, double value) {
+void Polygonizer::Impl::set_value(VertexId v, double value) {
   values_[v] = value;
   surface_->note_value(v);
   note_thin_vertex(v);
   if ((value == 0.0 && options_.refine_lone_zeros) || lpos_[v] != kNotListed) zcheck_.push_back(v);
 }
 
-void Polygonizer::set_lonely(VertexId v, bool on) {
+void Polygonizer::Impl::set_lonely(VertexId v, bool on) {
   if (on == (lpos_[v] != kNotListed)) return;
   set_listed(lonely_, lpos_, v, on);
   if (on || !tri_.is_vertex(v)) return;
@@ -379,30 +384,30 @@ void Polygonizer::set_lonely(VertexId v, bool on) {
       if (kind_[u] == VertexKind::Refinement && transverse_.count(u) == 0) idle_.push_back(u);
 }
 
-bool Polygonizer::touches_lonely(TetId t) const {
+bool Polygonizer::Impl::touches_lonely(TetId t) const {
   for (const VertexId u : tri_.tet_vertices(t))
     if (lpos_[u] != kNotListed) return true;
   return false;
 }
 
-bool Polygonizer::is_active(TetId t) const {
+bool Polygonizer::Impl::is_active(TetId t) const {
   if (!tri_.is_live(t)) return false;
   return transverse_.contains(t) || touches_lonely(t);
 }
 
-double Polygonizer::sized_radius(TetId t) const {
+double Polygonizer::Impl::sized_radius(TetId t) const {
   const double r = tri_.circumradius(t);
   if (!options_.size_scale) return r;
   return r / std::max(1.0, options_.size_scale(tri_.circumcenter(t)));
 }
 
-void Polygonizer::push_if_big(TetId t) {
+void Polygonizer::Impl::push_if_big(TetId t) {
   if (!std::isfinite(precision_)) return;  // before the first refine(): nothing is queued
   radius_[t] = sized_radius(t);
   if (radius_[t] > precision_) push(t);
 }
 
-void Polygonizer::settle_zeros(const std::vector<TetId>& created) {
+void Polygonizer::Impl::settle_zeros(const std::vector<TetId>& created) {
   for (const VertexId u : zcheck_) {
     const bool lone = tri_.is_vertex(u) && values_[u] == 0.0 && transverse_.count(u) == 0;
     if (lone == (lpos_[u] != kNotListed)) continue;
@@ -416,7 +421,7 @@ void Polygonizer::settle_zeros(const std::vector<TetId>& created) {
     if (tri_.is_live(t) && !transverse_.contains(t) && touches_lonely(t)) push_if_big(t);
 }
 
-void Polygonizer::on_killed(const ChangeSet& cs) {
+void Polygonizer::Impl::on_killed(const ChangeSet& cs) {
   if (cs.renumbered) {
     // The Delaunay tree rebuilt its history and renumbered every tetrahedron (rare: after Omega(n)
     // edited tetrahedra): drop the per-tetrahedron state; cs.created lists every live tetrahedron and
@@ -437,14 +442,14 @@ void Polygonizer::on_killed(const ChangeSet& cs) {
 }
 
 // After a rejected move: the tree may still have renumbered its tetrahedra before rejecting it.
-void Polygonizer::absorb_renumbering() {
+void Polygonizer::Impl::absorb_renumbering() {
   if (!changes_.renumbered) return;
   on_killed(changes_);
   std::vector<TetId> all(changes_.created.begin(), changes_.created.end());
   classify_created(all);
 }
 
-void Polygonizer::classify(TetId t, bool requeue) {
+void Polygonizer::Impl::classify(TetId t, bool requeue) {
   if (!tri_.is_live(t)) return;
   const bool now = is_transverse(t);
   const bool was = transverse_.contains(t);
@@ -453,7 +458,7 @@ void Polygonizer::classify(TetId t, bool requeue) {
 
 // classify() of the live tetrahedron t, whose transverse flag `now` (and circumradius, read when it is
 // transverse and newly listed or requeued) were computed by the caller.
-void Polygonizer::classify_as(TetId t, bool requeue, bool now, double radius) {
+void Polygonizer::Impl::classify_as(TetId t, bool requeue, bool now, double radius) {
   if (options_.refine_necks) note_neck_candidates(t);  // its vertices' links changed (necks.cpp)
   const bool was = transverse_.contains(t);
   if (now && (!was || requeue)) radius_[t] = radius;
@@ -465,7 +470,7 @@ void Polygonizer::classify_as(TetId t, bool requeue, bool now, double radius) {
 // nothing is queued): the transverse flags and the circumradii of the transverse ones on the threads (each
 // slice writes only its own entries), then the list in id order on this thread, as classify() one
 // tetrahedron after the other builds it. Every vertex is a neck candidate (find_necks() sorts them).
-void Polygonizer::classify_all() {
+void Polygonizer::Impl::classify_all() {
   const std::size_t n = tri_.tet_capacity();
   std::vector<std::uint8_t> transverse(n, 0);
   const std::size_t slices = slice_count(options_.threads, n, kClassifySliceMin);
@@ -488,7 +493,7 @@ void Polygonizer::classify_all() {
 // triangulation and the values, which the serial pass does not change), then classify_as() in order on
 // this thread, as classify() one tetrahedron after the other would. An id may appear twice (created,
 // killed and reused within the round): both entries see its final tetrahedron, as before.
-void Polygonizer::classify_created(std::vector<TetId>& created) {
+void Polygonizer::Impl::classify_created(std::vector<TetId>& created) {
   struct Ahead {
     double radius = 0;  // when transverse
     bool live = false, transverse = false;
@@ -515,7 +520,7 @@ void Polygonizer::classify_created(std::vector<TetId>& created) {
   created.clear();
 }
 
-void Polygonizer::push(TetId t) {
+void Polygonizer::Impl::push(TetId t) {
   if (options_.order == QueueOrder::Fifo) {
     fifo_.push_back(t);
   } else {
@@ -523,7 +528,7 @@ void Polygonizer::push(TetId t) {
   }
 }
 
-bool Polygonizer::pop(TetId& t) {
+bool Polygonizer::Impl::pop(TetId& t) {
   if (options_.order == QueueOrder::Fifo) {
     if (fifo_.empty()) return false;
     t = fifo_.front();
@@ -536,15 +541,15 @@ bool Polygonizer::pop(TetId& t) {
   return true;
 }
 
-std::size_t Polygonizer::queued() const { return options_.order == QueueOrder::Fifo ? fifo_.size() : heap_.size(); }
+std::size_t Polygonizer::Impl::queued() const { return options_.order == QueueOrder::Fifo ? fifo_.size() : heap_.size(); }
 
-void Polygonizer::clear_queue() {
+void Polygonizer::Impl::clear_queue() {
   fifo_.clear();
   heap_ = {};
 }
 
 // Index of a face of t on the box hull (its neighbour there is kNoTet), or -1.
-int Polygonizer::hull_face(TetId t) const {
+int Polygonizer::Impl::hull_face(TetId t) const {
   for (int i = 0; i < 4; ++i)
     if (tri_.tet_neighbor(t, i) == kNoTet) return i;
   return -1;
@@ -554,7 +559,7 @@ int Polygonizer::hull_face(TetId t) const {
 // rounding put p just outside t's exact circumsphere (a nearly flat t), with point location instead.
 // The proximity rule is the same either way. On success the new vertex is registered (kind, value
 // pending) and the created tetrahedra are appended to `created`.
-bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, VertexKind kind,
+bool Polygonizer::Impl::insert_point(const Point3& p, TetId t, double min_distance, VertexKind kind,
                                std::vector<TetId>& created) {
   changes_.clear();
   InsertResult r = tri_.insert_in_conflict(p, t, min_distance, &changes_);
@@ -572,7 +577,7 @@ bool Polygonizer::insert_point(const Point3& p, TetId t, double min_distance, Ve
   return true;
 }
 
-bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKind kind,
+bool Polygonizer::Impl::insert_refinement_point(TetId t, double min_distance, VertexKind kind,
                                           std::vector<TetId>& created) {
   const Box3& box = tri_.box();
   Point3 p = tri_.circumcenter(t);
@@ -617,7 +622,7 @@ bool Polygonizer::insert_refinement_point(TetId t, double min_distance, VertexKi
   return inserted;
 }
 
-void Polygonizer::sample(double radius) {
+void Polygonizer::Impl::sample(double radius) {
   // A cubic lattice of cell centers with spacing h = 2 radius / sqrt(3): every point of the box lies in
   // a cell, within half a cell diagonal (= radius) of its center. Values are evaluated later in batch.
   const Box3& box = tri_.box();
@@ -649,7 +654,7 @@ void Polygonizer::sample(double radius) {
   }
 }
 
-void Polygonizer::finish_round(std::vector<TetId>& created, double dmin) {
+void Polygonizer::Impl::finish_round(std::vector<TetId>& created, double dmin) {
   evaluate_pending();
   if (!options_.refine_thin_features) {
     classify_created(created);
@@ -660,13 +665,13 @@ void Polygonizer::finish_round(std::vector<TetId>& created, double dmin) {
   check_thin(fresh, thin_min_length(dmin));
 }
 
-void Polygonizer::cancel_refinement() {
+void Polygonizer::Impl::cancel_refinement() {
   thin_all_ = true;  // the next refine() checks every tetrahedron for thin features again
   clear_queue();
   thin_.clear();
 }
 
-bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info) {
+bool Polygonizer::Impl::drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const double precision = precision_;
   const double thin_dmin = kThinDistance * dmin;
   std::vector<TetId> created, retry;
@@ -716,7 +721,7 @@ bool Polygonizer::drain_queue(double dmin, const ProgressCallback& progress, Ref
   return true;
 }
 
-bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
+bool Polygonizer::Impl::refine(double precision, const ProgressCallback& progress) {
   if (!(precision > 0.0) || !std::isfinite(precision))
     throw InvalidArgument("refine: precision must be positive and finite");
   const auto t0 = Clock::now();
@@ -765,7 +770,9 @@ bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
   return completed;
 }
 
-PolygonizerStats Polygonizer::stats() const {
+Polygonizer::Impl::~Impl() = default;
+
+PolygonizerStats Polygonizer::Impl::stats() const {
   PolygonizerStats s = stats_;
   s.vertices = tri_.num_vertices();
   s.tetrahedra = tri_.num_tetrahedra();
@@ -773,5 +780,47 @@ PolygonizerStats Polygonizer::stats() const {
   s.lone_zeros = lonely_.size();
   return s;
 }
+
+// ---- The public class: forwards to its Impl ----------------------------------------------------------
+
+Polygonizer::~Polygonizer() = default;
+
+bool Polygonizer::refine(double precision, const ProgressCallback& progress) {
+  return impl_->refine(precision, progress);
+}
+SurfaceMesh Polygonizer::extract() { return impl_->extract(); }
+MeshDelta Polygonizer::update_surface() { return impl_->update_surface(); }
+const LiveMesh& Polygonizer::live_surface() const { return impl_->live_surface(); }
+SurfaceMesh Polygonizer::extract_fresh() { return impl_->extract_fresh(); }
+VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value, VertexKind kind) {
+  return impl_->insert_vertex(p, value, kind);
+}
+void Polygonizer::remove_vertex(VertexId v) { impl_->remove_vertex(v); }
+bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double> value) {
+  return impl_->move_vertex(v, p, value);
+}
+void Polygonizer::set_vertex_value(VertexId v, double value) { impl_->set_vertex_value(v, value); }
+void Polygonizer::function_changed() { impl_->function_changed(); }
+void Polygonizer::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
+  impl_->function_changed(may_have_changed);
+}
+void Polygonizer::function_changed(const std::vector<Ball>& changed) { impl_->function_changed(changed); }
+double Polygonizer::crossing_reach() const { return impl_->crossing_reach(); }
+std::size_t Polygonizer::collect_garbage(double min_fraction, std::size_t max_removals) {
+  return impl_->collect_garbage(min_fraction, max_removals);
+}
+const Triangulation& Polygonizer::triangulation() const { return impl_->tri_; }
+const ImplicitFunction& Polygonizer::function() const { return impl_->f_; }
+double Polygonizer::closing_band() const { return impl_->closed_ ? impl_->closed_->band() : 0.0; }
+double Polygonizer::vertex_value(VertexId v) const { return impl_->values_[v]; }
+VertexKind Polygonizer::vertex_kind(VertexId v) const { return impl_->kind_[v]; }
+const std::vector<VertexId>& Polygonizer::seed_vertices() const { return impl_->seed_vertices_; }
+const std::vector<TetId>& Polygonizer::transverse_tetrahedra() const { return impl_->transverse_.list(); }
+bool Polygonizer::is_transverse(TetId t) const { return impl_->is_transverse(t); }
+bool Polygonizer::is_active(TetId t) const { return impl_->is_active(t); }
+const std::vector<VertexId>& Polygonizer::lone_zero_vertices() const { return impl_->lonely_; }
+double Polygonizer::precision() const { return impl_->precision_; }
+PolygonizerStats Polygonizer::stats() const { return impl_->stats(); }
+const PolygonizerOptions& Polygonizer::options() const { return impl_->options_; }
 
 }  // namespace vitri

@@ -1,6 +1,7 @@
 // Thin features: the Polygonizer's test and refinement of Delaunay edges crossed twice by the surface
 // (docs/polygonize.md, "Thin features"). Split from polygonizer.cpp.
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 
 #include "polygonizer_internal.hpp"
 #include "slices.hpp"
@@ -37,7 +38,7 @@ constexpr std::size_t kThinSliceMin = std::size_t(1) << 12;  // tetrahedra per t
 // halves are checked again with the new gradient. Termination: these points too are >= dmin from every
 // vertex (docs/polygonize.md).
 
-bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
+bool Polygonizer::Impl::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
   double fa = values_[a], fb = values_[b];
   if (is_negative(fa) != is_negative(fb)) return false;
   const Point3& ga = grad_[a];
@@ -63,7 +64,7 @@ bool Polygonizer::crossed_twice(VertexId a, VertexId b, double min_length, doubl
   return s > 0.0 && s < 1.0;
 }
 
-void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) {
+void Polygonizer::Impl::check_thin(const std::vector<TetId>& tets, double min_length) {
   const std::size_t first = thin_.size();
   const auto check = [&](std::size_t lo, std::size_t hi, std::vector<ThinEdge>& out) {
     for (std::size_t k = lo; k < hi; ++k) {
@@ -108,19 +109,19 @@ void Polygonizer::check_thin(const std::vector<TetId>& tets, double min_length) 
 
 // Between refine() calls: remember what the next one must test (bounded: past the live tetrahedra
 // count, test everything instead).
-void Polygonizer::note_thin_vertex(VertexId v) {
+void Polygonizer::Impl::note_thin_vertex(VertexId v) {
   if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
   thin_vertices_.push_back(v);
   if (thin_vertices_.size() > tri_.num_vertices()) thin_all_ = true;
 }
 
-void Polygonizer::note_thin_tets(const std::vector<TetId>& tets) {
+void Polygonizer::Impl::note_thin_tets(const std::vector<TetId>& tets) {
   if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
   thin_tets_.insert(thin_tets_.end(), tets.begin(), tets.end());
   if (thin_tets_.size() > tri_.num_tetrahedra()) thin_all_ = true;
 }
 
-std::vector<TetId> Polygonizer::thin_recheck_set() {
+std::vector<TetId> Polygonizer::Impl::thin_recheck_set() {
   // With the history (an interactive session: a recheck per edit) repeated tetrahedra are dropped by
   // marks, O(set); a batch run rechecks rarely (a new precision checks every tetrahedron instead) and
   // sorts the repeats out instead, so that no mark array over every tetrahedron (4 bytes each, 0.12 GB
@@ -145,7 +146,7 @@ std::vector<TetId> Polygonizer::thin_recheck_set() {
   return tets;
 }
 
-bool Polygonizer::insert_thin_point(double min_distance, std::vector<TetId>& created) {
+bool Polygonizer::Impl::insert_thin_point(double min_distance, std::vector<TetId>& created) {
   const ThinEdge e = thin_.back();
   thin_.pop_back();
   if (!tri_.is_vertex(e.a) || !tri_.is_vertex(e.b)) return false;

@@ -1,6 +1,7 @@
 // Dynamic editing: vertices inserted, removed and moved with their values, the tetrahedra they change
 // reclassified (docs/polygonize.md, "Dynamic updates"). Split from polygonizer.cpp.
 #include "vitri/polygonize/polygonizer.hpp"
+#include "polygonizer_impl.hpp"
 
 #include "polygonizer_internal.hpp"
 #include "surface_tracker.hpp"
@@ -17,7 +18,7 @@ using namespace polygonizer_detail;
 
 // ---- Dynamic editing ----------------------------------------------------------------------------------
 
-VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value, VertexKind kind) {
+VertexId Polygonizer::Impl::insert_vertex(const Point3& p, std::optional<double> value, VertexKind kind) {
   if (!is_finite(p)) throw InvalidPoint(0, "coordinates are not finite");
   if (!strictly_inside(tri_.box(), p))
     throw InvalidPoint(0, "point " + describe(p) + " is not strictly inside the domain box");
@@ -45,7 +46,7 @@ VertexId Polygonizer::insert_vertex(const Point3& p, std::optional<double> value
   return v;
 }
 
-void Polygonizer::remove_vertex(VertexId v) {
+void Polygonizer::Impl::remove_vertex(VertexId v) {
   if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("remove_vertex: not a removable vertex");
   set_lonely(v, false);
   changes_.clear();
@@ -55,7 +56,7 @@ void Polygonizer::remove_vertex(VertexId v) {
   classify_created(created);
 }
 
-bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double> value) {
+bool Polygonizer::Impl::move_vertex(VertexId v, const Point3& p, std::optional<double> value) {
   if (!tri_.is_vertex(v) || tri_.is_corner(v)) throw InvalidArgument("move_vertex: not a movable vertex");
   if (!is_finite(p)) throw InvalidPoint(0, "coordinates are not finite");
   if (!strictly_inside(tri_.box(), p))
@@ -96,7 +97,7 @@ bool Polygonizer::move_vertex(VertexId v, const Point3& p, std::optional<double>
   return true;
 }
 
-void Polygonizer::set_vertex_value(VertexId v, double value) {
+void Polygonizer::Impl::set_vertex_value(VertexId v, double value) {
   if (!tri_.is_vertex(v)) throw InvalidArgument("set_vertex_value: not a vertex");
   if (!std::isfinite(value)) throw InvalidArgument("set_vertex_value: value is not finite");
   set_value(v, value);

@@ -110,14 +110,6 @@ std::vector<VertexId> Polygonizer::Impl::vertices_near(const std::vector<Ball>& 
   return out;
 }
 
-void Polygonizer::Impl::VisitMarks::begin(std::size_t capacity) {
-  if (stamp.size() < capacity) stamp.resize(capacity + capacity / 2, 0);
-  if (++epoch == 0) {  // wrapped: old stamps could match again
-    std::fill(stamp.begin(), stamp.end(), 0);
-    epoch = 1;
-  }
-}
-
 // New values at `ids` (one batch), then the tetrahedra around vertices whose sign flipped are
 // reclassified; the thin-feature test of the next refine() sees every vertex whose value changed.
 void Polygonizer::Impl::reevaluate(const std::vector<VertexId>& ids) {
@@ -148,7 +140,7 @@ std::size_t Polygonizer::Impl::collect_garbage(double min_fraction, std::size_t 
   // Keep the refinement of the stars of lone zeros (they are active; removing would redo it). Such a
   // vertex leaves the list; set_lonely() puts it back when the zero stops being lone.
   const auto serves = [&](VertexId v) {
-    if (lpos_[v] != kNotListed) return true;
+    if (lone_.contains(v)) return true;
     for (const TetId t : tri_.incident_tetrahedra(v))
       if (touches_lonely(t)) return true;
     return false;

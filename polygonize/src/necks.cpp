@@ -40,22 +40,10 @@ constexpr double kNeckDepth = 16.0;
 
 }  // namespace
 
-void Polygonizer::Impl::note_neck_vertex(VertexId v) {
-  if (neck_mark_[v]) return;
-  neck_mark_[v] = 1;
-  neck_candidates_.push_back(v);
-}
-
-void Polygonizer::Impl::note_neck_candidates(TetId t) {
-  for (const VertexId u : tri_.tet_vertices(t)) note_neck_vertex(u);
-}
-
 std::vector<VertexId> Polygonizer::Impl::find_necks() {
-  std::vector<VertexId> candidates;
-  candidates.swap(neck_candidates_);
+  std::vector<VertexId> candidates = necks_.take();
   std::size_t kept = 0;
   for (const VertexId v : candidates) {
-    neck_mark_[v] = 0;
     // A neck has vertices of both signs around it (a transverse tetrahedron); corners have no full link.
     if (tri_.is_vertex(v) && !tri_.is_corner(v) && transverse_.count(v) > 0) candidates[kept++] = v;
   }
@@ -134,7 +122,7 @@ bool Polygonizer::Impl::settle_necks(double dmin, const ProgressCallback& progre
       // Left as they are (no tetrahedron of theirs above d / kNeckDepth): checked again by the next
       // refine(), whose precision, hence d, may be smaller.
       stats_.necks_left = necks.size();
-      for (const VertexId v : necks) note_neck_vertex(v);
+      for (const VertexId v : necks) necks_.note(v);
       break;
     }
     stats_.neck_insertions += inserted;
@@ -142,7 +130,7 @@ bool Polygonizer::Impl::settle_necks(double dmin, const ProgressCallback& progre
     finish_round(created, dmin);
     if (progress) {  // after a round of checks (seconds at 10^6 points): the state is consistent here
       info.vertices = tri_.num_vertices();
-      info.queued = queued() + thin_.size();
+      info.queued = queue_.size() + thin_.edge_count();
       if (!progress(info)) {
         cancel_refinement();
         completed = false;

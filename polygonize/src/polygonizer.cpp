@@ -22,9 +22,14 @@
 // distance >= d_min in a bounded box are finitely many (packing), each queue entry is either dropped or
 // causes an insertion, and entries are created only by insertions: the loop ends.
 //
-// Files: this one (construction, evaluation, classification, lone zeros, queue, refinement), thin
-// features (thin_features.cpp), vertex edits (vertex_edits.cpp), function changes and garbage collection
-// (function_changes.cpp), necks (necks.cpp), extraction (extract.cpp over surface_tracker.hpp), the
+// Files: the state is Polygonizer::Impl (polygonizer_impl.hpp), which coordinates parts that own
+// their state: the transverse set (transverse_set.hpp), the lone zeros (lone_zeros.hpp), the refinement
+// queue (refinement_queue.hpp), the neck candidates (neck_candidates.hpp), the thin features
+// (thin_features.hpp) and the incremental mesh (surface_tracker.hpp); docs/polygonize.md "Inside the
+// Polygonizer". This file: construction, evaluation, classification, lone zeros, refinement, and the
+// public class forwarding to its Impl. The Impl's other steps: thin features (thin_features.cpp), vertex
+// edits (vertex_edits.cpp), function changes and garbage collection (function_changes.cpp), necks
+// (necks.cpp), the certificate (certify.cpp), extraction (extract.cpp over surface_tracker.hpp); the
 // closing function of close_at_box (box_closure.cpp).
 #include "vitri/polygonize/polygonizer.hpp"
 #include "polygonizer_impl.hpp"
@@ -66,24 +71,6 @@ constexpr std::size_t kRoundSize = 4096;  // queue entries per round (batch of e
 constexpr std::size_t kAheadRoundMin = 256;
 constexpr std::size_t kClassifySliceMin = std::size_t(1) << 16;  // tetrahedra per thread of classify_all
 constexpr std::size_t kCreatedSliceMin = std::size_t(1) << 12;   // of classify_created (a round's tetrahedra)
-
-/// Adds x to / removes x from an unordered list with positions (pos[x]: index in list, or kNotListed);
-/// removal swaps the last element in. @pre x is not listed (on) or listed (off).
-template <typename PosMap>  // a VertexMap or TetMap of std::uint32_t
-void set_listed(std::vector<std::uint32_t>& list, PosMap& pos, std::uint32_t x, bool on) {
-  if (on) {
-    pos[x] = static_cast<std::uint32_t>(list.size());
-    list.push_back(x);
-  } else {
-    const std::uint32_t i = pos[x];
-    const std::uint32_t last = list.back();
-    list[i] = last;
-    pos[last] = i;
-    list.pop_back();
-    pos[x] = kNotListed;
-  }
-}
-
 
 }  // namespace
 
@@ -193,12 +180,14 @@ Polygonizer::Impl::Impl(const ImplicitFunction& f, SeedTetrahedralization&& seed
       values_(tri_, 0.0),
       kind_(tri_, VertexKind::Refinement),
       fixed_(tri_, 0),
-      transverse_(tri_),
+      grad_(tri_, Point3{kNaN, kNaN, kNaN}),
       radius_(tri_, 0.0, TetRenumbering::Reset),
-      lpos_(tri_, kNotListed),
-      neck_mark_(tri_, 0),
-      surface_(std::make_unique<SurfaceTracker>(tri_)),
-      grad_(tri_, Point3{kNaN, kNaN, kNaN}) {
+      transverse_(tri_),
+      lone_(tri_),
+      queue_(options.order),
+      necks_(tri_),
+      thin_(tri_, values_, grad_),
+      surface_(std::make_unique<SurfaceTracker>(tri_)) {
   const auto t0 = Clock::now();
   check_options(options_);  // (the closing band was checked by closed_'s initializer)
   if (tri_.keeps_history() != options_.keep_history)
@@ -344,12 +333,12 @@ void Polygonizer::Impl::set_transverse(TetId t, bool on) {
   if (on == transverse_.contains(t)) return;
   if (on) {
     transverse_.add(t, tri_.tet_vertices(t), [this](VertexId u) {
-      if (lpos_[u] != kNotListed) set_lonely(u, false);  // no longer a lone zero
+      if (lone_.contains(u)) set_lonely(u, false);  // no longer a lone zero
     });
   } else {
     transverse_.remove(t, tri_.tet_vertices(t), [this](VertexId u) {
       // The vertex may have become a lone zero (decided after the batch), or garbage.
-      if (values_[u] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(u);
+      if (values_[u] == 0.0 && options_.refine_lone_zeros) lone_.note_check(u);
       if (kind_[u] == VertexKind::Refinement) idle_.push_back(u);
     });
   }
@@ -370,24 +359,17 @@ void Polygonizer::Impl::set_value(VertexId v, double value) {
   values_[v] = value;
   surface_->note_value(v);
   note_thin_vertex(v);
-  if ((value == 0.0 && options_.refine_lone_zeros) || lpos_[v] != kNotListed) zcheck_.push_back(v);
+  if ((value == 0.0 && options_.refine_lone_zeros) || lone_.contains(v)) lone_.note_check(v);
 }
 
 void Polygonizer::Impl::set_lonely(VertexId v, bool on) {
-  if (on == (lpos_[v] != kNotListed)) return;
-  set_listed(lonely_, lpos_, v, on);
+  if (!lone_.set(v, on)) return;  // no change
   if (on || !tri_.is_vertex(v)) return;
   // The refinement vertices around v may have served only its star: garbage candidates again
   // (collect_garbage() dropped them while they served).
   for (const TetId t : tri_.incident_tetrahedra(v))
     for (const VertexId u : tri_.tet_vertices(t))
       if (kind_[u] == VertexKind::Refinement && transverse_.count(u) == 0) idle_.push_back(u);
-}
-
-bool Polygonizer::Impl::touches_lonely(TetId t) const {
-  for (const VertexId u : tri_.tet_vertices(t))
-    if (lpos_[u] != kNotListed) return true;
-  return false;
 }
 
 bool Polygonizer::Impl::is_active(TetId t) const {
@@ -408,15 +390,14 @@ void Polygonizer::Impl::push_if_big(TetId t) {
 }
 
 void Polygonizer::Impl::settle_zeros(const std::vector<TetId>& created) {
-  for (const VertexId u : zcheck_) {
+  lone_.settle_checks([&](VertexId u) {
     const bool lone = tri_.is_vertex(u) && values_[u] == 0.0 && transverse_.count(u) == 0;
-    if (lone == (lpos_[u] != kNotListed)) continue;
+    if (lone == lone_.contains(u)) return;
     set_lonely(u, lone);
     if (lone)
       for (const TetId t : tri_.incident_tetrahedra(u)) push_if_big(t);
-  }
-  zcheck_.clear();
-  if (lonely_.empty()) return;
+  });
+  if (lone_.empty()) return;
   for (const TetId t : created)
     if (tri_.is_live(t) && !transverse_.contains(t) && touches_lonely(t)) push_if_big(t);
 }
@@ -428,8 +409,8 @@ void Polygonizer::Impl::on_killed(const ChangeSet& cs) {
     // the caller classifies them (O(n), amortized O(1) per edit). Vertex state is kept.
     surface_->note_renumbered();
     transverse_.clear();  // its positions and radius_ were reset by the tree (TetRenumbering::Reset)
-    clear_queue();
-    thin_all_ = true;
+    queue_.clear();
+    thin_.note_all();
     idle_.clear();  // every refinement vertex is a candidate again until classified
     for (VertexId v = 8; v < tri_.vertex_capacity(); ++v)
       if (tri_.is_vertex(v) && kind_[v] == VertexKind::Refinement) idle_.push_back(v);
@@ -459,7 +440,7 @@ void Polygonizer::Impl::classify(TetId t, bool requeue) {
 // classify() of the live tetrahedron t, whose transverse flag `now` (and circumradius, read when it is
 // transverse and newly listed or requeued) were computed by the caller.
 void Polygonizer::Impl::classify_as(TetId t, bool requeue, bool now, double radius) {
-  if (options_.refine_necks) note_neck_candidates(t);  // its vertices' links changed (necks.cpp)
+  if (options_.refine_necks) necks_.note(tri_.tet_vertices(t));  // its vertices' links changed (necks.cpp)
   const bool was = transverse_.contains(t);
   if (now && (!was || requeue)) radius_[t] = radius;
   set_transverse(t, now);
@@ -485,7 +466,7 @@ void Polygonizer::Impl::classify_all() {
     if (transverse[t]) set_transverse(static_cast<TetId>(t), true);
   if (options_.refine_necks)
     for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
-      if (tri_.is_vertex(v)) note_neck_vertex(v);
+      if (tri_.is_vertex(v)) necks_.note(v);
 }
 
 // The tetrahedra created by a round of insertions (thousands during a refinement): their liveness,
@@ -518,34 +499,6 @@ void Polygonizer::Impl::classify_created(std::vector<TetId>& created) {
   note_thin_tets(created);
   settle_zeros(created);
   created.clear();
-}
-
-void Polygonizer::Impl::push(TetId t) {
-  if (options_.order == QueueOrder::Fifo) {
-    fifo_.push_back(t);
-  } else {
-    heap_.emplace(radius_[t], t);
-  }
-}
-
-bool Polygonizer::Impl::pop(TetId& t) {
-  if (options_.order == QueueOrder::Fifo) {
-    if (fifo_.empty()) return false;
-    t = fifo_.front();
-    fifo_.pop_front();
-  } else {
-    if (heap_.empty()) return false;
-    t = heap_.top().second;
-    heap_.pop();
-  }
-  return true;
-}
-
-std::size_t Polygonizer::Impl::queued() const { return options_.order == QueueOrder::Fifo ? fifo_.size() : heap_.size(); }
-
-void Polygonizer::Impl::clear_queue() {
-  fifo_.clear();
-  heap_ = {};
 }
 
 // Index of a face of t on the box hull (its neighbour there is kNoTet), or -1.
@@ -662,25 +615,25 @@ void Polygonizer::Impl::finish_round(std::vector<TetId>& created, double dmin) {
   }
   const std::vector<TetId> fresh(created);  // classify_created() empties `created`
   classify_created(created);
-  check_thin(fresh, thin_min_length(dmin));
+  thin_.check(fresh, thin_min_length(dmin), options_.threads);
 }
 
 void Polygonizer::Impl::cancel_refinement() {
-  thin_all_ = true;  // the next refine() checks every tetrahedron for thin features again
-  clear_queue();
-  thin_.clear();
+  thin_.note_all();  // the next refine() checks every tetrahedron for thin features again
+  queue_.clear();
+  thin_.clear_edges();
 }
 
 bool Polygonizer::Impl::drain_queue(double dmin, const ProgressCallback& progress, RefineProgress& info) {
   const double precision = precision_;
   const double thin_dmin = kThinDistance * dmin;
   std::vector<TetId> created, retry;
-  while (queued() > 0 || !thin_.empty()) {
-    const std::size_t n = std::min(queued(), kRoundSize);
+  while (!queue_.empty() || thin_.has_edges()) {
+    const std::size_t n = std::min(queue_.size(), kRoundSize);
     // With threads, f at the round's new vertices on a helper while the insertions go on (they are
     // serial; values_ahead.hpp): the batch below then takes its results. At most one point per entry.
     std::optional<polygonizer_detail::ValuesAhead> ahead;
-    const std::size_t most = n + thin_.size();
+    const std::size_t most = n + thin_.edge_count();
     if (resolve_thread_count(options_.threads) > 1 && most >= kAheadRoundMin)
       ahead.emplace(f_, options_.refine_thin_features, most);
     struct Detach {  // ahead_ is cleared at the round's end, before the helper is joined, also on a throw
@@ -690,7 +643,7 @@ bool Polygonizer::Impl::drain_queue(double dmin, const ProgressCallback& progres
     ahead_ = ahead ? &*ahead : nullptr;
     for (std::size_t i = 0; i < n; ++i) {
       TetId t;
-      if (!pop(t)) break;
+      if (!queue_.pop(t)) break;
       if (!is_active(t) || radius_[t] <= precision) continue;
       const bool lone_star = !transverse_.contains(t);
       if (insert_refinement_point(t, dmin, VertexKind::Refinement, created)) {
@@ -700,9 +653,9 @@ bool Polygonizer::Impl::drain_queue(double dmin, const ProgressCallback& progres
       }
     }
     // Edges flagged by the previous round (or the initial check): one point each.
-    if (!thin_.empty()) {
+    if (thin_.has_edges()) {
       const std::size_t before = stats_.thin_insertions;
-      while (!thin_.empty()) insert_thin_point(thin_dmin, created);
+      while (thin_.has_edges()) insert_thin_point(thin_dmin, created);
       info.inserted += stats_.thin_insertions - before;
     }
     finish_round(created, dmin);
@@ -711,7 +664,7 @@ bool Polygonizer::Impl::drain_queue(double dmin, const ProgressCallback& progres
     retry.clear();
     if (progress) {
       info.vertices = tri_.num_vertices();
-      info.queued = queued() + thin_.size();
+      info.queued = queue_.size() + thin_.edge_count();
       if (!progress(info)) {
         cancel_refinement();
         return false;
@@ -728,25 +681,25 @@ bool Polygonizer::Impl::refine(double precision, const ProgressCallback& progres
   // After edits at the same precision (the Mesher's updates), the queue already holds every active
   // tetrahedron above the precision (classify() and settle_zeros() queue them as they appear), and only
   // the tetrahedra created or around changed vertices need the thin-feature test: no pass over the mesh.
-  const bool resume = queue_valid_ && precision == precision_ && !thin_all_;
+  const bool resume = queue_valid_ && precision == precision_ && !thin_.all();
   precision_ = precision;
   const double dmin = options_.min_distance_fraction * precision;
   if (!resume) {
-    clear_queue();
+    queue_.clear();
     for (const TetId t : transverse_.list())
       if (radius_[t] > precision) push(t);
-    for (const VertexId z : lonely_)
+    for (const VertexId z : lone_.list())
       for (const TetId t : tri_.incident_tetrahedra(z)) push_if_big(t);
   }
   // Thin features: edges shorter than 2 dmin are not checked (every point of them is within dmin of an
   // end, so its point would be rejected anyway). A new precision checks every live tetrahedron (the
   // length floor moved); a resumed one those changed since; from then on only the created ones.
-  thin_.clear();
+  thin_.clear_edges();
   if (options_.refine_thin_features)
-    check_thin(resume ? thin_recheck_set() : tri_.live_tetrahedra(), thin_min_length(dmin));
-  thin_tets_.clear();
-  thin_vertices_.clear();
-  thin_all_ = false;
+    thin_.check(resume ? thin_.recheck_set(options_.keep_history, tet_marks_, vertex_marks_)
+                       : tri_.live_tetrahedra(),
+                thin_min_length(dmin), options_.threads);
+  thin_.forget_notes();
   in_refine_ = true;
   RefineProgress info;
   bool completed = drain_queue(dmin, progress, info);
@@ -777,7 +730,7 @@ PolygonizerStats Polygonizer::Impl::stats() const {
   s.vertices = tri_.num_vertices();
   s.tetrahedra = tri_.num_tetrahedra();
   s.transverse = transverse_.size();
-  s.lone_zeros = lonely_.size();
+  s.lone_zeros = lone_.size();
   return s;
 }
 
@@ -818,7 +771,7 @@ const std::vector<VertexId>& Polygonizer::seed_vertices() const { return impl_->
 const std::vector<TetId>& Polygonizer::transverse_tetrahedra() const { return impl_->transverse_.list(); }
 bool Polygonizer::is_transverse(TetId t) const { return impl_->is_transverse(t); }
 bool Polygonizer::is_active(TetId t) const { return impl_->is_active(t); }
-const std::vector<VertexId>& Polygonizer::lone_zero_vertices() const { return impl_->lonely_; }
+const std::vector<VertexId>& Polygonizer::lone_zero_vertices() const { return impl_->lone_.list(); }
 double Polygonizer::precision() const { return impl_->precision_; }
 PolygonizerStats Polygonizer::stats() const { return impl_->stats(); }
 const PolygonizerOptions& Polygonizer::options() const { return impl_->options_; }

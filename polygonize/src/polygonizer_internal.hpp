@@ -12,8 +12,6 @@
 
 namespace vitri::polygonizer_detail {
 
-inline constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
-
 using Clock = std::chrono::steady_clock;
 inline double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();

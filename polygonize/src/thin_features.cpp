@@ -1,10 +1,12 @@
-// Thin features: the Polygonizer's test and refinement of Delaunay edges crossed twice by the surface
-// (docs/polygonize.md, "Thin features"). Split from polygonizer.cpp.
-#include "vitri/polygonize/polygonizer.hpp"
-#include "polygonizer_impl.hpp"
+// Thin features: the test of Delaunay edges crossed twice by the surface and the state around it
+// (ThinFeatures, thin_features.hpp), and the Polygonizer's refinement of the flagged edges
+// (docs/polygonize.md, "Thin features").
+#include "thin_features.hpp"
 
+#include "polygonizer_impl.hpp"
 #include "polygonizer_internal.hpp"
 #include "slices.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -38,7 +40,7 @@ constexpr std::size_t kThinSliceMin = std::size_t(1) << 12;  // tetrahedra per t
 // halves are checked again with the new gradient. Termination: these points too are >= dmin from every
 // vertex (docs/polygonize.md).
 
-bool Polygonizer::Impl::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
+bool ThinFeatures::crossed_twice(VertexId a, VertexId b, double min_length, double& s) const {
   double fa = values_[a], fb = values_[b];
   if (is_negative(fa) != is_negative(fb)) return false;
   const Point3& ga = grad_[a];
@@ -64,9 +66,9 @@ bool Polygonizer::Impl::crossed_twice(VertexId a, VertexId b, double min_length,
   return s > 0.0 && s < 1.0;
 }
 
-void Polygonizer::Impl::check_thin(const std::vector<TetId>& tets, double min_length) {
-  const std::size_t first = thin_.size();
-  const auto check = [&](std::size_t lo, std::size_t hi, std::vector<ThinEdge>& out) {
+void ThinFeatures::check(const std::vector<TetId>& tets, double min_length, unsigned threads) {
+  const std::size_t first = edges_.size();
+  const auto test = [&](std::size_t lo, std::size_t hi, std::vector<ThinEdge>& out) {
     for (std::size_t k = lo; k < hi; ++k) {
       // The test waits on memory: the records 16 ahead are fetched, and the values and gradients of
       // the vertices of the one 8 ahead (its record fetched 8 iterations ago).
@@ -86,58 +88,57 @@ void Polygonizer::Impl::check_thin(const std::vector<TetId>& tets, double min_le
         }
     }
   };
-  // The first check of a refinement reads every live tetrahedron: on the threads of options_.threads,
+  // The first check of a refinement reads every live tetrahedron: on `threads` (options_.threads),
   // each slice of `tets` into its own list, the lists then appended in slice order (the same entries in
   // the same order as one pass, so the same edges survive the deduplication below).
-  const std::size_t slices = slice_count(options_.threads, tets.size(), kThinSliceMin);
+  const std::size_t slices = slice_count(threads, tets.size(), kThinSliceMin);
   if (slices <= 1) {
-    check(0, tets.size(), thin_);
+    test(0, tets.size(), edges_);
   } else {
     std::vector<std::vector<ThinEdge>> found(slices);
     run_slices(tets.size(), slices,
-               [&](std::size_t k, std::size_t lo, std::size_t hi) { check(lo, hi, found[k]); });
-    for (const auto& part : found) thin_.insert(thin_.end(), part.begin(), part.end());
+               [&](std::size_t k, std::size_t lo, std::size_t hi) { test(lo, hi, found[k]); });
+    for (const auto& part : found) edges_.insert(edges_.end(), part.begin(), part.end());
   }
   // An edge is in several of these tetrahedra: keep one entry per edge.
   const auto key = [](const ThinEdge& e) { return std::make_pair(std::min(e.a, e.b), std::max(e.a, e.b)); };
-  std::sort(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
+  std::sort(edges_.begin() + static_cast<std::ptrdiff_t>(first), edges_.end(),
             [&](const ThinEdge& x, const ThinEdge& y) { return key(x) < key(y); });
-  thin_.erase(std::unique(thin_.begin() + static_cast<std::ptrdiff_t>(first), thin_.end(),
+  edges_.erase(std::unique(edges_.begin() + static_cast<std::ptrdiff_t>(first), edges_.end(),
                           [&](const ThinEdge& x, const ThinEdge& y) { return key(x) == key(y); }),
-              thin_.end());
+               edges_.end());
 }
 
 // Between refine() calls: remember what the next one must test (bounded: past the live tetrahedra
 // count, test everything instead).
-void Polygonizer::Impl::note_thin_vertex(VertexId v) {
-  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
-  thin_vertices_.push_back(v);
-  if (thin_vertices_.size() > tri_.num_vertices()) thin_all_ = true;
+void ThinFeatures::note_vertex(VertexId v) {
+  if (all_) return;
+  vertices_.push_back(v);
+  if (vertices_.size() > tri_.num_vertices()) all_ = true;
 }
 
-void Polygonizer::Impl::note_thin_tets(const std::vector<TetId>& tets) {
-  if (in_refine_ || thin_all_ || !options_.refine_thin_features) return;
-  thin_tets_.insert(thin_tets_.end(), tets.begin(), tets.end());
-  if (thin_tets_.size() > tri_.num_tetrahedra()) thin_all_ = true;
+void ThinFeatures::note_tets(const std::vector<TetId>& tets) {
+  if (all_) return;
+  tets_.insert(tets_.end(), tets.begin(), tets.end());
+  if (tets_.size() > tri_.num_tetrahedra()) all_ = true;
 }
 
-std::vector<TetId> Polygonizer::Impl::thin_recheck_set() {
+std::vector<TetId> ThinFeatures::recheck_set(bool marks, VisitMarks& tet_marks, VisitMarks& vertex_marks) const {
   // With the history (an interactive session: a recheck per edit) repeated tetrahedra are dropped by
   // marks, O(set); a batch run rechecks rarely (a new precision checks every tetrahedron instead) and
   // sorts the repeats out instead, so that no mark array over every tetrahedron (4 bytes each, 0.12 GB
   // at 10^6 input points) stays resident for a few thousand ids.
-  const bool marks = options_.keep_history;
   std::vector<TetId> tets;
-  if (marks) tet_marks_.begin(tri_.tet_capacity());
-  vertex_marks_.begin(tri_.vertex_capacity());
+  if (marks) tet_marks.begin(tri_.tet_capacity());
+  vertex_marks.begin(tri_.vertex_capacity());
   const auto add = [&](TetId t) {
-    if (!marks || tet_marks_.first_visit(t)) tets.push_back(t);
+    if (!marks || tet_marks.first_visit(t)) tets.push_back(t);
   };
-  for (const TetId t : thin_tets_)
+  for (const TetId t : tets_)
     if (t < tri_.tet_capacity()) add(t);
   std::vector<TetId> star;
-  for (const VertexId v : thin_vertices_) {
-    if (!tri_.is_vertex(v) || !vertex_marks_.first_visit(v)) continue;
+  for (const VertexId v : vertices_) {
+    if (!tri_.is_vertex(v) || !vertex_marks.first_visit(v)) continue;
     tri_.incident_tetrahedra(v, star);
     for (const TetId t : star) add(t);
   }
@@ -146,9 +147,22 @@ std::vector<TetId> Polygonizer::Impl::thin_recheck_set() {
   return tets;
 }
 
+// ---- The Polygonizer's side ------------------------------------------------------------------------------
+
+// Between refine() calls: remember what the next one must test (not while refine() runs: its own checks
+// cover what it changes).
+void Polygonizer::Impl::note_thin_vertex(VertexId v) {
+  if (in_refine_ || !options_.refine_thin_features) return;
+  thin_.note_vertex(v);
+}
+
+void Polygonizer::Impl::note_thin_tets(const std::vector<TetId>& tets) {
+  if (in_refine_ || !options_.refine_thin_features) return;
+  thin_.note_tets(tets);
+}
+
 bool Polygonizer::Impl::insert_thin_point(double min_distance, std::vector<TetId>& created) {
-  const ThinEdge e = thin_.back();
-  thin_.pop_back();
+  const ThinEdge e = thin_.pop_edge();
   if (!tri_.is_vertex(e.a) || !tri_.is_vertex(e.b)) return false;
   // A tetrahedron that still has the edge (the one that flagged it may have died; if the edge survived,
   // a tetrahedron around a or b has it).

@@ -90,9 +90,9 @@ bool Polygonizer::Impl::move_vertex(VertexId v, const Point3& p, std::optional<d
   // The star of a lone zero v is re-queued too (settle_zeros only sees the created tetrahedra).
   for (const TetId t : tri_.incident_tetrahedra(v)) {
     classify(t, true);
-    if (lpos_[v] != kNotListed) push_if_big(t);
+    if (lone_.contains(v)) push_if_big(t);
   }
-  if (values_[v] == 0.0 && options_.refine_lone_zeros) zcheck_.push_back(v);
+  if (values_[v] == 0.0 && options_.refine_lone_zeros) lone_.note_check(v);
   settle_zeros({});
   return true;
 }

@@ -9,20 +9,18 @@
 /// triangulation (property_map.hpp): pos_ is reset when it renumbers its tetrahedra, after which the owner
 /// calls clear() and lists the live tetrahedra again.
 
+#include "listed_ids.hpp"
 #include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 
 #include <array>
 #include <cstdint>
-#include <limits>
 #include <vector>
 
 namespace vitri::polygonizer_detail {
 
 class TransverseSet {
  public:
-  static constexpr std::uint32_t kNotListed = std::numeric_limits<std::uint32_t>::max();
-
   explicit TransverseSet(Triangulation& tri) : pos_(tri, kNotListed, TetRenumbering::Reset), count_(tri, 0) {}
 
   /// t is listed (t < tet_capacity()).
@@ -38,20 +36,14 @@ class TransverseSet {
   /// Lists t with vertices `v`; on_first(u) for each vertex whose count became 1, in the order of `v`.
   template <typename OnFirst>
   void add(TetId t, const std::array<VertexId, 4>& v, OnFirst&& on_first) {
-    pos_[t] = static_cast<std::uint32_t>(list_.size());
-    list_.push_back(t);
+    list_insert(list_, pos_, t);
     for (const VertexId u : v)
       if (count_[u]++ == 0) on_first(u);
   }
   /// Unlists t (listed, vertices `v`); on_last(u) for each vertex whose count became 0, in the order of `v`.
   template <typename OnLast>
   void remove(TetId t, const std::array<VertexId, 4>& v, OnLast&& on_last) {
-    const std::uint32_t i = pos_[t];
-    const TetId last = list_.back();
-    list_[i] = last;
-    pos_[last] = i;
-    list_.pop_back();
-    pos_[t] = kNotListed;
+    list_erase(list_, pos_, t);
     for (const VertexId u : v)
       if (--count_[u] == 0) on_last(u);
   }

@@ -9,10 +9,10 @@
 // decides the noted ones once the transverse set is up to date (settle_checks, after a batch of
 // classifications), listing or unlisting them with set().
 //
-// Invariants (beside the members below): v is listed iff pos_[v] != kNotListed, and then list_[pos_[v]] ==
-// v (listed_ids.hpp). Kept by the Polygonizer (after each of its public operations, with refine_lone_zeros): the listed
-// vertices are exactly the live vertices of value 0 that no transverse tetrahedron touches; check_ is
-// empty.
+// Invariants (beside the members below): v is listed iff pos_[v] != kNotListed, and then
+// list_[pos_[v]] == v (listed_ids.hpp). Kept by the Polygonizer: after each batch of classifications
+// (settle_zeros), check_ is empty and the listed vertices are the live vertices of value 0 that no
+// transverse tetrahedron touches (none without refine_lone_zeros).
 #include "listed_ids.hpp"
 #include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"

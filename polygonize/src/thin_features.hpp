@@ -7,9 +7,9 @@
 // (insert_thin_point in thin_features.cpp).
 //
 // Invariants (beside the members below): edges_ holds at most one entry per edge among those flagged by
-// one check(); between refine() calls edges_ is empty. With all_ set, tets_ and vertices_ are not
-// kept (the next refine() tests every live tetrahedron); they never hold more than the live tetrahedra
-// and vertices (past that, all_ is set instead).
+// one check(); between refine() calls it is empty (refine() drains it, a cancellation clears it). Once
+// all_ is set, tets_ and vertices_ grow no more (the next refine() tests every live tetrahedron, then
+// forgets them); all_ is set as soon as one of them outgrows the live tetrahedra or vertices.
 #include "visit_marks.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/delaunay/property_map.hpp"

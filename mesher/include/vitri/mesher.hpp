@@ -266,7 +266,7 @@ struct ScanFit {
   double far_level = 0, far_jump = 0;
 };
 
-/// prepare_scan() with options.scan (its threads from options.polygonizer's when 0), then the normal
+/// prepare_scan() with options.scan (threads 0: every available CPU), then the normal
 /// constraints of the prepared points: off-surface distance max(offset_spacings x the spacing, 3 x the
 /// noise) (at most offset x the diagonal), the function chosen as options.function says; under
 /// options.max_memory_bytes the points thinned evenly to what fits first (as from_scan).

@@ -711,13 +711,14 @@ void print_certificate(const PolygonizerStats& ps) {
     std::printf("      NOT certified: the function gives no enclosures (the local function has none yet, "
                 "docs/certificate.md); %zu tetrahedra unchecked\n", ps.uncertified);
   else if (ps.uncertified == 0)
-    std::printf("      certified: %zu tetrahedra checked, %zu points inserted, %.1f ms\n", ps.certify_checked,
-                ps.certify_insertions, 1e3 * ps.certify_seconds);
+    std::printf("      certified: %zu tetrahedra checked (%zu kept from before), %zu points inserted, %.1f ms\n",
+                ps.certify_checked, ps.certify_kept, ps.certify_insertions, 1e3 * ps.certify_seconds);
   else
     std::printf("      NOT certified: %zu tetrahedra left uncertified at the size floor, the largest (radius "
-                "%.3g) at (%.6g, %.6g, %.6g); %zu checked, %zu points, %.1f ms\n", ps.uncertified,
-                ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y, ps.uncertified_at.z,
-                ps.certify_checked, ps.certify_insertions, 1e3 * ps.certify_seconds);
+                "%.3g) at (%.6g, %.6g, %.6g); %zu checked (%zu kept from before), %zu points, %.1f ms\n",
+                ps.uncertified, ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y,
+                ps.uncertified_at.z, ps.certify_checked, ps.certify_kept, ps.certify_insertions,
+                1e3 * ps.certify_seconds);
 }
 
 /// Level k of the plan refined (within the vertex budget), extracted and written, its row printed.

@@ -26,7 +26,8 @@ namespace {
 const char* const kUsage =
     "usage: vitri studio [INPUT] [--port N] [--host ADDR] [--precision P] [--function F]\n"
     "                    [--offset D] [--sides both|inside|outside] [--neighbours K]\n"
-    "                    [--viewpoint X Y Z] [--drag-levels K] [--no-socket]\n"
+    "                    [--viewpoint X Y Z] [--drag-levels K] [--certify [--certify-floor F]]\n"
+    "                    [--no-socket]\n"
     "\n"
     "Starts the interactive modeler: a local web server; open the printed address in a browser. Click\n"
     "the surface to add a constraint, shift+click / alt+click for an outside / inside one, drag a\n"
@@ -52,6 +53,11 @@ const char* const kUsage =
     "  --neighbours K  as vitri mesh: neighbours per point of a scan (default: from the data)\n"
     "  --viewpoint X Y Z  as vitri mesh: the sensor's position for INPUT's points (default: the\n"
     "                  input's: PCD VIEWPOINT, NAME.viewpoint beside it)\n"
+    "  --certify       certified levels, as vitri mesh --certify (docs/certificate.md): every refinement\n"
+    "                  checks what changed and refines what it cannot certify; the status line says\n"
+    "                  'certified' or how many tetrahedra are not (slower: global-function edits check\n"
+    "                  the whole domain)\n"
+    "  --certify-floor F  the size floor of --certify, a fraction of the precision (default 0.1)\n"
     "  --no-socket     HTTP only: no WebSocket beside it (by default the page sends its requests\n"
     "                  over a WebSocket on a second, free port of the same host: faster updates)\n"
     "\n"
@@ -98,7 +104,7 @@ std::string parse_args(const Args& args, StudioArgs& out) {
     const std::string v = has_value ? args[i + 1] : std::string();
     double d = 0;
     if (a == "--port" || a == "--host" || a == "--precision" || a == "--function" || a == "--offset" ||
-        a == "--sides" || a == "--drag-levels" || a == "--neighbours") {
+        a == "--sides" || a == "--drag-levels" || a == "--neighbours" || a == "--certify-floor") {
       if (!has_value) return a + " needs a value";
       ++i;
     }
@@ -142,6 +148,11 @@ std::string parse_args(const Args& args, StudioArgs& out) {
       }
       out.scan.viewpoint = Point3{xyz[0], xyz[1], xyz[2]};
       out.viewpoint_given = true;
+    } else if (a == "--certify") {
+      out.session.mesher.polygonizer.certify = true;
+    } else if (a == "--certify-floor") {
+      if (!parse_number(v, d) || !(d > 0) || d > 1) return "--certify-floor needs a fraction of the precision in (0, 1]";
+      out.session.mesher.polygonizer.certify_floor_fraction = d;
     } else if (a == "--no-socket") {
       out.server.socket = false;
     } else if (!a.empty() && a[0] == '-') {

@@ -298,6 +298,9 @@ std::string Api::stats_json(const std::string& extra) {
          ",\"rbf_ms\":" + json_number(s.edit_rbf_seconds * 1e3) +
          ",\"extract_ms\":" + json_number(session_.last_update().extract_ms) +
          ",\"delaunay_vertices\":" + std::to_string(s.polygonizer.vertices) +
+         // The certified mode (docs/certificate.md): tetrahedra the last refinement left uncertified.
+         ",\"certify\":" + (session_.mesher().options().polygonizer.certify ? "true" : "false") +
+         ",\"uncertified\":" + std::to_string(s.polygonizer.uncertified) +
          ",\"rebuilds\":" + std::to_string(s.rebuilds) +
          ",\"undo\":" + std::to_string(session_.undo_depth()) +
          ",\"redo\":" + std::to_string(session_.redo_depth()) +

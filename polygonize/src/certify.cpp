@@ -121,6 +121,7 @@ bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progr
   // A circumcenter of a tetrahedron of circumradius R > floor is at least R from every vertex: it passes.
   const double min_distance = std::min(dmin, floor);
   stats_.certify_checked = 0;
+  stats_.certify_kept = 0;
   stats_.certify_insertions = 0;
   if (!f_.has_bounds()) {  // nothing can be certified: say so, refine nothing
     stats_.uncertified = tri_.num_tetrahedra();
@@ -129,7 +130,11 @@ bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progr
     stats_.certify_seconds = seconds_since(t0);
     return true;
   }
+  // Only what is not certified already (CertifiedTets' invariant: a flag still holds).
   std::vector<TetId> check = tri_.live_tetrahedra();
+  const std::size_t live = check.size();
+  check.erase(std::remove_if(check.begin(), check.end(), [&](TetId t) { return certified_.has(t); }), check.end());
+  stats_.certify_kept = live - check.size();
   // Uncertified tetrahedra at the floor, with their vertices (an id recycled later is another one).
   std::vector<std::pair<TetId, std::array<VertexId, 4>>> left;
   std::vector<TetId> created;
@@ -169,6 +174,8 @@ bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progr
         bad[i] = certify_cell(p, f, bounds[i]) == CellCertificate::Uncertified;
       }
     });
+    for (std::size_t i = 0; i < n; ++i)
+      if (!bad[i]) certified_.mark(check[i]);  // (an id the insertions below recycle is forgotten on creation)
     // The uncertified ones: circumcenters of those above the floor, the others are left.
     std::size_t inserted = 0;
     for (std::size_t i = 0; i < n; ++i) {

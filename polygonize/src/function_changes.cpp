@@ -29,6 +29,7 @@ void Polygonizer::Impl::function_changed() { function_changed([](const Point3&) 
 
 void Polygonizer::Impl::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
   const auto t0 = Clock::now();
+  certified_.forget_all();  // the predicate speaks of points, not of the tetrahedra's boxes
   std::vector<VertexId> ids;
   const std::size_t cap = tri_.vertex_capacity();
   for (VertexId v = 0; v < cap; ++v)
@@ -39,7 +40,9 @@ void Polygonizer::Impl::function_changed(const std::function<bool(const Point3&)
 
 void Polygonizer::Impl::function_changed(const std::vector<Ball>& changed) {
   const auto t0 = Clock::now();
-  std::vector<VertexId> ids = vertices_near(changed, crossing_reach());
+  std::vector<TetId> met;
+  std::vector<VertexId> ids = vertices_near(changed, crossing_reach(), &met);
+  for (const TetId t : met) certified_.forget(t);
   ids.erase(std::remove_if(ids.begin(), ids.end(), [&](VertexId v) { return !needs_evaluation(v); }), ids.end());
   reevaluate(ids);
   stats_.update_seconds = seconds_since(t0);
@@ -49,7 +52,8 @@ double Polygonizer::Impl::crossing_reach() const { return surface_->max_edge_len
 
 // Live vertices within `pad` of a ball, sorted. One walk from the tetrahedra holding the balls' centers
 // (clamped into the domain), entering a tetrahedron when its bounding box meets a dilated ball.
-std::vector<VertexId> Polygonizer::Impl::vertices_near(const std::vector<Ball>& balls, double pad) {
+std::vector<VertexId> Polygonizer::Impl::vertices_near(const std::vector<Ball>& balls, double pad,
+                                                        std::vector<TetId>* met) {
   std::vector<Ball> grown;
   const Box3& box = tri_.box();
   for (const Ball& b : balls) {
@@ -99,6 +103,7 @@ std::vector<VertexId> Polygonizer::Impl::vertices_near(const std::vector<Ball>& 
     const auto v = tri_.tet_vertices(t);
     for (const VertexId u : v) tb.extend(tri_.point(u));
     if (!meets(tb)) continue;
+    if (met) met->push_back(t);
     for (const VertexId u : v)
       if (vertex_marks_.first_visit(u) && meets(Box3{tri_.point(u), tri_.point(u)})) out.push_back(u);
     for (int i = 0; i < 4; ++i) {

@@ -187,6 +187,7 @@ Polygonizer::Impl::Impl(const ImplicitFunction& f, SeedTetrahedralization&& seed
       queue_(options.order),
       necks_(tri_),
       thin_(tri_, values_, grad_),
+      certified_(tri_),
       surface_(std::make_unique<SurfaceTracker>(tri_)) {
   const auto t0 = Clock::now();
   check_options(options_);  // (the closing band was checked by closed_'s initializer)
@@ -493,6 +494,7 @@ void Polygonizer::Impl::classify_created(std::vector<TetId>& created) {
   });
   if (certifying_) certify_new_.insert(certify_new_.end(), created.begin(), created.end());
   for (std::size_t k = 0; k < n; ++k) {
+    certified_.forget(created[k]);
     surface_->note_created(created[k]);
     if (ahead[k].live) classify_as(created[k], false, ahead[k].transverse, ahead[k].radius);
   }

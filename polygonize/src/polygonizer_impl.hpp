@@ -18,6 +18,7 @@
 #include "vitri/polygonize/box_closure.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 
+#include "certified_tets.hpp"
 #include "lone_zeros.hpp"
 #include "neck_candidates.hpp"
 #include "refinement_queue.hpp"
@@ -121,7 +122,8 @@ struct Polygonizer::Impl {
   /// Thin features (thin_features.cpp): the point of the last flagged edge, if it still exists.
   bool insert_thin_point(double min_distance, std::vector<TetId>& created);
   void reevaluate(const std::vector<VertexId>& ids);
-  std::vector<VertexId> vertices_near(const std::vector<Ball>& balls, double pad);
+  /// `met`, when given, receives every tetrahedron of the walk whose bounding box meets a dilated ball.
+  std::vector<VertexId> vertices_near(const std::vector<Ball>& balls, double pad, std::vector<TetId>* met = nullptr);
   /// Between refine() calls (edits): notes for the next thin-feature check (thin_features.cpp).
   void note_thin_vertex(VertexId v);
   void note_thin_tets(const std::vector<TetId>& tets);
@@ -146,6 +148,7 @@ struct Polygonizer::Impl {
   polygonizer_detail::RefinementQueue queue_;     // active tetrahedra waiting for refinement
   polygonizer_detail::NeckCandidates necks_;      // vertices to check for necks (refine_necks)
   polygonizer_detail::ThinFeatures thin_;         // edges crossed twice: flagged, and what to recheck
+  polygonizer_detail::CertifiedTets certified_;   // certified mode: what need not be checked again
   // The marching-tetrahedra mesh, kept up to date from the changes reported to it (surface_tracker.hpp).
   std::unique_ptr<SurfaceTracker> surface_;
 

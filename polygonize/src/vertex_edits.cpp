@@ -102,7 +102,10 @@ void Polygonizer::Impl::set_vertex_value(VertexId v, double value) {
   if (!std::isfinite(value)) throw InvalidArgument("set_vertex_value: value is not finite");
   set_value(v, value);
   fixed_[v] = 1;
-  for (const TetId t : tri_.incident_tetrahedra(v)) classify(t, false);
+  for (const TetId t : tri_.incident_tetrahedra(v)) {
+    certified_.forget(t);
+    classify(t, false);
+  }
   settle_zeros({});
 }
 

@@ -552,6 +552,35 @@ TEST_CASE("studio api: the page's files are served, three.js missing is a clear 
 // The session's three numberings (session.hpp): the API's indices shift on a removal, its ids do not (and
 // survive undo), the Mesher's ids are never reused. Index i of constraints() is always constraint i of the
 // Mesher's list, whatever removals, adds and undos came before.
+TEST_CASE("studio api: the certified mode's status follows every refinement", "[studio][api]") {
+  SessionOptions o = fast_options();
+  o.mesher.function = FunctionKind::Global;  // the global function gives enclosures (docs/certificate.md)
+  const bool certify = GENERATE(false, true);
+  o.mesher.polygonizer.certify = certify;
+  Session session(small_model(), "small", o);
+  Api api(session);
+  const auto stats = [&] {
+    const ApiResponse r = api.handle({"GET", "/api/stats", {}, ""});
+    REQUIRE(r.status == 200);
+    return Json::parse(r.body);
+  };
+  const auto check = [&] {
+    const Json s = stats();
+    const PolygonizerStats ps = session.mesher().stats().polygonizer;
+    CHECK(s.find("certify")->as_bool("") == certify);
+    CHECK(number(s, "uncertified") == static_cast<double>(ps.uncertified));
+    // The certificate ran over the level (checked now or kept from before) exactly when asked for.
+    CHECK((ps.certify_checked + ps.certify_kept > 0) == certify);
+  };
+  while (session.refine_step()) {
+  }
+  check();
+  session.add({0.3, 0.2, 1.05}, 0.0);
+  while (session.refine_step()) {
+  }
+  check();
+}
+
 TEST_CASE("studio session: indices, studio ids and the Mesher's ids stay in step", "[studio][session]") {
   SessionOptions o = fast_options();
   o.mesher.function = GENERATE(FunctionKind::Global, FunctionKind::Local);

@@ -13,6 +13,8 @@
 #include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <random>
 #include <string>
 #include <vector>
@@ -208,4 +210,125 @@ TEST_CASE("certificate: a small bubble", "[certificate]") {
   const LevelCounts c = check_levels(f, {2, 4}, {0.4, 0.2, 0.1});
   CHECK(c.certified >= 1);
   CHECK(c.fast_wrong >= 1);
+}
+
+namespace {
+
+// A sphere with a dent of depth `amplitude` around `center`, within `reach` of it (a Wendland bump,
+// compactly supported): f = sphere(x) - amplitude w(|x - center| / reach), w(s) = (1 - s)^4 (4 s + 1) for
+// s < 1, else 0. Changing the amplitude changes f only inside the ball (center, reach): an edit with a
+// known region. Enclosures: the sphere's, minus amplitude times w's (w decreases in s; its gradient is
+// -20 (1 - s)^3 (x - center) / reach^2).
+class DentedSphere final : public ImplicitFunction {
+ public:
+  DentedSphere(const SphereFunction& sphere, const Point3& center, double reach)
+      : sphere_(sphere), center_(center), reach_(reach) {}
+  void set_amplitude(double a) { amplitude_ = a; }
+  double value(const Point3& p) const override {
+    Point3 g;
+    return value_gradient(p, g);
+  }
+  double value_gradient(const Point3& p, Point3& gradient) const override {
+    const double v = sphere_.value_gradient(p, gradient);
+    const Point3 d = p - center_;
+    const double s = norm(d) / reach_;
+    if (s >= 1.0 || amplitude_ == 0.0) return v;
+    const double t = 1.0 - s;
+    gradient = gradient + (amplitude_ * 20.0 * t * t * t / (reach_ * reach_)) * d;
+    return v - amplitude_ * t * t * t * t * (4.0 * s + 1.0);
+  }
+  bool has_bounds() const override { return true; }
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override {
+    sphere_.bounds(boxes, n, out);
+    if (amplitude_ == 0.0) return;
+    for (std::size_t i = 0; i < n; ++i) {
+      const Box3& b = boxes[i];
+      // The nearest and farthest distances of the box to the center, in units of reach.
+      double near2 = 0, far2 = 0;
+      for (std::size_t k = 0; k < 3; ++k) {
+        const double lo = b.lo[k] - center_[k], hi = b.hi[k] - center_[k];
+        const double nk = lo > 0 ? lo : (hi < 0 ? -hi : 0.0);
+        near2 += nk * nk;
+        far2 += std::max(lo * lo, hi * hi);
+      }
+      const double s_lo = std::sqrt(near2) / reach_, s_hi = std::sqrt(far2) / reach_;
+      const auto w = [](double s) { return s >= 1.0 ? 0.0 : std::pow(1.0 - s, 4) * (4.0 * s + 1.0); };
+      FunctionBound& e = out[i];
+      e.lo -= amplitude_ * w(s_lo);
+      e.hi -= amplitude_ * w(s_hi);
+      const auto c = [&](double s) { return s >= 1.0 ? 0.0 : 20.0 * std::pow(1.0 - s, 3) / (reach_ * reach_); };
+      const double c_lo = c(s_hi), c_hi = c(s_lo);
+      for (std::size_t k = 0; k < 3; ++k) {
+        // + amplitude c (x - center)_k with c in [c_lo, c_hi]: the product of two intervals.
+        const double lo = b.lo[k] - center_[k], hi = b.hi[k] - center_[k];
+        const double p[4] = {c_lo * lo, c_lo * hi, c_hi * lo, c_hi * hi};
+        e.grad_lo[k] += amplitude_ * *std::min_element(p, p + 4);
+        e.grad_hi[k] += amplitude_ * *std::max_element(p, p + 4);
+      }
+      widen_bounds(e, 1e-12, 1e-12);
+    }
+  }
+
+ private:
+  const SphereFunction& sphere_;
+  Point3 center_;
+  double reach_;
+  double amplitude_ = 0.0;
+};
+
+}  // namespace
+
+TEST_CASE("certificate: an edit is certified again locally, and what was kept holds", "[certificate]") {
+  // A sphere of radius 0.4, then a dent 0.6 away from its surface that dips below 0 within about 0.04 of
+  // its center: a small bubble (two components, chi 4) where no vertex of the seeds' lattice lies.
+  const SphereFunction sphere({-0.3, 0.0, 0.02}, 0.4);
+  const Point3 c{0.467, 0.467, 0.467};
+  DentedSphere f(sphere, c, 0.2);
+  f.set_amplitude(0.8);
+  require_enclosures(f, 11);
+  f.set_amplitude(0.0);
+
+  PolygonizerOptions o;
+  o.certify = true;
+  o.certify_floor_fraction = 0.005;
+  Polygonizer cert(f, kDomain, {}, {}, o);
+  Polygonizer fast(f, kDomain, {}, {}, PolygonizerOptions{});
+  REQUIRE(cert.refine(0.2));
+  REQUIRE(fast.refine(0.2));
+  REQUIRE(cert.stats().uncertified == 0);
+  REQUIRE(topology_of(cert.extract()).components == 1);
+  // The same level again: nothing changed, nothing is checked.
+  REQUIRE(cert.refine(0.2));
+  CHECK(cert.stats().certify_checked == 0);
+  const std::size_t before = cert.triangulation().num_tetrahedra();
+  CHECK(cert.stats().certify_kept == before);
+
+  f.set_amplitude(0.8);
+  const std::vector<Ball> region{{c, 0.2}};
+  cert.function_changed(region);
+  fast.function_changed(region);
+  REQUIRE(cert.refine(0.2));
+  REQUIRE(fast.refine(0.2));
+  const PolygonizerStats s = cert.stats();
+  INFO(s.certify_checked << " checked, " << s.certify_kept << " kept, " << s.certify_insertions << " points, "
+                         << s.uncertified << " uncertified");
+  REQUIRE(s.uncertified == 0);
+  // Local: the tetrahedra away from the dent's ball keep their certificates (nearly all of them).
+  CHECK(s.certify_kept > 0.9 * static_cast<double>(before));
+  const Topology after = topology_of(cert.extract());
+  CHECK(after.components == 2);
+  CHECK(after.euler == 4);
+  // The fast mode misses the bubble: the certificate is what found it.
+  CHECK(topology_of(fast.extract()).components == 1);
+
+  // Every kept certificate still holds: a full check (the function changed everywhere, as far as the
+  // Polygonizer knows) finds nothing to refine and the same mesh.
+  cert.function_changed();
+  REQUIRE(cert.refine(0.2));
+  CHECK(cert.stats().certify_kept == 0);
+  CHECK(cert.stats().uncertified == 0);
+  CHECK(cert.stats().certify_insertions == 0);
+  const Topology full = topology_of(cert.extract());
+  CHECK(full.components == 2);
+  CHECK(full.euler == 4);
 }

@@ -268,7 +268,9 @@ class Studio {
       'update (edit to screen) ' + lat + '\n' +
       'server: edit ' + s.edit_ms.toFixed(1) + ' ms, extract ' + s.extract_ms.toFixed(1) + ' ms\n' +
       s.triangles + ' triangles, ' + s.vertices + ' vertices\n' +
-      s.constraints + ' constraints, ' + s.delaunay_vertices + ' Delaunay vertices';
+      s.constraints + ' constraints, ' + s.delaunay_vertices + ' Delaunay vertices' +
+      (s.certify ? '\n' + (s.uncertified === 0 ? 'topology certified'
+                                                : 'NOT certified: ' + s.uncertified + ' tetrahedra') : '');
     this.updateSelection();
   }
 

@@ -220,8 +220,11 @@ struct PolygonizerStats {
   double neck_seconds = 0;              ///< of the last refine(): the neck checks and their points
   /// Certified mode (PolygonizerOptions::certify), the last refine(): tetrahedra whose enclosure was
   /// computed, points inserted for uncertified tetrahedra, time of the certificate (enclosures, checks,
-  /// and the refinement they caused).
+  /// and the refinement they caused). certify_kept: live tetrahedra whose certificate from an earlier
+  /// refine() still held (unchanged since: same vertices, values and function over them), not checked
+  /// again; so a finer level or the refine() after a local edit checks only what changed.
   std::size_t certify_checked = 0;
+  std::size_t certify_kept = 0;
   std::size_t certify_insertions = 0;
   double certify_seconds = 0;
   /// After the last refine() in certified mode: live tetrahedra that may hold a zero (value interval

@@ -17,6 +17,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -36,6 +37,24 @@ struct Neighbours {
   double d(std::size_t i, std::size_t c) const { return dist[i * k + c]; }
 };
 
+/// Row i of `nb`: the nb.k nearest of p[i] in `index` but itself (`ids`, `d2`: the caller's scratch).
+void query_row(const PointIndex& index, const Point3& q, std::size_t i, Neighbours& nb, std::vector<Id>& ids,
+               std::vector<double>& d2) {
+  const std::size_t k = nb.k;
+  index.nearest(q, k + 1, ids, &d2);
+  std::size_t c = 0;
+  for (std::size_t j = 0; j < ids.size() && c < k; ++j) {
+    if (ids[j] == i) continue;
+    nb.ids[i * k + c] = ids[j];
+    nb.dist[i * k + c] = std::sqrt(d2[j]);
+    ++c;
+  }
+  for (; c < k; ++c) {  // fewer points than k + 1 (never: callers check), repeat the last
+    nb.ids[i * k + c] = nb.ids[i * k + c - 1];
+    nb.dist[i * k + c] = nb.dist[i * k + c - 1];
+  }
+}
+
 Neighbours nearest_neighbours(const std::vector<Point3>& p, const PointIndex& index, std::size_t k,
                               unsigned threads) {
   Neighbours nb;
@@ -45,30 +64,21 @@ Neighbours nearest_neighbours(const std::vector<Point3>& p, const PointIndex& in
   rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
     std::vector<Id> ids;
     std::vector<double> d2;
-    for (std::size_t i = b; i < e; ++i) {
-      index.nearest(p[i], k + 1, ids, &d2);
-      std::size_t c = 0;
-      for (std::size_t j = 0; j < ids.size() && c < k; ++j) {
-        if (ids[j] == i) continue;
-        nb.ids[i * k + c] = ids[j];
-        nb.dist[i * k + c] = std::sqrt(d2[j]);
-        ++c;
-      }
-      for (; c < k; ++c) {  // fewer points than k + 1 (never: callers check), repeat the last
-        nb.ids[i * k + c] = nb.ids[i * k + c - 1];
-        nb.dist[i * k + c] = nb.dist[i * k + c - 1];
-      }
-    }
+    for (std::size_t i = b; i < e; ++i) query_row(index, p[i], i, nb, ids, d2);
   });
   return nb;
 }
 
-double median(std::vector<double> v) {
+/// The median (the upper one of an even count) of v, whose order it changes: for the per-point loops'
+/// scratch vectors (no copy, no allocation).
+double median_in_place(std::vector<double>& v) {
   if (v.empty()) return 0.0;
   const auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
   std::nth_element(v.begin(), mid, v.end());
   return *mid;
 }
+
+double median(std::vector<double> v) { return median_in_place(v); }
 
 /// The local fit of one neighbourhood: tangent frame, the quadric height field over it, residual scale.
 struct LocalFit {
@@ -196,6 +206,47 @@ double local_spacing(const Neighbours& nb, std::size_t i) {
   return nb.d(i, nb.k - 1) * std::sqrt(kPi / static_cast<double>(nb.k));
 }
 
+/// The neighbour lists and fits after points were removed: `p` and `index` hold the survivors, `keep` their
+/// old ids (increasing), `nb` and `fit` the old lists and fits (rewritten in place for the survivors). A
+/// survivor none of whose k nearest was removed keeps them, renumbered: removing points brings none
+/// nearer, and the renumbering keeps the ids' order, so ties (broken by id) fall the same way; its fit,
+/// a function of its own and its neighbours' positions in list order, is the same. The others are queried
+/// again in `index` and fitted again. The result equals nearest_neighbours() and fit_neighbourhood() over
+/// the survivors, at the cost of the points near a removed one.
+void refresh_after_removal(const std::vector<Point3>& p, const PointIndex& index, const std::vector<std::size_t>& keep,
+                           Neighbours& nb, std::vector<LocalFit>& fit, unsigned threads) {
+  const std::size_t k = nb.k, old_n = fit.size(), n = keep.size();
+  constexpr Id kGone = std::numeric_limits<Id>::max();
+  std::vector<Id> renumber(old_n, kGone);
+  for (std::size_t r = 0; r < n; ++r) renumber[keep[r]] = static_cast<Id>(r);
+  std::vector<std::uint8_t> stale(n, 0);
+  for (std::size_t r = 0; r < n; ++r) {  // in place: row r reads row keep[r] >= r
+    const std::size_t u = keep[r];
+    for (std::size_t c = 0; c < k; ++c) {
+      const Id j = renumber[nb.ids[u * k + c]];
+      stale[r] |= j == kGone;
+      nb.ids[r * k + c] = j;
+      nb.dist[r * k + c] = nb.dist[u * k + c];
+    }
+    fit[r] = fit[u];
+  }
+  nb.ids.resize(n * k);
+  nb.dist.resize(n * k);
+  fit.resize(n);
+  std::vector<std::size_t> again;
+  for (std::size_t r = 0; r < n; ++r)
+    if (stale[r]) again.push_back(r);
+  rbf_detail::parallel_chunks(again.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Id> ids;
+    std::vector<double> d2;
+    for (std::size_t a = b; a < e; ++a) query_row(index, p[again[a]], again[a], nb, ids, d2);
+  });
+  // The fits after every list is complete (a fit reads only its own list, but keep the phases apart).
+  rbf_detail::parallel_chunks(again.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t a = b; a < e; ++a) fit[again[a]] = fit_neighbourhood(p, nb, again[a]);
+  });
+}
+
 /// Connected components of the neighbour graph restricted to edges no longer than 3 local spacings (of
 /// the longer-spaced end), among the points not flagged in `skip` (null: all): the root of each point's
 /// component (the smallest id in it).
@@ -241,7 +292,7 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neig
     for (std::size_t i = b; i < e; ++i) {
       tmp.clear();
       for (std::size_t c = 0; c < k; ++c) tmp.push_back(mean_d[nb.at(i, c)]);
-      const double local_d = median(tmp);
+      const double local_d = median_in_place(tmp);
       // Density: a point whose neighbours are 3x farther than theirs are (flying pixels, stray returns).
       if (mean_d[i] > 3.0 * local_d) {
         out[i] = 1;
@@ -271,12 +322,12 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Neig
       }
       tmp.clear();
       for (std::size_t c = 0; c < k; ++c) tmp.push_back(noise[nb.at(i, c)]);
-      const double local_noise = median(tmp);
+      const double local_noise = median_in_place(tmp);
       // Spacing of the neighbourhood (side of the area per point, the neighbours' own: a point off the
       // surface sees its neighbours from afar) as the floor: clean data lose nothing.
       tmp.clear();
       for (std::size_t c = 0; c < k; ++c) tmp.push_back(reach[nb.at(i, c)]);
-      const double h = median(tmp) * std::sqrt(kPi / static_cast<double>(k));
+      const double h = median_in_place(tmp) * std::sqrt(kPi / static_cast<double>(k));
       if (off > std::max(4.0 * local_noise, 2.0 * h)) out[i] = 1;
     }
   });
@@ -431,9 +482,11 @@ constexpr std::size_t kMaxNeighbours = 96;
 /// sheet), the point moves along its normal by the mean height (to the layers' middle, weighted by
 /// their densities). Returns the number of points moved; `shift` receives each move (0 elsewhere) and
 /// `reach` the distance to each examined point's farthest examined neighbour. With `only`, the points
-/// it does not mark are not examined (their shift 0, their reach left as it was).
+/// it does not mark are not examined (their shift 0, their reach left as it was). `nb` gives the local
+/// spacings; when it also holds the current neighbours of `p` (`nb_current`) and at least the 95 nearest
+/// others, its rows are the 96 nearest (the point itself first, skipped) with no query.
 std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>& n, const PointIndex& index,
-                         const Neighbours& nb, unsigned threads, std::vector<double>& shift,
+                         const Neighbours& nb, bool nb_current, unsigned threads, std::vector<double>& shift,
                          std::vector<double>& reach, const std::vector<std::uint8_t>* only = nullptr) {
   shift.assign(p.size(), 0.0);
   reach.resize(p.size(), 0.0);
@@ -442,6 +495,7 @@ std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>
   std::vector<double> spacing(p.size());
   for (std::size_t i = 0; i < p.size(); ++i) spacing[i] = local_spacing(nb, i);
   const double floor = 0.7 * median(spacing);
+  const bool rows = nb_current && nb.k >= kMergeNeighbours - 1 && p.size() >= kMergeNeighbours;
   rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
     std::vector<Id> near;
     std::vector<double> same, keep;
@@ -452,8 +506,14 @@ std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>
       const double rc = 2.0 * h, half = 4.0 * h;
       // The cylinder's points among the nearest 96 (a ball would hold thousands where a sparse point
       // borders a dense region: room scans): about 3.9 h in an overlap of two layers, 5.5 h on one.
-      index.nearest(p[i], kMergeNeighbours, near, &d2);
-      reach[i] = d2.empty() ? 0.0 : std::sqrt(d2.back());
+      if (rows) {  // the same ids in the same order as the query's (but itself), the same farthest
+        near.assign(nb.ids.begin() + static_cast<std::ptrdiff_t>(i * nb.k),
+                    nb.ids.begin() + static_cast<std::ptrdiff_t>(i * nb.k + kMergeNeighbours - 1));
+        reach[i] = nb.d(i, kMergeNeighbours - 2);
+      } else {
+        index.nearest(p[i], kMergeNeighbours, near, &d2);
+        reach[i] = d2.empty() ? 0.0 : std::sqrt(d2.back());
+      }
       same.clear();
       double opposite = 2 * half;  // |t| of the nearest opposite point along the line (none: 2 half)
       for (const Id j : near) {
@@ -575,13 +635,19 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     if (k2 < 48 && p.size() > 64) {
       const std::size_t k3 = clamp_k(48);
       Neighbours wide = nearest_neighbours(p, index, k3, threads);
-      std::vector<double> big(p.size());
+      std::vector<LocalFit> wide_fit(p.size());
       rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) big[i] = fit_neighbourhood(p, wide, i).noise;
+        for (std::size_t i = b; i < e; ++i) wide_fit[i] = fit_neighbourhood(p, wide, i);
       });
+      std::vector<double> big(p.size());
+      for (std::size_t i = 0; i < p.size(); ++i) big[i] = wide_fit[i].noise;
       // Only structure that matters against the spacing (a clean curved surface also fits a quadric a
       // little worse at a larger scale).
-      if (median(big) > std::max(1.5 * noise_small, 0.05 * median(nb.dist))) k2 = k3;
+      if (median(big) > std::max(1.5 * noise_small, 0.05 * median(nb.dist))) {
+        k = k2 = k3;  // these neighbourhoods and fits are the ones wanted: kept, not computed again
+        nb = std::move(wide);
+        fit.swap(wide_fit);
+      }
     }
     if (k2 > k) {
       k = k2;
@@ -612,10 +678,14 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     for (std::size_t r = 0; r < keep.size(); ++r) q[r] = p[keep[r]], s[r] = src[keep[r]];
     p.swap(q);
     src.swap(s);
-    k = clamp_k(k);
     index = PointIndex(p, threads);
-    nb = nearest_neighbours(p, index, k, threads);
-    fit_all(p);
+    if (clamp_k(k) == k) {
+      refresh_after_removal(p, index, keep, nb, fit, threads);
+    } else {
+      k = clamp_k(k);
+      nb = nearest_neighbours(p, index, k, threads);
+      fit_all(p);
+    }
   }
   std::size_t collinear = 0;
   for (const LocalFit& f : fit) collinear += f.collinear;
@@ -638,8 +708,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
           a.push_back(noise[nb.at(i, j)]);
           c.push_back(nb.d(nb.at(i, j), 0));
         }
-        region_noise[i] = median(a);
-        region_nn[i] = median(c);
+        region_noise[i] = median_in_place(a);
+        region_nn[i] = median_in_place(c);
       }
     });
   }
@@ -746,7 +816,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     std::vector<std::uint8_t> again;
     for (int pass = 0; pass < 2; ++pass) {
       if (pass > 0) index = PointIndex(p, threads);
-      if (merge_layers(p, n, index, nb, threads, shift, reach, pass > 0 ? &again : nullptr) == 0) break;
+      // (pass 0: nb holds the neighbours of these positions; pass 1: the points moved since)
+      if (merge_layers(p, n, index, nb, pass == 0, threads, shift, reach, pass > 0 ? &again : nullptr) == 0) break;
       std::vector<Point3> ends;  // the moved points' positions before and after
       for (std::size_t i = 0; i < p.size(); ++i)
         if (shift[i] != 0.0) ends.push_back(p[i]), ends.push_back(p[i] + shift[i] * n[i]);

@@ -3,8 +3,10 @@
 //
 // A patch lives in its own scaled coordinates u = (x - center) * inv_radius (R = support radius), so that
 // its kernel values are of order 1 whatever the model's size. Coefficient layout (`coef`):
-//   coef[0..3]               a0, a_x, a_y, a_z    (polynomial a0 + a . u)
-//   coef[4 + 4j .. 4 + 4j+3] u_j (x, y, z), w_j   (kernel terms w_j |u - u_j|^3), j < count
+//   coef[0..3]                   a0, a_x, a_y, a_z    (polynomial a0 + a . u)
+//   coef[4 .. 4 + 4 count)       the kernel terms w_j |u - u_j|^3, j < count, as four arrays (the evaluation
+//                                kernel's layout): u_j.x at coef[4 + j], u_j.y at coef[4 + count + j],
+//                                u_j.z at coef[4 + 2 count + j], w_j at coef[4 + 3 count + j]
 // A *linear* patch (no constraint in its support) has count = 0: a least-squares plane a0 + a . u.
 
 #include "vitri/core/point.hpp"

@@ -116,6 +116,9 @@ struct LocalRbf::Impl {
   double evaluate(const Point3& x, Point3* grad, std::uint32_t* leaf_hint = nullptr) const;
   double evaluate_inside(const Point3& x, Point3* grad, std::uint32_t* leaf_hint = nullptr) const;
 
+  /// An enclosure of f and its gradient over `box` (LocalRbf::bounds; local_rbf_bounds.cpp).
+  FunctionBound bound_box(const Box3& box) const;
+
   /// The slot of a live id. @throws UnknownConstraint.
   std::uint32_t slot_of(ConstraintId id) const;
   void check_new_position(const Point3& p, ConstraintId id, std::optional<std::uint32_t> moving) const;

@@ -210,6 +210,13 @@ void LocalTree::fill_candidates(unsigned threads) {
   });
 }
 
+void LocalTree::leaves_meeting_box(const Box3& box, std::vector<std::uint32_t>& out) const {
+  const auto meets = [&](const Cell& cell) {
+    return box.squared_distance(cell.center) < cell.radius * cell.radius * (1.0 + 1e-9);
+  };
+  collect_leaves(meets, meets, out);
+}
+
 void LocalTree::leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const {
   const auto meets = [&](const Cell& cell) { return cube_distance2(cell, center) < radius * radius; };
   collect_leaves(meets, meets, out);

@@ -106,6 +106,9 @@ class LocalTree {
   void fill_candidates(unsigned threads);
   /// Sorts leaf.candidates in cell_before order (the order sums run in) and trims their memory.
   void order_candidates(Cell& leaf) const;
+  /// Leaves whose support ball may meet the closed box `box`: every leaf with |c_L - box| < R_L, and
+  /// possibly a few more within a relative 1e-9 of R_L (for callers that must miss none despite rounding).
+  void leaves_meeting_box(const Box3& box, std::vector<std::uint32_t>& out) const;
   /// Leaves whose cube meets the open support ball of leaf `source`.
   void leaves_in_ball(const Point3& center, double radius, std::vector<std::uint32_t>& out) const;
   /// Leaves with |q - center|^2 <= fit_r2.

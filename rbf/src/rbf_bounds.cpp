@@ -1,133 +1,30 @@
 // The global RBF interpolant, enclosures of f and its gradient over boxes (ImplicitFunction::bounds, used
 // by the polygonizer's certificate; docs/certificate.md). In scaled coordinates s, f = sum_i w_i
-// |s - c_i|^3 + p0 + p.s. Two enclosures are computed in one pass over the centers and intersected:
-//  - term by term: |s - c_i| ranges over [r_lo, r_hi] on the box (nearest and farthest point), so
-//    w_i |s - c_i|^3 over w_i [r_lo^3, r_hi^3], and each gradient component 3 |s - c_i| (s - c_i)_k over
-//    the product of the two intervals; the linear part exactly;
-//  - second order Taylor at the box's center: the Hessian of |s - c|^3 is 3 (r I + (s - c)(s - c)^T / r),
-//    of spectral norm 6 r, so the gradient of f is Lipschitz over the box with constant
-//    sum_i |w_i| 6 r_hi (taylor_bound()).
-//  - third order Taylor at the center: the Hessian there exactly, and the Lipschitz constant 6 of the
-//    Hessian of |s - c|^3 (below).
-// The first is tighter for boxes far larger than their distance to the data; the third, whose width
-// shrinks as the cube of the box beyond its exact first and second order terms, near the surface (the
-// second-order one loses there: sum |w_i| r is orders of magnitude above |f''|, the weights cancel). Rounding: both are widened by (N + 8) ulp-sized
-// multiples of the sum of the absolute values of the terms (a bound of the error of the sums).
+// |s - c_i|^3 + p0 + p.s: the enclosure of that sum over the scaled box is cubic_bounds() (cubic_bounds.cpp:
+// term by term, second- and third-order Taylor, intersected, widened for rounding), shared with the
+// patches of the local function; here only the scaling and the threads.
 #include "rbf_impl.hpp"
 
+#include "cubic_bounds.hpp"
 #include "parallel.hpp"
-#include "vitri/core/bounds.hpp"
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
 
 namespace vitri {
-
-namespace {
-
-// [a_lo, a_hi] x [b_lo, b_hi].
-inline void product(double a_lo, double a_hi, double b_lo, double b_hi, double& lo, double& hi) {
-  const double p1 = a_lo * b_lo, p2 = a_lo * b_hi, p3 = a_hi * b_lo, p4 = a_hi * b_hi;
-  lo = std::min({p1, p2, p3, p4});
-  hi = std::max({p1, p2, p3, p4});
-}
-
-}  // namespace
 
 void Rbf::bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const {
   impl_->require_fitted();
   const Impl& m = *impl_;
   const std::size_t count = m.cx.size();
-  const double eps = std::numeric_limits<double>::epsilon();
-  const double rel = 2.0 * static_cast<double>(count + 8) * eps;
+  rbf_detail::CubicTerms terms;
+  terms.x = m.cx.data(), terms.y = m.cy.data(), terms.z = m.cz.data(), terms.w = m.w.data();
+  terms.count = count;
+  terms.a0 = m.poly(0);
+  terms.a = Point3{m.poly(1), m.poly(2), m.poly(3)};
   auto one = [&](const Box3& box) {
-    const Point3 lo = m.scaled(box.lo), hi = m.scaled(box.hi);
-    const Point3 c = 0.5 * (lo + hi);
-    double f_lo = 0, f_hi = 0, f_c = 0, hess = 0, abs_f = 0, abs_g = 0, abs_w = 0;
-    double h_c[3][3] = {{0, 0, 0}, {0, 0, 0}, {0, 0, 0}};
-    Point3 g_lo{0, 0, 0}, g_hi{0, 0, 0}, g_c{0, 0, 0};
-    for (std::size_t i = 0; i < count; ++i) {
-      const double w = m.w[i];
-      const Point3 ci{m.cx[i], m.cy[i], m.cz[i]};
-      double near2 = 0, far2 = 0;
-      double a_lo[3], a_hi[3];
-      for (std::size_t k = 0; k < 3; ++k) {
-        a_lo[k] = lo[k] - ci[k], a_hi[k] = hi[k] - ci[k];
-        const double below = a_lo[k] > 0 ? a_lo[k] : (a_hi[k] < 0 ? -a_hi[k] : 0.0);
-        near2 += below * below;
-        const double far = std::max(std::abs(a_lo[k]), std::abs(a_hi[k]));
-        far2 += far * far;
-      }
-      const double r_lo = std::sqrt(near2), r_hi = std::sqrt(far2);
-      const double t_lo = r_lo * r_lo * r_lo, t_hi = r_hi * r_hi * r_hi;
-      if (w >= 0) f_lo += w * t_lo, f_hi += w * t_hi;
-      else f_lo += w * t_hi, f_hi += w * t_lo;
-      for (std::size_t k = 0; k < 3; ++k) {
-        double p_lo, p_hi;
-        product(r_lo, r_hi, a_lo[k], a_hi[k], p_lo, p_hi);
-        const double q_lo = 3.0 * w * (w >= 0 ? p_lo : p_hi), q_hi = 3.0 * w * (w >= 0 ? p_hi : p_lo);
-        g_lo[k] += q_lo, g_hi[k] += q_hi;
-      }
-      const Point3 d = c - ci;
-      const double r = norm(d);
-      f_c += w * r * r * r;
-      g_c = g_c + (3.0 * w * r) * d;
-      if (r > 0) {
-        const double a = 3.0 * w * r, b = 3.0 * w / r;
-        for (std::size_t k = 0; k < 3; ++k)
-          for (std::size_t l = 0; l < 3; ++l) h_c[k][l] += (k == l ? a : 0.0) + b * d[k] * d[l];
-      }
-      hess += std::abs(w) * 6.0 * r_hi;
-      abs_w += std::abs(w);
-      abs_f += std::abs(w) * t_hi;
-      abs_g += 3.0 * std::abs(w) * r_hi * r_hi;
-    }
-    // The linear part: exact over the box (per axis, the coefficient's sign picks the end).
-    const double p0 = m.poly(0);
-    double lin_lo = p0, lin_hi = p0, abs_p = std::abs(p0);
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double a = m.poly(static_cast<Eigen::Index>(k + 1));
-      lin_lo += a >= 0 ? a * lo[k] : a * hi[k];
-      lin_hi += a >= 0 ? a * hi[k] : a * lo[k];
-      abs_p += std::abs(a) * std::max(std::abs(lo[k]), std::abs(hi[k]));
-    }
-    const Point3 lin{m.poly(1), m.poly(2), m.poly(3)};
-    FunctionBound direct;
-    direct.lo = f_lo + lin_lo;
-    direct.hi = f_hi + lin_hi;
-    direct.grad_lo = g_lo + lin;
-    direct.grad_hi = g_hi + lin;
     Box3 scaled_box;
-    scaled_box.lo = lo, scaled_box.hi = hi;
-    const FunctionBound taylor = taylor_bound(scaled_box, f_c + m.poly_at(c.x, c.y, c.z), g_c + lin, hess);
-    // Third order: the Hessian at the center exactly, and the Hessian of |s - c|^3 is Lipschitz with
-    // constant 6 (its derivative, a symmetric 3-tensor, has norm max_v 3 (3 cos - cos^3) = 6), so
-    // f = f(c) + g.d + d^T H d / 2 + R with |R| <= sum |w_i| rho^3, and each gradient component is
-    // g_k + (H d)_k + R_k with |R_k| <= 3 sum |w_i| rho^2.
-    const Point3 half = 0.5 * (hi - lo);
-    const double rho = norm(half);
-    const Point3 gc = g_c + lin;
-    const double fc = f_c + m.poly_at(c.x, c.y, c.z);
-    double quad = 0, lin_part = 0;
-    FunctionBound third;
-    for (std::size_t k = 0; k < 3; ++k) {
-      double row = 0;
-      for (std::size_t l = 0; l < 3; ++l) {
-        row += std::abs(h_c[k][l]) * half[l];
-        quad += std::abs(h_c[k][l]) * half[k] * half[l];
-      }
-      lin_part += std::abs(gc[k]) * half[k];
-      const double move = row + 3.0 * abs_w * rho * rho;
-      third.grad_lo[k] = gc[k] - move;
-      third.grad_hi[k] = gc[k] + move;
-    }
-    const double spread = lin_part + 0.5 * quad + abs_w * rho * rho * rho;
-    third.lo = fc - spread;
-    third.hi = fc + spread;
-    FunctionBound b = intersect_bounds(intersect_bounds(direct, taylor), third);
-    widen_bounds(b, rel * (abs_f + abs_p) + 4.0 * eps * (std::abs(b.lo) + std::abs(b.hi)),
-                 rel * (abs_g + norm(lin)) + rel * hess * rho);
+    scaled_box.lo = m.scaled(box.lo), scaled_box.hi = m.scaled(box.hi);
+    FunctionBound b = rbf_detail::cubic_bounds(terms, scaled_box).bound;
     // Back to the caller's units: the value is the same, the gradient is divided by the scale.
     b.grad_lo = b.grad_lo / m.scale;
     b.grad_hi = b.grad_hi / m.scale;

@@ -149,6 +149,16 @@ class LocalRbf : public EditableFunction {
   double value_gradient(const Point3& p, Point3& gradient) const override;
   void values(const Point3* points, std::size_t n, double* out) const override;
   void values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const override;
+  /// True once fitted: bounds() gives finite value enclosures (docs/certificate.md, "Local RBF").
+  bool has_bounds() const override { return fitted(); }
+  /// Enclosures of f and its gradient over each box (ImplicitFunction::bounds): the enclosures of the
+  /// patches whose support meets the box (the global function's enclosure of each patch's cubic sum)
+  /// blended within the bounds of their normalized weights, intersected with a common first-order model;
+  /// the gradient adds the weights' derivatives against a lower bound of the weights' sum. Threaded over
+  /// the boxes (LocalRbfOptions::threads).
+  /// @note Where the sum of the weights has no positive lower bound over a box (large boxes), the
+  ///       gradient is left infinite (unknown); the value interval is always finite once fitted.
+  void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override;
 
   // ----- edits: cost independent of N (amortized), each returns where f changed -----
   // Errors leave the function unchanged; they name constraints by id.

@@ -8,6 +8,8 @@
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/local_rbf.hpp"
 
+#include "support/enclosure_checks.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <algorithm>
@@ -58,26 +60,12 @@ TEST_CASE("local rbf bounds contain f and its gradient on shared models", "[rbf]
   std::uniform_real_distribution<double> unit(0.0, 1.0);
   // Boxes around random constraint points (near the surface) and anywhere in the domain, of sides from
   // 1e-3 to 0.3 of the diagonal; a few straddling a face of the root cube.
-  std::vector<Box3> boxes;
-  const int kBoxes = 600;
-  for (int i = 0; i < kBoxes; ++i) {
-    const double side = diag * std::pow(10.0, -3.0 + 2.5 * unit(rng));
-    Point3 center;
-    if (i % 2 == 0) {
-      center = c.points[static_cast<std::size_t>(unit(rng) * static_cast<double>(c.size())) % c.size()];
-    } else if (i % 50 == 1) {
-      for (std::size_t k = 0; k < 3; ++k) center[k] = root.lo[k] + (root.hi[k] - root.lo[k]) * unit(rng);
-      center[static_cast<std::size_t>(i / 50) % 3] = (i / 50) % 2 ? root.hi[(i / 50) % 3] : root.lo[(i / 50) % 3];
-    } else {
-      for (std::size_t k = 0; k < 3; ++k) center[k] = domain.lo[k] + (domain.hi[k] - domain.lo[k]) * unit(rng);
-    }
-    Box3 b;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double h = 0.5 * side * (0.3 + 0.7 * unit(rng));
-      b.lo[k] = center[k] - h, b.hi[k] = center[k] + h;
-    }
-    boxes.push_back(b);
-  }
+  const std::vector<Box3> boxes = test::random_boxes(c.points, domain, diag, 600, rng, [&](int i, Point3& center) {
+    if (i % 50 != 1) return false;
+    for (std::size_t k = 0; k < 3; ++k) center[k] = root.lo[k] + (root.hi[k] - root.lo[k]) * unit(rng);
+    center[static_cast<std::size_t>(i / 50) % 3] = (i / 50) % 2 ? root.hi[(i / 50) % 3] : root.lo[(i / 50) % 3];
+    return true;
+  });
   std::vector<FunctionBound> out(boxes.size());
   const auto t0 = std::chrono::steady_clock::now();
   f.bounds(boxes.data(), boxes.size(), out.data());
@@ -95,25 +83,9 @@ TEST_CASE("local rbf bounds contain f and its gradient on shared models", "[rbf]
       if (gradient_bounded(e)) ++small_bounded;
       if (has_cone(e)) ++cones;
     }
-    for (int s = 0; s < 200; ++s) {
-      Point3 p;
-      for (std::size_t k = 0; k < 3; ++k) p[k] = b.lo[k] + (b.hi[k] - b.lo[k]) * unit(rng);
-      if (s < 8)  // the corners too
-        for (std::size_t k = 0; k < 3; ++k) p[k] = (s >> k) & 1 ? b.hi[k] : b.lo[k];
-      Point3 g;
-      const double v = f.value_gradient(p, g);
-      ++samples;
-      INFO("box " << i << " (" << b.lo.x << ", " << b.lo.y << ", " << b.lo.z << ") - (" << b.hi.x << ", "
-                  << b.hi.y << ", " << b.hi.z << ") sample " << s << " f " << v << " in [" << e.lo
-                  << ", " << e.hi << "]");
-      REQUIRE(v >= e.lo);
-      REQUIRE(v <= e.hi);
-      for (std::size_t k = 0; k < 3; ++k) {
-        INFO("gradient " << k << " " << g[k] << " in [" << e.grad_lo[k] << ", " << e.grad_hi[k] << "]");
-        REQUIRE(g[k] >= e.grad_lo[k]);
-        REQUIRE(g[k] <= e.grad_hi[k]);
-      }
-    }
+    INFO("box " << i);
+    test::require_inside(f, b, e, 200, rng);
+    samples += 200;
   }
   // Measurements for docs/certificate.md (printed: a passing Catch2 run shows no INFO).
   std::cout << "local bounds, " << name << ", " << c.size() << " constraints, " << f.report().patches

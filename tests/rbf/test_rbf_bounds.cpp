@@ -6,6 +6,8 @@
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/rbf.hpp"
 
+#include "support/enclosure_checks.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -31,25 +33,9 @@ TEST_CASE("rbf bounds contain f and its gradient on shared models", "[rbf][bound
   const Box3 domain = model.scaled(1.5);
   const double diag = model.diagonal();
   std::mt19937 rng(7);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   // Boxes around random constraint points (near the surface) and anywhere in the domain, of sides from
   // 1e-3 to 0.3 of the diagonal.
-  std::vector<Box3> boxes;
-  for (int i = 0; i < 400; ++i) {
-    const double side = diag * std::pow(10.0, -3.0 + 2.5 * unit(rng));
-    Point3 center;
-    if (i % 2 == 0) {
-      center = c.points[static_cast<std::size_t>(unit(rng) * static_cast<double>(c.size())) % c.size()];
-    } else {
-      for (std::size_t k = 0; k < 3; ++k) center[k] = domain.lo[k] + (domain.hi[k] - domain.lo[k]) * unit(rng);
-    }
-    Box3 b;
-    for (std::size_t k = 0; k < 3; ++k) {
-      const double h = 0.5 * side * (0.3 + 0.7 * unit(rng));
-      b.lo[k] = center[k] - h, b.hi[k] = center[k] + h;
-    }
-    boxes.push_back(b);
-  }
+  const std::vector<Box3> boxes = test::random_boxes(c.points, domain, diag, 400, rng);
   std::vector<FunctionBound> out(boxes.size());
   f.bounds(boxes.data(), boxes.size(), out.data());
   std::size_t excluded = 0, cones = 0, small_near = 0;
@@ -66,22 +52,8 @@ TEST_CASE("rbf bounds contain f and its gradient on shared models", "[rbf][bound
       for (std::size_t k = 0; k < 3; ++k) least += mid[k] >= 0 ? mid[k] * e.grad_lo[k] : mid[k] * e.grad_hi[k];
       if (least > 0) ++cones;
     }
-    for (int s = 0; s < 100; ++s) {
-      Point3 p;
-      for (std::size_t k = 0; k < 3; ++k) p[k] = b.lo[k] + (b.hi[k] - b.lo[k]) * unit(rng);
-      if (s < 8)  // the corners too
-        for (std::size_t k = 0; k < 3; ++k) p[k] = (s >> k) & 1 ? b.hi[k] : b.lo[k];
-      Point3 g;
-      const double v = f.value_gradient(p, g);
-      INFO("box " << i << " f " << v << " in [" << e.lo << ", " << e.hi << "]");
-      REQUIRE(v >= e.lo);
-      REQUIRE(v <= e.hi);
-      for (std::size_t k = 0; k < 3; ++k) {
-        INFO("gradient " << k << " " << g[k] << " in [" << e.grad_lo[k] << ", " << e.grad_hi[k] << "]");
-        REQUIRE(g[k] >= e.grad_lo[k]);
-        REQUIRE(g[k] <= e.grad_hi[k]);
-      }
-    }
+    INFO("box " << i);
+    test::require_inside(f, b, e, 100, rng);
   }
   INFO(excluded << " of " << boxes.size() << " exclude 0; " << cones << " of " << small_near
                 << " small boxes at the surface have a gradient cone");

@@ -129,8 +129,9 @@ const char* const kUsage =
     "                       tetrahedra assumes; the others are refined (circumcenters) down to a floor,\n"
     "                       --certify-floor x the precision. Each level then prints 'certified' (the\n"
     "                       mesh is homeomorphic to the zero set in the box) or the count of tetrahedra\n"
-    "                       left uncertified and where the largest is. Costs far more time and vertices on RBF surfaces\n"
-    "                       (docs/benchmarks.md); the local function has no enclosure yet.\n"
+    "                       left uncertified and where the largest is. Costs far more time and\n"
+    "                       vertices on RBF surfaces, where no level has been certified so far\n"
+    "                       (docs/benchmarks.md); an edit checks again only what it changed.\n"
     "  --certify-floor F    the size floor of --certify, a fraction of the precision (default 0.1)\n"
     "  --threads N          threads of the fit, the seeds' insertion and the extraction (default 0:\n"
     "                       every CPU this process may run on, i.e. its affinity mask, so `taskset`\n"
@@ -708,8 +709,8 @@ void print_scan_surface(const MesherStats& st, SurfaceKind surface) {
 /// --certify: whether the level's mesh is certified, else what is left (stdout, below its row).
 void print_certificate(const PolygonizerStats& ps) {
   if (ps.certify_checked == 0 && ps.uncertified > 0)
-    std::printf("      NOT certified: the function gives no enclosures (the local function has none yet, "
-                "docs/certificate.md); %zu tetrahedra unchecked\n", ps.uncertified);
+    std::printf("      NOT certified: the function gives no enclosures (docs/certificate.md); %zu tetrahedra "
+                "unchecked\n", ps.uncertified);
   else if (ps.uncertified == 0)
     std::printf("      certified: %zu tetrahedra checked (%zu kept from before), %zu points inserted, %.1f ms\n",
                 ps.certify_checked, ps.certify_kept, ps.certify_insertions, 1e3 * ps.certify_seconds);

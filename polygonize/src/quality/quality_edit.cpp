@@ -2,6 +2,8 @@
 // dynamic edits (f changed: vertices go back onto the surface, changed facets are classified again).
 #include "vitri/polygonize/quality_mesher.hpp"
 
+#include "quality_mesher_impl.hpp"
+
 #include "vitri/core/error.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 
@@ -107,7 +109,7 @@ std::vector<Point3> QualityMesher::seed_points(const ImplicitFunction& f, const 
 // Newton steps along the gradient, p <- p - f(p) grad f(p) / |grad f(p)|^2, all points in lockstep (one
 // batch per step). ok[i] = 1 when point i reached |f| / |grad f| <= the root tolerance (a first-order
 // distance to the surface) without wandering further than 5% of the diagonal.
-std::vector<Point3> QualityMesher::newton_project(std::vector<Point3> p, std::vector<std::uint8_t>& ok) {
+std::vector<Point3> QualityMesher::Impl::newton_project(std::vector<Point3> p, std::vector<std::uint8_t>& ok) {
   const double tol = options_.root_tolerance * diagonal_;
   const std::vector<Point3> start = p;
   ok.assign(p.size(), 0);
@@ -141,7 +143,7 @@ std::vector<Point3> QualityMesher::newton_project(std::vector<Point3> p, std::ve
 }
 
 // Moves the surface vertices `ids` whose value is no longer 0 back onto the surface, or removes them.
-std::size_t QualityMesher::project_vertices(const std::vector<VertexId>& ids) {
+std::size_t QualityMesher::Impl::project_vertices(const std::vector<VertexId>& ids) {
   std::vector<Point3> p;
   for (VertexId v : ids) p.push_back(tri_.point(v));
   std::vector<std::uint8_t> ok;
@@ -168,7 +170,7 @@ std::size_t QualityMesher::project_vertices(const std::vector<VertexId>& ids) {
   return changed;
 }
 
-void QualityMesher::function_changed() {
+void QualityMesher::Impl::function_changed() {
   std::vector<Point3> at;
   std::vector<VertexId> ids;
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
@@ -194,14 +196,14 @@ void QualityMesher::function_changed() {
   function_changed(region);
 }
 
-void QualityMesher::function_changed(const Box3& region) {
+void QualityMesher::Impl::function_changed(const Box3& region) {
   edge_probes_.clear();  // probes of the old f
   if (region.empty()) return;
   std::vector<VertexId> ids;
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
     if (tri_.is_vertex(v) && on_surface_[v] && region.contains(tri_.point(v))) ids.push_back(v);
   project_vertices(ids);
-  old_facets_.clear();  // roots and probes of the old f
+  pending_.forget_old();  // roots and probes of the old f
   edge_probes_.clear();
   // Circumcentres inside the region get new values (their tetrahedra are classified again). A facet whose
   // two circumcentres are outside keeps its sign test (f did not change there); it is classified again
@@ -210,11 +212,11 @@ void QualityMesher::function_changed(const Box3& region) {
     if (std::isnan(cvalue_[t])) return;  // not evaluated yet (already pending)
     if (region.contains(ccenter_[t])) {
       cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
-      mark_pending(t);
+      pending_.mark(t);
     }
   });
-  for (const auto& kv : facets_)
-    if (region.contains(kv.second.center)) mark_pending(kv.second.t);
+  for (const auto& kv : facets_.records())
+    if (region.contains(kv.second.center)) pending_.mark(kv.second.t);
 }
 
 }  // namespace vitri

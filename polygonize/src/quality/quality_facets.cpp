@@ -14,6 +14,8 @@
 //        e
 #include "vitri/polygonize/quality_mesher.hpp"
 
+#include "quality_mesher_impl.hpp"
+
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
@@ -61,37 +63,11 @@ bool clip_to_box(const Point3& a, const Point3& b, const Box3& box, double& s0, 
 
 }  // namespace
 
-std::size_t QualityMesher::FacetKeyHash::operator()(const FacetKey& k) const {
-  std::uint64_t h = std::uint64_t(k.v[0]) * 0x9e3779b97f4a7c15ULL ^
-                    std::uint64_t(k.v[1]) * 0xc2b2ae3d27d4eb4fULL ^
-                    std::uint64_t(k.v[2]) * 0x165667b19e3779f9ULL;
-  h ^= h >> 31;
-  h *= 0xbf58476d1ce4e5b9ULL;
-  return static_cast<std::size_t>(h ^ (h >> 29));
-}
-
-// Flags facet i of t, seen from both tetrahedra that share it, as having a record (erase_facet()).
-void QualityMesher::flag_facet(TetId t, int i) {
-  rflags_[t] = std::uint8_t(rflags_[t] | (1u << i));
-  const TetId n = tri_.tet_neighbor(t, i);
-  for (int j = 0; j < 4; ++j)
-    if (tri_.tet_neighbor(n, j) == t) rflags_[n] = std::uint8_t(rflags_[n] | (1u << j));
-}
-
-std::uint64_t QualityMesher::edge_key(VertexId a, VertexId b) {
+std::uint64_t QualityMesher::Impl::edge_key(VertexId a, VertexId b) {
   return a < b ? (std::uint64_t(a) << 32) | b : (std::uint64_t(b) << 32) | a;
 }
 
-QualityMesher::FacetKey QualityMesher::key_of(TetId t, int i) const {
-  FacetKey k{};
-  int n = 0;
-  for (int j = 0; j < 4; ++j)
-    if (j != i) k.v[std::size_t(n++)] = tri_.tet_vertex(t, j);
-  std::sort(k.v.begin(), k.v.end());
-  return k;
-}
-
-void QualityMesher::evaluate(const std::vector<Point3>& p, std::vector<double>& out,
+void QualityMesher::Impl::evaluate(const std::vector<Point3>& p, std::vector<double>& out,
                              std::size_t& phase_counter) {
   out.resize(p.size());
   if (p.empty()) return;
@@ -102,7 +78,7 @@ void QualityMesher::evaluate(const std::vector<Point3>& p, std::vector<double>& 
 
 // f at the circumcentres of `tets` (one batch); a circumcentre outside the open box gets +infinity (the
 // surface lies inside the box, so the outside counts as positive).
-void QualityMesher::evaluate_circumcenters(const std::vector<TetId>& tets) {
+void QualityMesher::Impl::evaluate_circumcenters(const std::vector<TetId>& tets) {
   std::vector<Point3> points;
   std::vector<TetId> inside;
   for (TetId t : tets) {
@@ -122,20 +98,14 @@ void QualityMesher::evaluate_circumcenters(const std::vector<TetId>& tets) {
 
 // Brackets for the facets of the pending tetrahedra whose Voronoi edge changes sign; the other facets
 // of those tetrahedra lose their record. A facet between two pending tetrahedra is handled once.
-void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
-  std::vector<TetId> live;
-  for (TetId t : pending_list_)
-    if (pending_[t] && tri_.is_live(t))
-      live.push_back(t);
-    else
-      pending_[t] = 0;
-  pending_list_.clear();
+void QualityMesher::Impl::collect_brackets(std::vector<Bracket>& brackets) {
+  const std::vector<TetId> live = pending_.start(tri_);
   std::vector<TetId> unknown;
   for (TetId t : live) {
     if (std::isnan(cvalue_[t])) unknown.push_back(t);
     for (int i = 0; i < 4; ++i) {
       const TetId n = tri_.tet_neighbor(t, i);
-      if (n != kNoTet && !pending_[n] && std::isnan(cvalue_[n])) unknown.push_back(n);
+      if (n != kNoTet && !pending_.is_pending(n) && std::isnan(cvalue_[n])) unknown.push_back(n);
     }
   }
   std::sort(unknown.begin(), unknown.end());
@@ -144,7 +114,7 @@ void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
   for (TetId t : live) {
     for (int i = 0; i < 4; ++i) {
       const TetId n = tri_.tet_neighbor(t, i);
-      if (n == kNoTet || (pending_[n] && n < t)) continue;
+      if (n == kNoTet || (pending_.is_pending(n) && n < t)) continue;
       if (negative(cvalue_[t]) == negative(cvalue_[n])) {
         erase_facet(t, i);
         continue;
@@ -160,13 +130,13 @@ void QualityMesher::collect_brackets(std::vector<Bracket>& brackets) {
                           std::numeric_limits<double>::quiet_NaN()});
     }
   }
-  for (TetId t : live) pending_[t] = 0;
+  pending_.finish(live);
 }
 
 // An end outside the box (value +infinity) is replaced by the point where the edge leaves the box, with
 // its value (one batch). A bracket whose clipped end is negative (the surface would leave the box) is
 // dropped: the domain precondition is violated there.
-void QualityMesher::clip_brackets(std::vector<Bracket>& brackets) {
+void QualityMesher::Impl::clip_brackets(std::vector<Bracket>& brackets) {
   std::vector<Point3> points;
   std::vector<std::size_t> which;
   for (std::size_t k = 0; k < brackets.size(); ++k) {
@@ -201,7 +171,7 @@ void QualityMesher::clip_brackets(std::vector<Bracket>& brackets) {
 // (kClassifyTolerance x the diagonal, or the root tolerance if larger): enough for the criteria; the
 // centres that are inserted are polished to the root tolerance before insertion (insert_round()). On
 // return the midpoint of a and b lies within the tolerance of a root.
-void QualityMesher::solve_brackets(std::vector<Bracket>& brackets) {
+void QualityMesher::Impl::solve_brackets(std::vector<Bracket>& brackets) {
   const double tol = std::max(options_.root_tolerance, kClassifyTolerance) * diagonal_;
   std::vector<std::size_t> active(brackets.size());
   for (std::size_t k = 0; k < active.size(); ++k) active[k] = k;
@@ -266,39 +236,36 @@ void QualityMesher::solve_brackets(std::vector<Bracket>& brackets) {
 
 // Records the restricted facets of the solved brackets (ball centre and radius) and queues the bad ones;
 // those that meet every other criterion wait for their distance probes (probe_pending()).
-void QualityMesher::store_facets(const std::vector<Bracket>& brackets) {
+void QualityMesher::Impl::store_facets(const std::vector<Bracket>& brackets) {
   for (const Bracket& b : brackets) {
-    const FacetKey key = key_of(b.t, b.i);
-    FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, kNotProbed, ++stamp_, negative(cvalue_[b.t])};
-    const auto old = old_facets_.find(key);
-    if (old != old_facets_.end()) r.probe_distance = old->second.probe_distance;  // same triangle
+    const FacetKey key = facets_.key_of(b.t, b.i);
+    FacetRecord r{b.t, b.i, 0.5 * (b.a + b.b), 0.0, quality_detail::kNotProbed, 0, negative(cvalue_[b.t])};
+    if (const auto* old = pending_.old(key)) r.probe_distance = old->probe_distance;  // same triangle
     for (VertexId v : key.v) r.radius = std::max(r.radius, distance(r.center, tri_.point(v)));
-    facets_[key] = r;
-    flag_facet(b.t, b.i);
-    for (VertexId v : key.v) mark_vertex_dirty(v);
-    if (is_bad(r))
-      push(key, r, false);
-    else if (needs_probes(r))
-      unprobed_.push_back(key);
+    const FacetRecord& stored = facets_.store(key, r);
+    for (VertexId v : key.v) dirty_.note(v);
+    if (is_bad(stored))
+      push(key, stored, false);
+    else if (needs_probes(stored))
+      queue_.wait_for_probes(key);
   }
 }
 
 // Probes the facets waiting for it that still exist and still need it. Called when the queue is empty:
 // facets created and killed while the mesh is still coarse are never probed.
-void QualityMesher::probe_pending() {
+void QualityMesher::Impl::probe_pending() {
   std::vector<FacetKey> keys;
-  for (const FacetKey& k : unprobed_) {
-    const auto it = facets_.find(k);
-    if (it != facets_.end() && needs_probes(it->second)) keys.push_back(k);
+  for (const FacetKey& k : queue_.take_unprobed()) {
+    const FacetRecord* r = facets_.find(k);
+    if (r && needs_probes(*r)) keys.push_back(k);
   }
-  unprobed_.clear();
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
   probe_facets(keys);
 }
 
-bool QualityMesher::needs_probes(const FacetRecord& r) const {
-  return r.probe_distance == kNotProbed && options_.distance_probes > 0 &&
+bool QualityMesher::Impl::needs_probes(const FacetRecord& r) const {
+  return r.probe_distance == quality_detail::kNotProbed && options_.distance_probes > 0 &&
          std::isfinite(options_.max_distance) && (!options_.refine_where || options_.refine_where(r.center));
 }
 
@@ -307,7 +274,7 @@ bool QualityMesher::needs_probes(const FacetRecord& r) const {
 // probes on an edge are evaluated once for its two facets (edge_probes_, kept until f or a vertex moves).
 // Facets beyond the distance bound are queued. Probes are evaluated only for facets that meet every
 // other criterion, once nothing else is queued: most facets of an unfinished mesh are refined anyway.
-void QualityMesher::probe_facets(const std::vector<FacetKey>& keys) {
+void QualityMesher::Impl::probe_facets(const std::vector<FacetKey>& keys) {
   // Slots of probes: one per facet (its interior grid points and centroid), then one per edge not probed
   // before (its steps - 1 grid points; an edge's probes serve both of its facets, edge_probes_ keeps them).
   const int steps = options_.distance_probes;
@@ -352,44 +319,44 @@ void QualityMesher::probe_facets(const std::vector<FacetKey>& keys) {
   }
   for (const auto& kv : new_edges) edge_probes_[kv.first] = slot_distance[kv.second];
   for (std::size_t m = 0; m < keys.size(); ++m) {
-    FacetRecord& r = facets_.at(keys[m]);
-    r.probe_distance = slot_distance[m];
+    double probe_distance = slot_distance[m];
     for (int e = 0; e < 3; ++e)
-      r.probe_distance =
-          std::max(r.probe_distance,
+      probe_distance =
+          std::max(probe_distance,
                    edge_probes_.at(edge_key(keys[m].v[std::size_t(e)], keys[m].v[std::size_t((e + 1) % 3)])));
+    const FacetRecord& r = facets_.set_probe_distance(keys[m], probe_distance);
     if (r.probe_distance > options_.max_distance) push(keys[m], r, false);
   }
 }
 
 // A facet on the boundary of an insertion's cavity keeps its dual line (through its circumcentre,
 // perpendicular to it): only the ends of its Voronoi edge move. If its old ball centre, a root of f on that
-// line, lies inside the new edge, it is the crossing again: no evaluation. (old_facets_ holds the records
-// erased since the last classification; f has not changed since: function_changed() clears it.)
-void QualityMesher::warm_start(std::vector<Bracket>& brackets) {
+// line, lies inside the new edge, it is the crossing again: no evaluation. (pending_ holds what the records
+// erased since the last classification left; f has not changed since: function_changed() forgets them.)
+void QualityMesher::Impl::warm_start(std::vector<Bracket>& brackets) {
   for (Bracket& b : brackets) {
-    const auto it = old_facets_.find(key_of(b.t, b.i));
-    if (it == old_facets_.end()) continue;
+    const auto* old = pending_.old(facets_.key_of(b.t, b.i));
+    if (!old) continue;
     const Point3 d = b.b - b.a;
-    const double s = dot(it->second.center - b.a, d) / squared_norm(d);
-    if (s > 0.0 && s < 1.0) b.a = b.b = it->second.center;
+    const double s = dot(old->center - b.a, d) / squared_norm(d);
+    if (s > 0.0 && s < 1.0) b.a = b.b = old->center;
   }
 }
 
-void QualityMesher::classify_pending() {
+void QualityMesher::Impl::classify_pending() {
   std::vector<Bracket> brackets;
   collect_brackets(brackets);
   clip_brackets(brackets);
   warm_start(brackets);
   solve_brackets(brackets);
   store_facets(brackets);
-  old_facets_.clear();
+  pending_.forget_old();
 }
 
 // The refinement criteria of one restricted facet. The angle test uses sin(smallest angle) = |n| / (l1 l2)
 // with l1, l2 the two longest edges and |n| twice the area: the sine of the angle between them.
-bool QualityMesher::is_bad(const FacetRecord& r) const {
-  const FacetKey key = key_of(r.t, r.i);
+bool QualityMesher::Impl::is_bad(const FacetRecord& r) const {
+  const FacetKey key = facets_.key_of(r.t, r.i);
   for (VertexId v : key.v)
     if (!on_surface_[v]) return true;  // a box corner: never part of the mesh
   if (r.radius > options_.max_size) return true;
@@ -409,28 +376,27 @@ bool QualityMesher::is_bad(const FacetRecord& r) const {
   return options_.min_angle_degrees > 0.0 && sine < bound;
 }
 
-void QualityMesher::push(const FacetKey& key, const FacetRecord& r, bool topology) {
+void QualityMesher::Impl::push(const FacetKey& key, const FacetRecord& r, bool topology) {
   if (options_.refine_where && !options_.refine_where(r.center)) return;  // outside the refined region
   if (topology && r.radius < options_.min_topology_radius) return;         // thinner than asked for
   queue_.push({r.radius, key, r.stamp, topology});
 }
 
-void QualityMesher::requeue_all() {
-  queue_ = {};
-  unprobed_.clear();
-  for (const auto& kv : facets_) {
+void QualityMesher::Impl::requeue_all() {
+  queue_.clear();
+  for (const auto& kv : facets_.records()) {
     if (is_bad(kv.second))
       push(kv.first, kv.second, false);
     else if (needs_probes(kv.second))
-      unprobed_.push_back(kv.first);
+      queue_.wait_for_probes(kv.first);
   }
 }
 
-SurfaceMesh QualityMesher::extract() {
+SurfaceMesh QualityMesher::Impl::extract() {
   const auto t0 = std::chrono::steady_clock::now();
   std::vector<FacetKey> keys;
   keys.reserve(facets_.size());
-  for (const auto& kv : facets_) keys.push_back(kv.first);
+  for (const auto& kv : facets_.records()) keys.push_back(kv.first);
   std::sort(keys.begin(), keys.end());
   SurfaceMesh mesh;
   std::unordered_map<VertexId, std::uint32_t> index;
@@ -441,7 +407,7 @@ SurfaceMesh QualityMesher::extract() {
   };
   mesh.triangles.reserve(keys.size());
   for (const FacetKey& key : keys) {
-    const FacetRecord& r = facets_.at(key);
+    const FacetRecord& r = *facets_.find(key);
     const int* face = kOutwardFace[r.i];
     std::array<std::uint32_t, 3> tri{mesh_vertex(tri_.tet_vertex(r.t, face[0])),
                                      mesh_vertex(tri_.tet_vertex(r.t, face[1])),

@@ -14,6 +14,8 @@
 // It ends when steps 1 and 2 queue nothing. Termination and the guarantees: docs/quality.md.
 #include "vitri/polygonize/quality_mesher.hpp"
 
+#include "quality_mesher_impl.hpp"
+
 #include "vitri/core/error.hpp"
 #include "vitri/core/predicates.hpp"
 
@@ -25,18 +27,18 @@
 
 namespace vitri {
 
-QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
-                             const QualityOptions& options)
+QualityMesher::Impl::Impl(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
+                          const QualityOptions& options)
     : f_(f),
       options_(options),
       tri_(domain),
       diagonal_(domain.diagonal()),
       cvalue_(tri_, std::numeric_limits<double>::quiet_NaN(), TetRenumbering::Reset),
       ccenter_(tri_, Point3{}, TetRenumbering::Reset),
-      pending_(tri_, 0, TetRenumbering::Reset),
-      rflags_(tri_, 0, TetRenumbering::Reset),
       on_surface_(tri_, 0),
-      dirty_(tri_, 0) {
+      facets_(tri_),
+      pending_(tri_),
+      dirty_(tri_) {
   validate(options_);
   for (std::size_t i = 0; i < seeds.size(); ++i)
     if (!is_finite(seeds[i])) throw InvalidPoint(i, "seed is not finite");
@@ -54,7 +56,7 @@ QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, cons
   forget_all_facets();
 }
 
-bool QualityMesher::inside_domain(const Point3& p) const {
+bool QualityMesher::Impl::inside_domain(const Point3& p) const {
   const Box3& b = tri_.box();
   return p.x > b.lo.x && p.x < b.hi.x && p.y > b.lo.y && p.y < b.hi.y && p.z > b.lo.z && p.z < b.hi.z;
 }
@@ -77,52 +79,35 @@ void QualityMesher::validate(const QualityOptions& o) {
   if (o.max_vertices < 9) throw InvalidArgument("QualityOptions::max_vertices must be >= 9");
 }
 
-void QualityMesher::set_options(const QualityOptions& options) {
+void QualityMesher::Impl::set_options(const QualityOptions& options) {
   validate(options);
   if (options.distance_probes != options_.distance_probes) edge_probes_.clear();
   options_ = options;
 }
 
-QualityStats QualityMesher::stats() const {
+QualityStats QualityMesher::Impl::stats() const {
   QualityStats s = stats_;
   s.vertices = tri_.num_vertices();
   s.restricted_facets = facets_.size();
   return s;
 }
 
-void QualityMesher::mark_vertex_dirty(VertexId v) {
-  if (dirty_[v]) return;
-  dirty_[v] = 1;
-  dirty_list_.push_back(v);
-}
-
-// The tetrahedron's facets wait for classification.
-void QualityMesher::mark_pending(TetId t) {
-  if (pending_[t]) return;
-  pending_[t] = 1;
-  pending_list_.push_back(t);
-}
-
 // Drops every facet record and circumcentre value: all live tetrahedra are classified again (at
 // construction, after a history rebuild renumbered the tetrahedra, after function_changed()).
-void QualityMesher::forget_all_facets() {
+void QualityMesher::Impl::forget_all_facets() {
   facets_.clear();
-  queue_ = {};
-  unprobed_.clear();
-  old_facets_.clear();
+  queue_.clear();
+  pending_.clear();
   edge_probes_.clear();
   cvalue_.fill(std::numeric_limits<double>::quiet_NaN());
-  pending_.fill(0);
-  rflags_.fill(0);
-  pending_list_.clear();
-  tri_.for_each_tetrahedron([this](TetId t) { mark_pending(t); });
+  tri_.for_each_tetrahedron([this](TetId t) { pending_.mark(t); });
   for (VertexId v = 0; v < tri_.vertex_capacity(); ++v)
-    if (tri_.is_vertex(v)) mark_vertex_dirty(v);
+    if (tri_.is_vertex(v)) dirty_.note(v);
 }
 
 // Applies the change set of one Delaunay operation: facets of killed tetrahedra are forgotten (those on
 // the boundary of the changed region come back with the created tetrahedra, with their new Voronoi edge).
-void QualityMesher::absorb(const ChangeSet& cs) {
+void QualityMesher::Impl::absorb(const ChangeSet& cs) {
   if (cs.renumbered) {
     forget_all_facets();
     return;
@@ -133,28 +118,24 @@ void QualityMesher::absorb(const ChangeSet& cs) {
   }
   for (TetId t : cs.created) {
     cvalue_[t] = std::numeric_limits<double>::quiet_NaN();
-    rflags_[t] = 0;
-    mark_pending(t);
+    facets_.reset_flags(t);
+    pending_.mark(t);
   }
 }
 
 // Forgets the record of facet i of t, if t's flags say there may be one; its vertices then wait for the
-// topology check, its ball centre in old_facets_ for the next classification (warm_start()).
-void QualityMesher::erase_facet(TetId t, int i) {
-  const std::uint8_t bit = std::uint8_t(1u << i);
-  if (!(rflags_[t] & bit)) return;
-  rflags_[t] = std::uint8_t(rflags_[t] & ~bit);
-  const auto it = facets_.find(key_of(t, i));
-  if (it == facets_.end()) return;
-  for (VertexId v : it->first.v) mark_vertex_dirty(v);
-  old_facets_[it->first] = {it->second.center, it->second.probe_distance};
-  facets_.erase(it);
+// topology check, its ball centre and probes (pending_) for the next classification (warm_start()).
+void QualityMesher::Impl::erase_facet(TetId t, int i) {
+  facets_.erase(t, i, [this](const FacetKey& key, const FacetRecord& r) {
+    for (VertexId v : key.v) dirty_.note(v);
+    pending_.remember(key, {r.center, r.probe_distance});
+  });
 }
 
 // Inserts p (a polished ball centre of `facet`). The centre lies in the union of the circumballs of the
 // facet's two tetrahedra (its ball belongs to the pencil of spheres through the facet's circle, between
 // theirs), so one of them is usually in conflict with p and no point location is needed.
-bool QualityMesher::insert_point(const Point3& p, const FacetRecord* facet) {
+bool QualityMesher::Impl::insert_point(const Point3& p, const FacetRecord* facet) {
   if (!inside_domain(p)) {
     ++stats_.rejected;
     return false;
@@ -182,13 +163,12 @@ bool QualityMesher::insert_point(const Point3& p, const FacetRecord* facet) {
 // replaced or erased since they were queued (also by an insertion of this round). The centres, located
 // for the criteria only, are first moved onto the surface to the root tolerance (Newton steps, one batch
 // per step; a few 1e-7 of the diagonal at most). Returns the number of rejected centres.
-std::size_t QualityMesher::insert_round() {
+std::size_t QualityMesher::Impl::insert_round() {
   const std::size_t batch = std::max<std::size_t>(32, queue_.size() / 2);
   std::vector<QueueItem> items;
   std::vector<Point3> centers;
-  while (items.size() < batch && !queue_.empty()) {
-    const QueueItem item = queue_.top();
-    queue_.pop();
+  QueueItem item{};
+  while (items.size() < batch && queue_.pop(item)) {
     const FacetRecord* r = current(item);
     if (!r || (!item.topology && !is_bad(*r))) continue;
     items.push_back(item);
@@ -208,29 +188,24 @@ std::size_t QualityMesher::insert_round() {
   return rejected;
 }
 
-const QualityMesher::FacetRecord* QualityMesher::current(const QueueItem& item) const {
-  const auto it = facets_.find(item.key);
-  return it == facets_.end() || it->second.stamp != item.stamp ? nullptr : &it->second;
-}
-
 // The restricted stars of all vertices at once, from the facet records in O(F + V): the star of v is
 // entries[start[v] .. start[v + 1]) (compressed rows). Cheaper than looking up the faces of the incident
 // tetrahedra of every vertex (a surface vertex has many long tetrahedra through the volume).
-void QualityMesher::build_stars(std::vector<std::uint32_t>& start, std::vector<StarEntry>& entries) const {
+void QualityMesher::Impl::build_stars(std::vector<std::uint32_t>& start, std::vector<StarEntry>& entries) const {
   start.assign(tri_.vertex_capacity() + 1, 0);
-  for (const auto& kv : facets_)
+  for (const auto& kv : facets_.records())
     for (VertexId v : kv.first.v) ++start[v + 1];
   for (std::size_t v = 0; v + 1 < start.size(); ++v) start[v + 1] += start[v];
   entries.resize(start.back());
   std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
-  for (const auto& kv : facets_)
+  for (const auto& kv : facets_.records())
     for (VertexId v : kv.first.v) entries[fill[v]++] = {&kv.first, &kv.second};
 }
 
 // True when the restricted facets [begin, end) around v form one disk (or there are none). The link: one
 // edge (p, q) per facet; a disk's link is a single cycle: every link vertex on exactly two edges, and a
 // walk along the edges from the first one visits them all.
-bool QualityMesher::star_is_disk(VertexId v, const StarEntry* begin, const StarEntry* end) const {
+bool QualityMesher::Impl::star_is_disk(VertexId v, const StarEntry* begin, const StarEntry* end) const {
   if (begin == end) return true;
   if (end - begin < 3) return false;
   std::vector<std::pair<VertexId, VertexId>> link;
@@ -265,14 +240,11 @@ bool QualityMesher::star_is_disk(VertexId v, const StarEntry* begin, const StarE
 }
 
 // Queues the largest facet of the star of every changed vertex whose restricted star is not a disk.
-void QualityMesher::check_topology() {
+void QualityMesher::Impl::check_topology() {
   std::vector<std::uint32_t> start;
   std::vector<StarEntry> entries;
   build_stars(start, entries);
-  std::vector<VertexId> list;
-  list.swap(dirty_list_);
-  for (VertexId v : list) {
-    dirty_[v] = 0;
+  for (VertexId v : dirty_.take()) {
     const StarEntry* begin = entries.data() + start[v];
     const StarEntry* end = entries.data() + start[v + 1];
     if (!tri_.is_vertex(v) || star_is_disk(v, begin, end)) continue;
@@ -283,7 +255,7 @@ void QualityMesher::check_topology() {
   }
 }
 
-bool QualityMesher::refine() {
+bool QualityMesher::Impl::refine() {
   const auto t0 = std::chrono::steady_clock::now();
   std::size_t rejected = 0;
   requeue_all();
@@ -302,5 +274,31 @@ bool QualityMesher::refine() {
   stats_.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return rejected == 0;
 }
+
+// ---- The public QualityMesher: forwards to its Impl ---------------------------------------------------
+
+QualityMesher::QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
+                             const QualityOptions& options)
+    : impl_(std::make_unique<Impl>(f, domain, seeds, options)) {}
+
+QualityMesher::~QualityMesher() = default;
+
+bool QualityMesher::refine() { return impl_->refine(); }
+
+void QualityMesher::set_options(const QualityOptions& options) { impl_->set_options(options); }
+
+SurfaceMesh QualityMesher::extract() { return impl_->extract(); }
+
+void QualityMesher::function_changed() { impl_->function_changed(); }
+
+void QualityMesher::function_changed(const Box3& region) { impl_->function_changed(region); }
+
+const Triangulation& QualityMesher::triangulation() const { return impl_->tri_; }
+
+const ImplicitFunction& QualityMesher::function() const { return impl_->f_; }
+
+const QualityOptions& QualityMesher::options() const { return impl_->options_; }
+
+QualityStats QualityMesher::stats() const { return impl_->stats(); }
 
 }  // namespace vitri

@@ -25,17 +25,13 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/implicit.hpp"
 #include "vitri/core/point.hpp"
-#include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
 
-#include <array>
 #include <cstddef>
-#include <cstdint>
 #include <functional>
 #include <limits>
-#include <queue>
-#include <unordered_map>
+#include <memory>
 #include <vector>
 
 namespace vitri {
@@ -113,6 +109,9 @@ class QualityMesher {
   /// @throws InvalidArgument for a bad domain or options; InvalidPoint(i) for a non-finite seed i.
   QualityMesher(const ImplicitFunction& f, const Box3& domain, const std::vector<Point3>& seeds,
                 const QualityOptions& options = {});
+  ~QualityMesher();
+  QualityMesher(const QualityMesher&) = delete;
+  QualityMesher& operator=(const QualityMesher&) = delete;
 
   /// Seeds for the constructor: the fast Polygonizer's mesh at precision `spacing` (absolute), thinned
   /// with seeds_from_mesh(). @throws InvalidArgument when spacing <= 0, as Polygonizer otherwise.
@@ -149,116 +148,19 @@ class QualityMesher {
   /// inside it classified again (a facet with both circumcentres outside keeps its sign test).
   void function_changed(const Box3& region);
 
-  const Triangulation& triangulation() const { return tri_; }
-  const ImplicitFunction& function() const { return f_; }
-  const QualityOptions& options() const { return options_; }
+  /// The Delaunay tetrahedralization: the 8 box corners, the seeds and the inserted ball centres.
+  const Triangulation& triangulation() const;
+  /// The function meshed (the caller's, kept by reference).
+  const ImplicitFunction& function() const;
+  /// The criteria in force (the constructor's, or the last set_options()).
+  const QualityOptions& options() const;
+  /// Counters and timings (vertices and restricted_facets are current).
   QualityStats stats() const;
 
  private:
-  /// A facet by its three vertex ids, sorted.
-  struct FacetKey {
-    std::array<VertexId, 3> v;
-    bool operator==(const FacetKey& o) const { return v == o.v; }
-    bool operator<(const FacetKey& o) const { return v < o.v; }
-  };
-  struct FacetKeyHash {
-    std::size_t operator()(const FacetKey& k) const;
-  };
-  /// A restricted facet: the face opposite vertex `i` of live tetrahedron `t` (valid while the record
-  /// exists: any change to t or its neighbour erases it), its surface Delaunay ball, and a stamp that
-  /// tells queue entries from older records of the same key.
-  struct FacetRecord {
-    TetId t;
-    int i;
-    Point3 center;
-    double radius;
-    double probe_distance;  // largest |f| / |grad f| at the probes, or kNotProbed
-    std::uint32_t stamp;
-    bool inside_t;  // f < 0 at t's circumcentre: the facet faces outward from t
-  };
-  struct QueueItem {
-    double priority;
-    FacetKey key;
-    std::uint32_t stamp;
-    bool topology;  // pushed by the topology check (a vertex whose restricted star is not a disk)
-    bool operator<(const QueueItem& o) const { return priority < o.priority; }
-  };
-  /// A Voronoi edge crossing the surface, bracketed for the root finder.
-  struct Bracket {
-    TetId t;
-    int i;
-    Point3 a, b;    // a: t's side, b: the neighbour's side
-    double fa, fb;  // values at a and b (opposite signs)
-    int stale;      // Illinois: end kept twice in a row
-    Point3 last;    // the last point evaluated
-    double newton;  // Newton step from `last` along the edge (towards b), NaN when none
-  };
-
-  FacetKey key_of(TetId t, int i) const;
-  static std::uint64_t edge_key(VertexId a, VertexId b);
-  bool inside_domain(const Point3& p) const;  // strictly inside the box
-  void evaluate_circumcenters(const std::vector<TetId>& tets);
-  void classify_pending();
-  void collect_brackets(std::vector<Bracket>& brackets);
-  void clip_brackets(std::vector<Bracket>& brackets);
-  void warm_start(std::vector<Bracket>& brackets);
-  void solve_brackets(std::vector<Bracket>& brackets);
-  void store_facets(const std::vector<Bracket>& brackets);
-  bool needs_probes(const FacetRecord& r) const;
-  void probe_facets(const std::vector<FacetKey>& keys);
-  void probe_pending();
-  static constexpr double kNotProbed = -1.0;
-  bool is_bad(const FacetRecord& r) const;
-  void push(const FacetKey& key, const FacetRecord& r, bool topology);
-  void requeue_all();
-  void check_topology();
-  struct StarEntry {
-    const FacetKey* key;
-    const FacetRecord* record;
-  };
-  void build_stars(std::vector<std::uint32_t>& start, std::vector<StarEntry>& entries) const;
-  bool star_is_disk(VertexId v, const StarEntry* begin, const StarEntry* end) const;
-  std::size_t insert_round();
-  bool insert_point(const Point3& p, const FacetRecord* facet);
-  const FacetRecord* current(const QueueItem& item) const;
-  void mark_vertex_dirty(VertexId v);
-  void absorb(const ChangeSet& cs);
-  void mark_pending(TetId t);
-  void erase_facet(TetId t, int i);
-  void flag_facet(TetId t, int i);
-  void forget_all_facets();
-  std::size_t project_vertices(const std::vector<VertexId>& ids);
-  std::vector<Point3> newton_project(std::vector<Point3> p, std::vector<std::uint8_t>& ok);
-  void evaluate(const std::vector<Point3>& p, std::vector<double>& out, std::size_t& phase_counter);
-
-  const ImplicitFunction& f_;
-  QualityOptions options_;
-  Triangulation tri_;
-  double diagonal_;
-  // Per-element state: property maps of tri_ (vitri/delaunay/property_map.hpp), sized by it. The
-  // per-tetrahedron maps are reset when tri_ renumbers its tetrahedra (absorb() then forgets every facet).
-  TetMap<double> cvalue_;              // f at the circumcentre (NaN: unknown, +inf: outside box)
-  TetMap<Point3> ccenter_;             // circumcentre, valid with cvalue_
-  TetMap<std::uint8_t> pending_;       // its facets wait for classification
-  TetMap<std::uint8_t> rflags_;        // bit i set when facet i may have a record
-  std::vector<TetId> pending_list_;
-  VertexMap<std::uint8_t> on_surface_;  // a seed or ball centre (not a box corner)
-  VertexMap<std::uint8_t> dirty_;       // star changed since the last topology check
-  std::vector<VertexId> dirty_list_;
-  std::unordered_map<FacetKey, FacetRecord, FacetKeyHash> facets_;
-  std::priority_queue<QueueItem> queue_;
-  std::vector<FacetKey> unprobed_;  // facets that meet every criterion but wait for their probes
-  std::unordered_map<std::uint64_t, double> edge_probes_;  // per edge: largest distance at its probes
-  /// What a facet keeps when its record is erased by an insertion: it may come back (a facet on the
-  /// boundary of the cavity) with the same ball centre (same dual line) and the same probes (same triangle).
-  struct OldFacet {
-    Point3 center;
-    double probe_distance;
-  };
-  std::unordered_map<FacetKey, OldFacet, FacetKeyHash> old_facets_;  // records erased since classification
-  std::uint32_t stamp_ = 0;
-  ChangeSet changes_;
-  QualityStats stats_;
+  /// The state and the parts the QualityMesher coordinates (polygonize/src/quality/quality_mesher_impl.hpp).
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace vitri

@@ -445,6 +445,11 @@ void PointIndex::close_pairs_below(std::uint32_t index, Point3 lo, Point3 hi, do
 }
 
 void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, std::vector<double>* dist2) const {
+  nearest_within(q, k, std::numeric_limits<double>::infinity(), ids, dist2);
+}
+
+void PointIndex::nearest_within(const Point3& q, std::size_t k, double within2, std::vector<Id>& ids,
+                                std::vector<double>* dist2) const {
   ids.clear();
   if (dist2) dist2->clear();
   if (size_ == 0 || k == 0) return;
@@ -455,6 +460,7 @@ void PointIndex::nearest(const Point3& q, std::size_t k, std::vector<Id>& ids, s
   thread_local std::vector<Id> big_ids;
   NearestState state;
   state.k = k;
+  state.bound = within2;  // (infinite for nearest(); the state lowers it once it holds k)
   if (k <= NearestState::kInline) {
     state.d2 = inline_d2;
     state.ids = inline_ids;

@@ -76,6 +76,21 @@ void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rn
       index.nearest(c, k, got, &d2);
       REQUIRE(got == brute.nearest(c, k));
       for (std::size_t i = 0; i < got.size(); ++i) REQUIRE(d2[i] == vitri::squared_distance(index.point(got[i]), c));
+      if (got.empty()) continue;
+      // nearest_within: a bound at the k-th distance (ties there included) or beyond gives the same
+      // answer; a bound below it, the points within it only, still in order.
+      const std::vector<Id> expect = got;
+      const double kth = d2.back();
+      for (const double within : {kth, 1.5 * kth + 1e-3}) {
+        index.nearest_within(c, k, within, got);
+        REQUIRE(got == expect);
+      }
+      const double half = 0.25 * kth;
+      index.nearest_within(c, k, half, got, &d2);
+      std::vector<Id> inside;
+      for (const Id id : expect)
+        if (vitri::squared_distance(index.point(id), c) <= half) inside.push_back(id);
+      REQUIRE(got == inside);
     }
   }
 }

@@ -13,6 +13,8 @@
 //   balls (every tetrahedron whose bounding box meets a ball dilated by crossing_reach(): the walk of
 //   vertices_near(), which holds every tetrahedron incident to a re-evaluated vertex too).
 // A tetrahedron left uncertified is simply not flagged: it is checked again at every refine().
+// Outside the certified mode nothing is marked and the Impl calls nothing here (no cost on the edits'
+// path; PolygonizerOptions::certify is fixed for the Polygonizer's life).
 #include "vitri/delaunay/property_map.hpp"
 #include "vitri/delaunay/triangulation.hpp"
 

@@ -29,7 +29,7 @@ void Polygonizer::Impl::function_changed() { function_changed([](const Point3&) 
 
 void Polygonizer::Impl::function_changed(const std::function<bool(const Point3&)>& may_have_changed) {
   const auto t0 = Clock::now();
-  certified_.forget_all();  // the predicate speaks of points, not of the tetrahedra's boxes
+  if (options_.certify) certified_.forget_all();  // the predicate speaks of points, not of boxes
   std::vector<VertexId> ids;
   const std::size_t cap = tri_.vertex_capacity();
   for (VertexId v = 0; v < cap; ++v)
@@ -40,8 +40,8 @@ void Polygonizer::Impl::function_changed(const std::function<bool(const Point3&)
 
 void Polygonizer::Impl::function_changed(const std::vector<Ball>& changed) {
   const auto t0 = Clock::now();
-  std::vector<TetId> met;
-  std::vector<VertexId> ids = vertices_near(changed, crossing_reach(), &met);
+  std::vector<TetId> met;  // certified mode only: the tetrahedra whose certificates the change may break
+  std::vector<VertexId> ids = vertices_near(changed, crossing_reach(), options_.certify ? &met : nullptr);
   for (const TetId t : met) certified_.forget(t);
   ids.erase(std::remove_if(ids.begin(), ids.end(), [&](VertexId v) { return !needs_evaluation(v); }), ids.end());
   reevaluate(ids);

@@ -494,7 +494,7 @@ void Polygonizer::Impl::classify_created(std::vector<TetId>& created) {
   });
   if (certifying_) certify_new_.insert(certify_new_.end(), created.begin(), created.end());
   for (std::size_t k = 0; k < n; ++k) {
-    certified_.forget(created[k]);
+    if (options_.certify) certified_.forget(created[k]);
     surface_->note_created(created[k]);
     if (ahead[k].live) classify_as(created[k], false, ahead[k].transverse, ahead[k].radius);
   }

@@ -103,7 +103,7 @@ void Polygonizer::Impl::set_vertex_value(VertexId v, double value) {
   set_value(v, value);
   fixed_[v] = 1;
   for (const TetId t : tri_.incident_tetrahedra(v)) {
-    certified_.forget(t);
+    if (options_.certify) certified_.forget(t);
     classify(t, false);
   }
   settle_zeros({});

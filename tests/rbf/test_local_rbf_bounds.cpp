@@ -37,18 +37,27 @@ bool gradient_bounded(const FunctionBound& e) {
   return true;
 }
 
+/// 3000 constraints of a shared model (a few thousand: the boxes meet patches of several sizes).
+Constraints model_constraints(const std::string& name) {
+  const TriangleMesh m = read_mesh(std::string(VITRI_DATA_DIR) + "/" + name);
+  ConstraintBuildOptions opt;
+  opt.max_constraints = 3000;
+  return constraints_from_mesh(m.V, m.F, opt);
+}
+
+LocalRbf fit_local(const Constraints& c) {
+  LocalRbfOptions lo;
+  lo.threads = 2;
+  return LocalRbf(c, lo);
+}
+
 }  // namespace
 
 TEST_CASE("local rbf bounds contain f and its gradient on shared models", "[rbf][bounds][local][data]") {
   const std::string name = GENERATE(std::string("hand.off"), std::string("bunny.off"));
   INFO(name);
-  const TriangleMesh m = read_mesh(std::string(VITRI_DATA_DIR) + "/" + name);
-  ConstraintBuildOptions opt;
-  opt.max_constraints = 3000;
-  const Constraints c = constraints_from_mesh(m.V, m.F, opt);
-  LocalRbfOptions lo;
-  lo.threads = 2;
-  const LocalRbf f(c, lo);
+  const Constraints c = model_constraints(name);
+  const LocalRbf f = fit_local(c);
   REQUIRE(f.has_bounds());
   Box3 model;
   for (const Point3& p : c.points) model.extend(p);
@@ -100,13 +109,8 @@ TEST_CASE("local rbf bounds contain f and its gradient on shared models", "[rbf]
 TEST_CASE("local rbf bounds shrink to f and its gradient on tiny boxes at the data", "[rbf][bounds][local][data]") {
   // Tiny boxes at constraint points: the value interval shrinks around f(p), the gradient box around
   // grad f(p) (a sanity check of the Taylor models; rigor is the test above).
-  const TriangleMesh m = read_mesh(std::string(VITRI_DATA_DIR) + "/bunny.off");
-  ConstraintBuildOptions opt;
-  opt.max_constraints = 3000;
-  const Constraints c = constraints_from_mesh(m.V, m.F, opt);
-  LocalRbfOptions lo;
-  lo.threads = 2;
-  const LocalRbf f(c, lo);
+  const Constraints c = model_constraints("bunny.off");
+  const LocalRbf f = fit_local(c);
   Box3 model;
   for (const Point3& p : c.points) model.extend(p);
   const double h = 1e-6 * model.diagonal();

@@ -48,6 +48,40 @@ bool meets_line(const FunctionBound& b, const Point3& n) {
   return t_lo <= t_hi;
 }
 
+// u^T H v for the symmetric H stored row-major.
+double form(const std::array<double, 9>& h, const Point3& u, const Point3& v) {
+  double s = 0;
+  for (std::size_t k = 0; k < 3; ++k)
+    for (std::size_t l = 0; l < 3; ++l) s += u[k] * h[3 * k + l] * v[l];
+  return s;
+}
+
+// The sign of f's curvature along the line of the unit e1 (e2 == nullptr) or in the plane of the
+// orthonormal e1, e2, over the whole region of the enclosure: +1 when every Hessian of the enclosure
+// restricted there is positive definite (f strictly convex on every segment or triangle of that
+// direction or plane in the region), -1 when negative definite, 0 when neither can be shown. The
+// restriction of hess_center is within hess_radius of every restricted Hessian (a restriction to
+// orthonormal vectors does not increase the spectral norm); the slack covers the rounding of the forms
+// and of the basis.
+int curvature_sign(const FunctionBound& b, const Point3& e1, const Point3* e2) {
+  if (!std::isfinite(b.hess_radius)) return 0;
+  double size = 0;
+  for (const double e : b.hess_center) size += std::abs(e);
+  const double margin = b.hess_radius + 1e-12 * size;
+  double lo = 0, hi = 0;
+  const double p = form(b.hess_center, e1, e1);
+  if (e2 == nullptr) {
+    lo = hi = p;
+  } else {  // the eigenvalues of the 2 x 2 restriction [p q; q s]
+    const double q = form(b.hess_center, e1, *e2), s = form(b.hess_center, *e2, *e2);
+    const double mean = 0.5 * (p + s), spread = std::hypot(0.5 * (p - s), q);
+    lo = mean - spread, hi = mean + spread;
+  }
+  if (lo > margin) return 1;
+  if (hi < -margin) return -1;
+  return 0;
+}
+
 // Condition 3 of certify_cell() for the edge from a (value fa) to b (value fb).
 bool edge_certified(const FunctionBound& bound, const Point3& a, const Point3& b, double fa, double fb) {
   const Point3 e = b - a;
@@ -56,8 +90,14 @@ bool edge_certified(const FunctionBound& bound, const Point3& a, const Point3& b
   const Point3 d = e / length;
   const double m = min_dot(bound, d), M = max_dot(bound, d);
   const bool monotone = m > 0 || M < 0;
-  if ((fa < 0) != (fb < 0)) return monotone;
+  // Or f strictly convex or concave along the edge (read with sign(0) = + as f + e): ends of opposite
+  // signs then have exactly one crossing between them, transversal; two negative ends and a convex f,
+  // or two positive ends and a concave one, none.
+  const int curvature = monotone ? 0 : curvature_sign(bound, d, nullptr);
+  if ((fa < 0) != (fb < 0)) return monotone || curvature != 0;
   if (monotone) return true;
+  if (curvature > 0 && fa < 0) return true;
+  if (curvature < 0 && !(fa < 0)) return true;
   if (fa == 0 || fb == 0 || !std::isfinite(m) || !std::isfinite(M)) return false;
   if (!(M > m)) return true;  // m = M = 0: f is constant along the edge, of its ends' sign
   // m <= 0 <= M: f(t) >= max(fa + m t, fb - M (length - t)) (positive ends; the mirror for negative
@@ -101,8 +141,18 @@ CellCertificate certify_cell(const std::array<Point3, 4>& p, const std::array<do
     if (!(nn > 0)) return CellCertificate::Uncertified;
     n = n / nn;
     if (!meets_line(bound, n)) continue;
-    const double wn = norm(mid - dot(mid, n) * n);
     const double fa = values[ia], fb = values[ib], fc = values[ic];
+    // Or f strictly convex on the face's plane (K = {f + e <= 0} on F convex) and not every vertex
+    // positive: K holds the negative vertices and, with condition 3, meets F's boundary in one connected
+    // piece (the negative vertices, the edges between them, up to the single crossings), so Z meets F
+    // in K's one remaining boundary arc, joining the two crossings, or not at all; a regular arc (a
+    // critical point of the strictly convex f on F would be its minimum, negative). Strictly concave
+    // and not every vertex negative: the same with {f + e >= 0}.
+    const bool all_negative = fa < 0 && fb < 0 && fc < 0, all_positive = !(fa < 0) && !(fb < 0) && !(fc < 0);
+    const Point3 e1 = (b - a) / norm(b - a), e2 = cross(n, e1);
+    const int curvature = curvature_sign(bound, e1, &e2);
+    if ((curvature > 0 && !all_positive) || (curvature < 0 && !all_negative)) continue;
+    const double wn = norm(mid - dot(mid, n) * n);
     const bool one_sign = (fa < 0) == (fb < 0) && (fb < 0) == (fc < 0) && fa != 0 && fb != 0 && fc != 0;
     const double least = std::min({std::abs(fa), std::abs(fb), std::abs(fc)});
     const double longest = std::sqrt(std::max({squared_distance(a, b), squared_distance(b, c), squared_distance(c, a)}));

@@ -26,7 +26,9 @@ struct CubicTerms {
 /// What cubic_bounds() gives over a box B (closed, non-empty, in the sum's coordinates), c its center.
 struct CubicBound {
   /// f and grad f (with respect to s) over B: three enclosures intersected (term by term, second- and
-  /// third-order Taylor at c), widened by a bound of the rounding of their sums.
+  /// third-order Taylor at c), widened by a bound of the rounding of their sums; the Hessian over B
+  /// (hess_center: the Hessian at c; hess_radius: its Lipschitz constant times B's half-diagonal, plus
+  /// rounding).
   FunctionBound bound;
   /// A first-order Taylor model over B: |f(s) - value - gradient . (s - c)| <= remainder for s in B
   /// (value, gradient: f and grad f at c as computed; remainder covers their rounding too).

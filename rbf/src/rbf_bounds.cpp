@@ -9,6 +9,7 @@
 #include "parallel.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 namespace vitri {
 
@@ -28,6 +29,11 @@ void Rbf::bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const {
     // Back to the caller's units: the value is the same, the gradient is divided by the scale.
     b.grad_lo = b.grad_lo / m.scale;
     b.grad_hi = b.grad_hi / m.scale;
+    // The Hessian by its square (the products' rounding: a few ulps of each entry, added to the radius).
+    const double h = 1.0 / (m.scale * m.scale);
+    double size = 0;
+    for (double& e : b.hess_center) e *= h, size += std::abs(e);
+    b.hess_radius = b.hess_radius * h * (1.0 + 1e-14) + 1e-14 * size;
     return b;
   };
   // Each box costs about 30 flops per center: threads when the work is large.

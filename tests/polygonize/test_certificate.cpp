@@ -154,6 +154,42 @@ TEST_CASE("certificate: certify_cell on known cells", "[certificate]") {
   REQUIRE(certify_cell(p, {1.0, 1.0, -1.0, 0.5}, dip) == CellCertificate::Uncertified);
 }
 
+TEST_CASE("certificate: certify_cell with curvature, a face almost on the surface", "[certificate]") {
+  // f = z + a (x^2 + y^2) - b y - c over the unit cube, a = 0.1, b = 0.1, c = 0.05: the base face z = 0 is
+  // tangent to the surface somewhere inside it (the gradient (2 a x, 2 a y - b, 1) is normal to it at
+  // (0, 0.5)), its values are of mixed signs, and f along its edge (0,0,0)-(1,0,0) is not monotone (2 a x
+  // vanishes at x = 0): the first-order conditions cannot tell. f is strictly convex on the base's plane
+  // and along its edges (H = diag(2 a, 2 a, 0)): with that Hessian the face and edges are settled, the
+  // cell is a Disk; with a saddle's Hessian (diag(2 a, -2 a, 0)) it is not, nor without a Hessian.
+  const double a = 0.1, b = 0.1, c = 0.05;
+  const std::array<Point3, 4> p{Point3{0, 0, 0}, Point3{1, 0, 0}, Point3{0, 1, 0}, Point3{0.2, 0.2, 1}};
+  auto f = [&](const Point3& x) { return x.z + a * (x.x * x.x + x.y * x.y) - b * x.y - c; };
+  const std::array<double, 4> values{f(p[0]), f(p[1]), f(p[2]), f(p[3])};
+  REQUIRE(values[0] < 0);  // -0.05, 0.05, -0.05, 0.938
+  REQUIRE(values[1] > 0);
+  REQUIRE(values[2] < 0);
+  REQUIRE(values[3] > 0);
+  FunctionBound first;  // exact over the cube [0, 1]^3
+  first.lo = -c - b, first.hi = 1 + 2 * a - c;
+  first.grad_lo = Point3{0, -b, 1}, first.grad_hi = Point3{2 * a, 2 * a - b, 1};
+  REQUIRE(certify_cell(p, values, first) == CellCertificate::Uncertified);
+  FunctionBound convex = first;
+  convex.hess_center = {2 * a, 0, 0, 0, 2 * a, 0, 0, 0, 0};
+  convex.hess_radius = 0;
+  REQUIRE(certify_cell(p, values, convex) == CellCertificate::Disk);
+  // The Hessian known only within a radius as large as its eigenvalues: no definite sign, nothing shown.
+  FunctionBound loose = convex;
+  loose.hess_radius = 2 * a;
+  REQUIRE(certify_cell(p, values, loose) == CellCertificate::Uncertified);
+  FunctionBound saddle = first;
+  saddle.hess_center = {2 * a, 0, 0, 0, -2 * a, 0, 0, 0, 0};
+  saddle.hess_radius = 0;
+  REQUIRE(certify_cell(p, values, saddle) == CellCertificate::Uncertified);
+  // Convex, every base vertex positive (a closed loop of zeros may hide in the face): not from curvature.
+  const std::array<double, 4> lifted{0.01, 0.11, 0.01, 1.0};
+  REQUIRE(certify_cell(p, lifted, convex) == CellCertificate::Uncertified);
+}
+
 TEST_CASE("certificate: a function without enclosures certifies nothing", "[certificate]") {
   class Plain final : public ImplicitFunction {
    public:

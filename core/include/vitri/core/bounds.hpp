@@ -52,19 +52,24 @@ inline double smaller(double x, double y) { return std::min(x, y); }
 inline double larger(double x, double y) { return std::max(x, y); }
 }  // namespace bounds_detail
 
-/// The intersection of two enclosures of the same function (both valid: so is the intersection).
+/// The intersection of two enclosures of the same function (both valid: so is the intersection); of the
+/// two Hessian enclosures, the one of smaller radius.
 inline FunctionBound intersect_bounds(const FunctionBound& a, const FunctionBound& b) {
-  return bounds_detail::combine(a, b, bounds_detail::larger, bounds_detail::smaller);
+  FunctionBound r = bounds_detail::combine(a, b, bounds_detail::larger, bounds_detail::smaller);
+  const FunctionBound& h = a.hess_radius <= b.hess_radius ? a : b;
+  r.hess_center = h.hess_center;
+  r.hess_radius = h.hess_radius;
+  return r;
 }
 
-/// The smallest enclosure holding both (values and gradients).
+/// The smallest enclosure holding both (values and gradients; no Hessian enclosure).
 inline FunctionBound hull_bounds(const FunctionBound& a, const FunctionBound& b) {
   return bounds_detail::combine(a, b, bounds_detail::smaller, bounds_detail::larger);
 }
 
 /// min(a, b): the value interval of the min; the gradient is a's where a < b for sure, b's where b < a
 /// for sure, otherwise the hull of both (every Clarke gradient of a min is a convex combination of the
-/// active ones).
+/// active ones) and no Hessian enclosure (the min need not be C^2).
 inline FunctionBound min_bounds(const FunctionBound& a, const FunctionBound& b) {
   if (a.hi < b.lo) return a;
   if (b.hi < a.lo) return b;
@@ -85,7 +90,8 @@ inline FunctionBound max_bounds(const FunctionBound& a, const FunctionBound& b) 
 }
 
 /// Widens the value interval by `value_slack` and each gradient component by `gradient_slack` on each
-/// side (bounds of the rounding error of the arithmetic that computed them).
+/// side (bounds of the rounding error of the arithmetic that computed them). The Hessian enclosure is
+/// left as it is (its producer covers its own rounding).
 inline void widen_bounds(FunctionBound& b, double value_slack, double gradient_slack) {
   b.lo -= value_slack;
   b.hi += value_slack;

@@ -6,6 +6,7 @@
 #include "vitri/core/box.hpp"
 #include "vitri/core/point.hpp"
 
+#include <array>
 #include <cstddef>
 #include <limits>
 
@@ -15,11 +16,18 @@ namespace vitri {
 /// point x of the region, lo <= f(x) <= hi and grad_lo[k] <= d f / d x_k (x) <= grad_hi[k]; where f is
 /// only Lipschitz (a min or max of smooth functions), every generalized (Clarke) gradient lies in that
 /// box. The default value, infinite everywhere, is a valid enclosure that certifies nothing.
+///
+/// Optionally, second order: where f is C^2 over the region, every Hessian H(x) of f there is within
+/// `hess_radius` of `hess_center` in spectral norm (|H(x) - hess_center|_2 <= hess_radius). The default
+/// hess_radius, infinite, says nothing (and must stay so where f is not C^2: a min or max of functions
+/// whose pieces may both be active, the domain box's wall).
 struct FunctionBound {
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   double lo = -kInf, hi = kInf;
   Point3 grad_lo{-kInf, -kInf, -kInf};
   Point3 grad_hi{kInf, kInf, kInf};
+  std::array<double, 9> hess_center{};  ///< symmetric, row-major (entry (k, l) at 3 k + l)
+  double hess_radius = kInf;
 };
 
 /// A scalar field on R^3 with its gradient. Implementations: the RBF interpolant (vitri::rbf), analytic

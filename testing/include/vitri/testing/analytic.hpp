@@ -57,7 +57,7 @@ class QuadricSphereFunction final : public ImplicitFunction {
     gradient = 2.0 * (p - center_);
     return value(p);
   }
-  /// Enclosures: second-order Taylor with the Hessian 2 I (exact).
+  /// Enclosures: second-order Taylor with the Hessian 2 I (exact; also given as the Hessian enclosure).
   bool has_bounds() const override { return true; }
   void bounds(const Box3* boxes, std::size_t n, FunctionBound* out) const override {
     for (std::size_t i = 0; i < n; ++i) {
@@ -66,6 +66,8 @@ class QuadricSphereFunction final : public ImplicitFunction {
       out[i] = taylor_bound(boxes[i], v, g, 2.0);
       const double scale = squared_norm(boxes[i].center() - center_) + radius_ * radius_;
       widen_bounds(out[i], 1e-12 * scale, 1e-12 * std::sqrt(scale));
+      out[i].hess_center = {2, 0, 0, 0, 2, 0, 0, 0, 2};
+      out[i].hess_radius = 0;
     }
   }
   /// Exact distance from p to the zero set.

@@ -302,9 +302,9 @@ void LocalRbf::Impl::fill_report() {
     const Cell& cell = tree.cell(c);
     ++report.patches;
     report.depth = std::max(report.depth, cell.depth);
-    if (cell.terms == 0) ++report.far_patches;
-    if (cell.far_settled) ++report.far_settled;
+    if (cell.terms == 0) ++report.far_patches;  // a plane (or far_side's constant): no RBF term
     else ++rbf_patches;
+    if (cell.far_settled) ++report.far_settled;
     fitted_terms += cell.terms;
     report.max_fitted = std::max<std::size_t>(report.max_fitted, cell.terms);
     bytes += cell.coef.capacity() * 8 + (cell.candidates.capacity() + cell.listed_in.capacity()) * 4;

@@ -71,6 +71,10 @@ TEST_CASE("LocalRbf interpolates every constraint and has a valid structure", "[
   const auto& rep = f.report();
   CHECK(rep.patches > 8);
   CHECK(rep.max_fitted <= LocalRbfOptions{}.max_per_patch);
+  // Every RBF patch fits at least min_per_patch constraints; far patches (none in their support, a
+  // plane) are not RBF patches and must not lower the mean.
+  CHECK(rep.far_patches > 0);
+  CHECK(rep.mean_fitted >= static_cast<double>(LocalRbfOptions{}.min_per_patch));
   CHECK(max_residual(f, c) < 1e-9);  // values are +-0.01 x diagonal ~ 0.03: relative 3e-8
   // The fit's steps are timed one after the other inside its total.
   const double steps[5] = {rep.index_seconds, rep.duplicates_seconds, rep.tree_seconds, rep.links_seconds,

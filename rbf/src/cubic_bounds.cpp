@@ -13,8 +13,10 @@
 // second-order one loses there: sum |w_i| r is orders of magnitude above |f''|, the weights cancel).
 // Rounding: all are widened by (N + 8) ulp-sized multiples of the sum of the absolute values of the
 // terms (a bound of the error of the sums).
-// The Hessian over the box: the center's, within 6 sum |w_i| rho (spectral norm; FunctionBound's optional
-// second-order part, read by the certificate's face and edge tests).
+//  - fourth order for the terms at least kFar x rho from the box (their third derivative at the center
+//    exactly, a remainder in rho / r_lo), the near ones as in the third: the sharp one far from the data.
+// The Hessian over the box: the center's, within min(6 sum |w_i| rho, the fourth-order radius) in
+// spectral norm (FunctionBound's optional second-order part, read by the certificate's face and edge tests).
 #include "cubic_bounds.hpp"
 
 #include "vitri/core/bounds.hpp"

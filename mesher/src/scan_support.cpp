@@ -26,6 +26,9 @@ constexpr double kMinComponentResolutions = 8.0;
 constexpr double kMinComponentFraction = 0.005;
 /// ... or nearest to fewer than max(this, 1 / 2000 of the points) of the data points.
 constexpr std::size_t kMinComponentPoints = 30;
+/// ... or nearest to more set-aside outliers than this many times its data points (a blob grown around
+/// the few outliers of a cloud that read as a surface, among the many set aside).
+constexpr std::size_t kMaxAsidePerPoint = 1;
 
 double triangle_area(const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t) {
   return 0.5 * norm(cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]));
@@ -35,6 +38,7 @@ double triangle_area(const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t
 
 ScanSupport::ScanSupport(const ScanPoints& points, double resolution, unsigned threads)
     : points_(points.points),
+      set_aside_(points.set_aside),
       spacing_(points.spacing),
       normals_(points.normals),
       index_(points_, threads),
@@ -114,8 +118,9 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
     if (root[v] == v && supported[v]) largest = std::max(largest, area[v]);
   const double min_area = std::max(std::pow(kMinComponentResolutions * resolution_, 2), kMinComponentFraction * largest);
   // The data behind each component: every point votes for the component of its nearest mesh vertex. A
-  // blob grown around a few stray points that survived the outlier rules has only their votes.
-  std::vector<std::size_t> votes(nv, 0);
+  // blob grown around a few stray points that survived the outlier rules has only their votes; the
+  // set-aside outliers vote too, against: a blob among a cloud of them has more of theirs.
+  std::vector<std::size_t> votes(nv, 0), aside(nv, 0);
   {
     std::vector<PointIndex::Id> ids;
     std::vector<Point3> used_at;
@@ -130,13 +135,18 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
         vertices.nearest(q, 1, ids);
         ++votes[find(used_id[ids[0]])];
       }
+      for (const Point3& q : set_aside_) {
+        vertices.nearest(q, 1, ids);
+        ++aside[find(used_id[ids[0]])];
+      }
     }
   }
   const std::size_t min_votes = std::max<std::size_t>(kMinComponentPoints, points_.size() / 2000);
   std::vector<std::uint8_t> keep(nv, 0);
   for (std::uint32_t v = 0; v < nv; ++v)
     if (root[v] == v && area[v] > 0) {
-      keep[v] = editing || (supported[v] && area[v] >= min_area && votes[v] >= min_votes);
+      keep[v] = editing || (supported[v] && area[v] >= min_area && votes[v] >= min_votes &&
+                            aside[v] <= kMaxAsidePerPoint * votes[v]);
       rep.small_components += !keep[v];
     }
   if (rep.small_components) {

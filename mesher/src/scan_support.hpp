@@ -54,6 +54,7 @@ class ScanSupport {
 
  private:
   std::vector<Point3> points_;
+  std::vector<Point3> set_aside_;  // the outliers prepare_scan set aside (ScanPoints::set_aside)
   std::vector<double> spacing_;
   std::vector<Point3> normals_;
   PointIndex index_;

@@ -422,3 +422,54 @@ TEST_CASE("prepare_scan_fit: the winding number's far side for objects, not for 
   CHECK(!global.options.local.far_side);
   CHECK(global.far_jump == 0);
 }
+
+// The component rule's vote of the set-aside outliers (docs/scans.md, "Outliers"): a small separate
+// component is kept when its points outnumber the outliers set aside around it, dropped when not (a blob
+// grown on the few points of an outlier cloud that read as a surface).
+TEST_CASE("from_scan: a component among more set-aside outliers than its points is dropped", "[mesher][scan]") {
+  std::vector<Point3> points, normals;
+  auto sphere = [&](const Point3& c, double r, int n) {
+    for (int i = 0; i < n; ++i) {
+      const double z = 1 - (2 * i + 1.0) / n, s = std::sqrt(1 - z * z), phi = i * 3.14159265358979 * (3 - std::sqrt(5.0));
+      const Point3 u{s * std::cos(phi), s * std::sin(phi), z};
+      points.push_back(c + u * r);
+      normals.push_back(u);
+    }
+  };
+  sphere({0, 0, 0}, 1.0, 6000);
+  const Point3 small_c{2.2, 0, 0};
+  sphere(small_c, 0.2, 150);
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  o.polygonizer.threads = 2;
+  o.polygonizer.keep_history = false;
+  auto components = [&](ScanFit fit) {
+    Mesher m = Mesher::from_scan(std::move(fit));
+    REQUIRE(m.refine(0.04));
+    const MeshMetrics mm = test::metrics_of(m.surface());
+    INFO("V " << mm.vertices << " components " << mm.components << " dropped " << m.stats().scan_small_components);
+    CHECK(mm.closed_manifold());
+    return mm.components;
+  };
+  ScanFit fit = prepare_scan_fit(points, normals, o);
+  REQUIRE(fit.report.outliers == 0);
+  REQUIRE(fit.prepared.set_aside.empty());
+  CHECK(components(fit) == 2);
+  // 200 outliers set aside around the small sphere (a shell 0.35-0.6 from its centre): more than its 150
+  // points, and it goes; 100, and it stays.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<Point3> cloud;
+  while (cloud.size() < 200) {
+    const Point3 d{u(rng), u(rng), u(rng)};
+    const double len = norm(d);
+    if (len < 0.35 / 0.6 || len > 1.0) continue;
+    cloud.push_back(small_c + d * 0.6);
+  }
+  ScanFit more = fit;
+  more.prepared.set_aside = cloud;
+  CHECK(components(more) == 1);
+  ScanFit fewer = fit;
+  fewer.prepared.set_aside.assign(cloud.begin(), cloud.begin() + 100);
+  CHECK(components(fewer) == 2);
+}

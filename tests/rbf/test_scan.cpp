@@ -5,6 +5,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <random>
@@ -183,6 +184,64 @@ TEST_CASE("prepare_scan: outliers in the box get no vote, the surface keeps its 
   keep.remove_outliers = false;
   CHECK(vitri::prepare_scan(p, {}, keep, &r).points.size() == p.size());
   CHECK(r.outliers == 0);
+}
+
+TEST_CASE("prepare_scan: a thick plate sampled 10x more sparsely is kept; outliers around it are not", "[scan]") {
+  // A unit sphere (8000 points, spacing about 0.04) and beside it a plate 2 x 2 x 0.1 sampled over its six
+  // faces 10x more sparsely (spacing about 0.125): the plate's neighbourhoods hold both large faces
+  // (thick, nearly isotropic) and reach 3x farther than is typical, as outliers in the box do; its points
+  // lie on a surface (local dimension 2) and are kept. 3% outliers in the box around both are set aside.
+  std::vector<Point3> p = noisy_sphere(8000, 0.0, 21);
+  const double density = 8000 / (4 * kPi) / 10;
+  const Point3 lo{1.1, -1.0, -0.05}, hi{3.1, 1.0, 0.05};
+  Gauss g(22);
+  std::vector<Point3> plate;
+  for (std::size_t axis = 0; axis < 3; ++axis)
+    for (const int side : {0, 1}) {
+      const std::size_t a = (axis + 1) % 3, b = (axis + 2) % 3;
+      const double area = (hi[a] - lo[a]) * (hi[b] - lo[b]);
+      const auto count = static_cast<std::size_t>(area * density);
+      for (std::size_t i = 0; i < count; ++i) {
+        Point3 q;
+        q[axis] = side ? hi[axis] : lo[axis];
+        q[a] = lo[a] + (hi[a] - lo[a]) * g.uniform();
+        q[b] = lo[b] + (hi[b] - lo[b]) * g.uniform();
+        plate.push_back(q);
+      }
+    }
+  auto on_plate = [&](const Point3& q) {  // (prepared points may have moved a little)
+    for (std::size_t c = 0; c < 3; ++c)
+      if (q[c] < lo[c] - 0.02 || q[c] > hi[c] + 0.02) return false;
+    return true;
+  };
+  p.insert(p.end(), plate.begin(), plate.end());
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  std::size_t kept_plate = 0;
+  for (const Point3& q : s.points) kept_plate += on_plate(q);
+  CHECK(plate.size() > 400);
+  CHECK(kept_plate >= plate.size() * 95 / 100);  // 61% with the volume rule alone (before 2026-12-02)
+
+  // With outliers spread over the box [-1.5, 3.5] x [-1.5, 1.5]^2, away from both surfaces.
+  const std::size_t before = p.size();
+  while (p.size() < before + before * 3 / 100) {
+    const Point3 q{-1.5 + 5 * g.uniform(), -1.5 + 3 * g.uniform(), -1.5 + 3 * g.uniform()};
+    const double off_plate = std::max({lo.x - q.x, q.x - hi.x, lo.y - q.y, q.y - hi.y, lo.z - q.z, q.z - hi.z});
+    if (std::abs(vitri::norm(q) - 1) < 0.2 || (off_plate > -0.2 && off_plate < 0.2)) continue;
+    p.push_back(q);
+  }
+  const std::size_t added = p.size() - before;
+  vitri::ScanReport ro;
+  const vitri::ScanPoints so = vitri::prepare_scan(p, {}, {}, &ro);
+  INFO(vitri::describe(ro));
+  std::size_t kept_plate_o = 0, stray = 0;
+  for (const Point3& q : so.points) {
+    kept_plate_o += on_plate(q);
+    stray += !on_plate(q) && std::abs(vitri::norm(q) - 1) > 0.1;
+  }
+  CHECK(stray <= added / 20);
+  CHECK(kept_plate_o >= plate.size() * 90 / 100);  // 60% before
 }
 
 TEST_CASE("prepare_scan: a single view is oriented toward its viewpoint; a contradicting one is rejected",

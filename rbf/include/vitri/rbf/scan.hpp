@@ -93,6 +93,9 @@ struct ScanPoints {
   std::vector<Point3> points;
   std::vector<Point3> normals;  ///< unit, oriented outward (toward the sensor for a single view)
   std::vector<double> spacing;
+  /// The points set aside as outliers, where they were given: what the mesher's component rule weighs
+  /// against the kept points (a component grown among set-aside points is a blob of outliers).
+  std::vector<Point3> set_aside;
 };
 
 /// Prepares scanned points for the normal constraints: exact duplicates dropped, outliers set aside,

@@ -78,7 +78,7 @@ struct LocalFitReport {
   std::size_t patches = 0;        ///< leaf cells (one patch each)
   std::size_t far_patches = 0;    ///< of which patches with no constraint in their support (linear)
   std::size_t far_settled = 0;    ///< patches LocalRbfOptions::far_side settled: far ones made constant,
-                                  ///< RBF ones fitted again with their centre
+                                  ///< RBF ones with an empty centre fitted with anchors there
   std::size_t max_fitted = 0;     ///< largest number of constraints fitted by one patch
   double mean_fitted = 0;         ///< mean number of constraints fitted by an RBF patch
   int depth = 0;                  ///< deepest leaf level

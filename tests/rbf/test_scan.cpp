@@ -186,7 +186,7 @@ TEST_CASE("prepare_scan: outliers in the box get no vote, the surface keeps its 
   CHECK(r.outliers == 0);
 }
 
-TEST_CASE("prepare_scan: a thick plate sampled 10x more sparsely is kept; outliers around it are not", "[scan]") {
+TEST_CASE("prepare_scan: a thin plate sampled 10x more sparsely is kept; outliers around it are not", "[scan]") {
   // A unit sphere (8000 points, spacing about 0.04) and beside it a plate 2 x 2 x 0.1 sampled over its six
   // faces 10x more sparsely (spacing about 0.125): the plate's neighbourhoods hold both large faces
   // (thick, nearly isotropic) and reach 3x farther than is typical, as outliers in the box do; its points

@@ -5,11 +5,13 @@
 #include "mesh_view.hpp"
 #include "phases.hpp"
 
+#include "vitri/blocks.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 #include "vitri/mesher.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <chrono>
 #include <cmath>
@@ -145,6 +147,10 @@ const char* const kUsage =
     "                       Delaunay vertices the rest holds (without --precision: a coarser mesh with a\n"
     "                       warning; with it: an error); an input whose coarsest mesh does not fit is\n"
     "                       refused (exit 1) naming the sizes.\n"
+    "  --blocks N|NxMxK     mesh a scan in N x N x N (or N x M x K) blocks, one after another: each block's\n"
+    "                       function and refinement from its own points and a halo, the block meshes\n"
+    "                       stitched into one mesh whose seams share vertices exactly (docs/blocks.md).\n"
+    "                       Point inputs only; one level; not with --edits, --quality or --certify.\n"
     "  --ascii              PLY output as text (default: binary little-endian, about half the size and\n"
     "                       several times faster to write; OBJ and OFF are always text)\n"
     "  -q, --quiet          no table, no progress\n"
@@ -333,6 +339,7 @@ struct MeshCommand {
   PlyEncoding ply = PlyEncoding::BinaryLittleEndian;  ///< --ascii: text
   unsigned threads = 0;    ///< --threads: 0 = every available CPU
   std::size_t memory = 0;  ///< --memory: 0 = the default limit
+  std::array<int, 3> blocks{0, 0, 0};  ///< --blocks: blocks per axis; 0: one piece (no split)
   /// The CLI's defaults and what the flags set over them (quality mode, off-surface constraints, scan,
   /// surface, function, smoothing, certificate). Threads, memory and history are the plan's to resolve.
   MesherOptions options;
@@ -343,6 +350,12 @@ struct MeshCommand {
 std::string check_mesh_command(const MeshCommand& c) {
   if (c.input.empty()) return "no input file";
   if (c.output.empty()) return "no output file (-o OUT.obj)";
+  if (c.blocks[0] > 0) {
+    if (!c.edits.empty()) return "--blocks makes one mesh: not with --edits";
+    if (c.precisions.size() > 1) return "--blocks makes one level: give at most one --precision";
+    if (c.options.mode == MeshMode::Quality) return "--blocks is not available in the quality mode";
+    if (c.options.polygonizer.certify) return "--blocks is not available with --certify";
+  }
   for (const auto* list : {&c.precisions, &c.distances})
     for (std::size_t k = 1; k < list->size(); ++k)
       if (!((*list)[k] < (*list)[k - 1])) {
@@ -356,6 +369,28 @@ std::string check_mesh_command(const MeshCommand& c) {
   if (ext != "obj" && ext != "ply" && ext != "off")
     return "output must end in .obj, .ply or .off, got '" + c.output + "'";
   return {};
+}
+
+/// --blocks: "N" (N x N x N) or "NxMxK", each count in [1, 64].
+bool parse_block_counts(const std::string& text, std::array<int, 3>& out) {
+  std::vector<int> n;
+  std::size_t at = 0;
+  while (at <= text.size()) {
+    const std::size_t x = text.find_first_of("xX", at);
+    const std::string part = text.substr(at, x == std::string::npos ? std::string::npos : x - at);
+    if (part.empty() || part.size() > 2 || !std::all_of(part.begin(), part.end(), [](char ch) { return std::isdigit(static_cast<unsigned char>(ch)); }))
+      return false;
+    n.push_back(std::stoi(part));
+    if (x == std::string::npos) break;
+    at = x + 1;
+  }
+  if (n.size() == 1) n = {n[0], n[0], n[0]};
+  if (n.size() != 3) return false;
+  for (int k = 0; k < 3; ++k) {
+    if (n[k] < 1 || n[k] > 64) return false;
+    out[k] = n[k];
+  }
+  return true;
 }
 
 /// Stage 1, parse: the arguments of `vitri mesh` into `c` (as cmd_studio's parse_args). Returns the
@@ -461,6 +496,9 @@ std::string parse_mesh_args(const Args& args, MeshCommand& c) {
     } else if (a == "--memory") {
       if (!value(v) || !parse_memory_size(v, c.memory))
         return "--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'";
+    } else if (a == "--blocks") {
+      if (!value(v) || !parse_block_counts(v, c.blocks))
+        return "--blocks needs N or NxMxK, each from 1 to 64, got '" + v + "'";
     } else if (a == "-q" || a == "--quiet") {
       c.quiet = true;
     } else if (a == "--ascii") {
@@ -887,6 +925,65 @@ void run_mesh_plan(const MeshCommand& c, MeshPlan& plan, PhaseTimes& phases) {
   replay_edits(c, plan);
 }
 
+/// --blocks: the scan meshed block after block (docs/blocks.md), the stitched mesh written, a summary on
+/// stdout. @throws InvalidArgument for an input that is not points.
+void run_blocks(const MeshCommand& c, PhaseTimes& phases) {
+  MesherOptions options = c.options;
+  options.threads = c.threads;
+  options = with_threads_applied(options);
+  options.max_memory_bytes = c.memory ? c.memory : default_memory_limit();
+  phases.start("read", "reading " + c.input);
+  Input data = read_input(c.input);
+  open_mesh_as_points(data, c, options);
+  if (!is_scan(data))
+    throw InvalidArgument(c.input + ": --blocks meshes points (a scan); this input is " +
+                          (data.kind == InputKind::Constraints ? "constraints" : "a mesh"));
+  if (!options.scan.viewpoint && data.points.viewpoint) options.scan.viewpoint = data.points.viewpoint;
+  if (data.points.has_sensors()) options.scan.sensors = std::move(data.points.sensors);
+  const std::vector<Point3> points = std::move(data.points.points);
+  const std::vector<Point3> normals = std::move(data.points.normals);
+  data = Input{};
+  BlockOptions bo;
+  bo.counts = c.blocks;
+  bo.mesher = options;
+  Box3 box;
+  for (const Point3& p : points) box.extend(p);
+  if (!c.precisions.empty()) bo.precision = c.precisions[0] * box.diagonal();
+  phases.start("blocks", "meshing " + std::to_string(points.size()) + " points in " + std::to_string(c.blocks[0]) +
+                             "x" + std::to_string(c.blocks[1]) + "x" + std::to_string(c.blocks[2]) + " blocks");
+  BlockStats st;
+  auto progress = [&](const std::string& what) {
+    if (!c.quiet) std::fprintf(stderr, "  %s\n", what.c_str());
+  };
+  SurfaceMesh mesh;
+  try {
+    mesh = mesh_in_blocks(points, normals, bo, &st, progress);
+  } catch (const InvalidPoint& e) {
+    throw InvalidPoint(e.index(), c.input + ": " + e.what());
+  }
+  phases.start("writing", "writing " + c.output);
+  write_mesh(c.output, view_of(mesh), c.ply);
+  phases.stop();
+  if (c.quiet) return;
+  std::printf("%s: %zu points in %zu blocks: %zu vertices, %zu triangles -> %s\n", c.input.c_str(), points.size(),
+              st.blocks, mesh.vertices.size(), mesh.triangles.size(), c.output.c_str());
+  std::printf("  pass 1 (fit, refinement) %.1f s, pass 2 (merge) %.1f s, stitch %.1f s; precision %.4g (%.4g of "
+              "the diagonal)\n", st.pass1_seconds, st.pass2_seconds, st.stitch_seconds, st.precision,
+              st.precision / box.diagonal());
+  std::printf("  %zu outliers set aside; %zu zero vertices collapsed, %zu left at their offset; surface %s, "
+              "%zu small or unsupported components dropped\n", st.outliers, st.snapped, st.offset,
+              st.open ? "open, trimmed to the data" : "closed", st.small_components);
+  if (st.unfinished > 0 || st.boundary_edges > 0 || st.nonmanifold_edges > 0)
+    std::fprintf(stderr, "vitri mesh: warning: the blocks left %zu transverse tetrahedra uncertified (a halo too "
+                 "narrow); the stitched mesh had %zu boundary and %zu non-manifold edges before the finishing\n",
+                 st.unfinished, st.boundary_edges, st.nonmanifold_edges);
+  if (st.budget_blocks > 0)
+    std::fprintf(stderr, "vitri mesh: warning: %zu blocks reached their vertex budget: coarser there\n",
+                 st.budget_blocks);
+  std::printf("\n");
+  phases.print(stdout);
+}
+
 }  // namespace
 
 const char* mesh_usage() { return kUsage; }
@@ -897,6 +994,10 @@ int run_mesh(const Args& args) {
   // Read the edit script up front so that a bad script fails before the long work.
   std::vector<std::string> script = read_edit_script(command.edits);
   PhaseTimes phases(command.quiet);  // the plan's and the run's phases, announced and timed
+  if (command.blocks[0] > 0) {
+    run_blocks(command, phases);
+    exit_without_teardown(0);
+  }
   MeshPlan plan = plan_mesh(command, std::move(script), phases);
   run_mesh_plan(command, plan, phases);
   // Every output file is closed (write_mesh), every line printed: the Mesher, the constraints and the

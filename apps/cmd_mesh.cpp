@@ -36,7 +36,7 @@ const char* const kUsage =
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z]\n"
     "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
-    "                  [--threads N] [--memory M] [--ascii] [-q]\n"
+    "                  [--threads N] [--memory M] [--blocks N|NxMxK] [--ascii] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"

@@ -8,6 +8,7 @@
 #include "vitri/core/spatial_order.hpp"
 #include "vitri/rbf/normals.hpp"
 #include "vitri/rbf/point_index.hpp"
+#include "vitri/rbf/winding.hpp"
 
 #include "parallel.hpp"
 #include "spaced_subset.hpp"
@@ -482,10 +483,15 @@ std::size_t vote_signs(const std::vector<Point3>& p, const Neighbours& nb, std::
   return flips;
 }
 
+/// settle_components(): a closed part with an unclear divergence sum is settled by its winding number,
+/// read at up to this many of its points, when it has at least kSettleWindingMin.
+constexpr std::size_t kSettleWindingReads = 256;
+constexpr std::size_t kSettleWindingMin = 32;
+
 /// Settles the sign of each connected component of the neighbour graph (edges no longer than 3 local
 /// spacings) that the spanning tree oriented on its own: a closed component's outward normals satisfy
 /// sum n . (p - c) > 0 (the divergence theorem: 3 x its volume), so a component whose normals give a clear
-/// negative sum is flipped whole; an open one (no clear sign) is made to agree with a common direction:
+/// negative sum is flipped whole (an unclear sum on a closed one: its winding number's level decides); an open one (no clear sign) is made to agree with a common direction:
 /// the mean normal of the largest open component, itself turned toward +z (up) when nothing else says.
 /// Returns the points whose sign changed.
 std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb, std::vector<Point3>& n) {
@@ -498,6 +504,7 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     Eigen::Matrix3d tensor = Eigen::Matrix3d::Zero();  // sum of n n^T: where the normals point, unsigned
     double signed_sum = 0, abs_sum = 0;
     int verdict = 0;  // +1 closed outward, -1 closed inward, 0 open, 2 a sheet seen along `axis`
+    bool unclear_closed = false;  // closed, but the divergence sum's sign is unclear
     Point3 axis;
   };
   std::vector<Part> part(count);
@@ -535,6 +542,41 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     const double ratio = q.abs_sum > 0 ? q.signed_sum / q.abs_sum : 0.0;
     const bool closed = norm(q.normal_sum) < 0.3 * static_cast<double>(q.size);
     q.verdict = !closed ? 0 : ratio > 0.5 ? 1 : ratio < -0.5 ? -1 : 0;
+    q.unclear_closed = closed && q.verdict == 0;
+  }
+  // A closed part whose divergence sum is unclear: a thin part far from its centroid (a ring, a knot:
+  // n . (p - c) is about R cos v + r on a torus, so the sum, 3 x the volume, is small beside its
+  // magnitude). Its winding number tells instead: read just inside (p - d n) and just outside (p + d n)
+  // at up to kSettleWindingReads of its points, the level (their mean) is about +1/2 when the normals
+  // point out, -1/2 when they point in (WindingSides' calibration), against a jump of about 1.
+  std::vector<std::vector<Id>> members(count);
+  for (std::size_t i = 0; i < count; ++i) {
+    const Id r = find(static_cast<Id>(i));
+    if (part[r].unclear_closed) members[r].push_back(static_cast<Id>(i));
+  }
+  for (std::size_t r = 0; r < count; ++r) {
+    const std::vector<Id>& m = members[r];
+    if (m.size() < kSettleWindingMin) continue;
+    std::vector<Point3> mp, mn;
+    std::vector<double> area, level, jump;
+    for (const Id i : m) {
+      const double h = local_spacing(nb, i);
+      if (!(h > 0)) continue;
+      mp.push_back(p[i]), mn.push_back(n[i]), area.push_back(h * h);
+    }
+    if (mp.size() < kSettleWindingMin) continue;
+    const WindingNumber w(mp, mn, area);
+    const std::size_t step = std::max<std::size_t>(1, mp.size() / kSettleWindingReads);
+    for (std::size_t k = 0; k < mp.size(); k += step) {
+      const double d = 0.5 * std::sqrt(area[k]);
+      const double in = w(mp[k] - d * mn[k]), out = w(mp[k] + d * mn[k]);
+      level.push_back(0.5 * (in + out));
+      jump.push_back(in - out);
+    }
+    std::nth_element(level.begin(), level.begin() + level.size() / 2, level.end());
+    std::nth_element(jump.begin(), jump.begin() + jump.size() / 2, jump.end());
+    const double lv = level[level.size() / 2], jp = jump[jump.size() / 2];
+    if (jp > 0 && std::abs(lv) > 0.25 * jp) part[r].verdict = lv > 0 ? 1 : -1;
   }
   std::size_t changed = 0;
   std::vector<std::uint8_t> undecided(count, 0);

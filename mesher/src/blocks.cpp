@@ -6,9 +6,9 @@
 
 #include "scan_support.hpp"
 #include "vitri/core/error.hpp"
-#include "vitri/core/predicates.hpp"
 #include "vitri/core/threads.hpp"
 #include "vitri/delaunay/triangulation.hpp"
+#include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/point_index.hpp"
 
 #include <algorithm>
@@ -29,8 +29,6 @@ double axis(const Point3& p, int k) { return k == 0 ? p.x : k == 1 ? p.y : p.z; 
 
 /// Fewer points than this in a block's view make no surface there: the block owns nothing.
 constexpr std::size_t kMinBlockPoints = 16;
-/// Spacing estimate: at most this many points sampled evenly.
-constexpr std::size_t kSpacingSample = 100000;
 /// A crossing whose positive end has f = 0 and which is not collapsed lies this fraction of the edge from
 /// that end (PolygonizerOptions::zero_offset's default).
 constexpr double kZeroOffset = 0.05;
@@ -48,31 +46,6 @@ struct KeyHash {
   }
 };
 using KeyMap = std::unordered_map<std::pair<GlobalId, GlobalId>, std::uint32_t, KeyHash>;
-
-/// Median nearest-neighbour spacing of the points, from at most kSpacingSample of them: the sample's
-/// spacing scaled by sqrt(sample / n) (a surface's spacing goes as n^-1/2).
-double estimate_spacing(const std::vector<Point3>& points) {
-  const std::size_t n = points.size();
-  const std::size_t stride = std::max<std::size_t>(1, (n + kSpacingSample - 1) / kSpacingSample);
-  std::vector<Point3> sample;
-  for (std::size_t i = 0; i < n; i += stride) sample.push_back(points[i]);
-  PointIndex index(sample);
-  std::vector<PointIndex::Id> ids;
-  std::vector<double> d2;
-  std::vector<double> nearest;
-  nearest.reserve(sample.size());
-  for (const Point3& p : sample) {
-    index.nearest(p, 2, ids, &d2);
-    for (std::size_t k = 0; k < ids.size(); ++k)
-      if (d2[k] > 0) {
-        nearest.push_back(std::sqrt(d2[k]));
-        break;
-      }
-  }
-  if (nearest.empty()) return 0;
-  std::nth_element(nearest.begin(), nearest.begin() + nearest.size() / 2, nearest.end());
-  return nearest[nearest.size() / 2] * std::sqrt(double(sample.size()) / double(n));
-}
 
 /// The root of the cubic Hermite interpolant along the edge from the positive end (t = 0: value fp,
 /// slope dp) to the negative end (t = 1: fn, dn): Illinois regula falsi on [0, 1], deterministic (the
@@ -159,7 +132,6 @@ int BlockGrid::owner(const Point3& p) const {
     const double l = axis(domain_.lo, a), h = axis(domain_.hi, a), w = (h - l) / counts_[a];
     const double x = axis(p, a);
     int i = x >= l ? static_cast<int>((x - l) / w) : 0;
-    if (!(x >= l)) i = 0;
     i = std::clamp(i, 0, counts_[a] - 1);
     // The division may round across a boundary: the cell's own bounds decide.
     if (i > 0 && x < l + w * i) --i;
@@ -195,8 +167,9 @@ BlockPlan plan_blocks(const std::vector<Point3>& points, const BlockOptions& opt
     box.extend(p);
   }
   BlockPlan plan;
-  plan.spacing = estimate_spacing(points);
-  if (!(plan.spacing > 0)) plan.spacing = 1e-3 * box.diagonal();
+  // The data's resolution as the rest of the scan path measures it (median_spacing throws for fewer than
+  // two distinct positions: no surface, refused by the blocks' preparation anyway).
+  plan.spacing = median_spacing(points);
   plan.data_halo = options.data_halo_spacings * plan.spacing;
   // The grid covers the points grown by the halo on every side (a flat input still gets a volume).
   const double grow = std::max(plan.data_halo, 1e-6 * box.diagonal());
@@ -437,21 +410,17 @@ BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const
   std::vector<TetId> tets = tri.live_tetrahedra();
   for (TetId t : tets) {
     const std::array<VertexId, 4> v = tri.tet_vertices(t);
-    bool corner = false;
-    std::array<std::uint32_t, 4> li{};
-    for (int i = 0; i < 4; ++i) {
-      if (tri.is_corner(v[i]) || local[v[i]] == std::numeric_limits<std::uint32_t>::max()) {
-        corner = true;
-        break;
-      }
-      li[i] = local[v[i]];
-    }
-    int negatives = 0;
-    for (int i = 0; i < 4; ++i) negatives += corner ? 0 : (val[li[i]] < 0);
     // A tetrahedron on a corner of the merge's domain is never final (the corners lie beyond every
     // cell's halo); should the surface need one, the stitched mesh shows the hole (boundary edges).
-    if (corner) continue;
-    if (negatives == 0 || negatives == 4) continue;
+    if (tri.is_corner(v[0]) || tri.is_corner(v[1]) || tri.is_corner(v[2]) || tri.is_corner(v[3])) continue;
+    std::array<std::uint32_t, 4> li{};
+    std::array<int, 4> negs{}, poss{};
+    int nn = 0, np = 0;
+    for (int i = 0; i < 4; ++i) {
+      li[i] = local[v[i]];
+      (val[li[i]] < 0 ? negs[nn++] : poss[np++]) = i;
+    }
+    if (nn == 0 || nn == 4) continue;
     // Canonical order (by global id) for the circumsphere: every block computes the same bits.
     std::array<int, 4> order{0, 1, 2, 3};
     std::sort(order.begin(), order.end(), [&](int x, int y) { return gid[li[x]] < gid[li[y]]; });
@@ -471,9 +440,6 @@ BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const
     // Marching tetrahedra: the tetrahedron (v0..v3) is positively oriented; a permutation p of it has
     // orient3d sign parity(p).
     std::array<int, 4> neg_first{};
-    int nn = 0, np = 0;
-    std::array<int, 4> negs{}, poss{};
-    for (int i = 0; i < 4; ++i) (val[li[i]] < 0 ? negs[nn++] : poss[np++]) = i;
     for (int i = 0; i < nn; ++i) neg_first[i] = negs[i];
     for (int i = 0; i < np; ++i) neg_first[nn + i] = poss[i];
     const bool positive = parity(neg_first) > 0;

@@ -483,9 +483,8 @@ std::size_t vote_signs(const std::vector<Point3>& p, const Neighbours& nb, std::
   return flips;
 }
 
-/// settle_components(): a closed part with an unclear divergence sum is settled by its winding number,
-/// read at up to this many of its points, when it has at least kSettleWindingMin.
-constexpr std::size_t kSettleWindingReads = 256;
+/// settle_components(): a closed part with an unclear divergence sum is settled by its winding number
+/// when it has at least this many points.
 constexpr std::size_t kSettleWindingMin = 32;
 
 /// Settles the sign of each connected component of the neighbour graph (edges no longer than 3 local
@@ -546,37 +545,26 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   }
   // A closed part whose divergence sum is unclear: a thin part far from its centroid (a ring, a knot:
   // n . (p - c) is about R cos v + r on a torus, so the sum, 3 x the volume, is small beside its
-  // magnitude). Its winding number tells instead: read just inside (p - d n) and just outside (p + d n)
-  // at up to kSettleWindingReads of its points, the level (their mean) is about +1/2 when the normals
-  // point out, -1/2 when they point in (WindingSides' calibration), against a jump of about 1.
+  // magnitude). Its winding number's calibration tells instead (WindingSides: w read just inside and
+  // just outside its points, half a spacing off): the level is about +1/2 when the normals point out,
+  // -1/2 when they point in, against a jump of about 1.
   std::vector<std::vector<Id>> members(count);
   for (std::size_t i = 0; i < count; ++i) {
     const Id r = find(static_cast<Id>(i));
     if (part[r].unclear_closed) members[r].push_back(static_cast<Id>(i));
   }
   for (std::size_t r = 0; r < count; ++r) {
-    const std::vector<Id>& m = members[r];
-    if (m.size() < kSettleWindingMin) continue;
+    if (members[r].size() < kSettleWindingMin) continue;
     std::vector<Point3> mp, mn;
-    std::vector<double> area, level, jump;
-    for (const Id i : m) {
-      const double h = local_spacing(nb, i);
-      if (!(h > 0)) continue;
-      mp.push_back(p[i]), mn.push_back(n[i]), area.push_back(h * h);
+    std::vector<double> area, h;
+    for (const Id i : members[r]) {
+      const double s = local_spacing(nb, i);
+      if (s > 0) mp.push_back(p[i]), mn.push_back(n[i]), area.push_back(s * s), h.push_back(s);
     }
     if (mp.size() < kSettleWindingMin) continue;
-    const WindingNumber w(mp, mn, area);
-    const std::size_t step = std::max<std::size_t>(1, mp.size() / kSettleWindingReads);
-    for (std::size_t k = 0; k < mp.size(); k += step) {
-      const double d = 0.5 * std::sqrt(area[k]);
-      const double in = w(mp[k] - d * mn[k]), out = w(mp[k] + d * mn[k]);
-      level.push_back(0.5 * (in + out));
-      jump.push_back(in - out);
-    }
-    std::nth_element(level.begin(), level.begin() + level.size() / 2, level.end());
-    std::nth_element(jump.begin(), jump.begin() + jump.size() / 2, jump.end());
-    const double lv = level[level.size() / 2], jp = jump[jump.size() / 2];
-    if (jp > 0 && std::abs(lv) > 0.25 * jp) part[r].verdict = lv > 0 ? 1 : -1;
+    const WindingSides sides(mp, mn, area, 0.5 * median(h));
+    if (sides.jump() > 0 && std::abs(sides.level()) > 0.25 * sides.jump())
+      part[r].verdict = sides.level() > 0 ? 1 : -1;
   }
   std::size_t changed = 0;
   std::vector<std::uint8_t> undecided(count, 0);

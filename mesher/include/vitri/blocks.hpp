@@ -43,8 +43,8 @@
 
 namespace vitri {
 
-/// Global id of a point of P: the 8 corners of the grid's domain are 0..7; the k-th vertex owned by
-/// block b is kBlockIdBase + (b << kBlockIdShift) + k.
+/// Global id of a point of P: 0..7 are left to the merge domain's corners (never meshed); the k-th
+/// vertex owned by block b is kBlockIdBase + (b << kBlockIdShift) + k.
 using GlobalId = std::uint64_t;
 inline constexpr GlobalId kBlockIdBase = 8;
 inline constexpr int kBlockIdShift = 36;
@@ -105,13 +105,13 @@ struct BlockOptions {
 /// The plan of a split: the grid and the halos in absolute units.
 struct BlockPlan {
   BlockGrid grid;
-  double spacing = 0;    ///< the data's median nearest-neighbour spacing (estimated on a subsample)
+  double spacing = 0;    ///< the data's median nearest-neighbour spacing (median_spacing())
   double data_halo = 0;  ///< absolute: BlockOptions::data_halo_spacings x spacing
 };
 
 /// The plan for `points`: the grid over the box of the points grown by the data halo on every side (the
-/// Delaunay domain of the merge: its corners are the global ids 0..7), the spacing estimated from at most
-/// 100,000 points. @throws InvalidArgument for fewer than 8 points or non-finite coordinates.
+/// merge's Delaunay domain is that box scaled by 2), the spacing from median_spacing(). @throws
+/// InvalidArgument for fewer than 8 points, non-finite coordinates or fewer than 2 distinct positions.
 BlockPlan plan_blocks(const std::vector<Point3>& points, const BlockOptions& options);
 
 /// The input indices of the points block b sees: those within the data halo of its cell, increasing.

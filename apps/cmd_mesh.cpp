@@ -13,10 +13,13 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -36,7 +39,7 @@ const char* const kUsage =
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z]\n"
     "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
-    "                  [--threads N] [--memory M] [--blocks N|NxMxK] [--ascii] [-q]\n"
+    "                  [--threads N] [--memory M] [--blocks N|NxMxK|auto] [--spill DIR] [--ascii] [-q]\n"
     "\n"
     "Fits the variational implicit function of INPUT (an RBF through its constraint points), builds the\n"
     "Delaunay tetrahedralization of the constraints and of their bounding box enlarged by 2, refines\n"
@@ -146,11 +149,17 @@ const char* const kUsage =
     "                       what fits, with a warning (a coarser mesh); the refinement stops at the\n"
     "                       Delaunay vertices the rest holds (without --precision: a coarser mesh with a\n"
     "                       warning; with it: an error); an input whose coarsest mesh does not fit is\n"
-    "                       refused (exit 1) naming the sizes.\n"
-    "  --blocks N|NxMxK     mesh a scan in N x N x N (or N x M x K) blocks, one after another: each block's\n"
-    "                       function and refinement from its own points and a halo, the block meshes\n"
-    "                       stitched into one mesh whose seams share vertices exactly (docs/blocks.md).\n"
-    "                       Point inputs only; one level; not with --edits, --quality or --certify.\n"
+    "                       refused (exit 1) naming the sizes. A scan too large for one piece is meshed\n"
+    "                       in blocks instead (as --blocks auto) when the options allow it.\n"
+    "  --blocks N|NxMxK|auto  mesh a scan in N x N x N (or N x M x K) blocks, one after another: each\n"
+    "                       block's function and refinement from its own points and a halo, the block\n"
+    "                       meshes stitched into one mesh whose seams share vertices exactly\n"
+    "                       (docs/blocks.md). auto: the coarsest split the memory limit holds (one piece\n"
+    "                       when it fits). Point inputs only; one level; not with --edits, --quality or\n"
+    "                       --certify.\n"
+    "  --spill DIR          with blocks: the blocks' results wait in DIR (one file per block, removed at\n"
+    "                       the end) instead of in memory. Default: in memory, or in a directory of\n"
+    "                       $TMPDIR (else /tmp) when they would take over a quarter of the memory limit.\n"
     "  --ascii              PLY output as text (default: binary little-endian, about half the size and\n"
     "                       several times faster to write; OBJ and OFF are always text)\n"
     "  -q, --quiet          no table, no progress\n"
@@ -340,6 +349,8 @@ struct MeshCommand {
   unsigned threads = 0;    ///< --threads: 0 = every available CPU
   std::size_t memory = 0;  ///< --memory: 0 = the default limit
   std::array<int, 3> blocks{0, 0, 0};  ///< --blocks: blocks per axis; 0: one piece (no split)
+  bool blocks_auto = false;            ///< --blocks auto: the split from the memory limit
+  std::string spill;                   ///< --spill DIR
   /// The CLI's defaults and what the flags set over them (quality mode, off-surface constraints, scan,
   /// surface, function, smoothing, certificate). Threads, memory and history are the plan's to resolve.
   MesherOptions options;
@@ -350,7 +361,8 @@ struct MeshCommand {
 std::string check_mesh_command(const MeshCommand& c) {
   if (c.input.empty()) return "no input file";
   if (c.output.empty()) return "no output file (-o OUT.obj)";
-  if (c.blocks[0] > 0) {
+  if (!c.spill.empty() && c.blocks[0] == 0 && !c.blocks_auto) return "--spill needs --blocks";
+  if (c.blocks[0] > 0 || c.blocks_auto) {
     if (!c.edits.empty()) return "--blocks makes one mesh: not with --edits";
     if (c.precisions.size() > 1) return "--blocks makes one level: give at most one --precision";
     if (c.options.mode == MeshMode::Quality) return "--blocks is not available in the quality mode";
@@ -497,8 +509,18 @@ std::string parse_mesh_args(const Args& args, MeshCommand& c) {
       if (!value(v) || !parse_memory_size(v, c.memory))
         return "--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'";
     } else if (a == "--blocks") {
-      if (!value(v) || !parse_block_counts(v, c.blocks))
-        return "--blocks needs N or NxMxK, each from 1 to 64, got '" + v + "'";
+      if (!value(v)) return "--blocks needs N, NxMxK (each from 1 to 64) or auto";
+      if (v == "auto") {
+        c.blocks_auto = true;
+        c.blocks = {0, 0, 0};
+      } else if (!parse_block_counts(v, c.blocks)) {
+        return "--blocks needs N or NxMxK, each from 1 to 64, or auto, got '" + v + "'";
+      } else {
+        c.blocks_auto = false;
+      }
+    } else if (a == "--spill") {
+      if (!value(v) || v.empty()) return "--spill needs a directory";
+      c.spill = v;
     } else if (a == "-q" || a == "--quiet") {
       c.quiet = true;
     } else if (a == "--ascii") {
@@ -551,6 +573,11 @@ struct MeshPlan {
   double diagonal = 0;             ///< mesher->diagonal(): the unit of the relative sizes
   std::vector<MeshLevel> levels;   ///< coarse to fine, each continuing the previous one
   std::vector<std::string> script; ///< the --edits script's lines, replayed after the last level
+  /// A scan too large for one piece under the memory limit (or --blocks auto): meshed in blocks instead;
+  /// the input as read waits here for run_blocks() (no Mesher is built).
+  bool in_blocks = false;
+  Input blocks_input;
+  BlockBudget budget;
 };
 
 /// A mesh that bounds no volume (a hole, an open sheet, flipped or non-manifold triangles) has no inside
@@ -690,6 +717,31 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
   // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
   // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
   plan.scan_input = is_scan(data);
+  if (plan.scan_input && c.precisions.size() <= 1 && plan.script.empty() && options.mode != MeshMode::Quality &&
+      !options.polygonizer.certify) {
+    // The memory limit decides between one piece and blocks (docs/blocks.md "Memory"): a scan whose one
+    // piece would be thinned is meshed whole in blocks instead, when the blocks fit.
+    const double n = static_cast<double>(data.points.points.size());
+    const double one_piece = kMemoryBaseBytes + n * (kMemoryBytesPerPoint + kMemorySeedsPerPoint *
+                                                                              kMemoryBytesPerVertexBatch);
+    if (c.blocks_auto || (options.max_memory_bytes && one_piece > static_cast<double>(options.max_memory_bytes))) {
+      BlockOptions bo;
+      bo.mesher = options;
+      plan.budget = plan_block_budget(data.points.points, options.max_memory_bytes, bo);
+      const bool split = plan.budget.counts != std::array<int, 3>{1, 1, 1};
+      if (split && plan.budget.fits) {
+        plan.in_blocks = true;
+        plan.blocks_input = std::move(data);
+        phases.stop();
+        return plan;
+      }
+      if (split && !c.quiet)
+        std::fprintf(stderr, "vitri mesh: no split into blocks fits the memory limit either (%dx%dx%d: about %.3g GB "
+                     "for the largest block beside %.3g GB held between blocks): one piece, thinned to the limit\n",
+                     plan.budget.counts[0], plan.budget.counts[1], plan.budget.counts[2],
+                     plan.budget.block_bytes / 1e9, plan.budget.held_bytes / 1e9);
+    }
+  }
   if (c.surface_given && !plan.scan_input && options.surface != SurfaceKind::Closed)
     std::fprintf(stderr, "vitri mesh: warning: --surface applies to point inputs; %s gives a closed surface\n",
                  c.input.c_str());
@@ -925,32 +977,71 @@ void run_mesh_plan(const MeshCommand& c, MeshPlan& plan, PhaseTimes& phases) {
   replay_edits(c, plan);
 }
 
-/// --blocks: the scan meshed block after block (docs/blocks.md), the stitched mesh written, a summary on
-/// stdout. @throws InvalidArgument for an input that is not points.
-void run_blocks(const MeshCommand& c, PhaseTimes& phases) {
-  MesherOptions options = c.options;
-  options.threads = c.threads;
-  options = with_threads_applied(options);
-  options.max_memory_bytes = c.memory ? c.memory : default_memory_limit();
-  phases.start("read", "reading " + c.input);
-  Input data = read_input(c.input);
-  open_mesh_as_points(data, c, options);
-  if (!is_scan(data))
-    throw InvalidArgument(c.input + ": --blocks meshes points (a scan); this input is " +
-                          (data.kind == InputKind::Constraints ? "constraints" : "a mesh"));
+/// A private directory of $TMPDIR (else /tmp), removed with what is left in it.
+class TempDirectory {
+ public:
+  explicit TempDirectory(const std::string& prefix) {
+    std::error_code ec;
+    std::filesystem::path base = std::filesystem::temp_directory_path(ec);
+    if (ec) base = "/tmp";
+    std::string pattern = (base / (prefix + "XXXXXX")).string();
+    if (!mkdtemp(pattern.data()))
+      throw Error("cannot create a temporary directory in " + base.string() + " for the blocks' results: " +
+                  std::strerror(errno) + " (give one with --spill DIR)");
+    path_ = pattern;
+  }
+  TempDirectory(const TempDirectory&) = delete;
+  TempDirectory& operator=(const TempDirectory&) = delete;
+  ~TempDirectory() {
+    std::error_code ec;
+    std::filesystem::remove_all(path_, ec);
+  }
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+/// The scan meshed block after block (docs/blocks.md), the stitched mesh written, a summary on stdout.
+/// `options`: the command's, resolved (threads, memory limit, a mesh's points interpolated); `data`: the
+/// input as read (points); `counts`: the split (--blocks, or the memory budget's when `budget`).
+void run_blocks(const MeshCommand& c, MesherOptions options, Input data, std::array<int, 3> counts,
+                const BlockBudget* budget, PhaseTimes& phases) {
   if (!options.scan.viewpoint && data.points.viewpoint) options.scan.viewpoint = data.points.viewpoint;
   if (data.points.has_sensors()) options.scan.sensors = std::move(data.points.sensors);
   const std::vector<Point3> points = std::move(data.points.points);
   const std::vector<Point3> normals = std::move(data.points.normals);
   data = Input{};
+  const double n = static_cast<double>(points.size());
+  const double limit = static_cast<double>(options.max_memory_bytes);
+  // What waits between the passes: on disk when --spill says so, or when held in memory it would take
+  // over a quarter of the limit (a directory of $TMPDIR, removed at the end).
+  std::string spill = c.spill;
+  std::unique_ptr<TempDirectory> temp;
+  if (spill.empty() && limit > 0 && (budget ? budget->spill : kBlockHeldBytesPerPoint * n > 0.25 * limit)) {
+    temp = std::make_unique<TempDirectory>("vitri-blocks-");
+    spill = temp->path();
+  }
+  const double held = (spill.empty() ? kBlockHeldBytesPerPoint : kBlockSpilledBytesPerPoint) * n;
+  if (budget && !c.quiet)
+    std::fprintf(stderr, "vitri mesh: %s %zu points in %dx%dx%d blocks: the largest sees %zu points (about %.3g GB), "
+                 "%.3g GB held between blocks%s; memory limit %.3g GB (%s) (docs/blocks.md)\n",
+                 c.blocks_auto ? "--blocks auto:" : "too large for one piece, meshing", points.size(), counts[0],
+                 counts[1], counts[2], budget->largest_block, budget->block_bytes / 1e9, held / 1e9,
+                 spill.empty() ? "" : (", the blocks' results spilled to " + spill).c_str(), limit / 1e9,
+                 c.memory ? "--memory" : "the machine's available memory less a reserve");
   BlockOptions bo;
-  bo.counts = c.blocks;
+  bo.counts = counts;
   bo.mesher = options;
+  bo.spill_directory = spill;
+  // Each block's Mesher gets what the run does not hold between blocks (its own check thins a block
+  // that still does not fit: a coarser block, with MesherStats' warning counted in BlockStats).
+  if (limit > 0) bo.mesher.max_memory_bytes = static_cast<std::size_t>(std::max(limit - held, 0.25 * limit));
   Box3 box;
   for (const Point3& p : points) box.extend(p);
   if (!c.precisions.empty()) bo.precision = c.precisions[0] * box.diagonal();
-  phases.start("blocks", "meshing " + std::to_string(points.size()) + " points in " + std::to_string(c.blocks[0]) +
-                             "x" + std::to_string(c.blocks[1]) + "x" + std::to_string(c.blocks[2]) + " blocks");
+  phases.start("blocks", "meshing " + std::to_string(points.size()) + " points in " + std::to_string(counts[0]) +
+                             "x" + std::to_string(counts[1]) + "x" + std::to_string(counts[2]) + " blocks");
   BlockStats st;
   auto progress = [&](const std::string& what) {
     if (!c.quiet) std::fprintf(stderr, "  %s\n", what.c_str());
@@ -973,6 +1064,8 @@ void run_blocks(const MeshCommand& c, PhaseTimes& phases) {
   std::printf("  %zu outliers set aside; %zu zero vertices collapsed, %zu left at their offset; surface %s, "
               "%zu small or unsupported components dropped\n", st.outliers, st.snapped, st.offset,
               st.open ? "open, trimmed to the data" : "closed", st.small_components);
+  if (st.spilled_bytes > 0)
+    std::printf("  %.3g GB of the blocks' results spilled to %s (removed)\n", static_cast<double>(st.spilled_bytes) / 1e9, spill.c_str());
   if (st.unfinished > 0 || st.boundary_edges > 0 || st.nonmanifold_edges > 0)
     std::fprintf(stderr, "vitri mesh: warning: the blocks left %zu transverse tetrahedra uncertified (a halo too "
                  "narrow); the stitched mesh had %zu boundary and %zu non-manifold edges before the finishing\n",
@@ -995,10 +1088,25 @@ int run_mesh(const Args& args) {
   std::vector<std::string> script = read_edit_script(command.edits);
   PhaseTimes phases(command.quiet);  // the plan's and the run's phases, announced and timed
   if (command.blocks[0] > 0) {
-    run_blocks(command, phases);
+    // An explicit split: the input read here, as plan_mesh() reads it.
+    MesherOptions options = command.options;
+    options.threads = command.threads;
+    options = with_threads_applied(options);
+    options.max_memory_bytes = command.memory ? command.memory : default_memory_limit();
+    phases.start("read", "reading " + command.input);
+    Input data = read_input(command.input);
+    open_mesh_as_points(data, command, options);
+    if (!is_scan(data))
+      throw InvalidArgument(command.input + ": --blocks meshes points (a scan); this input is " +
+                            (data.kind == InputKind::Constraints ? "constraints" : "a mesh"));
+    run_blocks(command, options, std::move(data), command.blocks, nullptr, phases);
     exit_without_teardown(0);
   }
   MeshPlan plan = plan_mesh(command, std::move(script), phases);
+  if (plan.in_blocks) {
+    run_blocks(command, plan.options, std::move(plan.blocks_input), plan.budget.counts, &plan.budget, phases);
+    exit_without_teardown(0);
+  }
   run_mesh_plan(command, plan, phases);
   // Every output file is closed (write_mesh), every line printed: the Mesher, the constraints and the
   // meshes are left to the system (freeing them block by block took 0.5 s at 10^6 points).

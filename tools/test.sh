@@ -5,7 +5,8 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 bash tools/deps.sh cmake make g++ libeigen3-dev catch2 libstb-dev pkg-config libcpp-httplib-dev libjs-three \
                    chromium chromium-driver python3-selenium liblzf-dev \
-                   pybind11-dev python3-dev python3-numpy python3-pytest python3-open3d  # python/ (docs/python.md)
+                   pybind11-dev python3-dev python3-numpy python3-pytest python3-open3d \
+                   python3-distributed  # python/ (docs/python.md); Dask for the blocks (docs/blocks.md)
 jobs=$(nproc 2>/dev/null || echo 2)
 cmake -S . -B build-test -DCMAKE_BUILD_TYPE=RelWithDebInfo -DVITRI_SANITIZE=address,undefined \
       -DVITRI_BUILD_BENCH=OFF -DVITRI_WERROR=ON -DVITRI_BUILD_PYTHON=ON -DPython_EXECUTABLE=/usr/bin/python3

@@ -12,8 +12,12 @@
 #include "vitri/rbf/point_index.hpp"
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
 #include <limits>
 #include <unordered_map>
 #include <utility>
@@ -259,37 +263,48 @@ BlockSeeds refine_block(const BlockPlan& plan, int b, const std::vector<Point3>&
 
 // ---- Orientation between blocks ---------------------------------------------------------------------
 
-std::size_t align_blocks(const BlockPlan& plan, std::vector<BlockSeeds>& seeds) {
-  const int nb = static_cast<int>(seeds.size());
-  // votes[b][c]: agreements minus disagreements between b's owned normals and c's view of them.
-  std::vector<std::vector<double>> votes(nb, std::vector<double>(nb, 0.0));
+std::vector<double> block_votes(const BlockPlan& plan, const BlockSeeds& block,
+                                const std::vector<const BlockSeeds*>& others) {
+  const int nb = plan.grid.size();
+  std::vector<double> row(nb, 0.0);
+  const int b = block.block;
+  if (block.prepared.points.empty() || block.prepared.normals.size() != block.prepared.points.size()) return row;
   const double match2 = kVoteMatchSpacings * plan.spacing * kVoteMatchSpacings * plan.spacing;
+  const PointIndex index(block.prepared.points);
   std::vector<PointIndex::Id> ids;
   std::vector<double> d2;
-  for (int b = 0; b < nb; ++b) {
-    if (seeds[b].prepared.points.empty() || seeds[b].prepared.normals.size() != seeds[b].prepared.points.size())
-      continue;
-    const PointIndex index(seeds[b].prepared.points);
-    for (int c = 0; c < nb; ++c) {
-      if (c == b) continue;
-      const BlockSeeds& s = seeds[c];
-      for (std::size_t k = 0; k < s.halo_points.size(); ++k) {
-        if (plan.grid.owner(s.halo_points[k]) != b) continue;
-        index.nearest(s.halo_points[k], 1, ids, &d2);
-        if (ids.empty() || d2[0] > match2) continue;
-        const double agree = dot(seeds[b].prepared.normals[ids[0]], s.halo_normals[k]);
-        votes[std::min(b, c)][std::max(b, c)] += agree > 0 ? 1 : agree < 0 ? -1 : 0;
-      }
+  for (const BlockSeeds* s : others) {
+    if (!s || s->block == b || s->block < 0 || s->block >= nb) continue;
+    for (std::size_t k = 0; k < s->halo_points.size(); ++k) {
+      if (plan.grid.owner(s->halo_points[k]) != b) continue;
+      index.nearest(s->halo_points[k], 1, ids, &d2);
+      if (ids.empty() || d2[0] > match2) continue;
+      const double agree = dot(block.prepared.normals[ids[0]], s->halo_normals[k]);
+      row[s->block] += agree > 0 ? 1 : agree < 0 ? -1 : 0;
     }
   }
+  return row;
+}
+
+std::vector<bool> block_flips(const std::vector<std::vector<double>>& rows,
+                              const std::vector<std::size_t>& prepared_counts) {
+  const int nb = static_cast<int>(rows.size());
+  if (prepared_counts.size() != rows.size())
+    throw InvalidArgument("block_flips: " + std::to_string(rows.size()) + " rows of votes for " +
+                          std::to_string(prepared_counts.size()) + " blocks");
+  for (const auto& r : rows)
+    if (static_cast<int>(r.size()) != nb)
+      throw InvalidArgument("block_flips: a row of " + std::to_string(r.size()) + " votes for " +
+                            std::to_string(nb) + " blocks");
+  // votes(u, v): agreements minus disagreements between u's owned normals and v's view of them, both ways.
+  auto votes = [&](int u, int v) { return rows[u][v] + rows[v][u]; };
   // A maximum spanning forest of |votes| (Prim from each unvisited block, the largest first): each
   // block's sign relative to its tree's root.
   std::vector<int> sign(nb, 0);
   std::vector<int> root_of(nb, -1);
   std::vector<int> order(nb);
   for (int b = 0; b < nb; ++b) order[b] = b;
-  std::sort(order.begin(), order.end(),
-            [&](int x, int y) { return seeds[x].prepared.points.size() > seeds[y].prepared.points.size(); });
+  std::sort(order.begin(), order.end(), [&](int x, int y) { return prepared_counts[x] > prepared_counts[y]; });
   for (int root : order) {
     if (sign[root] != 0) continue;
     sign[root] = 1;
@@ -301,35 +316,74 @@ std::size_t align_blocks(const BlockPlan& plan, std::vector<BlockSeeds>& seeds) 
         if (root_of[u] != root) continue;
         for (int v = 0; v < nb; ++v) {
           if (sign[v] != 0) continue;
-          const double w = votes[std::min(u, v)][std::max(u, v)];
+          const double w = votes(u, v);
           if (std::abs(w) > best) best = std::abs(w), best_from = u, best_to = v;
         }
       }
       if (best_to < 0) break;
-      sign[best_to] = sign[best_from] * (votes[std::min(best_from, best_to)][std::max(best_from, best_to)] > 0 ? 1 : -1);
+      sign[best_to] = sign[best_from] * (votes(best_from, best_to) > 0 ? 1 : -1);
       root_of[best_to] = root;
     }
   }
   // Per tree, the orientation most prepared points were given by their own block is kept.
-  std::size_t flipped = 0;
+  std::vector<bool> flip(nb, false);
   for (int root = 0; root < nb; ++root) {
     if (root_of[root] != root) continue;
     double keep = 0, turn = 0;
     for (int b = 0; b < nb; ++b)
-      if (root_of[b] == root) (sign[b] > 0 ? keep : turn) += double(seeds[b].prepared.points.size());
+      if (root_of[b] == root) (sign[b] > 0 ? keep : turn) += double(prepared_counts[b]);
     const int global = keep >= turn ? 1 : -1;
-    for (int b = 0; b < nb; ++b) {
-      if (root_of[b] != root || sign[b] * global > 0) continue;
-      BlockSeeds& s = seeds[b];
-      for (double& v : s.values) v = -v;
-      for (Point3& g : s.gradients) g = -1.0 * g;
-      for (Point3& n : s.prepared.normals) n = -1.0 * n;
-      for (Point3& n : s.halo_normals) n = -1.0 * n;
-      s.flipped = !s.flipped;
-      ++flipped;
-    }
+    for (int b = 0; b < nb; ++b)
+      if (root_of[b] == root && sign[b] * global < 0) flip[b] = true;
   }
+  return flip;
+}
+
+void turn_over(BlockSeeds& s) {
+  for (double& v : s.values) v = -v;
+  for (Point3& g : s.gradients) g = -1.0 * g;
+  for (Point3& n : s.prepared.normals) n = -1.0 * n;
+  for (Point3& n : s.halo_normals) n = -1.0 * n;
+  s.flipped = !s.flipped;
+}
+
+std::size_t align_blocks(const BlockPlan& plan, std::vector<BlockSeeds>& seeds) {
+  const int nb = static_cast<int>(seeds.size());
+  std::vector<const BlockSeeds*> all;
+  std::vector<std::size_t> counts(nb);
+  for (int b = 0; b < nb; ++b) all.push_back(&seeds[b]), counts[b] = seeds[b].prepared.points.size();
+  std::vector<std::vector<double>> rows(nb);
+  for (int b = 0; b < nb; ++b) {
+    rows[b] = block_votes(plan, seeds[b], all);
+    rows[b].resize(nb, 0.0);
+  }
+  const std::vector<bool> flip = block_flips(rows, counts);
+  std::size_t flipped = 0;
+  for (int b = 0; b < nb; ++b)
+    if (flip[b]) turn_over(seeds[b]), ++flipped;
   return flipped;
+}
+
+BlockSeeds block_border(const BlockPlan& plan, const BlockSeeds& s, double merge_halo) {
+  BlockSeeds out;
+  out.block = s.block;
+  out.flipped = s.flipped;
+  out.resolution = s.resolution;
+  out.precision = s.precision;
+  if (s.block < 0 || s.block >= plan.grid.size()) return out;
+  const Box3 cell = plan.grid.cell(s.block);
+  for (std::size_t k = 0; k < s.points.size(); ++k) {
+    const Point3& p = s.points[k];
+    bool inner = true;
+    for (int a = 0; a < 3 && inner; ++a)
+      inner = axis(p, a) > axis(cell.lo, a) + merge_halo && axis(p, a) < axis(cell.hi, a) - merge_halo;
+    if (inner) continue;
+    out.points.push_back(p);
+    out.values.push_back(s.values[k]);
+    out.gradients.push_back(s.gradients[k]);
+    out.ids.push_back(s.id(k));
+  }
+  return out;
 }
 
 // ---- Pass 2 ---------------------------------------------------------------------------------------
@@ -676,6 +730,169 @@ SurfaceMesh finish_blocks(SurfaceMesh mesh, const std::vector<const BlockSeeds*>
   return mesh;
 }
 
+// ---- Memory budget ---------------------------------------------------------------------------------
+
+BlockBudget plan_block_budget(const std::vector<Point3>& points, std::size_t limit, const BlockOptions& options) {
+  BlockBudget out;
+  const double n = static_cast<double>(points.size());
+  out.largest_block = points.size();
+  const double per_point =
+      kMemoryBytesPerPoint + kMemorySeedsPerPoint * kMemoryBytesPerVertexBatch * kMemoryRefineFactor;
+  out.block_bytes = kMemoryBaseBytes + per_point * n;
+  out.held_bytes = 0;
+  if (limit == 0 || out.block_bytes <= static_cast<double>(limit)) return out;
+  BlockOptions one = options;
+  one.counts = {1, 1, 1};
+  const BlockPlan base = plan_blocks(points, one);
+  const double lim = static_cast<double>(limit);
+  out.spill = kBlockHeldBytesPerPoint * n > 0.25 * lim;
+  out.held_bytes = (out.spill ? kBlockSpilledBytesPerPoint : kBlockHeldBytesPerPoint) * n;
+  const Box3& dom = base.grid.domain();
+  const double ext[3] = {dom.hi.x - dom.lo.x, dom.hi.y - dom.lo.y, dom.hi.z - dom.lo.z};
+  // Counted on at most 10^6 evenly spaced points, scaled up.
+  const std::size_t stride = std::max<std::size_t>(1, points.size() / 1000000);
+  std::array<int, 3> last{1, 1, 1};
+  for (double edge = std::max({ext[0], ext[1], ext[2]}) * 0.8;; edge *= 0.8) {
+    std::array<int, 3> counts{};
+    for (int a = 0; a < 3; ++a)
+      counts[a] = std::max(1, std::min(64, static_cast<int>(std::ceil(ext[a] / edge - 1e-9))));
+    if (counts == last) continue;
+    last = counts;
+    const BlockGrid grid(dom, counts);
+    std::vector<double> seen(static_cast<std::size_t>(grid.size()), 0.0);
+    for (std::size_t i = 0; i < points.size(); i += stride) {
+      int range[3][2];
+      for (int a = 0; a < 3; ++a) {
+        const double h = ext[a] / counts[a];
+        const double x = axis(points[i], a) - axis(dom.lo, a);
+        range[a][0] = std::max(0, std::min(counts[a] - 1, static_cast<int>(std::floor((x - base.data_halo) / h))));
+        range[a][1] = std::max(0, std::min(counts[a] - 1, static_cast<int>(std::floor((x + base.data_halo) / h))));
+      }
+      for (int k = range[2][0]; k <= range[2][1]; ++k)
+        for (int j = range[1][0]; j <= range[1][1]; ++j)
+          for (int ii = range[0][0]; ii <= range[0][1]; ++ii) seen[(k * counts[1] + j) * counts[0] + ii] += static_cast<double>(stride);
+    }
+    const double largest = *std::max_element(seen.begin(), seen.end());
+    out.counts = counts;
+    out.largest_block = static_cast<std::size_t>(largest);
+    out.block_bytes = kMemoryBaseBytes + per_point * largest;
+    if (out.block_bytes + out.held_bytes <= lim) return out;
+    if (counts[0] == 64 && counts[1] == 64 && counts[2] == 64) break;
+  }
+  out.fits = false;
+  return out;
+}
+
+// ---- The whole run ----------------------------------------------------------------------------------
+
+namespace {
+
+/// Where pass 1's owned results wait for the merge: in memory (`dir` empty: the seeds themselves), or
+/// on disk, one file per block (seeds-B.vtrb) and its border (border-B.vtrb), with only what the
+/// orientation's vote reads of the other blocks (their halo's prepared points) kept in memory.
+class SeedStore {
+ public:
+  SeedStore(const std::string& dir, int blocks) : dir_(dir), held_(blocks) {
+    if (dir_.empty()) return;
+    std::error_code ec;
+    created_ = std::filesystem::create_directories(dir_, ec);
+    if (ec) throw Error("mesh in blocks: cannot create the spill directory " + dir_ + ": " + ec.message());
+  }
+  SeedStore(const SeedStore&) = delete;
+  SeedStore& operator=(const SeedStore&) = delete;
+  ~SeedStore() {
+    if (dir_.empty()) return;
+    std::error_code ec;
+    for (const std::string& f : files_) std::filesystem::remove(f, ec);
+    if (created_) std::filesystem::remove(dir_, ec);
+  }
+  bool spilled() const { return !dir_.empty(); }
+  std::size_t bytes_written() const { return written_; }
+  /// Pass 1's result of a block: kept, or written and reduced to its summary.
+  void put(BlockSeeds&& s) {
+    const int b = s.block;
+    if (dir_.empty()) {
+      held_[b] = std::move(s);
+      return;
+    }
+    write(path("seeds", b), encode_block_seeds(s));
+    BlockSeeds summary;
+    summary.block = b;
+    summary.halo_points = std::move(s.halo_points);
+    summary.halo_normals = std::move(s.halo_normals);
+    summary.resolution = s.resolution;
+    summary.precision = s.precision;
+    held_[b] = std::move(summary);
+  }
+  /// The summaries (spilled) or the results (in memory) of every block.
+  std::vector<BlockSeeds>& held() { return held_; }
+  BlockSeeds load(int b) const { return read(path("seeds", b)); }
+  void put_border(const BlockSeeds& border) { write(path("border", border.block), encode_block_seeds(border)); }
+  BlockSeeds load_border(int b) const { return read(path("border", b)); }
+
+ private:
+  std::string path(const char* what, int b) const {
+    return (std::filesystem::path(dir_) / (std::string(what) + "-" + std::to_string(b) + ".vtrb")).string();
+  }
+  void write(const std::string& file, const std::vector<std::uint8_t>& bytes) {
+    files_.push_back(file);
+    std::FILE* f = std::fopen(file.c_str(), "wb");
+    const bool ok = f && std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size();
+    const int err = errno;
+    const bool closed = f && std::fclose(f) == 0;
+    if (!ok || !closed)
+      throw Error("mesh in blocks: spilling " + std::to_string(bytes.size()) + " bytes to " + file + ": " +
+                  std::strerror(err ? err : EIO));
+    written_ += bytes.size();
+  }
+  static BlockSeeds read(const std::string& file) {
+    std::FILE* f = std::fopen(file.c_str(), "rb");
+    if (!f) throw Error("mesh in blocks: reading back " + file + ": " + std::strerror(errno));
+    std::vector<std::uint8_t> bytes;
+    std::uint8_t buf[1 << 16];
+    std::size_t got;
+    while ((got = std::fread(buf, 1, sizeof buf, f)) > 0) bytes.insert(bytes.end(), buf, buf + got);
+    const bool bad = std::ferror(f) != 0;
+    std::fclose(f);
+    if (bad) throw Error("mesh in blocks: reading back " + file + ": read error");
+    try {
+      return decode_block_seeds(bytes.data(), bytes.size());
+    } catch (const InvalidArgument& e) {
+      throw Error("mesh in blocks: " + file + " was changed while the run used it: " + e.what());
+    }
+  }
+  std::string dir_;
+  bool created_ = false;
+  std::vector<std::string> files_;
+  std::vector<BlockSeeds> held_;
+  std::size_t written_ = 0;
+};
+
+/// True when some point within `halo` of cell c can lie within `halo` of cell b (their cells grown by
+/// the halo overlap): c's vertices may be among those b's merge sees.
+bool cells_near(const BlockGrid& grid, int b, int c, double halo) {
+  const Box3 x = grid.cell(b), y = grid.cell(c);
+  for (int a = 0; a < 3; ++a)
+    if (axis(x.lo, a) > axis(y.hi, a) + 2 * halo || axis(y.lo, a) > axis(x.hi, a) + 2 * halo) return false;
+  return true;
+}
+
+}  // namespace
+
+std::vector<Point3> orient_for_blocks(const std::vector<Point3>& points, const BlockOptions& options) {
+  ScanOptions o = options.mesher.scan;
+  o.threads = options.mesher.threads ? options.mesher.threads : o.threads;
+  const ScanPoints sp = prepare_scan(points, {}, o);
+  const PointIndex index(sp.points);
+  std::vector<Point3> oriented(points.size());
+  std::vector<PointIndex::Id> ids;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    index.nearest(points[i], 1, ids);
+    oriented[i] = ids.empty() ? Point3{0, 0, 0} : sp.normals[ids[0]];
+  }
+  return oriented;
+}
+
 SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                            const BlockOptions& options, BlockStats* stats,
                            const std::function<void(const std::string&)>& progress) {
@@ -690,27 +907,19 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
   auto say = [&](const std::string& what) {
     if (progress) progress(what);
   };
-  // Unoriented points with no viewpoint or sensors: oriented once, on all of them (the blocks alone
-  // would each orient a piece of the surface, and a piece can be oriented inside out).
+  // Unoriented points with no viewpoint or sensors: oriented once, on all of them (orient_for_blocks()).
   const auto t1 = Clock::now();
-  std::vector<Point3> oriented;
   const ScanOptions& scan = options.mesher.scan;
+  std::vector<Point3> oriented;
   if (normals.empty() && !scan.viewpoint && scan.sensors.size() != points.size()) {
     say("orienting " + std::to_string(points.size()) + " points (all of them, once)");
-    ScanOptions o = scan;
-    o.threads = options.mesher.threads ? options.mesher.threads : scan.threads;
-    const ScanPoints sp = prepare_scan(points, {}, o);
-    const PointIndex index(sp.points);
-    oriented.resize(points.size());
-    std::vector<PointIndex::Id> ids;
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      index.nearest(points[i], 1, ids);
-      oriented[i] = ids.empty() ? Point3{0, 0, 0} : sp.normals[ids[0]];
-    }
+    oriented = orient_for_blocks(points, options);
   }
   const std::vector<Point3>& given = oriented.empty() ? normals : oriented;
-  // Pass 1, block after block: only the owned results stay.
-  std::vector<BlockSeeds> seeds(nb);
+  // Pass 1, block after block: only the owned results stay (in memory, or on disk with their summaries).
+  SeedStore store(options.spill_directory, nb);
+  std::vector<BlockSeeds>& seeds = store.held();
+  std::vector<std::size_t> prepared_counts(nb, 0);
   double max_precision = 0;
   for (int b = 0; b < nb; ++b) {
     const std::vector<std::size_t> idx = block_points(plan, b, points);
@@ -727,25 +936,53 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
     }
     say("block " + std::to_string(b + 1) + " of " + std::to_string(nb) + ": " + std::to_string(idx.size()) +
         " points, refining");
-    seeds[b] = refine_block(plan, b, p, n, bo);
-    max_precision = std::max(max_precision, seeds[b].precision);
-    st.block_seconds[b] += seeds[b].seconds;
-    st.outliers += seeds[b].outliers;
-    st.budget_blocks += seeds[b].budget_reached;
+    BlockSeeds s = refine_block(plan, b, p, n, bo);
+    max_precision = std::max(max_precision, s.precision);
+    st.block_seconds[b] += s.seconds;
+    st.outliers += s.outliers;
+    st.budget_blocks += s.budget_reached;
+    prepared_counts[b] = s.prepared.points.size();
+    store.put(std::move(s));
   }
-  st.flipped = align_blocks(plan, seeds);
-  st.pass1_seconds = seconds_since(t1);
   if (!(max_precision > 0))
     throw InvalidArgument("mesh in blocks: no block found a surface in " + std::to_string(points.size()) + " points");
-  // Pass 2.
-  const auto t2 = Clock::now();
+  const double merge_halo = options.merge_halo_precisions * max_precision;
   std::vector<const BlockSeeds*> ptrs;
   for (const BlockSeeds& s : seeds) ptrs.push_back(&s);
-  const double merge_halo = options.merge_halo_precisions * max_precision;
+  std::vector<bool> flip(nb, false);
+  if (!store.spilled()) {
+    st.flipped = align_blocks(plan, seeds);
+  } else {
+    // The votes, block by block from disk (the others' halos are held), and each block's border written.
+    std::vector<std::vector<double>> rows(nb);
+    for (int b = 0; b < nb; ++b) {
+      const BlockSeeds full = store.load(b);
+      rows[b] = block_votes(plan, full, ptrs);
+      store.put_border(block_border(plan, full, merge_halo));
+    }
+    flip = block_flips(rows, prepared_counts);
+    for (int b = 0; b < nb; ++b) st.flipped += flip[b];
+  }
+  st.pass1_seconds = seconds_since(t1);
+  // Pass 2.
+  const auto t2 = Clock::now();
   std::vector<BlockSurface> surfaces(nb);
   for (int b = 0; b < nb; ++b) {
     say("block " + std::to_string(b + 1) + " of " + std::to_string(nb) + ": merging");
-    surfaces[b] = extract_block(plan, b, ptrs, merge_halo);
+    if (!store.spilled()) {
+      surfaces[b] = extract_block(plan, b, ptrs, merge_halo);
+    } else {
+      // Its own results and the borders of the blocks near it, turned over as the vote said.
+      std::vector<BlockSeeds> near(nb);
+      std::vector<const BlockSeeds*> view(nb, nullptr);
+      for (int c = 0; c < nb; ++c) {
+        if (c != b && !cells_near(plan.grid, b, c, merge_halo)) continue;
+        near[c] = c == b ? store.load(c) : store.load_border(c);
+        if (flip[c]) turn_over(near[c]);
+        view[c] = &near[c];
+      }
+      surfaces[b] = extract_block(plan, b, view, merge_halo);
+    }
     st.block_seconds[b] += surfaces[b].seconds;
   }
   st.pass2_seconds = seconds_since(t2);
@@ -753,6 +990,17 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
   SurfaceMesh mesh = stitch_blocks(surfaces, &st);
   surfaces.clear();
   say("finishing");
+  if (store.spilled()) {
+    // The finishing reads every block's prepared points: read back, nothing else kept.
+    for (int b = 0; b < nb; ++b) {
+      BlockSeeds full = store.load(b);
+      if (flip[b]) turn_over(full);
+      seeds[b].prepared = std::move(full.prepared);
+      seeds[b].halo_points.clear();
+      seeds[b].halo_normals.clear();
+    }
+    st.spilled_bytes = store.bytes_written();
+  }
   mesh = finish_blocks(std::move(mesh), ptrs, options.mesher.surface, options.mesher.threads, &st);
   if (stats) *stats = st;
   return mesh;

@@ -12,6 +12,7 @@
 //  - long calls release the GIL; the library's callbacks take it back to check for signals (Ctrl-C) and
 //    to call the user's progress callback (Progress below).
 #include "vitri/core/error.hpp"
+#include "vitri/mesher.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/polygonize/surface_mesh.hpp"
@@ -106,6 +107,12 @@ void bind_functions(py::module_& m);
 void bind_delaunay(py::module_& m);
 void bind_mesher(py::module_& m);
 void bind_io(py::module_& m);
+void bind_blocks(py::module_& m);
+
+/// The keyword options of reconstruct() (the CLI's scan options by name, docs/python.md) as the
+/// library's MesherOptions with the CLI's defaults; `precision`, the quality mode, certify and progress
+/// are refused (InvalidArgument / TypeError naming `fn`).
+MesherOptions mesher_options_from(const py::kwargs& kw, const char* fn);
 
 /// The Python exception type vitri.Cancelled (a progress callback returned False).
 PyObject* cancelled_type();

@@ -381,6 +381,14 @@ py::dict delta_of(Mesher& mesher, MeshDelta&& d) {
 
 }  // namespace
 
+MesherOptions mesher_options_from(const py::kwargs& kw, const char* fn) {
+  const Options o = parse_options(kw, fn, false);
+  if (o.mesher.mode == MeshMode::Quality) throw InvalidArgument(std::string(fn) + ": the quality mode does not apply");
+  if (o.mesher.polygonizer.certify) throw InvalidArgument(std::string(fn) + ": certify does not apply");
+  if (!o.progress.is_none()) throw InvalidArgument(std::string(fn) + ": progress does not apply");
+  return o.mesher;
+}
+
 void bind_mesher(py::module_& m) {
   m.def("reconstruct", &reconstruct, py::arg("points"), py::arg("normals") = py::none(),
         R"(reconstruct(points, normals=None, **options) -> Mesh

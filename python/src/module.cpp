@@ -334,4 +334,5 @@ PYBIND11_MODULE(_vitri, m) {
   vp::bind_delaunay(m);
   vp::bind_mesher(m);
   vp::bind_io(m);
+  vp::bind_blocks(m);
 }

@@ -674,3 +674,34 @@ TEST_CASE("vitri mesh --blocks: a scan meshed in blocks is one closed outward me
   REQUIRE(run(one + " -o " + kDir + "/mesh_blocks_again.ply --blocks 2", o, e) == 1);
   CHECK(e.find("--blocks meshes points") != std::string::npos);
 }
+
+TEST_CASE("vitri mesh: a scan too large for one piece under --memory is meshed whole in blocks; --spill",
+          "[cli][mesh][blocks]") {
+  // 20000 oriented points on the sphere: one piece needs about 64 MB + 20000 x 4.3 KB = 150 MB
+  // (docs/memory.md's model); under 130 MiB the run splits instead of thinning (docs/blocks.md).
+  const std::string in = write_sphere_points("mesh_budget.pwn", 20000);
+  const std::string one = kDir + "/mesh_budget_one.ply", split = kDir + "/mesh_budget_split.ply";
+  std::string o, e;
+  REQUIRE(run(in + " -o " + one, o, e) == 0);
+  CHECK(e.find("blocks") == std::string::npos);
+  REQUIRE(run(in + " -o " + split + " --memory 130M", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("too large for one piece, meshing 20000 points in") != std::string::npos);
+  CHECK(e.find("thinned") == std::string::npos);
+  const long v1 = check_mesh(one), vs = check_mesh(split);  // closed, outward, a sphere
+  CHECK(std::abs(vs - v1) < v1 / 20);  // every point meshed: no coarser mesh
+  // --blocks auto where one piece fits: the one-piece run, the same file.
+  const std::string autod = kDir + "/mesh_budget_auto.ply";
+  REQUIRE(run(in + " -o " + autod + " --blocks auto", o, e) == 0);
+  CHECK(slurp(autod) == slurp(one));
+  // --spill: the same file as in memory, the directory left as it was (created, emptied, removed).
+  const std::string held = kDir + "/mesh_budget_held.ply", spilled = kDir + "/mesh_budget_spilled.ply";
+  const std::string dir = kDir + "/mesh_budget_spill";
+  REQUIRE(run(in + " -o " + held + " --blocks 2", o, e) == 0);
+  REQUIRE(run(in + " -o " + spilled + " --blocks 2 --spill " + dir, o, e) == 0);
+  CHECK(o.find("spilled to " + dir) != std::string::npos);
+  CHECK(slurp(held) == slurp(spilled));
+  CHECK(!exists(dir));
+  REQUIRE(run(in + " -o " + spilled + " --spill " + dir, o, e) == 2);
+  CHECK(e.find("--spill needs --blocks") != std::string::npos);
+}

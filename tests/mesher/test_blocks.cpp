@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <filesystem>
 #include <cmath>
 #include <map>
 #include <set>
@@ -260,4 +261,140 @@ TEST_CASE("align_blocks: a block turned inside out is turned back, and blocks th
   const bool back = seeds[1].values == values;
   const bool both = seeds[0].flipped && !seeds[1].flipped;
   CHECK((back || both));
+}
+
+TEST_CASE("blocks: the encodings give back what was encoded; damaged bytes are refused, never misread",
+          "[blocks]") {
+  std::vector<Point3> p, n;
+  torus(4000, 1.0, 0.35, {0, 0, 0}, p, n);
+  const BlockOptions options = quiet_options({2, 1, 1});
+  const BlockPlan plan = plan_blocks(p, options);
+  std::vector<Point3> bp, bn;
+  for (std::size_t i : block_points(plan, 0, p)) bp.push_back(p[i]), bn.push_back(n[i]);
+  const BlockSeeds s = refine_block(plan, 0, bp, bn, options);
+  REQUIRE(!s.points.empty());
+  const std::vector<std::uint8_t> bytes = encode_block_seeds(s);
+  const BlockSeeds t = decode_block_seeds(bytes.data(), bytes.size());
+  CHECK(t.block == s.block);
+  CHECK(t.points == s.points);
+  CHECK(t.values == s.values);
+  CHECK(t.gradients == s.gradients);
+  CHECK(t.prepared.points == s.prepared.points);
+  CHECK(t.prepared.normals == s.prepared.normals);
+  CHECK(t.halo_points == s.halo_points);
+  CHECK(t.precision == s.precision);
+  CHECK(t.id(3) == s.id(3));
+  const std::vector<std::uint8_t> plan_bytes = encode_block_plan(plan);
+  const BlockPlan q = decode_block_plan(plan_bytes.data(), plan_bytes.size());
+  CHECK(q.grid.counts() == plan.grid.counts());
+  CHECK(q.spacing == plan.spacing);
+  CHECK(q.grid.cell(1).lo == plan.grid.cell(1).lo);
+  const BlockSurface surf = extract_block(plan, 0, {&s}, 4 * s.precision);
+  const std::vector<std::uint8_t> sb = encode_block_surface(surf);
+  const BlockSurface back = decode_block_surface(sb.data(), sb.size());
+  REQUIRE(back.crossings.size() == surf.crossings.size());
+  CHECK(back.triangles == surf.triangles);
+  CHECK(back.crossings.back().x == surf.crossings.back().x);
+  CHECK(back.crossings.back().neg == surf.crossings.back().neg);
+  // Truncated, another kind, another version, trailing bytes: refused with what is wrong.
+  CHECK_THROWS_WITH(decode_block_seeds(bytes.data(), bytes.size() - 5), Catch::Contains("truncated"));
+  CHECK_THROWS_WITH(decode_block_seeds(plan_bytes.data(), plan_bytes.size()), Catch::Contains("block plan"));
+  std::vector<std::uint8_t> v2 = bytes;
+  v2[8] = 99;  // the version field
+  CHECK_THROWS_WITH(decode_block_seeds(v2.data(), v2.size()), Catch::Contains("format version 99"));
+  std::vector<std::uint8_t> longer = bytes;
+  longer.push_back(0);
+  CHECK_THROWS_WITH(decode_block_seeds(longer.data(), longer.size()), Catch::Contains("left over"));
+  CHECK_THROWS_AS(decode_block_seeds(nullptr, 0), InvalidArgument);
+}
+
+TEST_CASE("blocks: spilled to disk, the run gives the mesh it gives in memory, and the files are removed",
+          "[blocks]") {
+  std::vector<Point3> p, n;
+  const Point3 c{0.03, -0.02, 0.01};
+  torus(6000, 1.0, 0.35, c, p, n);
+  BlockOptions memory = quiet_options({2, 2, 2});
+  BlockStats held, spilled;
+  const SurfaceMesh a = mesh_in_blocks(p, n, memory, &held);
+  BlockOptions disk = memory;
+  disk.spill_directory = (std::filesystem::temp_directory_path() / "vitri-test-blocks-spill").string();
+  std::filesystem::remove_all(disk.spill_directory);
+  const SurfaceMesh b = mesh_in_blocks(p, n, disk, &spilled);
+  CHECK(held.spilled_bytes == 0);
+  CHECK(spilled.spilled_bytes > 0);
+  CHECK(!std::filesystem::exists(disk.spill_directory));
+  CHECK(a.vertices == b.vertices);
+  CHECK(a.triangles == b.triangles);
+  CHECK(a.normals == b.normals);
+  check_closed(b, 1, 0);
+}
+
+TEST_CASE("blocks: a block's border gives the neighbours' merge what the whole block gives", "[blocks]") {
+  std::vector<Point3> p, n;
+  torus(5000, 1.0, 0.35, {0, 0, 0}, p, n);
+  const BlockOptions options = quiet_options({2, 1, 1});
+  const BlockPlan plan = plan_blocks(p, options);
+  std::vector<BlockSeeds> seeds(2);
+  for (int b = 0; b < 2; ++b) {
+    std::vector<Point3> bp, bn;
+    for (std::size_t i : block_points(plan, b, p)) bp.push_back(p[i]), bn.push_back(n[i]);
+    seeds[b] = refine_block(plan, b, bp, bn, options);
+  }
+  const double halo = 4 * std::max(seeds[0].precision, seeds[1].precision);
+  const BlockSeeds border = block_border(plan, seeds[1], halo);
+  CHECK(border.points.size() < seeds[1].points.size() / 2);  // the part near the faces only
+  // Ids kept, not renumbered: each border vertex has the id it has in the whole block.
+  std::map<GlobalId, Point3> whole_ids;
+  for (std::size_t k = 0; k < seeds[1].points.size(); ++k) whole_ids[seeds[1].id(k)] = seeds[1].points[k];
+  REQUIRE(border.ids.size() == border.points.size());
+  std::size_t same = 0;
+  for (std::size_t k = 0; k < border.points.size(); ++k) {
+    const auto it = whole_ids.find(border.id(k));
+    same += it != whole_ids.end() && it->second == border.points[k];
+  }
+  CHECK(same == border.points.size());
+  const BlockSurface whole = extract_block(plan, 0, {&seeds[0], &seeds[1]}, halo);
+  const BlockSurface part = extract_block(plan, 0, {&seeds[0], &border}, halo);
+  CHECK(whole.triangles == part.triangles);
+  REQUIRE(whole.crossings.size() == part.crossings.size());
+  for (std::size_t k = 0; k < whole.crossings.size(); ++k) {
+    CHECK(whole.crossings[k].neg == part.crossings[k].neg);
+    CHECK(whole.crossings[k].pos == part.crossings[k].pos);
+  }
+  // The two steps of align_blocks() agree with it.
+  std::vector<std::vector<double>> rows;
+  for (int b = 0; b < 2; ++b) rows.push_back(block_votes(plan, seeds[b], {&seeds[0], &seeds[1]}));
+  CHECK(rows[0][1] + rows[1][0] > 0);  // the oriented blocks agree
+  CHECK(block_flips(rows, {seeds[0].prepared.points.size(), seeds[1].prepared.points.size()}) ==
+        std::vector<bool>{false, false});
+  rows[1][0] = -rows[1][0] - 1000;  // block 1 now disagrees: the smaller one is turned over
+  const std::vector<bool> f = block_flips(rows, {10, 5});
+  CHECK(f == std::vector<bool>{false, true});
+}
+
+TEST_CASE("plan_block_budget: one piece when it fits; else the coarsest split whose largest block fits",
+          "[blocks]") {
+  std::vector<Point3> p, n;
+  torus(20000, 1.0, 0.35, {0, 0, 0}, p, n);
+  const BlockOptions options = quiet_options({1, 1, 1});
+  const BlockBudget none = plan_block_budget(p, 0, options);
+  CHECK(none.counts == std::array<int, 3>{1, 1, 1});
+  const BlockBudget roomy = plan_block_budget(p, std::size_t(8) << 30, options);
+  CHECK(roomy.counts == std::array<int, 3>{1, 1, 1});
+  CHECK(roomy.fits);
+  // One piece needs about 64 MB + 20000 x 4.3 KB = 150 MB: 120 MB asks for a split.
+  const std::size_t limit = 120u << 20;
+  const BlockBudget b = plan_block_budget(p, limit, options);
+  CHECK(b.fits);
+  CHECK(b.counts[0] * b.counts[1] * b.counts[2] > 1);
+  CHECK(b.counts[2] <= b.counts[0]);  // a flat torus: fewer cuts across its thickness
+  CHECK(b.block_bytes + b.held_bytes <= double(limit));
+  // The largest block counted as block_points() counts it.
+  const BlockPlan plan = plan_blocks(p, quiet_options(b.counts));
+  std::size_t largest = 0;
+  for (int k = 0; k < plan.grid.size(); ++k) largest = std::max(largest, block_points(plan, k, p).size());
+  CHECK(b.largest_block == largest);
+  // A limit below what the run holds between blocks: no split fits.
+  const BlockBudget tiny = plan_block_budget(p, 4u << 20, options);
+  CHECK(!tiny.fits);
 }

@@ -96,6 +96,9 @@ struct BlockOptions {
   /// The merge halo, in units of the largest block precision: a transverse tetrahedron whose
   /// circumradius is below it is certified by the block that owns its circumcentre.
   double merge_halo_precisions = 4;
+  /// Where the owned results of pass 1 wait between the passes (mesh_in_blocks()): empty, in memory; else
+  /// a directory (created if missing) that takes one file per block and its border, removed at the end.
+  std::string spill_directory;
   /// A block's Delaunay vertex budget: this many per point it sees plus the base (as a scan without a
   /// precision in one piece); reaching it leaves the block coarser, counted in BlockStats.
   std::size_t vertices_per_point = run_defaults::scan_vertices_per_point;
@@ -135,8 +138,13 @@ struct BlockSeeds {
   std::size_t delaunay_vertices = 0;  ///< its Mesher's tetrahedralization at the end (halo included)
   bool budget_reached = false;    ///< the vertex budget stopped its refinement (a coarser block)
   double seconds = 0;
+  /// The global ids of points when they are not the block's k-th (a part of the block's vertices:
+  /// block_border()); empty: points[k] is the block's k-th vertex.
+  std::vector<GlobalId> ids;
   /// Global id of points[k].
-  GlobalId id(std::size_t k) const { return kBlockIdBase + (GlobalId(block) << kBlockIdShift) + k; }
+  GlobalId id(std::size_t k) const {
+    return ids.empty() ? kBlockIdBase + (GlobalId(block) << kBlockIdShift) + k : ids[k];
+  }
 };
 
 /// Pass 1 for block b: `points` (and `normals`, one per point or empty) are the points it sees
@@ -151,6 +159,22 @@ BlockSeeds refine_block(const BlockPlan& plan, int b, const std::vector<Point3>&
 /// blocks that the tree says disagree (values, gradients and normals negated: the function fitted to
 /// flipped normals is -f), the side with fewer prepared points. Returns how many blocks were turned over.
 std::size_t align_blocks(const BlockPlan& plan, std::vector<BlockSeeds>& seeds);
+
+/// The two steps of align_blocks(), for runs that never hold every block's results at once (spilled to
+/// disk, or tasks of a distributed engine): block_votes() is one block's row of the agreement (its owned
+/// prepared points against the other blocks' views of them: `others` need only their block, halo_points
+/// and halo_normals); block_flips() the spanning tree's verdict from every row and each block's count of
+/// prepared points. turn_over() applies one verdict (values, gradients and normals negated).
+std::vector<double> block_votes(const BlockPlan& plan, const BlockSeeds& block,
+                                const std::vector<const BlockSeeds*>& others);
+std::vector<bool> block_flips(const std::vector<std::vector<double>>& votes,
+                              const std::vector<std::size_t>& prepared_counts);
+void turn_over(BlockSeeds& seeds);
+
+/// The part of a block's vertices another block's pass 2 can see: those within `merge_halo` of the
+/// cell's faces (with their values, gradients and global ids; no prepared points). extract_block() of
+/// any other block gives the same surface from the border as from the whole.
+BlockSeeds block_border(const BlockPlan& plan, const BlockSeeds& seeds, double merge_halo);
 
 /// A mesh vertex of marching tetrahedra: the crossing of the Delaunay edge (neg, pos) of P.
 struct BlockCrossing {
@@ -195,6 +219,7 @@ struct BlockStats {
   double unsupported_area = 0;
   std::size_t trimmed_triangles = 0;
   double pass1_seconds = 0, pass2_seconds = 0, stitch_seconds = 0;
+  std::size_t spilled_bytes = 0;     ///< written to BlockOptions::spill_directory (0: held in memory)
   std::vector<double> block_seconds; ///< pass 1 + pass 2 per block
 };
 
@@ -206,6 +231,45 @@ SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats*
 /// the data resolve dropped, open or closed as `kind` says (Auto decides from the whole mesh).
 SurfaceMesh finish_blocks(SurfaceMesh mesh, const std::vector<const BlockSeeds*>& seeds, SurfaceKind kind,
                           unsigned threads, BlockStats* stats = nullptr);
+
+/// The split a memory limit asks for (`vitri mesh --blocks auto`, or a scan too large for one piece;
+/// docs/blocks.md "Memory"): the coarsest grid (cells as near cubes as the domain allows, at most 64 per
+/// axis) whose largest block, halo included, fits in the limit beside what the run holds between blocks.
+/// The sizes follow the memory model of one piece (kMemory* in mesher.hpp) per point a block sees, and
+/// kBlockHeldBytesPerPoint per input point for what stays (the input, the owned results, the surfaces,
+/// the stitch); `spill` when the owned results would take more than a quarter of the limit.
+struct BlockBudget {
+  std::array<int, 3> counts{1, 1, 1};
+  std::size_t largest_block = 0;  ///< points the largest block sees (cell and data halo)
+  double block_bytes = 0;         ///< its estimated peak
+  double held_bytes = 0;          ///< estimated memory held between blocks and for the stitch
+  bool spill = false;             ///< the owned results should wait on disk
+  bool fits = true;               ///< false: even 64 blocks per axis do not fit (the largest split given)
+};
+/// Bytes per input point a run in blocks holds between blocks without spilling (the input with its
+/// normals, the owned vertices with values and gradients, the prepared points, the surfaces, the stitch),
+/// and with the owned results spilled; measured at 10^6 points (docs/blocks.md).
+constexpr double kBlockHeldBytesPerPoint = 700.0;
+constexpr double kBlockSpilledBytesPerPoint = 450.0;
+/// @throws InvalidArgument as plan_blocks().
+BlockBudget plan_block_budget(const std::vector<Point3>& points, std::size_t limit, const BlockOptions& options);
+
+/// Binary encodings of the passes' results, for spilling them to disk and for a distributed engine's
+/// tasks (the Python package's pickling): native byte order and sizes, tagged with a magic number, a
+/// format version and the byte order, so that a file of another version or machine is refused, never
+/// misread. decode_*() @throws InvalidArgument naming what is wrong (magic, version, truncated at byte N).
+std::vector<std::uint8_t> encode_block_seeds(const BlockSeeds& seeds);
+BlockSeeds decode_block_seeds(const std::uint8_t* data, std::size_t size);
+std::vector<std::uint8_t> encode_block_surface(const BlockSurface& surface);
+BlockSurface decode_block_surface(const std::uint8_t* data, std::size_t size);
+std::vector<std::uint8_t> encode_block_plan(const BlockPlan& plan);
+BlockPlan decode_block_plan(const std::uint8_t* data, std::size_t size);
+
+/// Normals for unoriented points without a viewpoint or sensors, oriented once on all of them (the scan
+/// preparation of the whole set; each point takes its nearest prepared point's normal): blocks orienting
+/// their own pieces could each orient one inside out. mesh_in_blocks() calls it for such points; a
+/// distributed run calls it once before its tasks. @throws as prepare_scan().
+std::vector<Point3> orient_for_blocks(const std::vector<Point3>& points, const BlockOptions& options);
 
 /// Everything in one process, the blocks one after another (only the owned results of pass 1 are kept
 /// between blocks): plan, pass 1, pass 2, stitch, finishing. `progress` (optional) is told each step.

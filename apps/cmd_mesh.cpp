@@ -737,9 +737,10 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
       }
       if (split && !c.quiet)
         std::fprintf(stderr, "vitri mesh: no split into blocks fits the memory limit either (%dx%dx%d: about %.3g GB "
-                     "for the largest block beside %.3g GB held between blocks): one piece, thinned to the limit\n",
-                     plan.budget.counts[0], plan.budget.counts[1], plan.budget.counts[2],
-                     plan.budget.block_bytes / 1e9, plan.budget.held_bytes / 1e9);
+                     "for the largest block beside %.3g GB held between blocks, %.3g GB for the stitch): one "
+                     "piece, thinned to the limit\n", plan.budget.counts[0], plan.budget.counts[1],
+                     plan.budget.counts[2], plan.budget.block_bytes / 1e9, plan.budget.held_bytes / 1e9,
+                     plan.budget.stitch_bytes / 1e9);
     }
   }
   if (c.surface_given && !plan.scan_input && options.surface != SurfaceKind::Closed)
@@ -1015,21 +1016,25 @@ void run_blocks(const MeshCommand& c, MesherOptions options, Input data, std::ar
   const double n = static_cast<double>(points.size());
   const double limit = static_cast<double>(options.max_memory_bytes);
   // What waits between the passes: on disk when --spill says so, or when held in memory it would take
-  // over a quarter of the limit (a directory of $TMPDIR, removed at the end).
+  // over a tenth of the limit (a directory of $TMPDIR, removed at the end).
   std::string spill = c.spill;
   std::unique_ptr<TempDirectory> temp;
-  if (spill.empty() && limit > 0 && (budget ? budget->spill : kBlockHeldBytesPerPoint * n > 0.25 * limit)) {
+  if (spill.empty() && limit > 0 && (budget ? budget->spill : kBlockSeedsBytesPerPoint * n > 0.1 * limit)) {
     temp = std::make_unique<TempDirectory>("vitri-blocks-");
     spill = temp->path();
   }
-  const double held = (spill.empty() ? kBlockHeldBytesPerPoint : kBlockSpilledBytesPerPoint) * n;
+  const double held = (kBlockInputBytesPerPoint + (spill.empty() ? kBlockSeedsBytesPerPoint : 0.0)) * n;
+  const double stitch = kMemoryBaseBytes + (kBlockStitchBytesPerPoint - (spill.empty() ? 0.0 : kBlockSeedsBytesPerPoint)) * n;
+  if (limit > 0 && stitch > limit && !c.quiet)
+    std::fprintf(stderr, "vitri mesh: warning: the stitch of %zu points needs about %.3g GB, over the memory limit "
+                 "of %.3g GB (docs/blocks.md \"Memory\")\n", points.size(), stitch / 1e9, limit / 1e9);
   if (budget && !c.quiet)
     std::fprintf(stderr, "vitri mesh: %s %zu points in %dx%dx%d blocks: the largest sees %zu points (about %.3g GB), "
-                 "%.3g GB held between blocks%s; memory limit %.3g GB (%s) (docs/blocks.md)\n",
+                 "%.3g GB held between blocks%s, %.3g GB for the stitch; memory limit %.3g GB (%s) (docs/blocks.md)\n",
                  c.blocks_auto ? "--blocks auto:" : "too large for one piece, meshing", points.size(), counts[0],
                  counts[1], counts[2], budget->largest_block, budget->block_bytes / 1e9, held / 1e9,
-                 spill.empty() ? "" : (", the blocks' results spilled to " + spill).c_str(), limit / 1e9,
-                 c.memory ? "--memory" : "the machine's available memory less a reserve");
+                 spill.empty() ? "" : (" (the blocks' results spilled to " + spill + ")").c_str(), stitch / 1e9,
+                 limit / 1e9, c.memory ? "--memory" : "the machine's available memory less a reserve");
   BlockOptions bo;
   bo.counts = counts;
   bo.mesher = options;
@@ -1043,8 +1048,13 @@ void run_blocks(const MeshCommand& c, MesherOptions options, Input data, std::ar
   phases.start("blocks", "meshing " + std::to_string(points.size()) + " points in " + std::to_string(counts[0]) +
                              "x" + std::to_string(counts[1]) + "x" + std::to_string(counts[2]) + " blocks");
   BlockStats st;
+  // Each step with the memory held when it starts (free pages given back first) and the peak so far:
+  // what the budget's model (docs/blocks.md "Memory") is checked against.
   auto progress = [&](const std::string& what) {
-    if (!c.quiet) std::fprintf(stderr, "  %s\n", what.c_str());
+    if (c.quiet) return;
+    release_free_memory();
+    std::fprintf(stderr, "  %s (held %.2f GB, peak %.2f GB)\n", what.c_str(),
+                 static_cast<double>(current_rss_bytes()) / 1e9, static_cast<double>(peak_rss_bytes()) / 1e9);
   };
   SurfaceMesh mesh;
   try {

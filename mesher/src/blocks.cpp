@@ -19,6 +19,7 @@
 #include <cstring>
 #include <filesystem>
 #include <limits>
+#include <tuple>
 #include <unordered_map>
 #include <utility>
 
@@ -563,49 +564,90 @@ void count_edges(const std::vector<std::array<std::uint32_t, 3>>& tris, std::siz
 
 }  // namespace
 
-SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats* stats) {
+SurfaceMesh stitch_blocks(std::vector<BlockSurface> surfaces, BlockStats* stats) {
   const auto t0 = Clock::now();
-  // One mesh vertex per crossing key.
-  KeyMap index;
-  std::vector<const BlockCrossing*> vertex;
-  std::vector<std::array<std::uint32_t, 3>> tris;
-  for (const BlockSurface& s : surfaces) {
-    std::vector<std::uint32_t> map(s.crossings.size());
-    for (std::size_t k = 0; k < s.crossings.size(); ++k) {
-      const BlockCrossing& c = s.crossings[k];
-      const auto [it, added] = index.emplace(std::make_pair(c.neg, c.pos), static_cast<std::uint32_t>(vertex.size()));
-      if (added) vertex.push_back(&c);
-      map[k] = it->second;
-    }
-    for (const auto& t : s.triangles) tris.push_back({map[t[0]], map[t[1]], map[t[2]]});
+  constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+  std::size_t unfinished = 0;
+  for (const BlockSurface& s : surfaces) unfinished += s.unfinished;
+  // One mesh vertex per crossing key: every crossing's key sorted (flat arrays, not a hash map: a third
+  // of the memory and of the time at 10^6 points), the first of each key (in block, then crossing order)
+  // its representative. Shared crossings are bit-identical, so which one is kept does not matter.
+  struct Entry {
+    GlobalId neg, pos;
+    std::uint32_t block, k;
+  };
+  std::vector<Entry> entries;
+  {
+    std::size_t total = 0;
+    for (const BlockSurface& s : surfaces) total += s.crossings.size();
+    entries.reserve(total);
   }
-  const std::size_t nv = vertex.size();
-  // Zero-valued vertices: the anchored crossings grouped by their positive end.
-  std::unordered_map<GlobalId, std::uint32_t> zero_of_id;
-  std::vector<Point3> zero_point;
-  std::vector<std::uint32_t> zero(nv, std::numeric_limits<std::uint32_t>::max());
-  for (std::uint32_t v = 0; v < nv; ++v)
-    if (vertex[v]->anchored) {
-      const auto [it, added] = zero_of_id.emplace(vertex[v]->pos, static_cast<std::uint32_t>(zero_point.size()));
-      if (added) zero_point.push_back(vertex[v]->pos_point);
-      zero[v] = it->second;
+  for (std::size_t b = 0; b < surfaces.size(); ++b)
+    for (std::size_t k = 0; k < surfaces[b].crossings.size(); ++k)
+      entries.push_back({surfaces[b].crossings[k].neg, surfaces[b].crossings[k].pos, static_cast<std::uint32_t>(b),
+                         static_cast<std::uint32_t>(k)});
+  std::sort(entries.begin(), entries.end(), [](const Entry& x, const Entry& y) {
+    return std::tie(x.neg, x.pos, x.block, x.k) < std::tie(y.neg, y.pos, y.block, y.k);
+  });
+  // The vertices' data, copied out of the representatives; each crossing's vertex id.
+  std::vector<std::vector<std::uint32_t>> vertex_of(surfaces.size());
+  for (std::size_t b = 0; b < surfaces.size(); ++b) vertex_of[b].assign(surfaces[b].crossings.size(), kNone);
+  std::vector<Point3> vx, vnormal;
+  std::vector<GlobalId> vpos;             // the positive end's id (anchored vertices; 0 otherwise)
+  std::vector<Point3> vpos_point;         // its position (anchored vertices)
+  std::vector<char> vanchored;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const Entry& e = entries[i];
+    if (i == 0 || e.neg != entries[i - 1].neg || e.pos != entries[i - 1].pos) {
+      const BlockCrossing& c = surfaces[e.block].crossings[e.k];
+      vx.push_back(c.x);
+      vnormal.push_back(c.normal);
+      vanchored.push_back(c.anchored ? 1 : 0);
+      vpos.push_back(c.anchored ? c.pos : 0);
+      vpos_point.push_back(c.anchored ? c.pos_point : Point3{0, 0, 0});
     }
+    vertex_of[e.block][e.k] = static_cast<std::uint32_t>(vx.size() - 1);
+  }
+  std::vector<Entry>().swap(entries);
+  // The triangles over the vertex ids, each block's crossings freed once read.
+  std::vector<std::array<std::uint32_t, 3>> tris;
+  for (std::size_t b = 0; b < surfaces.size(); ++b) {
+    const std::vector<std::uint32_t>& map = vertex_of[b];
+    for (const auto& t : surfaces[b].triangles) tris.push_back({map[t[0]], map[t[1]], map[t[2]]});
+    BlockSurface().crossings.swap(surfaces[b].crossings);
+    std::vector<std::array<std::uint32_t, 3>>().swap(surfaces[b].triangles);
+    std::vector<std::uint32_t>().swap(vertex_of[b]);
+  }
+  const std::size_t nv = vx.size();
+  // Zero-valued vertices: the anchored crossings grouped by their positive end (sorted, as the keys).
+  std::vector<std::pair<GlobalId, std::uint32_t>> anchored;
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (vanchored[v]) anchored.push_back({vpos[v], v});
+  std::sort(anchored.begin(), anchored.end());
+  std::vector<Point3> zero_point;
+  std::vector<std::uint32_t> zero(nv, kNone);
+  for (std::size_t i = 0; i < anchored.size(); ++i) {
+    if (i == 0 || anchored[i].first != anchored[i - 1].first) zero_point.push_back(vpos_point[anchored[i].second]);
+    zero[anchored[i].second] = static_cast<std::uint32_t>(zero_point.size() - 1);
+  }
+  std::vector<std::pair<GlobalId, std::uint32_t>>().swap(anchored);
+  std::vector<GlobalId>().swap(vpos);
+  std::vector<Point3>().swap(vpos_point);
   const std::size_t nz = zero_point.size();
   // Collapsed zero z becomes mesh vertex nv + z. Start with all collapsed; undo those whose star is not a
   // disk without folds (or that touch a bad edge) until nothing changes: the fixpoint does not depend on
   // any order.
   std::vector<char> collapsed(nz, 1);
   std::vector<std::array<std::uint32_t, 3>> mapped;
-  std::vector<char> kept;
   auto rep = [&](std::uint32_t v) {
     return zero[v] != std::numeric_limits<std::uint32_t>::max() && collapsed[zero[v]] ? static_cast<std::uint32_t>(nv + zero[v]) : v;
   };
-  auto position = [&](std::uint32_t v) -> const Point3& { return v < nv ? vertex[v]->x : zero_point[v - nv]; };
+  auto position = [&](std::uint32_t v) -> const Point3& { return v < nv ? vx[v] : zero_point[v - nv]; };
+  std::vector<std::uint32_t> star_start, star;  // per collapsed zero, the triangles (in mapped) at it (CSR)
   for (int round = 0; round < 64; ++round) {
     mapped.clear();
-    kept.clear();
-    std::vector<std::vector<std::uint32_t>> star(nz);  // triangles (in mapped) at each collapsed zero
     std::vector<char> bad(nz, 0);
+    star_start.assign(nz + 1, 0);
     for (const auto& t : tris) {
       const std::array<std::uint32_t, 3> m = {rep(t[0]), rep(t[1]), rep(t[2])};
       if (m[0] == m[1] || m[1] == m[2] || m[0] == m[2]) continue;  // collapsed away
@@ -613,13 +655,20 @@ SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats*
       const Point3 before = face_normal(position(t[0]), position(t[1]), position(t[2]));
       const Point3 after = face_normal(position(m[0]), position(m[1]), position(m[2]));
       const bool folded = !(dot(before, after) > 0);
-      const auto id = static_cast<std::uint32_t>(mapped.size());
       mapped.push_back(m);
       for (int i = 0; i < 3; ++i)
         if (m[i] >= nv) {
-          star[m[i] - nv].push_back(id);
+          ++star_start[m[i] - nv + 1];
           if (folded) bad[m[i] - nv] = 1;
         }
+    }
+    for (std::size_t z = 0; z < nz; ++z) star_start[z + 1] += star_start[z];
+    star.assign(star_start[nz], 0);
+    {
+      std::vector<std::uint32_t> fill(star_start.begin(), star_start.end() - 1);
+      for (std::size_t id = 0; id < mapped.size(); ++id)
+        for (int i = 0; i < 3; ++i)
+          if (mapped[id][i] >= nv) star[fill[mapped[id][i] - nv]++] = static_cast<std::uint32_t>(id);
     }
     // The link of each collapsed zero: one simple cycle of at least 3 vertices.
     std::vector<std::pair<std::uint32_t, std::uint32_t>> link;
@@ -627,8 +676,8 @@ SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats*
       if (!collapsed[z] || bad[z]) continue;
       const auto zv = static_cast<std::uint32_t>(nv + z);
       link.clear();
-      for (std::uint32_t id : star[z]) {
-        const auto& m = mapped[id];
+      for (std::uint32_t j = star_start[z]; j < star_start[z + 1]; ++j) {
+        const auto& m = mapped[star[j]];
         const int i = m[0] == zv ? 0 : m[1] == zv ? 1 : 2;
         link.push_back({m[(i + 1) % 3], m[(i + 2) % 3]});
       }
@@ -669,7 +718,7 @@ SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats*
     if (out_of[v] == std::numeric_limits<std::uint32_t>::max()) {
       out_of[v] = static_cast<std::uint32_t>(mesh.vertices.size());
       mesh.vertices.push_back(position(v));
-      mesh.normals.push_back(v < nv ? vertex[v]->normal : Point3{0, 0, 0});
+      mesh.normals.push_back(v < nv ? vnormal[v] : Point3{0, 0, 0});
     }
     return out_of[v];
   };
@@ -678,7 +727,7 @@ SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats*
   for (std::uint32_t v = 0; v < nv; ++v) {
     const std::uint32_t r = rep(v);
     if (r >= nv && out_of[r] != std::numeric_limits<std::uint32_t>::max())
-      mesh.normals[out_of[r]] = mesh.normals[out_of[r]] + vertex[v]->normal;
+      mesh.normals[out_of[r]] = mesh.normals[out_of[r]] + vnormal[v];
   }
   for (Point3& nrm : mesh.normals) {
     const double len = norm(nrm);
@@ -689,8 +738,7 @@ SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats*
     for (char c : collapsed) snapped += c != 0;
     stats->snapped = snapped;
     stats->offset = nz - snapped;
-    stats->unfinished = 0;
-    for (const BlockSurface& s : surfaces) stats->unfinished += s.unfinished;
+    stats->unfinished = unfinished;
     count_edges(mesh.triangles, stats->boundary_edges, stats->nonmanifold_edges);
     stats->stitch_seconds = seconds_since(t0);
   }
@@ -739,14 +787,15 @@ BlockBudget plan_block_budget(const std::vector<Point3>& points, std::size_t lim
   const double per_point =
       kMemoryBytesPerPoint + kMemorySeedsPerPoint * kMemoryBytesPerVertexBatch * kMemoryRefineFactor;
   out.block_bytes = kMemoryBaseBytes + per_point * n;
-  out.held_bytes = 0;
   if (limit == 0 || out.block_bytes <= static_cast<double>(limit)) return out;
+  const double lim = static_cast<double>(limit);
+  out.spill = kBlockSeedsBytesPerPoint * n > 0.1 * lim;
+  out.held_bytes = (kBlockInputBytesPerPoint + (out.spill ? 0.0 : kBlockSeedsBytesPerPoint)) * n;  // the base is the block's
+  out.stitch_bytes = kMemoryBaseBytes + (out.spill ? kBlockStitchBytesPerPoint - kBlockSeedsBytesPerPoint
+                                                   : kBlockStitchBytesPerPoint) * n;
   BlockOptions one = options;
   one.counts = {1, 1, 1};
   const BlockPlan base = plan_blocks(points, one);
-  const double lim = static_cast<double>(limit);
-  out.spill = kBlockHeldBytesPerPoint * n > 0.25 * lim;
-  out.held_bytes = (out.spill ? kBlockSpilledBytesPerPoint : kBlockHeldBytesPerPoint) * n;
   const Box3& dom = base.grid.domain();
   const double ext[3] = {dom.hi.x - dom.lo.x, dom.hi.y - dom.lo.y, dom.hi.z - dom.lo.z};
   // Counted on at most 10^6 evenly spaced points, scaled up.
@@ -770,12 +819,14 @@ BlockBudget plan_block_budget(const std::vector<Point3>& points, std::size_t lim
       }
       for (int k = range[2][0]; k <= range[2][1]; ++k)
         for (int j = range[1][0]; j <= range[1][1]; ++j)
-          for (int ii = range[0][0]; ii <= range[0][1]; ++ii) seen[(k * counts[1] + j) * counts[0] + ii] += static_cast<double>(stride);
+          for (int ii = range[0][0]; ii <= range[0][1]; ++ii)
+            seen[(k * counts[1] + j) * counts[0] + ii] += static_cast<double>(stride);
     }
     const double largest = *std::max_element(seen.begin(), seen.end());
     out.counts = counts;
     out.largest_block = static_cast<std::size_t>(largest);
     out.block_bytes = kMemoryBaseBytes + per_point * largest;
+    if (out.stitch_bytes > lim) break;  // no split helps the stitch
     if (out.block_bytes + out.held_bytes <= lim) return out;
     if (counts[0] == 64 && counts[1] == 64 && counts[2] == 64) break;
   }
@@ -987,8 +1038,7 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
   }
   st.pass2_seconds = seconds_since(t2);
   say("stitching");
-  SurfaceMesh mesh = stitch_blocks(surfaces, &st);
-  surfaces.clear();
+  SurfaceMesh mesh = stitch_blocks(std::move(surfaces), &st);
   say("finishing");
   if (store.spilled()) {
     // The finishing reads every block's prepared points: read back, nothing else kept.

@@ -305,8 +305,7 @@ void bind_blocks(py::module_& m) {
           SurfaceMesh mesh;
           {
             py::gil_scoped_release release;
-            mesh = stitch_blocks(surf, &st);
-            surf.clear();
+            mesh = stitch_blocks(std::move(surf), &st);
             mesh = finish_blocks(std::move(mesh), s, kind, threads, &st);
           }
           py::dict d;

@@ -224,8 +224,9 @@ struct BlockStats {
 };
 
 /// The stitch: one vertex per crossing key, collapses at zero-valued vertices, triangles joined. The
-/// finishing (components, open or closed) is left to finish_blocks().
-SurfaceMesh stitch_blocks(const std::vector<BlockSurface>& surfaces, BlockStats* stats = nullptr);
+/// finishing (components, open or closed) is left to finish_blocks(). Takes the surfaces (move them in:
+/// each block's arrays are freed as soon as they are read).
+SurfaceMesh stitch_blocks(std::vector<BlockSurface> surfaces, BlockStats* stats = nullptr);
 
 /// The scan's finishing on the stitched mesh (docs/scans.md): components without data or smaller than
 /// the data resolve dropped, open or closed as `kind` says (Auto decides from the whole mesh).
@@ -234,23 +235,25 @@ SurfaceMesh finish_blocks(SurfaceMesh mesh, const std::vector<const BlockSeeds*>
 
 /// The split a memory limit asks for (`vitri mesh --blocks auto`, or a scan too large for one piece;
 /// docs/blocks.md "Memory"): the coarsest grid (cells as near cubes as the domain allows, at most 64 per
-/// axis) whose largest block, halo included, fits in the limit beside what the run holds between blocks.
-/// The sizes follow the memory model of one piece (kMemory* in mesher.hpp) per point a block sees, and
-/// kBlockHeldBytesPerPoint per input point for what stays (the input, the owned results, the surfaces,
-/// the stitch); `spill` when the owned results would take more than a quarter of the limit.
+/// axis) whose largest block, halo included, fits in the limit beside what the run holds between blocks,
+/// when the stitch fits too. A block's peak follows the memory model of one piece (kMemory* in
+/// mesher.hpp) for the points it sees; what the run holds, per input point, the constants below.
 struct BlockBudget {
   std::array<int, 3> counts{1, 1, 1};
   std::size_t largest_block = 0;  ///< points the largest block sees (cell and data halo)
   double block_bytes = 0;         ///< its estimated peak
-  double held_bytes = 0;          ///< estimated memory held between blocks and for the stitch
-  bool spill = false;             ///< the owned results should wait on disk
-  bool fits = true;               ///< false: even 64 blocks per axis do not fit (the largest split given)
+  double held_bytes = 0;          ///< estimated memory held between blocks (the input, the owned results)
+  double stitch_bytes = 0;        ///< estimated peak of the stitch (the input, the surfaces, the joined mesh)
+  bool spill = false;             ///< the owned results wait on disk (they would take over a tenth of the limit)
+  bool fits = true;               ///< false: no split fits (the largest tried given)
 };
-/// Bytes per input point a run in blocks holds between blocks without spilling (the input with its
-/// normals, the owned vertices with values and gradients, the prepared points, the surfaces, the stitch),
-/// and with the owned results spilled; measured at 10^6 points (docs/blocks.md).
-constexpr double kBlockHeldBytesPerPoint = 700.0;
-constexpr double kBlockSpilledBytesPerPoint = 450.0;
+/// Measured at 10^6 points in 2 x 2 x 2 blocks (docs/blocks.md "Memory"), per input point: the input with
+/// its normals as the CLI holds it; pass 1's owned results (vertices with values and gradients, prepared
+/// points, halo views) held in memory; the stitch's peak above the input (the blocks' surfaces, the sorted
+/// keys, the joined triangles; with the owned results spilled, their part is not held then).
+constexpr double kBlockInputBytesPerPoint = 70.0;
+constexpr double kBlockSeedsBytesPerPoint = 200.0;
+constexpr double kBlockStitchBytesPerPoint = 1050.0;
 /// @throws InvalidArgument as plan_blocks().
 BlockBudget plan_block_budget(const std::vector<Point3>& points, std::size_t limit, const BlockOptions& options);
 

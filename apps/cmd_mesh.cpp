@@ -1068,9 +1068,9 @@ void run_blocks(const MeshCommand& c, MesherOptions options, Input data, std::ar
   if (c.quiet) return;
   std::printf("%s: %zu points in %zu blocks: %zu vertices, %zu triangles -> %s\n", c.input.c_str(), points.size(),
               st.blocks, mesh.vertices.size(), mesh.triangles.size(), c.output.c_str());
-  std::printf("  pass 1 (fit, refinement) %.1f s, pass 2 (merge) %.1f s, stitch %.1f s; precision %.4g (%.4g of "
-              "the diagonal)\n", st.pass1_seconds, st.pass2_seconds, st.stitch_seconds, st.precision,
-              st.precision / box.diagonal());
+  std::printf("  pass 1 (fit, refinement) %.1f s, pass 2 (merge) %.1f s (%zu blocks merged again with a wider "
+              "halo), stitch %.1f s; precision %.4g (%.4g of the diagonal)\n", st.pass1_seconds, st.pass2_seconds,
+              st.merged_again, st.stitch_seconds, st.precision, st.precision / box.diagonal());
   std::printf("  %zu outliers set aside; %zu zero vertices collapsed, %zu left at their offset; surface %s, "
               "%zu small or unsupported components dropped\n", st.outliers, st.snapped, st.offset,
               st.open ? "open, trimmed to the data" : "closed", st.small_components);

@@ -389,9 +389,12 @@ BlockSeeds block_border(const BlockPlan& plan, const BlockSeeds& s, double merge
 
 // ---- Pass 2 ---------------------------------------------------------------------------------------
 
-BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const BlockSeeds*>& seeds,
-                           double merge_halo) {
-  const auto t0 = Clock::now();
+namespace {
+
+/// One round of pass 2 for block b with this merge halo; `needed` (out) the halo that would make every
+/// owned transverse tetrahedron left unfinished final (0 when none or none could be).
+BlockSurface extract_round(const BlockPlan& plan, int b, const std::vector<const BlockSeeds*>& seeds,
+                           double merge_halo, double& needed) {
   BlockSurface out;
   out.block = b;
   const BlockGrid& grid = plan.grid;
@@ -412,10 +415,7 @@ BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const
       }
   }
   out.points = pts.size();
-  if (pts.size() < 4) {
-    out.seconds = seconds_since(t0);
-    return out;
-  }
+  if (pts.size() < 4) return out;
   TriangulationOptions topt;
   topt.keep_history = false;
   topt.threads = 1;
@@ -490,6 +490,11 @@ BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const
     if (grid.owner(centre) != b) continue;
     if (!final_ball(centre, std::sqrt(r2))) {
       ++out.unfinished;
+      const double r = std::sqrt(r2);
+      for (int a = 0; a < 3; ++a) {
+        if (cijk[a] > 0) needed = std::max(needed, r - (axis(centre, a) - axis(cell.lo, a)));
+        if (cijk[a] + 1 < n[a]) needed = std::max(needed, axis(centre, a) + r - axis(cell.hi, a));
+      }
       continue;
     }
     // Marching tetrahedra: the tetrahedron (v0..v3) is positively oriented; a permutation p of it has
@@ -530,6 +535,28 @@ BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const
         out.triangles.push_back({quad[1], quad[2], quad[3]});
       }
     }
+  }
+  return out;
+}
+
+}  // namespace
+
+BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const BlockSeeds*>& seeds,
+                           double merge_halo, double max_merge_halo) {
+  const auto t0 = Clock::now();
+  // Rounds: a block with owned transverse tetrahedra left unfinished merges again with the halo they
+  // need (at least twice the last), up to max_merge_halo. A tetrahedron is emitted only by the block
+  // that owns its circumcentre, and only once final there (a tetrahedron of the Delaunay
+  // tetrahedralization of all of P): a block's larger halo adds its own tetrahedra and no other's.
+  double halo = merge_halo;
+  BlockSurface out;
+  for (int round = 0;; ++round) {
+    double needed = 0;
+    out = extract_round(plan, b, seeds, halo, needed);
+    out.halo = halo;
+    out.rounds = round + 1;
+    if (out.unfinished == 0 || !(halo < max_merge_halo) || !(needed > halo)) break;
+    halo = std::min(max_merge_halo, std::max(2 * halo, 1.05 * needed));
   }
   out.seconds = seconds_since(t0);
   return out;
@@ -998,6 +1025,7 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
   if (!(max_precision > 0))
     throw InvalidArgument("mesh in blocks: no block found a surface in " + std::to_string(points.size()) + " points");
   const double merge_halo = options.merge_halo_precisions * max_precision;
+  const double max_merge_halo = std::max(merge_halo, options.max_merge_halo_precisions * max_precision);
   std::vector<const BlockSeeds*> ptrs;
   for (const BlockSeeds& s : seeds) ptrs.push_back(&s);
   std::vector<bool> flip(nb, false);
@@ -1009,7 +1037,7 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
     for (int b = 0; b < nb; ++b) {
       const BlockSeeds full = store.load(b);
       rows[b] = block_votes(plan, full, ptrs);
-      store.put_border(block_border(plan, full, merge_halo));
+      store.put_border(block_border(plan, full, max_merge_halo));
     }
     flip = block_flips(rows, prepared_counts);
     for (int b = 0; b < nb; ++b) st.flipped += flip[b];
@@ -1021,20 +1049,21 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
   for (int b = 0; b < nb; ++b) {
     say("block " + std::to_string(b + 1) + " of " + std::to_string(nb) + ": merging");
     if (!store.spilled()) {
-      surfaces[b] = extract_block(plan, b, ptrs, merge_halo);
+      surfaces[b] = extract_block(plan, b, ptrs, merge_halo, max_merge_halo);
     } else {
       // Its own results and the borders of the blocks near it, turned over as the vote said.
       std::vector<BlockSeeds> near(nb);
       std::vector<const BlockSeeds*> view(nb, nullptr);
       for (int c = 0; c < nb; ++c) {
-        if (c != b && !cells_near(plan.grid, b, c, merge_halo)) continue;
+        if (c != b && !cells_near(plan.grid, b, c, max_merge_halo)) continue;
         near[c] = c == b ? store.load(c) : store.load_border(c);
         if (flip[c]) turn_over(near[c]);
         view[c] = &near[c];
       }
-      surfaces[b] = extract_block(plan, b, view, merge_halo);
+      surfaces[b] = extract_block(plan, b, view, merge_halo, max_merge_halo);
     }
     st.block_seconds[b] += surfaces[b].seconds;
+    st.merged_again += surfaces[b].rounds > 1;
   }
   st.pass2_seconds = seconds_since(t2);
   say("stitching");

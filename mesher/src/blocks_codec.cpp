@@ -173,6 +173,8 @@ std::vector<std::uint8_t> encode_block_surface(const BlockSurface& s) {
   w.array(s.triangles);
   w.put(static_cast<std::uint64_t>(s.points));
   w.put(static_cast<std::uint64_t>(s.unfinished));
+  w.put(s.halo);
+  w.put(static_cast<std::int32_t>(s.rounds));
   w.put(s.seconds);
   return w.take();
 }
@@ -198,6 +200,8 @@ BlockSurface decode_block_surface(const std::uint8_t* data, std::size_t size) {
   r.array(s.triangles);
   s.points = static_cast<std::size_t>(r.get<std::uint64_t>());
   s.unfinished = static_cast<std::size_t>(r.get<std::uint64_t>());
+  s.halo = r.get<double>();
+  s.rounds = r.get<std::int32_t>();
   s.seconds = r.get<double>();
   r.done();
   for (const auto& t : s.triangles)

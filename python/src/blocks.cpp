@@ -183,6 +183,8 @@ void bind_blocks(py::module_& m) {
       .def_property_readonly("crossings", [](const BlockSurface& s) { return s.crossings.size(); })
       .def_property_readonly("triangles", [](const BlockSurface& s) { return s.triangles.size(); })
       .def_property_readonly("unfinished", [](const BlockSurface& s) { return s.unfinished; })
+      .def_property_readonly("halo", [](const BlockSurface& s) { return s.halo; }, "the merge halo of its last round")
+      .def_property_readonly("rounds", [](const BlockSurface& s) { return s.rounds; })
       .def_property_readonly("seconds", [](const BlockSurface& s) { return s.seconds; })
       .def(py::pickle([](const BlockSurface& s) { return to_bytes(encode_block_surface(s)); },
                       [](const py::bytes& b) { return from_bytes<BlockSurface>(b, decode_block_surface); }))
@@ -276,16 +278,16 @@ void bind_blocks(py::module_& m) {
         py::arg("votes"), py::arg("prepared_counts"));
 
   m.def("extract_block",
-        [](const BlockPlan& plan, int b, py::handle seeds, double merge_halo) {
+        [](const BlockPlan& plan, int b, py::handle seeds, double merge_halo, double max_merge_halo) {
           if (b < 0 || b >= plan.grid.size())
             throw InvalidArgument("extract_block: block " + std::to_string(b) + " of " + std::to_string(plan.grid.size()));
           if (!(merge_halo > 0) || !std::isfinite(merge_halo))
             throw InvalidArgument("extract_block: merge_halo must be positive and finite");
           const std::vector<const BlockSeeds*> s = seeds_list(seeds, "seeds");
           py::gil_scoped_release release;
-          return extract_block(plan, b, s, merge_halo);
+          return extract_block(plan, b, s, merge_halo, max_merge_halo);
         },
-        py::arg("plan"), py::arg("block"), py::arg("seeds"), py::arg("merge_halo"));
+        py::arg("plan"), py::arg("block"), py::arg("seeds"), py::arg("merge_halo"), py::arg("max_merge_halo") = 0.0);
 
   m.def("stitch_blocks",
         [](py::handle surfaces, py::handle seeds, const std::string& surface, unsigned threads) {

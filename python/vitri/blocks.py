@@ -20,7 +20,8 @@ The task graph (one task per block and pass; B the blocks, the arrows what each 
     extract[b]  <- refine[b], border[c] for the blocks c near b, flips
     prepared[b] <- refine[b], flips
     stitch      <- extract[*], prepared[*]      (one task: the seams joined, the scan's finishing)
-The client waits for the blocks' precisions after pass 1 (the merge halo is 4 x the largest of them)
+The client waits for the blocks' precisions after pass 1 (the merge halo is 4 x the largest of them,
+up to 16 x in a block's later rounds)
 and holds the futures until the end, so that the scheduler can recompute what a lost worker held.
 
 Run from a shell (docs/blocks.md "On a cluster"):
@@ -33,8 +34,10 @@ import numpy as np
 from . import _vitri
 from ._vitri import BlockPlan, BlockSeeds, BlockSurface  # noqa: F401  (re-exported)
 
-#: The merge halo in units of the largest block precision (BlockOptions::merge_halo_precisions).
+#: The merge halo in units of the largest block precision (BlockOptions::merge_halo_precisions), and the
+#: largest a block's later rounds may take (max_merge_halo_precisions: the borders' width).
 MERGE_HALO_PRECISIONS = 4.0
+MAX_MERGE_HALO_PRECISIONS = 16.0
 
 __all__ = ["reconstruct", "BlockPlan", "BlockSeeds", "BlockSurface", "MERGE_HALO_PRECISIONS"]
 
@@ -84,12 +87,12 @@ def _border(plan, seeds, merge_halo):
     return seeds.border(plan, merge_halo)
 
 
-def _extract(plan, block, merge_halo, flips, nblocks, near, own, *borders):
+def _extract(plan, block, merge_halo, max_merge_halo, flips, nblocks, near, own, *borders):
     view = [None] * nblocks
     for c, s in zip(near, borders):
         view[c] = s.turned_over() if flips[c] else s
     view[block] = own.turned_over() if flips[block] else own
-    return _vitri.extract_block(plan, block, view, merge_halo)
+    return _vitri.extract_block(plan, block, view, merge_halo, max_merge_halo)
 
 
 def _prepared(seeds, flips):
@@ -159,6 +162,7 @@ def _run_dask(client, points, normals, counts, absolute, surface, options):
     if not max_precision > 0:
         raise _vitri.InvalidArgument("mesh in blocks: no block found a surface in %d points" % len(points))
     merge_halo = MERGE_HALO_PRECISIONS * max_precision
+    max_merge_halo = max(merge_halo, MAX_MERGE_HALO_PRECISIONS * max_precision)
     prepared_counts = [s[1] for s in sizes]
     halo = [client.submit(_halo, f, key="vitri-halo-%d" % b, pure=False) for b, f in enumerate(refine)]
     votes = []
@@ -167,12 +171,12 @@ def _run_dask(client, points, normals, counts, absolute, surface, options):
         votes.append(client.submit(_votes, plan, refine[b], *[halo[c] for c in near], key="vitri-votes-%d" % b,
                                    pure=False))
     flips = client.submit(_flips, prepared_counts, *votes, key="vitri-flips", pure=False)
-    border = [client.submit(_border, plan, f, merge_halo, key="vitri-border-%d" % b, pure=False)
+    border = [client.submit(_border, plan, f, max_merge_halo, key="vitri-border-%d" % b, pure=False)
               for b, f in enumerate(refine)]
     surfaces = []
     for b in range(nb):
-        near = [c for c in plan.cells_near(b, merge_halo) if c != b]
-        surfaces.append(client.submit(_extract, plan, b, merge_halo, flips, nb, near, refine[b],
+        near = [c for c in plan.cells_near(b, max_merge_halo) if c != b]
+        surfaces.append(client.submit(_extract, plan, b, merge_halo, max_merge_halo, flips, nb, near, refine[b],
                                       *[border[c] for c in near], key="vitri-extract-%d" % b, pure=False))
     prepared = [client.submit(_prepared, f, flips, key="vitri-prepared-%d" % b, pure=False)
                 for b, f in enumerate(refine)]

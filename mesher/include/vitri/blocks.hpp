@@ -96,6 +96,9 @@ struct BlockOptions {
   /// The merge halo, in units of the largest block precision: a transverse tetrahedron whose
   /// circumradius is below it is certified by the block that owns its circumcentre.
   double merge_halo_precisions = 4;
+  /// The largest merge halo a block's later rounds may take (extract_block()), in the same unit: what
+  /// the borders of a spilled or distributed run carry.
+  double max_merge_halo_precisions = 64;
   /// Where the owned results of pass 1 wait between the passes (mesh_in_blocks()): empty, in memory; else
   /// a directory (created if missing) that takes one file per block and its border, removed at the end.
   std::string spill_directory;
@@ -193,18 +196,24 @@ struct BlockSurface {
   std::vector<std::array<std::uint32_t, 3>> triangles;
   std::size_t points = 0;       ///< points of P it tetrahedralized (cell and merge halo)
   std::size_t unfinished = 0;   ///< owned transverse tetrahedra not final (the halo was too narrow)
+  double halo = 0;              ///< the merge halo of its last round
+  int rounds = 0;               ///< rounds of extract_block() (1: the first halo was enough)
   double seconds = 0;
 };
 
-/// Pass 2 for block b: `seeds` are the pass-1 results (all blocks, or at least those within the merge
-/// halo of cell b); `merge_halo` absolute.
+/// Pass 2 for block b: `seeds` are the pass-1 results (all blocks, or at least those within
+/// max_merge_halo of cell b: their borders of that width do); halos absolute. When owned transverse
+/// tetrahedra are left unfinished with `merge_halo`, the block merges again with the halo they need (at
+/// least doubled each round) up to `max_merge_halo` (0: no second round); what is still unfinished then is
+/// counted.
 BlockSurface extract_block(const BlockPlan& plan, int b, const std::vector<const BlockSeeds*>& seeds,
-                           double merge_halo);
+                           double merge_halo, double max_merge_halo = 0);
 
 /// What the whole split did.
 struct BlockStats {
   std::size_t blocks = 0;
   std::size_t unfinished = 0;        ///< transverse tetrahedra no block certified (holes)
+  std::size_t merged_again = 0;      ///< blocks that merged again with a wider halo (extract_block() rounds)
   std::size_t budget_blocks = 0;     ///< blocks whose vertex budget stopped them
   std::size_t outliers = 0;          ///< points set aside as outliers (owned ones, all blocks)
   std::size_t flipped = 0;           ///< blocks whose orientation align_blocks() turned over

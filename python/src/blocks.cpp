@@ -193,6 +193,9 @@ void bind_blocks(py::module_& m) {
                " triangles>";
       });
 
+  m.attr("BLOCK_MERGE_HALO_PRECISIONS") = BlockOptions{}.merge_halo_precisions;
+  m.attr("BLOCK_MAX_MERGE_HALO_PRECISIONS") = BlockOptions{}.max_merge_halo_precisions;
+
   m.def("plan_blocks",
         [](py::handle points, py::handle counts, double data_halo_spacings) {
           const std::vector<Point3> pts = points_arg(points, "points");

@@ -167,6 +167,9 @@ class Mesher:
     def function(self) -> str: ...
 
 # ---- The passes of a reconstruction in blocks (vitri.blocks, docs/blocks.md); sizes absolute ----------
+BLOCK_MERGE_HALO_PRECISIONS: float
+BLOCK_MAX_MERGE_HALO_PRECISIONS: float
+
 class BlockPlan:
     counts: Tuple[int, int, int]
     size: int

@@ -21,7 +21,7 @@ The task graph (one task per block and pass; B the blocks, the arrows what each 
     prepared[b] <- refine[b], flips
     stitch      <- extract[*], prepared[*]      (one task: the seams joined, the scan's finishing)
 The client waits for the blocks' precisions after pass 1 (the merge halo is 4 x the largest of them,
-up to 16 x in a block's later rounds)
+up to 64 x in a block's later rounds)
 and holds the futures until the end, so that the scheduler can recompute what a lost worker held.
 
 Run from a shell (docs/blocks.md "On a cluster"):
@@ -35,9 +35,9 @@ from . import _vitri
 from ._vitri import BlockPlan, BlockSeeds, BlockSurface  # noqa: F401  (re-exported)
 
 #: The merge halo in units of the largest block precision (BlockOptions::merge_halo_precisions), and the
-#: largest a block's later rounds may take (max_merge_halo_precisions: the borders' width).
-MERGE_HALO_PRECISIONS = 4.0
-MAX_MERGE_HALO_PRECISIONS = 16.0
+#: largest a block's later rounds may take (max_merge_halo_precisions: the borders' width): the library's.
+MERGE_HALO_PRECISIONS = _vitri.BLOCK_MERGE_HALO_PRECISIONS
+MAX_MERGE_HALO_PRECISIONS = _vitri.BLOCK_MAX_MERGE_HALO_PRECISIONS
 
 __all__ = ["reconstruct", "BlockPlan", "BlockSeeds", "BlockSurface", "MERGE_HALO_PRECISIONS"]
 

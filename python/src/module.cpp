@@ -75,10 +75,18 @@ std::string shape_of(const py::array& a) {
   return s.str();
 }
 
+/// `a` itself when its elements are aligned, else an aligned copy: arrays unpickled from out-of-band
+/// buffers (Dask's transfers, pickle protocol 5) can start at any byte, and reading a double there is
+/// undefined behaviour.
+py::array aligned(py::array a) {
+  if (a.attr("flags").attr("aligned").cast<bool>()) return a;
+  return py::array(py::module_::import("numpy").attr("require")(a, py::none(), "A"));
+}
+
 /// obj as a float32 or float64 array (integers converted to float64). @throws py::type_error.
 py::array float_array(py::handle obj, const char* name) {
-  py::array a = py::isinstance<py::array>(obj) ? py::reinterpret_borrow<py::array>(obj)
-                                               : py::array(py::module_::import("numpy").attr("asarray")(obj));
+  py::array a = aligned(py::isinstance<py::array>(obj) ? py::reinterpret_borrow<py::array>(obj)
+                                                       : py::array(py::module_::import("numpy").attr("asarray")(obj)));
   const char kind = a.dtype().kind();
   if (kind == 'f' && (a.itemsize() == 8 || a.itemsize() == 4)) return a;
   if (kind == 'i' || kind == 'u') return py::array_t<double, py::array::forcecast>(a);
@@ -161,8 +169,8 @@ Point3 point_arg(py::handle obj, const char* name) {
 }
 
 std::vector<std::array<std::uint32_t, 3>> triangles_arg(py::handle obj, const char* name, std::size_t bound) {
-  py::array a = py::isinstance<py::array>(obj) ? py::reinterpret_borrow<py::array>(obj)
-                                               : py::array(py::module_::import("numpy").attr("asarray")(obj));
+  py::array a = aligned(py::isinstance<py::array>(obj) ? py::reinterpret_borrow<py::array>(obj)
+                                                       : py::array(py::module_::import("numpy").attr("asarray")(obj)));
   const char kind = a.dtype().kind();
   if (kind != 'i' && kind != 'u')
     throw py::type_error(std::string(name) + ": expected an integer array, got dtype " +

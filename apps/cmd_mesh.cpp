@@ -1074,6 +1074,11 @@ void run_blocks(const MeshCommand& c, MesherOptions options, Input data, std::ar
   std::printf("  %zu outliers set aside; %zu zero vertices collapsed, %zu left at their offset; surface %s, "
               "%zu small or unsupported components dropped\n", st.outliers, st.snapped, st.offset,
               st.open ? "open, trimmed to the data" : "closed", st.small_components);
+  std::printf("  per block (points seen: pass 1 s + pass 2 s):");
+  for (std::size_t b = 0; b < st.block_inputs.size(); ++b)
+    std::printf("%s %zu: %.1f + %.1f", b ? ";" : "", st.block_inputs[b], st.pass1_block_seconds[b],
+                st.pass2_block_seconds[b]);
+  std::printf("\n");
   if (st.spilled_bytes > 0)
     std::printf("  %.3g GB of the blocks' results spilled to %s (removed)\n", static_cast<double>(st.spilled_bytes) / 1e9, spill.c_str());
   if (st.unfinished > 0 || st.boundary_edges > 0 || st.nonmanifold_edges > 0)

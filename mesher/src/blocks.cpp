@@ -982,6 +982,9 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
   const int nb = plan.grid.size();
   st.blocks = static_cast<std::size_t>(nb);
   st.block_seconds.assign(nb, 0.0);
+  st.pass1_block_seconds.assign(nb, 0.0);
+  st.pass2_block_seconds.assign(nb, 0.0);
+  st.block_inputs.assign(nb, 0);
   auto say = [&](const std::string& what) {
     if (progress) progress(what);
   };
@@ -1017,6 +1020,8 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
     BlockSeeds s = refine_block(plan, b, p, n, bo);
     max_precision = std::max(max_precision, s.precision);
     st.block_seconds[b] += s.seconds;
+    st.pass1_block_seconds[b] = s.seconds;
+    st.block_inputs[b] = idx.size();
     st.outliers += s.outliers;
     st.budget_blocks += s.budget_reached;
     prepared_counts[b] = s.prepared.points.size();
@@ -1063,6 +1068,7 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
       surfaces[b] = extract_block(plan, b, view, merge_halo, max_merge_halo);
     }
     st.block_seconds[b] += surfaces[b].seconds;
+    st.pass2_block_seconds[b] = surfaces[b].seconds;
     st.merged_again += surfaces[b].rounds > 1;
   }
   st.pass2_seconds = seconds_since(t2);

@@ -230,6 +230,8 @@ struct BlockStats {
   double pass1_seconds = 0, pass2_seconds = 0, stitch_seconds = 0;
   std::size_t spilled_bytes = 0;     ///< written to BlockOptions::spill_directory (0: held in memory)
   std::vector<double> block_seconds; ///< pass 1 + pass 2 per block
+  std::vector<double> pass1_block_seconds, pass2_block_seconds;  ///< per block
+  std::vector<std::size_t> block_inputs;  ///< points each block saw (cell and data halo)
 };
 
 /// The stitch: one vertex per crossing key, collapses at zero-valued vertices, triangles joined. The

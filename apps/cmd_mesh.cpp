@@ -159,7 +159,7 @@ const char* const kUsage =
     "                       --certify.\n"
     "  --spill DIR          with blocks: the blocks' results wait in DIR (one file per block, removed at\n"
     "                       the end) instead of in memory. Default: in memory, or in a directory of\n"
-    "                       $TMPDIR (else /tmp) when they would take over a quarter of the memory limit.\n"
+    "                       $TMPDIR (else /tmp) when they would take over a tenth of the memory limit.\n"
     "  --ascii              PLY output as text (default: binary little-endian, about half the size and\n"
     "                       several times faster to write; OBJ and OFF are always text)\n"
     "  -q, --quiet          no table, no progress\n"
@@ -717,6 +717,9 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
   // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
   // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
   plan.scan_input = is_scan(data);
+  if (c.blocks_auto && !plan.scan_input)
+    throw InvalidArgument(c.input + ": --blocks meshes points (a scan); this input is " +
+                          (data.kind == InputKind::Constraints ? "constraints" : "a mesh"));
   if (plan.scan_input && c.precisions.size() <= 1 && plan.script.empty() && options.mode != MeshMode::Quality &&
       !options.polygonizer.certify) {
     // The memory limit decides between one piece and blocks (docs/blocks.md "Memory"): a scan whose one

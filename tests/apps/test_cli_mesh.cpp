@@ -704,4 +704,7 @@ TEST_CASE("vitri mesh: a scan too large for one piece under --memory is meshed w
   CHECK(!exists(dir));
   REQUIRE(run(in + " -o " + spilled + " --spill " + dir, o, e) == 2);
   CHECK(e.find("--spill needs --blocks") != std::string::npos);
+  // --blocks auto on a closed mesh (not points): refused as --blocks N is.
+  REQUIRE(run(one + " -o " + kDir + "/mesh_budget_again.ply --blocks auto", o, e) == 1);
+  CHECK(e.find("--blocks meshes points") != std::string::npos);
 }

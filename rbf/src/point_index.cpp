@@ -64,18 +64,33 @@ class NodeStack {
 
 }  // namespace
 
-/// The running answer of nearest(): the k smallest (squared distance, id) so far, kept sorted (for the
-/// small k of the callers an insertion into a short sorted array beats a heap's sift-downs) in arrays of
-/// the query's own (on the stack up to kInline entries, in thread-local vectors beyond), copied to the
-/// caller's vectors at the end (the shifts through the caller's vectors, reloaded at every step, were a
-/// tenth of a query).
+/// The running answer of nearest(): the k smallest (squared distance, id) so far. For small k (at most
+/// kSortedUpTo) kept sorted: an insertion into a short sorted array beats a heap's sift-downs; in arrays
+/// of the query's own (on the stack), copied to the caller's vectors at the end (the shifts through the
+/// caller's vectors, reloaded at every step, were a tenth of a query). For larger k (the scan's 49 and
+/// 97 nearest) the shifts were a third of a query: candidates are appended to a buffer of 2k instead,
+/// which a selection (nth_element on (distance, id)) cuts back to the k smallest whenever it is full,
+/// lowering the bound to the k-th; the answer is sorted once at the end. Both keep the k smallest
+/// (distance, id) pairs among the points offered, so both give the same answer (ties broken by id).
 struct PointIndex::NearestState {
-  static constexpr std::size_t kInline = 64;
+  static constexpr std::size_t kSortedUpTo = 24;
+  struct Candidate {
+    double d2;
+    Id id;
+    bool operator<(const Candidate& o) const { return d2 < o.d2 || (d2 == o.d2 && id < o.id); }
+  };
   std::size_t k = 0, n = 0;
-  double* d2;
-  Id* ids;
+  double* d2 = nullptr;
+  Id* ids = nullptr;
+  Candidate* buffer = nullptr;  // k > kSortedUpTo: 2k entries, the first n in use, unordered
   double bound = std::numeric_limits<double>::infinity();  // nothing beyond can enter the answer
+  /// Offers a candidate with dist2 <= bound (the caller's test).
   void offer(double dist2, Id id) {
+    if (buffer) {
+      buffer[n++] = {dist2, id};
+      if (n == 2 * k) cut();
+      return;
+    }
     std::size_t at;
     if (n == k) {
       if (!(dist2 < d2[n - 1] || (dist2 == d2[n - 1] && id < ids[n - 1]))) return;
@@ -92,6 +107,28 @@ struct PointIndex::NearestState {
     d2[at] = dist2;
     ids[at] = id;
     if (n == k) bound = d2[n - 1];
+  }
+  /// The buffer cut back to its k smallest; the bound lowered to the k-th distance.
+  void cut() {
+    std::nth_element(buffer, buffer + (k - 1), buffer + n);
+    n = k;
+    bound = buffer[k - 1].d2;
+  }
+  /// The answer, sorted, into the caller's vectors.
+  void finish(std::vector<Id>& out_ids, std::vector<double>* out_d2) {
+    if (buffer) {
+      if (n > k) cut();
+      std::sort(buffer, buffer + n);
+      out_ids.resize(n);
+      for (std::size_t c = 0; c < n; ++c) out_ids[c] = buffer[c].id;
+      if (out_d2) {
+        out_d2->resize(n);
+        for (std::size_t c = 0; c < n; ++c) (*out_d2)[c] = buffer[c].d2;
+      }
+      return;
+    }
+    out_ids.assign(ids, ids + n);
+    if (out_d2) out_d2->assign(d2, d2 + n);
   }
 };
 
@@ -454,21 +491,18 @@ void PointIndex::nearest_within(const Point3& q, std::size_t k, double within2, 
   if (dist2) dist2->clear();
   if (size_ == 0 || k == 0) return;
   k = std::min(k, size_);
-  double inline_d2[NearestState::kInline];
-  Id inline_ids[NearestState::kInline];
-  thread_local std::vector<double> big_d2;
-  thread_local std::vector<Id> big_ids;
+  double inline_d2[NearestState::kSortedUpTo];
+  Id inline_ids[NearestState::kSortedUpTo];
+  thread_local std::vector<NearestState::Candidate> big;
   NearestState state;
   state.k = k;
   state.bound = within2;  // (infinite for nearest(); the state lowers it once it holds k)
-  if (k <= NearestState::kInline) {
+  if (k <= NearestState::kSortedUpTo) {
     state.d2 = inline_d2;
     state.ids = inline_ids;
   } else {
-    big_d2.resize(k);
-    big_ids.resize(k);
-    state.d2 = big_d2.data();
-    state.ids = big_ids.data();
+    big.resize(2 * k);
+    state.buffer = big.data();
   }
   // Depth first, the nearer child first; a pending far child keeps its box distance so that it is
   // skipped once the answer's bound drops below it.
@@ -518,8 +552,7 @@ void PointIndex::nearest_within(const Point3& q, std::size_t k, double within2, 
       node = near;
     }
   }
-  ids.assign(state.ids, state.ids + state.n);
-  if (dist2) dist2->assign(state.d2, state.d2 + state.n);
+  state.finish(ids, dist2);
 }
 
 }  // namespace vitri

@@ -112,10 +112,11 @@ double median_in_place(std::vector<double>& v) {
 
 double median(std::vector<double> v) { return median_in_place(v); }
 
-/// prepare_scan()'s test for wider neighbourhoods reads the residuals of at most about this many points
-/// (an even subsample of a larger scan: the median of 65,536 is within a few tenths of a percent of the
-/// whole's in rank).
-constexpr std::size_t kStructureSample = 65536;
+/// prepare_scan()'s test for wider neighbourhoods puts its question first to at most about this many
+/// points (an even subsample of a larger scan), and answers from them when their share above the
+/// threshold is more than kStructureBand standard errors (0.5 / sqrt(sample)) away from a half.
+constexpr std::size_t kStructureSample = 16384;
+constexpr double kStructureBand = 5.0;
 
 /// fit_neighbourhood()'s row: the point's own.
 constexpr std::size_t kNoRow = std::numeric_limits<std::size_t>::max();
@@ -785,50 +786,57 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     std::size_t k2 = clamp_k(static_cast<std::size_t>(std::min(double(kMaxNeighbours), std::max(16.0, std::ceil(want)))));
     if (k2 < 48 && p.size() > 64) {
       const std::size_t k3 = clamp_k(48);
-      // The test reads a median of the wider fits' residuals: on a large scan, of an even subsample
-      // (every stride-th point, kStructureSample of them); the wider neighbourhoods of every point are
-      // computed only when the test asks for them (on a clean scan of 10^6 points the wider queries and
-      // fits of all were 9.6 of the preparation's 25 s).
+      // Only structure that matters against the spacing (a clean curved surface also fits a quadric a
+      // little worse at a larger scale): the wider fits' median residual above `threshold`.
+      const double threshold = std::max(1.5 * noise_small, 0.05 * median(nb.dist));
+      // On a large scan the question is first put to an even subsample (every stride-th point, at most
+      // kStructureSample): the share of its wider residuals above the threshold. Clearly away from a half
+      // (kStructureBand standard errors of a sampled share), the subsample answers and the wider
+      // neighbourhoods of every point are computed only when wanted (on a clean scan of 10^6 points the
+      // wider queries and fits of all were 9.6 of the preparation's 25 s); near a half (a scan at the
+      // threshold, such as the quantized office capture), every point's, as on a small scan: the same
+      // answer as the whole's median but with a chance of about 10^-6.
       const std::size_t stride = (p.size() + kStructureSample - 1) / kStructureSample;
-      Neighbours wide;
-      std::vector<LocalFit> wide_fit;
-      std::vector<double> big;
-      if (stride == 1) {
-        wide = nearest_neighbours(p, index, k3, threads);
-        wide_fit.resize(p.size());
-        rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
-          for (std::size_t i = b; i < e; ++i) wide_fit[i] = fit_neighbourhood(p, wide, i);
-        });
-        big.resize(p.size());
-        for (std::size_t i = 0; i < p.size(); ++i) big[i] = wide_fit[i].noise;
-      } else {
+      int verdict = 0;  // +1 wider, -1 not, 0 every point's median decides
+      if (stride > 1) {
         const std::size_t rows = (p.size() + stride - 1) / stride;
         Neighbours sample;  // row r: point r x stride
         sample.k = k3;
         sample.ids.resize(rows * k3);
         sample.dist.resize(rows * k3);
-        big.resize(rows);
+        std::vector<std::uint8_t> above(rows);
         rbf_detail::parallel_chunks(rows, threads, kGrain, [&](std::size_t b, std::size_t e) {
           std::vector<Id> ids;
           std::vector<double> d2;
           for (std::size_t r = b; r < e; ++r) {
             index.nearest(p[r * stride], k3 + 1, ids, &d2);
             fill_row(r, ids, d2, sample, r * stride);
-            big[r] = fit_neighbourhood(p, sample, r * stride, nullptr, r).noise;
+            above[r] = fit_neighbourhood(p, sample, r * stride, nullptr, r).noise > threshold;
           }
         });
+        std::size_t count = 0;
+        for (const std::uint8_t a : above) count += a;
+        const double share = static_cast<double>(count) / static_cast<double>(rows);
+        const double band = kStructureBand * 0.5 / std::sqrt(static_cast<double>(rows));
+        verdict = share > 0.5 + band ? 1 : share < 0.5 - band ? -1 : 0;
       }
-      // Only structure that matters against the spacing (a clean curved surface also fits a quadric a
-      // little worse at a larger scale).
-      if (median(big) > std::max(1.5 * noise_small, 0.05 * median(nb.dist))) {
-        k = k2 = k3;
-        if (stride == 1) {  // these neighbourhoods and fits are the ones wanted: kept, not computed again
+      if (verdict == 0) {
+        Neighbours wide = nearest_neighbours(p, index, k3, threads);
+        std::vector<LocalFit> wide_fit(p.size());
+        rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+          for (std::size_t i = b; i < e; ++i) wide_fit[i] = fit_neighbourhood(p, wide, i);
+        });
+        std::vector<double> big(p.size());
+        for (std::size_t i = 0; i < p.size(); ++i) big[i] = wide_fit[i].noise;
+        if (median(big) > threshold) {
+          k = k2 = k3;  // these neighbourhoods and fits are the ones wanted: kept, not computed again
           nb = std::move(wide);
           fit.swap(wide_fit);
-        } else {
-          nb = nearest_neighbours(p, index, k, threads);
-          fit_all(p);
         }
+      } else if (verdict > 0) {
+        k = k2 = k3;
+        nb = nearest_neighbours(p, index, k, threads);
+        fit_all(p);
       }
     }
     if (k2 > k) {

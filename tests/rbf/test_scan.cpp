@@ -373,20 +373,20 @@ TEST_CASE("prepare_scan: duplicates counted; inputs with no surface refused with
 
 TEST_CASE("prepare_scan: depth quantized into layers widens the neighbourhoods on a large scan, a clean one "
           "keeps 16", "[scan]") {
-  // 70,225 points (more than the structure test's sample of 65,536: it reads every second point's wider
-  // fit). A jittered grid on a plane z = 0.4 x over the unit square (grid step 1/265): clean, 16
-  // neighbours fit it; its depth rounded to steps of 0.006 (a range camera's quantization: stairs 0.015
-  // wide, 4 grid steps), a quadric follows a 16-neighbourhood and not the stairs under 48. (Steps of
-  // 0.004 and 0.01 also give 48; 0.002 is noise to 16 neighbours already.)
+  // 22,500 points (more than the structure test's sample of 16,384: it reads every second point's wider
+  // fit). A jittered grid on a plane z = 0.4 x over the unit square (grid step 1/150): clean, 16
+  // neighbours fit it; its depth rounded to steps of 0.01 (a range camera's quantization: stairs 0.025
+  // wide, 3.75 grid steps), a quadric follows a 16-neighbourhood and not the stairs under 48. (Steps of
+  // 0.006 to 0.02 also give 48; 0.004 is noise to 16 neighbours already.)
   Gauss g(11);
-  const std::size_t side = 265;
+  const std::size_t side = 150;
   std::vector<Point3> clean, stairs;
   for (std::size_t a = 0; a < side; ++a)
     for (std::size_t b = 0; b < side; ++b) {
       const double x = (static_cast<double>(a) + 0.5 + 0.3 * g()) / side;
       const double y = (static_cast<double>(b) + 0.5 + 0.3 * g()) / side;
       clean.push_back({x, y, 0.4 * x});
-      stairs.push_back({x, y, 0.006 * std::round(0.4 * x / 0.006)});
+      stairs.push_back({x, y, 0.01 * std::round(0.4 * x / 0.01)});
     }
   vitri::ScanReport r;
   vitri::prepare_scan(clean, {}, {}, &r);

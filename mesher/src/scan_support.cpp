@@ -1,5 +1,6 @@
 #include "scan_support.hpp"
 
+#include "vitri/core/parallel.hpp"
 #include "vitri/mesher.hpp"
 #include "vitri/polygonize/mesh_trim.hpp"
 
@@ -30,6 +31,9 @@ constexpr std::size_t kMinComponentPoints = 30;
 /// the few outliers of a cloud that read as a surface, among the many set aside).
 constexpr std::size_t kMaxAsidePerPoint = 1;
 
+/// Queries per chunk of finish()'s parallel loops.
+constexpr std::size_t kQueryGrain = 4096;
+
 double triangle_area(const SurfaceMesh& m, const std::array<std::uint32_t, 3>& t) {
   return 0.5 * norm(cross(m.vertices[t[1]] - m.vertices[t[0]], m.vertices[t[2]] - m.vertices[t[0]]));
 }
@@ -42,11 +46,14 @@ ScanSupport::ScanSupport(const ScanPoints& points, double resolution, unsigned t
       spacing_(points.spacing),
       normals_(points.normals),
       index_(points_, threads),
-      resolution_(resolution) {}
+      resolution_(resolution),
+      threads_(threads) {}
 
 double ScanSupport::distance(const Point3& x, double* spacing, Point3* normal) const {
-  std::vector<PointIndex::Id> ids;
-  std::vector<double> d2;
+  // (asked for every Delaunay vertex by the sizing field and every mesh vertex by finish(): the answer's
+  // vectors are the thread's own, not allocated per call)
+  thread_local std::vector<PointIndex::Id> ids;
+  thread_local std::vector<double> d2;
   index_.nearest(x, 1, ids, &d2);
   if (ids.empty()) {
     if (spacing) *spacing = resolution_;
@@ -85,11 +92,13 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   // (Tried and not kept, 2026-11-28: also unsupported where the mesh faces away from the nearest point,
   // to cut the lip where an open scan's zero set turns back: the partial cuts left more small boundary
   // loops at the rim, 3 -> 5-8 on a single view of a sphere cap.)
-  for (std::size_t v = 0; v < nv; ++v) {
-    double d = 0;
-    const double r = reach(mesh.vertices[v], precision, &d);
-    s[v] = d - r;
-  }
+  parallel_chunks(nv, threads_, kQueryGrain, [&](std::size_t b, std::size_t e) {
+    for (std::size_t v = b; v < e; ++v) {
+      double d = 0;
+      const double r = reach(mesh.vertices[v], precision, &d);
+      s[v] = d - r;
+    }
+  });
   // Components through shared vertices: area and support.
   std::vector<std::uint32_t> root(nv);
   std::iota(root.begin(), root.end(), 0u);
@@ -122,7 +131,6 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   // set-aside outliers vote too, against: a blob among a cloud of them has more of theirs.
   std::vector<std::size_t> votes(nv, 0), aside(nv, 0);
   {
-    std::vector<PointIndex::Id> ids;
     std::vector<Point3> used_at;
     std::vector<std::uint32_t> used_id;
     std::vector<std::uint8_t> used(nv, 0);
@@ -130,15 +138,21 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
     for (std::uint32_t v = 0; v < nv; ++v)
       if (used[v]) used_at.push_back(mesh.vertices[v]), used_id.push_back(v);
     if (!used_at.empty()) {
-      const PointIndex vertices(used_at);
-      for (const Point3& q : points_) {
-        vertices.nearest(q, 1, ids);
-        ++votes[find(used_id[ids[0]])];
-      }
-      for (const Point3& q : set_aside_) {
-        vertices.nearest(q, 1, ids);
-        ++aside[find(used_id[ids[0]])];
-      }
+      const PointIndex vertices(used_at, threads_);
+      // Each point's nearest vertex on the threads, then the counts in order.
+      auto nearest_vertex = [&](const std::vector<Point3>& from) {
+        std::vector<std::uint32_t> at(from.size());
+        parallel_chunks(from.size(), threads_, kQueryGrain, [&](std::size_t b, std::size_t e) {
+          std::vector<PointIndex::Id> one;
+          for (std::size_t i = b; i < e; ++i) {
+            vertices.nearest(from[i], 1, one);
+            at[i] = used_id[one[0]];
+          }
+        });
+        return at;
+      };
+      for (const std::uint32_t v : nearest_vertex(points_)) ++votes[find(v)];
+      for (const std::uint32_t v : nearest_vertex(set_aside_)) ++aside[find(v)];
     }
   }
   const std::size_t min_votes = std::max<std::size_t>(kMinComponentPoints, points_.size() / 2000);

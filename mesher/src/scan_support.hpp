@@ -59,6 +59,7 @@ class ScanSupport {
   std::vector<Point3> normals_;
   PointIndex index_;
   double resolution_ = 0;
+  unsigned threads_ = 1;  // finish()'s queries (each vertex's and each point's own: the same on any count)
   std::optional<bool> decided_open_;
 };
 

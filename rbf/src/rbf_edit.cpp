@@ -23,8 +23,9 @@ using rbf_detail::kNoSlot;
 // kBoundJump either way (a near-duplicate added, or removed), the residual and the condition are
 // measured at once (drift check, refit from scratch if inaccurate), so that the report says what a
 // fresh fit would; otherwise the condition estimate is extrapolated by the bound and the residual is
-// left unmeasured (NaN) until the periodic drift check. When the measured residual is above
-// fail_residual even after a refit, `undo` restores the previous constraints, the function is refitted
+// left unmeasured (NaN) until the periodic drift check. A measured residual above fail_residual is
+// measured again after a refit from scratch (the verdict is a fresh fit's, not the updated factor's
+// rounding); when it is still above, `undo` restores the previous constraints, the function is refitted
 // to them and NumericalError is thrown, as fit() would.
 void Rbf::Impl::after_edit(ConstraintId id, const std::function<void()>& undo) {
   constexpr double kBoundJump = 100.0;
@@ -38,7 +39,13 @@ void Rbf::Impl::after_edit(ConstraintId id, const std::function<void()>& undo) {
     finish_report(std::numeric_limits<double>::quiet_NaN());
     return;
   }
-  drift_check(moved);
+  if (!drift_check(moved) && rep.relative_residual > opt.fail_residual) {
+    // The updated factor may carry rounding a fresh one would not: the verdict is a fresh fit's.
+    factor_from_scratch();
+    solve_weights(2);
+    fit_residual = rep.relative_residual;
+    ++refits;
+  }
   if (!(rep.relative_residual > opt.fail_residual)) return;
   const double rel = rep.relative_residual, cond = rep.condition_estimate;
   undo();

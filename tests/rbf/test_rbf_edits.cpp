@@ -285,6 +285,11 @@ TEST_CASE("rbf report after an edit says what a fresh fit would: near-duplicates
   }
   CHECK(edit_fits == fresh_fits);
   CHECK(f.report().warning == (fresh_fits && fresh_warns));
+  if (edit_fits) {  // moved back, the warning goes as it came
+    f.move_constraint(8, c.points[8]);
+    CHECK_FALSE(f.report().warning);
+    CHECK(probe_difference(f, Rbf(c), 13) <= 1e-8);
+  }
   // Add it instead: a value change alone keeps the verdict (the points are unchanged).
   f.add_constraint(p, c.values[7] + 0.5);
   REQUIRE(f.report().warning);

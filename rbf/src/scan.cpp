@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -242,6 +243,123 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   move = std::max(-cap, std::min(cap, move));
   out.projected = o + Point3::from(move * nrm);
   return out;
+}
+
+/// Depth quantization undone (ScanOptions::dequantize; docs/scans.md, step 1b). A depth camera stores
+/// one measure of each point in discrete steps (the z offset from the viewpoint for structured light and
+/// stereo, the range for some scanners): the cloud is a stack of levels, each a band of the surface seen
+/// as flat, and the surface between bands a step. Interpolating them makes terraces. The true measure of
+/// a point lies within half a step of its level's value; across the band of level j it runs from the
+/// middle of levels j-1 and j (at the band's edge toward level j-1) to the middle of j and j+1 (at its
+/// other edge). Each point takes the value interpolated between the two edges by its distances to them,
+/// measured as angles seen from the viewpoint (the nearest point of level j-1 and of j+1 among the
+/// points' directions: the image's distances, whatever the depth), and moves along its ray to it. An
+/// edge farther than 20 of the image's typical spacings counts as that far, and a point with neither
+/// edge nearer stays (a wide flat band). Never more than half a step; nothing when the data show no
+/// quantization. Returns the points moved.
+std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned threads, ScanReport& rep) {
+  const std::size_t n = p.size();
+  if (n < 1000) return 0;
+  auto measure = [&](int m, const Point3& q) {
+    const Point3 d = q - vp;
+    return m == 0 ? d.x : m == 1 ? d.y : m == 2 ? d.z : norm(d);
+  };
+  // Distinct values of each measure; the quantized one has at most n / 100 and 10x fewer than the others.
+  std::array<std::size_t, 4> distinct{};
+  std::vector<double> v(n);
+  for (int m = 0; m < 4; ++m) {
+    for (std::size_t i = 0; i < n; ++i) v[i] = measure(m, p[i]);
+    std::sort(v.begin(), v.end());
+    distinct[m] = static_cast<std::size_t>(std::unique(v.begin(), v.end()) - v.begin());
+  }
+  int chosen = -1;
+  for (int m = 0; m < 4; ++m) {
+    bool coarse = distinct[m] >= 3 && distinct[m] * 100 <= n;
+    for (int o = 0; o < 4 && coarse; ++o)
+      if (o != m && distinct[m] * 10 > distinct[o]) coarse = false;
+    if (coarse) chosen = m;
+  }
+  if (chosen < 0) return 0;
+  std::vector<double> value(n);
+  for (std::size_t i = 0; i < n; ++i) value[i] = measure(chosen, p[i]);
+  // Every point on one side of the viewpoint along the measure (moving along the ray scales it).
+  const bool positive = value[0] > 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(positive ? value[i] > 0 : value[i] < 0)) return 0;
+  std::vector<double> level(value);
+  std::sort(level.begin(), level.end());
+  level.erase(std::unique(level.begin(), level.end()), level.end());
+  const std::size_t L = level.size();
+  std::vector<std::uint32_t> at(n);
+  std::vector<std::vector<Id>> members(L);
+  std::vector<Point3> dir(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    at[i] = static_cast<std::uint32_t>(std::lower_bound(level.begin(), level.end(), value[i]) - level.begin());
+    members[at[i]].push_back(static_cast<Id>(i));
+    const Point3 d = p[i] - vp;
+    const double r = norm(d);
+    dir[i] = r > 0 ? d / r : d;
+  }
+  std::vector<PointIndex> index(L);
+  {
+    std::vector<Point3> at_level;
+    for (std::size_t j = 0; j < L; ++j) {
+      at_level.clear();
+      for (Id i : members[j]) at_level.push_back(dir[i]);
+      index[j].build(at_level, 1);  // ids: positions in members[j] (an index's arrays follow its ids)
+    }
+  }
+  // The image's typical spacing: the median angle to the nearest point of the same level.
+  std::vector<double> same(n, std::numeric_limits<double>::infinity());
+  rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Id> ids;
+    std::vector<double> d2;
+    for (std::size_t i = b; i < e; ++i) {
+      index[at[i]].nearest(dir[i], 2, ids, &d2);  // itself (or a point of the same direction) first
+      if (ids.size() == 2) same[i] = std::sqrt(d2[1]);
+    }
+  });
+  std::vector<double> finite;
+  for (double a : same)
+    if (std::isfinite(a)) finite.push_back(a);
+  if (finite.empty()) return 0;
+  const double reach = 20 * median(finite);
+  if (!(reach > 0)) return 0;
+  double smin = std::numeric_limits<double>::infinity(), smax = 0;
+  for (std::size_t j = 1; j < L; ++j) {
+    smin = std::min(smin, level[j] - level[j - 1]);
+    smax = std::max(smax, level[j] - level[j - 1]);
+  }
+  std::vector<Point3> moved(p);
+  std::vector<std::uint8_t> changed(n, 0);
+  rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Id> ids;
+    std::vector<double> d2;
+    for (std::size_t i = b; i < e; ++i) {
+      const std::size_t j = at[i];
+      auto edge = [&](std::size_t other) {  // the angle to the nearest point of level `other`, capped
+        if (other >= L) return reach;
+        index[other].nearest(dir[i], 1, ids, &d2);
+        return ids.empty() ? reach : std::min(reach, std::sqrt(d2[0]));
+      };
+      const double below = j > 0 ? edge(j - 1) : reach, above = edge(j + 1);
+      if (below >= reach && above >= reach) continue;
+      const double step_below = j > 0 ? level[j] - level[j - 1] : level[j + 1] - level[j];
+      const double step_above = j + 1 < L ? level[j + 1] - level[j] : step_below;
+      const double lo = level[j] - step_below / 2, hi = level[j] + step_above / 2;
+      const double t = below / (below + above);
+      const double target = lo + t * (hi - lo);
+      if (target == value[i]) continue;
+      moved[i] = vp + (p[i] - vp) * (target / value[i]);
+      changed[i] = 1;
+    }
+  });
+  p.swap(moved);
+  rep.quantized = chosen == 0 ? "x" : chosen == 1 ? "y" : chosen == 2 ? "z" : "range";
+  rep.levels = L;
+  rep.step_min = smin;
+  rep.step_max = smax;
+  return static_cast<std::size_t>(std::count(changed.begin(), changed.end(), std::uint8_t(1)));
 }
 
 /// The side of the area per point around point i (its k-th neighbour's distance x sqrt(pi / k)).
@@ -755,6 +873,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
                           std::to_string(kMinPoints) + " needed)");
   std::vector<Point3> p(src.size());
   for (std::size_t u = 0; u < src.size(); ++u) p[u] = input[src[u]];
+  if (options.dequantize && options.approximate && options.viewpoint && options.sensors.empty())
+    rep.dequantized = dequantize_depth(p, *options.viewpoint, options.threads, rep);
 
   // Neighbourhoods: k from the data. 16 neighbours first; where the noise is large against their
   // radius, more (the plane residual grows with the noise, the radius with sqrt(k)).
@@ -1131,6 +1251,9 @@ std::string describe(const ScanReport& r) {
     << r.outliers << " outliers set aside); " << r.k << " neighbours; spacing " << r.spacing << ", noise "
     << r.noise << " (" << (r.spacing > 0 ? r.noise / r.spacing : 0) << " spacings), points moved by "
     << r.moved << " (median)";
+  if (r.dequantized)
+    s << ", " << r.dequantized << " moved within their depth step (" << r.quantized << " quantized in " << r.levels
+      << " levels, steps " << r.step_min << " to " << r.step_max << ")";
   if (r.merged) s << ", " << r.merged << " moved to the middle of misregistered layers";
   if (r.thinned) s << ", " << r.thinned << " thinned to the resolution " << r.resolution;
   s << "; normals from " << source;

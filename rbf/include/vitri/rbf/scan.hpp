@@ -38,6 +38,12 @@ struct ScanOptions {
   std::optional<Point3> viewpoint;
   /// One sensor position per point (empty, or one per point): each normal is oriented toward its own.
   std::vector<Point3> sensors;
+  /// Depth quantization undone (with a viewpoint and `approximate` only; docs/scans.md, step 1b): when
+  /// one measure of the points seen from the viewpoint (its x, y or z offset, or the range) takes at most
+  /// n / 100 distinct values and at least 10x fewer than the others (structured-light and stereo
+  /// cameras store depth in discrete steps), each point moves along its ray within its own step, to the
+  /// depth interpolated between the edges of its step's band (ScanReport::dequantized).
+  bool dequantize = true;
   /// Threads (0: every available CPU). The result does not depend on it.
   unsigned threads = 0;
 };
@@ -62,6 +68,13 @@ struct ScanReport {
   /// Points moved to the middle of two misregistered layers (sheets of one orientation a few spacings
   /// apart: docs/scans.md) before the projection.
   std::size_t merged = 0;
+  /// Depth quantization found (ScanOptions::dequantize): the measure ("x", "y", "z": the offset from
+  /// the viewpoint along that axis, or "range"), its distinct values (levels), the smallest and largest
+  /// step between neighbouring levels, and the points moved within their step (empty measure: none).
+  std::string quantized;
+  std::size_t levels = 0;
+  double step_min = 0, step_max = 0;
+  std::size_t dequantized = 0;
   std::size_t k = 0;           ///< neighbours per point used
   /// The median distance from a returned point to its nearest other one.
   double spacing = 0;

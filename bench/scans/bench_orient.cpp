@@ -22,6 +22,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <iostream>
 #include <string>
@@ -137,6 +138,15 @@ int main(int argc, char** argv) {
         oriented += c > 0;
         tangent += std::abs(c) >= cos_tangent;
         flipped += c <= -cos_tangent;
+      }
+      if (const char* dump = std::getenv("BENCH_ORIENT_DUMP")) {  // x y z nx ny nz agrees (debugging)
+        std::ofstream f(dump);
+        for (std::size_t i = 0; i < normals.size(); ++i) {
+          const Point3& q = method == "scan" ? scan.points[i] : input.points[i];
+          const Point3& t = reference.normals[truth_of[i]];
+          f << q.x << ' ' << q.y << ' ' << q.z << ' ' << normals[i].x << ' ' << normals[i].y << ' ' << normals[i].z
+            << ' ' << (dot(normals[i], t) > 0) << '\n';
+        }
       }
       const double n = static_cast<double>(counted ? counted : 1u);
       std::cout << ", \"counted\": " << counted << ", \"oriented\": " << static_cast<double>(oriented) / n

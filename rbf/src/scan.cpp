@@ -616,6 +616,46 @@ std::size_t vote_signs(const std::vector<Point3>& p, const Neighbours& nb, std::
   return flips;
 }
 
+/// Whether a part whose normals lie mostly along `axis` is layered along it: a thin closed object (a
+/// disc, a plate, a turbine's wheel) has points on both faces over most of its extent, a 2.5D sheet
+/// (airborne data, a facade, a table top seen from one side) one layer at each place, except at walls,
+/// edges and trees. Up to 2000 of the part's points whose normals are within 37 degrees of the axis are
+/// examined: layered when another point of the part lies within 2 local spacings of its line along the
+/// axis but more than 4 local spacings away along it. More than half layered: a closed thin object.
+bool layered_along(const std::vector<Point3>& p, const std::vector<Point3>& n, const Neighbours& nb,
+                   const std::vector<Id>& members, const Point3& axis) {
+  const Eigen::Vector3d a = axis.eigen().normalized();
+  Eigen::Vector3d e1 = a.unitOrthogonal(), e2 = a.cross(e1);
+  std::vector<Point3> flat(members.size());
+  for (std::size_t m = 0; m < members.size(); ++m) {
+    const Eigen::Vector3d q = p[members[m]].eigen();
+    flat[m] = Point3{q.dot(e1), q.dot(e2), 0.0};
+  }
+  std::vector<std::size_t> along;
+  for (std::size_t m = 0; m < members.size(); ++m)
+    if (std::abs(dot(n[members[m]], axis)) >= 0.8) along.push_back(m);
+  if (along.size() < 32) return false;
+  const PointIndex index(flat, 1);
+  const std::size_t stride = std::max<std::size_t>(1, along.size() / 2000);
+  std::size_t examined = 0, layered = 0;
+  std::vector<Id> ball;
+  for (std::size_t s = 0; s < along.size(); s += stride) {
+    const std::size_t m = along[s];
+    const Id i = members[m];
+    const double h = local_spacing(nb, i);
+    if (!(h > 0)) continue;
+    ++examined;
+    index.ball(flat[m], 4 * h * h, ball);
+    const double height = dot(p[i], axis);
+    for (const Id o : ball)
+      if (std::abs(dot(p[members[o]], axis) - height) > 4 * h) {
+        ++layered;
+        break;
+      }
+  }
+  return examined > 0 && 2 * layered > examined;
+}
+
 /// settle_components(): a closed part with an unclear divergence sum is settled by its winding number
 /// when it has at least this many points.
 constexpr std::size_t kSettleWindingMin = 32;
@@ -656,13 +696,31 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     q.abs_sum += std::abs(v);
     q.normal_sum = q.normal_sum + n[i];
   }
-  for (Part& q : part) {
+  // Parts with most normals along one axis, and whether they are layered along it (a thin closed object,
+  // not a sheet: layered_along()).
+  std::vector<std::vector<Id>> flat_members(count);
+  std::vector<Point3> flat_axis(count);
+  for (std::size_t r = 0; r < count; ++r) {
+    if (!part[r].size) continue;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(part[r].tensor / static_cast<double>(part[r].size));
+    if (es.eigenvalues()(2) >= 0.6) flat_axis[r] = Point3::from(es.eigenvectors().col(2).normalized());
+  }
+  for (std::size_t i = 0; i < count; ++i) {
+    const Id r = find(static_cast<Id>(i));
+    if (!(flat_axis[r] == Point3{})) flat_members[r].push_back(static_cast<Id>(i));
+  }
+  std::vector<std::uint8_t> thin_closed(count, 0);
+  for (std::size_t r = 0; r < count; ++r)
+    if (!flat_members[r].empty()) thin_closed[r] = layered_along(p, n, nb, flat_members[r], flat_axis[r]);
+  for (std::size_t r = 0; r < count; ++r) {
+    Part& q = part[r];
     if (!q.size) continue;
     // A sheet: most normals along one axis (airborne scans, facades, a table top). The tree cannot be
     // trusted across its sharp edges (roof to ground through a wall); it is seen from one side instead:
-    // from above when the axis is within 45 degrees of z, else from the side most normals face.
+    // from above when the axis is within 45 degrees of z, else from the side most normals face. Unless
+    // it is layered along that axis: a thin closed object (a disc) is settled as closed, below.
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(q.tensor / static_cast<double>(q.size));
-    if (es.eigenvalues()(2) >= 0.6) {
+    if (es.eigenvalues()(2) >= 0.6 && !thin_closed[r]) {
       Point3 axis = Point3::from(es.eigenvectors().col(2).normalized());
       const bool vertical = std::abs(axis.z) >= std::sqrt(0.5);
       const double sign = vertical ? axis.z : dot(q.normal_sum, axis);

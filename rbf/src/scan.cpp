@@ -671,9 +671,16 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   const std::size_t count = p.size();
   const std::vector<Id> root = surface_components(nb, count, nullptr);
   auto find = [&](Id a) { return root[a]; };
+  // The sums over a part are weighted by each point's area (its local spacing squared): the integral of
+  // n dA over a closed surface vanishes, the sum of unit normals of a closed surface sampled 10x more
+  // densely on one side does not (cactus with one half thinned 10x: |sum| 0.35 per point, settled as
+  // open and turned the wrong way; 0% oriented).
+  std::vector<double> area(count);
+  for (std::size_t i = 0; i < count; ++i) area[i] = local_spacing(nb, i) * local_spacing(nb, i);
   struct Part {
     std::size_t size = 0;
-    Point3 centroid, normal_sum;
+    double area = 0;
+    Point3 centroid, normal_sum;  // area-weighted
     Eigen::Matrix3d tensor = Eigen::Matrix3d::Zero();  // sum of n n^T: where the normals point, unsigned
     double signed_sum = 0, abs_sum = 0;
     int verdict = 0;  // +1 closed outward, -1 closed inward, 0 open, 2 a sheet seen along `axis`
@@ -684,17 +691,18 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   for (std::size_t i = 0; i < count; ++i) {
     Part& q = part[find(static_cast<Id>(i))];
     ++q.size;
-    q.centroid = q.centroid + p[i];
+    q.area += area[i];
+    q.centroid = q.centroid + p[i] * area[i];
     q.tensor += n[i].eigen() * n[i].eigen().transpose();
   }
   for (Part& q : part)
-    if (q.size) q.centroid = q.centroid * (1.0 / static_cast<double>(q.size));
+    if (q.area > 0) q.centroid = q.centroid * (1.0 / q.area);
   for (std::size_t i = 0; i < count; ++i) {
     Part& q = part[find(static_cast<Id>(i))];
-    const double v = dot(n[i], p[i] - q.centroid);
+    const double v = area[i] * dot(n[i], p[i] - q.centroid);
     q.signed_sum += v;
     q.abs_sum += std::abs(v);
-    q.normal_sum = q.normal_sum + n[i];
+    q.normal_sum = q.normal_sum + n[i] * area[i];
   }
   // Parts with most normals along one axis, and whether they are layered along it (a thin closed object,
   // not a sheet: layered_along()).
@@ -731,7 +739,7 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     // Closed: the normals of a closed surface sum to about 0 (the integral of n dA vanishes), and the
     // divergence sum n . (p - c) has a clear sign (3 x the enclosed volume).
     const double ratio = q.abs_sum > 0 ? q.signed_sum / q.abs_sum : 0.0;
-    const bool closed = norm(q.normal_sum) < 0.3 * static_cast<double>(q.size);
+    const bool closed = norm(q.normal_sum) < 0.3 * q.area;
     q.verdict = !closed ? 0 : ratio > 0.5 ? 1 : ratio < -0.5 ? -1 : 0;
     q.unclear_closed = closed && q.verdict == 0;
   }

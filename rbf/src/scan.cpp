@@ -245,6 +245,10 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   return out;
 }
 
+/// Directions averaged by dequantize_depth() (the office capture: Euler characteristic -425 without the
+/// average, -264 with 32).
+constexpr std::size_t kDequantizeSmooth = 32;
+
 /// Depth quantization undone (ScanOptions::dequantize; docs/scans.md, step 1b). A depth camera stores
 /// one measure of each point in discrete steps (the z offset from the viewpoint for structured light and
 /// stereo, the range for some scanners): the cloud is a stack of levels, each a band of the surface seen
@@ -255,8 +259,9 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
 /// measured as angles seen from the viewpoint (the nearest point of level j-1 and of j+1 among the
 /// points' directions: the image's distances, whatever the depth), and moves along its ray to it. An
 /// edge farther than 20 of the image's typical spacings counts as that far, and a point with neither
-/// edge nearer stays (a wide flat band). Never more than half a step; nothing when the data show no
-/// quantization. Returns the points moved.
+/// edge nearer stays (a wide flat band). The values are then averaged over the kDequantizeSmooth nearest
+/// directions (ragged band edges: pixels dither between two levels), each kept within its own step.
+/// Never more than half a step; nothing when the data show no quantization. Returns the points moved.
 std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned threads, ScanReport& rep) {
   const std::size_t n = p.size();
   if (n < 1000) return 0;
@@ -330,13 +335,16 @@ std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned 
     smin = std::min(smin, level[j] - level[j - 1]);
     smax = std::max(smax, level[j] - level[j - 1]);
   }
-  std::vector<Point3> moved(p);
-  std::vector<std::uint8_t> changed(n, 0);
+  // The measure interpolated across each band, and the interval its quantization allows.
+  std::vector<double> target(value), lo(n), hi(n);
   rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
     std::vector<Id> ids;
     std::vector<double> d2;
     for (std::size_t i = b; i < e; ++i) {
       const std::size_t j = at[i];
+      const double step_below = j > 0 ? level[j] - level[j - 1] : level[j + 1] - level[j];
+      const double step_above = j + 1 < L ? level[j + 1] - level[j] : step_below;
+      lo[i] = level[j] - step_below / 2, hi[i] = level[j] + step_above / 2;
       auto edge = [&](std::size_t other) {  // the angle to the nearest point of level `other`, capped
         if (other >= L) return reach;
         index[other].nearest(dir[i], 1, ids, &d2);
@@ -344,16 +352,33 @@ std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned 
       };
       const double below = j > 0 ? edge(j - 1) : reach, above = edge(j + 1);
       if (below >= reach && above >= reach) continue;
-      const double step_below = j > 0 ? level[j] - level[j - 1] : level[j + 1] - level[j];
-      const double step_above = j + 1 < L ? level[j + 1] - level[j] : step_below;
-      const double lo = level[j] - step_below / 2, hi = level[j] + step_above / 2;
-      const double t = below / (below + above);
-      const double target = lo + t * (hi - lo);
-      if (target == value[i]) continue;
-      moved[i] = vp + (p[i] - vp) * (target / value[i]);
-      changed[i] = 1;
+      target[i] = lo[i] + below / (below + above) * (hi[i] - lo[i]);
     }
   });
+  // Smoothed over the image: the band edges of a noisy capture are ragged (pixels dither between two
+  // levels), and so is the distance to them; each point takes the mean of its kDequantizeSmooth nearest
+  // directions' values (any level), kept within its own interval.
+  {
+    const PointIndex all(dir, threads);
+    std::vector<double> mean(n);
+    rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
+      std::vector<Id> ids;
+      for (std::size_t i = b; i < e; ++i) {
+        all.nearest(dir[i], kDequantizeSmooth, ids);
+        double sum = 0;
+        for (const Id q : ids) sum += target[q];
+        mean[i] = ids.empty() ? target[i] : std::clamp(sum / static_cast<double>(ids.size()), lo[i], hi[i]);
+      }
+    });
+    target.swap(mean);
+  }
+  std::vector<Point3> moved(p);
+  std::vector<std::uint8_t> changed(n, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (target[i] == value[i]) continue;
+    moved[i] = vp + (p[i] - vp) * (target[i] / value[i]);
+    changed[i] = 1;
+  }
   p.swap(moved);
   rep.quantized = chosen == 0 ? "x" : chosen == 1 ? "y" : chosen == 2 ? "z" : "range";
   rep.levels = L;
@@ -675,8 +700,8 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   // n dA over a closed surface vanishes, the sum of unit normals of a closed surface sampled 10x more
   // densely on one side does not (cactus with one half thinned 10x: |sum| 0.35 per point, settled as
   // open and turned the wrong way; 0% oriented).
-  std::vector<double> area(count);
-  for (std::size_t i = 0; i < count; ++i) area[i] = local_spacing(nb, i) * local_spacing(nb, i);
+  std::vector<double> point_area(count);
+  for (std::size_t i = 0; i < count; ++i) point_area[i] = local_spacing(nb, i) * local_spacing(nb, i);
   struct Part {
     std::size_t size = 0;
     double area = 0;
@@ -691,18 +716,18 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
   for (std::size_t i = 0; i < count; ++i) {
     Part& q = part[find(static_cast<Id>(i))];
     ++q.size;
-    q.area += area[i];
-    q.centroid = q.centroid + p[i] * area[i];
+    q.area += point_area[i];
+    q.centroid = q.centroid + p[i] * point_area[i];
     q.tensor += n[i].eigen() * n[i].eigen().transpose();
   }
   for (Part& q : part)
     if (q.area > 0) q.centroid = q.centroid * (1.0 / q.area);
   for (std::size_t i = 0; i < count; ++i) {
     Part& q = part[find(static_cast<Id>(i))];
-    const double v = area[i] * dot(n[i], p[i] - q.centroid);
+    const double v = point_area[i] * dot(n[i], p[i] - q.centroid);
     q.signed_sum += v;
     q.abs_sum += std::abs(v);
-    q.normal_sum = q.normal_sum + n[i] * area[i];
+    q.normal_sum = q.normal_sum + n[i] * point_area[i];
   }
   // Parts with most normals along one axis, and whether they are layered along it (a thin closed object,
   // not a sheet: layered_along()).

@@ -260,7 +260,8 @@ constexpr std::size_t kDequantizeSmooth = 32;
 /// points' directions: the image's distances, whatever the depth), and moves along its ray to it. An
 /// edge farther than 20 of the image's typical spacings counts as that far, and a point with neither
 /// edge nearer stays (a wide flat band). The values are then averaged over the kDequantizeSmooth nearest
-/// directions (ragged band edges: pixels dither between two levels), each kept within its own step.
+/// directions of its own or a neighbouring level (ragged band edges: pixels dither between two levels;
+/// not across an occluding edge), each kept within its own step.
 /// Never more than half a step; nothing when the data show no quantization. Returns the points moved.
 std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned threads, ScanReport& rep) {
   const std::size_t n = p.size();
@@ -356,8 +357,8 @@ std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned 
     }
   });
   // Smoothed over the image: the band edges of a noisy capture are ragged (pixels dither between two
-  // levels), and so is the distance to them; each point takes the mean of its kDequantizeSmooth nearest
-  // directions' values (any level), kept within its own interval.
+  // levels), and so is the distance to them; each point takes the mean of the values of its
+  // kDequantizeSmooth nearest directions of its own or a neighbouring level, kept within its own interval.
   {
     const PointIndex all(dir, threads);
     std::vector<double> mean(n);
@@ -366,8 +367,10 @@ std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned 
       for (std::size_t i = b; i < e; ++i) {
         all.nearest(dir[i], kDequantizeSmooth, ids);
         double sum = 0;
-        for (const Id q : ids) sum += target[q];
-        mean[i] = ids.empty() ? target[i] : std::clamp(sum / static_cast<double>(ids.size()), lo[i], hi[i]);
+        std::size_t used = 0;
+        for (const Id q : ids)  // the same surface: its own level or a neighbouring one (not across an
+          if (at[q] + 1 >= at[i] && at[q] <= at[i] + 1) sum += target[q], ++used;  // occluding edge)
+        mean[i] = used == 0 ? target[i] : std::clamp(sum / static_cast<double>(used), lo[i], hi[i]);
       }
     });
     target.swap(mean);

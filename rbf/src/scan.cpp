@@ -246,7 +246,7 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
 }
 
 /// Directions averaged by dequantize_depth() (the office capture: Euler characteristic -425 without the
-/// average, -264 with 32).
+/// average, -239 with 32 of the point's own or a neighbouring level).
 constexpr std::size_t kDequantizeSmooth = 32;
 
 /// Depth quantization undone (ScanOptions::dequantize; docs/scans.md, step 1b). A depth camera stores

@@ -42,7 +42,8 @@ struct ScanOptions {
   /// one measure of the points seen from the viewpoint (its x, y or z offset, or the range) takes at most
   /// n / 100 distinct values and at least 10x fewer than the others (structured-light and stereo
   /// cameras store depth in discrete steps), each point moves along its ray within its own step, to the
-  /// depth interpolated between the edges of its step's band (ScanReport::dequantized).
+  /// depth interpolated between the edges of its step's band and averaged with its neighbours in the
+  /// image (ScanReport::dequantized). The points stay within half a step of where they were given.
   bool dequantize = true;
   /// Threads (0: every available CPU). The result does not depend on it.
   unsigned threads = 0;

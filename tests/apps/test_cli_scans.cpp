@@ -343,6 +343,54 @@ TEST_CASE("vitri mesh, scan defaults: the bundled real scans mesh with no parame
   }
 }
 
+TEST_CASE("vitri mesh, scan defaults: depth stored in steps is spread within them when the viewpoint is known",
+          "[cli][scan]") {
+  // A single view from the origin of the plane z = 2.5 + 0.2 x (120 x 120 jittered pixel rays), its depth
+  // rounded to steps of 0.03 (11 levels, bands about 12 pixels wide): with NAME.viewpoint beside it the
+  // steps are undone and the mesh lies near the plane; without it the terraces stay (the same points).
+  Gauss g(31);
+  std::vector<Point3> pts;
+  const int side = 120;
+  for (int a = 0; a < side; ++a)
+    for (int b = 0; b < side; ++b) {
+      const double u = -0.3 + 0.6 * (a + 0.5 + 0.2 * g()) / side, v = -0.3 + 0.6 * (b + 0.5 + 0.2 * g()) / side;
+      const double z = 0.03 * std::round(2.5 / (1 - 0.2 * u) / 0.03);
+      pts.push_back({u * z, v * z, z});
+    }
+  auto write = [&](const std::string& path) {
+    std::ofstream f(path);
+    f.precision(17);
+    for (const Point3& q : pts) f << q.x << ' ' << q.y << ' ' << q.z << '\n';
+  };
+  const std::string with = kDir + "/scan_steps.xyz", without = kDir + "/scan_steps_novp.xyz";
+  write(with);
+  write(without);
+  std::ofstream(kDir + "/scan_steps.viewpoint") << "0 0 0\n";
+  auto rms_to_plane = [](const Shape& s) {  // away from the view's rim (rays within 0.25 of the axis)
+    double sum = 0;
+    std::size_t count = 0;
+    for (const Point3& q : s.v)
+      if (q.z > 0 && std::abs(q.x / q.z) < 0.25 && std::abs(q.y / q.z) < 0.25)
+        sum += (q.z - 2.5 - 0.2 * q.x) * (q.z - 2.5 - 0.2 * q.x) / 1.04, ++count;
+    return std::sqrt(sum / static_cast<double>(std::max<std::size_t>(1, count)));
+  };
+  std::string o, e;
+  REQUIRE(run(with + " -o " + kDir + "/scan_steps.ply", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("moved within their depth step (z quantized in 11 levels") != std::string::npos);
+  const Shape s = shape_of(kDir + "/scan_steps.ply");
+  REQUIRE(run(without + " -o " + kDir + "/scan_steps_novp.ply", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("depth step") == std::string::npos);
+  const Shape t = shape_of(kDir + "/scan_steps_novp.ply");
+  const double a = rms_to_plane(s), b = rms_to_plane(t);
+  INFO("RMS distance of the mesh vertices to the plane: " << a << " with the viewpoint, " << b << " without");
+  CHECK(s.components == 1);
+  CHECK(s.nonmanifold_edges == 0);
+  CHECK(b > 0.004);      // the terraces: 0.0064 measured (steps of 0.03, uniform error 0.0087 along z)
+  CHECK(a < 0.25 * b);  // 0.0005 measured
+}
+
 TEST_CASE("vitri mesh, scan defaults: a PCD file with its VIEWPOINT", "[cli][scan]") {
   // The cap of the previous case as an ascii PCD with a VIEWPOINT line.
   std::vector<Point3> all = write_noisy_sphere(kDir + "/scan_pcd_all.xyz", 6000, 0.0, 0, 13);

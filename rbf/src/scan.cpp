@@ -375,19 +375,14 @@ std::size_t dequantize_depth(std::vector<Point3>& p, const Point3& vp, unsigned 
     });
     target.swap(mean);
   }
-  std::vector<Point3> moved(p);
-  std::vector<std::uint8_t> changed(n, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    if (target[i] == value[i]) continue;
-    moved[i] = vp + (p[i] - vp) * (target[i] / value[i]);
-    changed[i] = 1;
-  }
-  p.swap(moved);
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < n; ++i)
+    if (target[i] != value[i]) p[i] = vp + (p[i] - vp) * (target[i] / value[i]), ++moved;
   rep.quantized = chosen == 0 ? "x" : chosen == 1 ? "y" : chosen == 2 ? "z" : "range";
   rep.levels = L;
   rep.step_min = smin;
   rep.step_max = smax;
-  return static_cast<std::size_t>(std::count(changed.begin(), changed.end(), std::uint8_t(1)));
+  return moved;
 }
 
 /// The side of the area per point around point i (its k-th neighbour's distance x sqrt(pi / k)).
@@ -732,8 +727,8 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     q.abs_sum += std::abs(v);
     q.normal_sum = q.normal_sum + n[i] * point_area[i];
   }
-  // Parts with most normals along one axis, and whether they are layered along it (a thin closed object,
-  // not a sheet: layered_along()).
+    // Parts with most normals along one axis (its eigenvector of the normal tensor; zero elsewhere), and
+  // whether they are layered along it (a thin closed object, not a sheet: layered_along()).
   std::vector<std::vector<Id>> flat_members(count);
   std::vector<Point3> flat_axis(count);
   for (std::size_t r = 0; r < count; ++r) {
@@ -755,9 +750,8 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     // trusted across its sharp edges (roof to ground through a wall); it is seen from one side instead:
     // from above when the axis is within 45 degrees of z, else from the side most normals face. Unless
     // it is layered along that axis: a thin closed object (a disc) is settled as closed, below.
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(q.tensor / static_cast<double>(q.size));
-    if (es.eigenvalues()(2) >= 0.6 && !thin_closed[r]) {
-      Point3 axis = Point3::from(es.eigenvectors().col(2).normalized());
+    if (!(flat_axis[r] == Point3{}) && !thin_closed[r]) {
+      const Point3 axis = flat_axis[r];
       const bool vertical = std::abs(axis.z) >= std::sqrt(0.5);
       const double sign = vertical ? axis.z : dot(q.normal_sum, axis);
       q.axis = sign < 0 ? -axis : axis;

@@ -187,6 +187,54 @@ TEST_CASE("prepare_scan: outliers in the box get no vote, the surface keeps its 
   CHECK(r.outliers == 0);
 }
 
+TEST_CASE("prepare_scan: outliers near the surface (2-5 spacings off) get no vote; corners and noise keep theirs",
+          "[scan]") {
+  // Stray points just off the surface (a flying pixel beside its edge, a misread return): their neighbours
+  // are surface points, their own residuals small, so the point stands off their quadric by many times
+  // the neighbours' scale. Before the quadric rule, those within about 4 spacings stayed and each grew a
+  // spike of the mesh (docs/scans.md, step 4).
+  // Area-uniform random samples (as a scan's, not a grid's: the nearest-neighbour spacing is about half
+  // the side of the area per point, which the plane rule's floor follows).
+  Gauss g(21);
+  auto on_sphere = [&g] {
+    const Point3 d{g(), g(), g()};
+    return d * (1 / vitri::norm(d));
+  };
+  std::vector<Point3> p;
+  for (int i = 0; i < 6000; ++i) p.push_back(on_sphere());
+  // The median nearest-neighbour distance of n uniform points on the unit sphere: sqrt(4 ln 2 / n).
+  const double spacing = std::sqrt(4 * std::log(2.0) / 6000.0);  // about 0.0215
+  const std::size_t clean = p.size();
+  for (int i = 0; i < 120; ++i) {  // 2%, each 2 to 5 spacings inside or outside the sphere
+    const double off = (2 + 3 * g.uniform()) * spacing * (g.uniform() < 0.5 ? -1 : 1);
+    p.push_back(on_sphere() * (1 + off));
+  }
+  vitri::ScanReport r;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.outliers >= 114);  // at least 95% of the 120
+  CHECK(r.outliers <= 120 + clean / 200);
+  std::size_t stray = 0;
+  for (const Point3& q : s.points) stray += std::abs(vitri::norm(q) - 1) > 1.5 * spacing;
+  CHECK(stray <= 6);
+
+  // The surface of a cube (sharp edges and corners, a regular grid of 6 x 24^2 points, spacing 1/23):
+  // nothing set aside. Noise of half a spacing on the sphere: under 1% set aside.
+  std::vector<Point3> cube;
+  for (int f = 0; f < 6; ++f)
+    for (int a = 0; a < 24; ++a)
+      for (int b = 0; b < 24; ++b) {
+        const double u = a / 23.0 - 0.5, v = b / 23.0 - 0.5, w = f % 2 ? 0.5 : -0.5;
+        cube.push_back(f / 2 == 0 ? Point3{w, u, v} : f / 2 == 1 ? Point3{u, w, v} : Point3{u, v, w});
+      }
+  vitri::prepare_scan(cube, {}, {}, &r);
+  CHECK(r.outliers == 0);
+  std::vector<Point3> noisy;
+  for (int i = 0; i < 6000; ++i) noisy.push_back(on_sphere() * (1 + 0.5 * spacing * g()));
+  vitri::prepare_scan(noisy, {}, {}, &r);
+  CHECK(r.outliers <= 60);
+}
+
 TEST_CASE("prepare_scan: a thin plate sampled 10x more sparsely is kept; outliers around it are not", "[scan]") {
   // A unit sphere (8000 points, spacing about 0.04) and beside it a plate 2 x 2 x 0.1 sampled over its six
   // faces 10x more sparsely (spacing about 0.125): the plate's neighbourhoods hold both large faces

@@ -397,8 +397,9 @@ double local_spacing(const Neighbours& nb, std::size_t i) {
 /// a function of its own and its neighbours' positions in list order, is the same. The others are queried
 /// again in `index` and fitted again. The result equals nearest_neighbours() and fit_neighbourhood() over
 /// the survivors, at the cost of the points near a removed one.
-void refresh_after_removal(const std::vector<Point3>& p, const PointIndex& index, const std::vector<std::size_t>& keep,
-                           Neighbours& nb, std::vector<LocalFit>& fit, unsigned threads) {
+std::vector<std::uint8_t> refresh_after_removal(const std::vector<Point3>& p, const PointIndex& index,
+                                                const std::vector<std::size_t>& keep, Neighbours& nb,
+                                                std::vector<LocalFit>& fit, unsigned threads) {
   const std::size_t k = nb.k, old_n = fit.size(), n = keep.size();
   constexpr Id kGone = std::numeric_limits<Id>::max();
   std::vector<Id> renumber(old_n, kGone);
@@ -426,6 +427,7 @@ void refresh_after_removal(const std::vector<Point3>& p, const PointIndex& index
   rbf_detail::parallel_chunks(again.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
     for (std::size_t a = b; a < e; ++a) fit[again[a]] = fit_neighbourhood(p, nb, again[a]);
   });
+  return stale;
 }
 
 /// Connected components of the neighbour graph restricted to edges no longer than 3 local spacings (of
@@ -547,10 +549,24 @@ QuadricCheck neighbours_quadric(const std::vector<Point3>& p, const Neighbours& 
   return out;
 }
 
+/// What find_outliers() hands from one round of prepare_scan()'s outlier rules to the next.
+struct OutlierRound {
+  /// The volume candidates of the round (one flag per point; the caller keeps the rows of the points
+  /// kept, in their new order, before the next round).
+  std::vector<std::uint8_t> volume;
+  double typical_reach = 0;  ///< the round's median reach (k-th neighbour distance)
+};
+
 /// Outliers among distinct points: far off the plane of their neighbours, much sparser than their
 /// neighbours, scattered in a volume, or in a small cluster cut off from the rest. Returns a flag per point.
+/// `stale` (a later round: the rows refresh_after_removal() recomputed; null: every point) with `last`
+/// (that round's OutlierRound, rows of the kept points): a point whose row, whose neighbours' rows and
+/// whose side of the density thresholds did not change gets the per-point verdict of the round before
+/// (kept, its volume flag) without computing it again: every input of that verdict is the same. `last`
+/// is then overwritten with this round's.
 std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const PointIndex& index, const Neighbours& nb,
-                                        const std::vector<double>& noise, unsigned threads) {
+                                        const std::vector<double>& noise, unsigned threads, OutlierRound& last,
+                                        const std::vector<std::uint8_t>* stale) {
   const std::size_t n = p.size(), k = nb.k;
   std::vector<double> mean_d(n);
   for (std::size_t i = 0; i < n; ++i) {
@@ -563,10 +579,27 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Poin
   for (std::size_t i = 0; i < n; ++i) reach[i] = nb.d(i, k - 1);
   const double typical_reach = median(reach);
   std::vector<std::uint8_t> volume(n, 0);
+  // The points whose verdict must be computed: all, or those whose inputs changed (their row or a
+  // neighbour's row: mean distances, reaches, noise; or the k-th neighbour between the two rounds'
+  // thresholds of 2 x the typical reach).
+  std::vector<std::uint8_t> compute(n, 1);
+  if (stale && last.volume.size() == n) {
+    const double lo = 2.0 * std::min(typical_reach, last.typical_reach);
+    const double hi = 2.0 * std::max(typical_reach, last.typical_reach);
+    for (std::size_t i = 0; i < n; ++i) {
+      bool changed = (*stale)[i] || (nb.d(i, k - 1) >= lo && nb.d(i, k - 1) <= hi);
+      for (std::size_t c = 0; c < k && !changed; ++c) changed = (*stale)[nb.at(i, c)];
+      compute[i] = changed;
+    }
+  }
   rbf_detail::parallel_chunks(n, threads, kGrain, [&](std::size_t b, std::size_t e) {
     std::vector<double> tmp;
     Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
     for (std::size_t i = b; i < e; ++i) {
+      if (!compute[i]) {  // kept by the round before (a point it set aside is gone), the same inputs
+        volume[i] = last.volume[i];
+        continue;
+      }
       tmp.clear();
       for (std::size_t c = 0; c < k; ++c) tmp.push_back(mean_d[nb.at(i, c)]);
       const double local_d = median_in_place(tmp);
@@ -620,6 +653,8 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Poin
       if (qc.valid && qc.residual > std::max(6.0 * qc.scale, h)) out[i] = 1;
     }
   });
+  last.volume = volume;
+  last.typical_reach = typical_reach;
   // The volume candidates: set aside unless the points around them lie on a surface. The local dimension
   // (64 neighbours: past the thickness of a thin part, whose two sides then read as one sheet) of the
   // candidate and its k neighbours, their median: on the simulated cases (docs/scans.md) sparse thin
@@ -1140,10 +1175,14 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // Outliers: set aside, then the neighbourhoods of the inliers; again, up to three rounds, while some
   // are found: outliers whose neighbours were other outliers (spread over the box) look ordinary among
   // them, and stand out once those are gone (their neighbours are then surface points).
+  // (A later round computes again only the points whose inputs changed: find_outliers, `stale`.)
+  OutlierRound last;
+  std::vector<std::uint8_t> stale;
   for (int round = 0; round < 3 && options.remove_outliers; ++round) {
     std::vector<double> noise(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) noise[i] = fit[i].noise;
-    const std::vector<std::uint8_t> outlier = find_outliers(p, index, nb, noise, threads);
+    const std::vector<std::uint8_t> outlier =
+        find_outliers(p, index, nb, noise, threads, last, stale.empty() ? nullptr : &stale);
     std::vector<std::size_t> keep;
     for (std::size_t u = 0; u < p.size(); ++u)
       if (!outlier[u]) keep.push_back(u);
@@ -1160,12 +1199,15 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     p.swap(q);
     src.swap(s);
     index = PointIndex(p, threads);
+    for (std::size_t r = 0; r < keep.size(); ++r) last.volume[r] = last.volume[keep[r]];
+    last.volume.resize(keep.size());
     if (clamp_k(k) == k) {
-      refresh_after_removal(p, index, keep, nb, fit, threads);
+      stale = refresh_after_removal(p, index, keep, nb, fit, threads);
     } else {
       k = clamp_k(k);
       nb = nearest_neighbours(p, index, k, threads);
       fit_all(p);
+      stale.clear();  // every row new: every point computed
     }
   }
   std::size_t collinear = 0;

@@ -843,7 +843,7 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     q.abs_sum += std::abs(v);
     q.normal_sum = q.normal_sum + n[i] * point_area[i];
   }
-    // Parts with most normals along one axis (its eigenvector of the normal tensor; zero elsewhere), and
+  // Parts with most normals along one axis (its eigenvector of the normal tensor; zero elsewhere), and
   // whether they are layered along it (a thin closed object, not a sheet: layered_along()).
   std::vector<std::vector<Id>> flat_members(count);
   std::vector<Point3> flat_axis(count);

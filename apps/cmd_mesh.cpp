@@ -246,6 +246,17 @@ void print_init_split(const PolygonizerStats& s) {
                1e3 * s.init_classify_seconds);
 }
 
+/// The scan preparation's own steps (stderr): where the time of a large scan goes.
+void print_scan_split(const ScanReport& r) {
+  std::string line = "  preparation:";
+  char buf[96];
+  for (std::size_t i = 0; i < r.steps.size(); ++i) {
+    std::snprintf(buf, sizeof buf, "%s %s %.0f ms", i ? "," : "", r.steps[i].first.c_str(), 1e3 * r.steps[i].second);
+    line += buf;
+  }
+  std::fprintf(stderr, "%s (%.0f ms in all)\n", line.c_str(), 1e3 * r.seconds);
+}
+
 /// The local fit's own steps (stderr): where the time of a large fit goes.
 void print_fit_split(const LocalFitReport& r) {
   std::fprintf(stderr,
@@ -760,6 +771,7 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
     const ScanReport& sr = mesher.stats().scan;
     if (!c.quiet) {
       std::fprintf(stderr, "%s\n", describe(sr).c_str());
+      if (mesher.size() >= kFitProgressConstraints) print_scan_split(sr);
       print_build_report(mesher.stats().scan_constraints, options.constraint_build);
     }
     if (plan.default_precision) {

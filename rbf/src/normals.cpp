@@ -23,6 +23,7 @@
 
 #include "vitri/rbf/normals.hpp"
 
+#include "normals_detail.hpp"
 #include "parallel.hpp"
 
 #include "vitri/rbf/point_index.hpp"
@@ -37,7 +38,7 @@
 #include <functional>
 #include <limits>
 #include <numeric>
-#include <queue>
+#include <vector>
 #include <thread>
 #include <tuple>
 
@@ -119,6 +120,11 @@ class NeighbourTable {
           if (v != u && c < k) ids_[u * k + c++] = v;
       }
     });
+  }
+  /// Rows given: the first k of each `stride`-long row of `rows` (n rows).
+  NeighbourTable(const std::uint32_t* rows, std::size_t n, std::size_t stride, std::size_t k)
+      : k_(k), ids_(n * k) {
+    for (std::size_t u = 0; u < n; ++u) std::copy_n(rows + u * stride, k, ids_.begin() + u * k);
   }
   std::size_t k() const { return k_; }
   std::size_t size() const { return ids_.size() / k_; }
@@ -229,23 +235,97 @@ double edge_cost(const DistinctPoints& d, const std::vector<Point3>& n, Id a, Id
   return 1.0 - std::abs(dot(n[a], n[b])) + along;
 }
 
+/// The frontier of Prim's algorithm: for every point not yet reached, its cheapest known edge (cost,
+/// from), in a binary heap ordered by (cost, to, from). Its pops are those of a heap holding every edge
+/// offered (the lazy form): the smallest (cost, to, from) of all edges offered to points not yet reached
+/// is the smallest over those points of each one's smallest (cost, from). It holds at most one entry per
+/// point instead of one per edge (the neighbour graph of k = 12 has about 24 per point).
+class PrimFrontier {
+ public:
+  explicit PrimFrontier(std::size_t n) : at_(n, kAbsent) {}
+  bool empty() const { return heap_.empty(); }
+  /// Offers edge (from, to) of this cost; kept when it is the cheapest known edge to `to`.
+  void offer(double cost, Id to, Id from) {
+    const Entry e{cost, to, from};
+    std::size_t i = at_[to];
+    if (i == kAbsent) {
+      i = heap_.size();
+      heap_.push_back(e);
+    } else if (less(e, heap_[i])) {
+      heap_[i] = e;
+    } else {
+      return;
+    }
+    up(i);
+  }
+  /// Removes and returns the smallest entry (cost, to, from).
+  std::tuple<double, Id, Id> pop() {
+    const Entry top = heap_.front();
+    at_[top.to] = kRemoved;
+    const Entry last = heap_.back();
+    heap_.pop_back();
+    if (!heap_.empty()) {
+      heap_[0] = last;
+      at_[last.to] = 0;
+      down(0);
+    }
+    return {top.cost, top.to, top.from};
+  }
+
+ private:
+  struct Entry {
+    double cost;
+    Id to, from;
+  };
+  static constexpr std::size_t kAbsent = std::numeric_limits<std::size_t>::max();
+  static constexpr std::size_t kRemoved = kAbsent - 1;  // popped: never offered again (the caller's done[])
+  static bool less(const Entry& a, const Entry& b) {
+    return a.cost < b.cost || (a.cost == b.cost && (a.to < b.to || (a.to == b.to && a.from < b.from)));
+  }
+  void place(std::size_t i, const Entry& e) {
+    heap_[i] = e;
+    at_[e.to] = i;
+  }
+  void up(std::size_t i) {
+    const Entry e = heap_[i];
+    while (i > 0) {
+      const std::size_t parent = (i - 1) / 2;
+      if (!less(e, heap_[parent])) break;
+      place(i, heap_[parent]);
+      i = parent;
+    }
+    place(i, e);
+  }
+  void down(std::size_t i) {
+    const Entry e = heap_[i];
+    const std::size_t n = heap_.size();
+    for (;;) {
+      std::size_t c = 2 * i + 1;
+      if (c >= n) break;
+      if (c + 1 < n && less(heap_[c + 1], heap_[c])) ++c;
+      if (!less(heap_[c], e)) break;
+      place(i, heap_[c]);
+      i = c;
+    }
+    place(i, e);
+  }
+  std::vector<Entry> heap_;
+  std::vector<std::size_t> at_;  // heap position of each point's entry, kAbsent or kRemoved
+};
+
 /// Orients the normals of one component by Prim's algorithm from `seed`; updates the report.
 void orient_component(const DistinctPoints& d, const NeighbourGraph& g, Id seed, std::vector<Point3>& n,
                       std::vector<char>& done, OrientationReport& rep, double min_link, std::size_t k,
-                      bool strict) {
-  using Item = std::tuple<double, Id, Id>;  // (cost, to, from): ties broken by ids, deterministic
-  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> frontier;
+                      bool strict, PrimFrontier& frontier) {
   auto visit = [&](Id u) {
     done[u] = 1;
     for (const Id* v = g.begin(u); v != g.end(u); ++v)
-      if (!done[*v]) frontier.emplace(edge_cost(d, n, u, *v), *v, u);
+      if (!done[*v]) frontier.offer(edge_cost(d, n, u, *v), *v, u);
   };
   visit(seed);
   while (!frontier.empty()) {
-    const auto [cost, to, from] = frontier.top();
-    frontier.pop();
+    const auto [cost, to, from] = frontier.pop();
     (void)cost;
-    if (done[to]) continue;
     const double c = dot(n[from], n[to]);
     if (std::abs(c) < min_link && !strict) {
       ++rep.ambiguous;
@@ -354,6 +434,7 @@ OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable&
   const std::size_t min_size = opt.min_component ? opt.min_component : 2 * (opt.k + 1);
   OrientationReport rep;
   std::vector<char> done(g.size(), 0);
+  PrimFrontier frontier(g.size());
   for (const Component& part : parts) {
     if (part.size == 0) continue;
     const Id s = part.seed;
@@ -376,7 +457,7 @@ OrientationReport orient_distinct(const DistinctPoints& d, const NeighbourTable&
       ++rep.flipped;
     }
     ++rep.components;
-    orient_component(d, g, s, n, done, rep, opt.min_link, opt.k, opt.strict);
+    orient_component(d, g, s, n, done, rep, opt.min_link, opt.k, opt.strict, frontier);
   }
   const Disagreement dis = disagreement(d, t, n);
   rep.disagreement = dis.fraction;
@@ -410,13 +491,10 @@ std::vector<Point3> estimate_normals(const std::vector<Point3>& points, const No
   return expand(d, pca_normals(d, t, options));
 }
 
-OrientationReport orient_normals(const std::vector<Point3>& points, std::vector<Point3>& normals,
-                                 const NormalOptions& options) {
-  if (normals.size() != points.size())
-    throw InvalidArgument("orient_normals: " + std::to_string(points.size()) + " points but " +
-                          std::to_string(normals.size()) + " normals");
-  const DistinctPoints d = distinct_points(points);
-  check_options(options, d.points.size());
+namespace {
+
+/// The given normals of the distinct points, unit; InvalidPoint (input index) for a non-finite or zero one.
+std::vector<Point3> unit_normals(const DistinctPoints& d, const std::vector<Point3>& normals) {
   std::vector<Point3> n(d.points.size());
   for (std::size_t u = 0; u < n.size(); ++u) {
     const std::size_t i = d.first[u];
@@ -424,11 +502,49 @@ OrientationReport orient_normals(const std::vector<Point3>& points, std::vector<
     if (!(norm(normals[i]) > 0)) throw InvalidPoint(i, "zero normal");
     n[u] = normals[i] / norm(normals[i]);
   }
+  return n;
+}
+
+}  // namespace
+
+OrientationReport orient_normals(const std::vector<Point3>& points, std::vector<Point3>& normals,
+                                 const NormalOptions& options) {
+  if (normals.size() != points.size())
+    throw InvalidArgument("orient_normals: " + std::to_string(points.size()) + " points but " +
+                          std::to_string(normals.size()) + " normals");
+  const DistinctPoints d = distinct_points(points);
+  check_options(options, d.points.size());
+  std::vector<Point3> n = unit_normals(d, normals);
   const NeighbourTable t(d.points, options.k, options.threads);
   const OrientationReport rep = orient_distinct(d, t, n, options);
   normals = expand(d, n);
   return rep;
 }
+
+namespace rbf_detail {
+
+OrientationReport orient_distinct_normals(const std::vector<Point3>& points, const std::uint32_t* rows,
+                                          std::size_t stride, std::vector<Point3>& normals,
+                                          const NormalOptions& options) {
+  if (normals.size() != points.size())
+    throw InvalidArgument("orient_normals: " + std::to_string(points.size()) + " points but " +
+                          std::to_string(normals.size()) + " normals");
+  if (options.k > stride)
+    throw InvalidArgument("orient_normals: k = " + std::to_string(options.k) + " but rows of " +
+                          std::to_string(stride) + " neighbours given");
+  DistinctPoints d;  // the points as they are: distinct by the caller's word
+  d.points = points;
+  d.first.resize(points.size());
+  std::iota(d.first.begin(), d.first.end(), std::size_t(0));
+  check_options(options, d.points.size());
+  std::vector<Point3> n = unit_normals(d, normals);
+  const NeighbourTable t(rows, points.size(), stride, options.k);
+  const OrientationReport rep = orient_distinct(d, t, n, options);
+  normals.swap(n);
+  return rep;
+}
+
+}  // namespace rbf_detail
 
 std::vector<Point3> estimate_oriented_normals(const std::vector<Point3>& points, const NormalOptions& options,
                                               OrientationReport* report) {

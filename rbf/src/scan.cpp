@@ -10,6 +10,7 @@
 #include "vitri/rbf/point_index.hpp"
 #include "vitri/rbf/winding.hpp"
 
+#include "normals_detail.hpp"
 #include "parallel.hpp"
 #include "spaced_subset.hpp"
 
@@ -1038,6 +1039,12 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
                         const ScanOptions& options, ScanReport* report) {
   const auto t0 = std::chrono::steady_clock::now();
   ScanReport rep;
+  auto last_lap = t0;
+  const auto lap = [&](const char* step) {  // ScanReport::steps
+    const auto now = std::chrono::steady_clock::now();
+    rep.steps.emplace_back(step, std::chrono::duration<double>(now - last_lap).count());
+    last_lap = now;
+  };
   rep.input = input.size();
   if (!normals.empty() && normals.size() != input.size())
     throw InvalidArgument("prepare_scan: " + std::to_string(input.size()) + " points but " +
@@ -1077,8 +1084,11 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
                           std::to_string(kMinPoints) + " needed)");
   std::vector<Point3> p(src.size());
   for (std::size_t u = 0; u < src.size(); ++u) p[u] = input[src[u]];
-  if (options.dequantize && options.approximate && options.viewpoint && options.sensors.empty())
+  lap("duplicates");
+  if (options.dequantize && options.approximate && options.viewpoint && options.sensors.empty()) {
     rep.dequantized = dequantize_depth(p, *options.viewpoint, options.threads, rep);
+    lap("dequantize");
+  }
 
   // Neighbourhoods: k from the data. 16 neighbours first; where the noise is large against their
   // radius, more (the plane residual grows with the noise, the radius with sqrt(k)).
@@ -1170,6 +1180,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     }
   }
   rep.k = k;
+  lap("neighbours");
 
   std::vector<Point3> set_aside;
   // Outliers: set aside, then the neighbourhoods of the inliers; again, up to three rounds, while some
@@ -1210,6 +1221,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       stale.clear();  // every row new: every point computed
     }
   }
+  if (options.remove_outliers) lap("outliers");
   std::size_t collinear = 0;
   for (const LocalFit& f : fit) collinear += f.collinear;
   if (collinear == p.size())
@@ -1282,7 +1294,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       no.k = std::min<std::size_t>(k, 12);
       no.threads = threads;
       no.strict = false;
-      orient_normals(p, own, no);
+      rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, own, no);
       settle_components(p, nb, own, threads);
       std::size_t same = 0;
       for (std::size_t i = 0; i < p.size(); ++i) same += dot(own[i], n[i]) > 0;
@@ -1311,7 +1323,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     no.threads = threads;
     no.strict = false;
     no.min_link = 0.1;
-    const OrientationReport orep = orient_normals(p, n, no);
+    const OrientationReport orep = rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, n, no);
     rep.ambiguous += orep.ambiguous;
     settle_components(p, nb, n, threads);
   }
@@ -1328,6 +1340,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     undecided_count = 0;
     if (flips == 0) break;
   }
+
+  lap("orientation");  // (with the per-region noise above)
 
   // Misregistered layers merged (merge_layers), before the projection smooths what is left.
   // The second pass examines only the points whose neighbours the first one may have changed: those it
@@ -1362,6 +1376,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       });
     }
     for (const double t : total) rep.merged += t != 0.0;
+    lap("layers");
   }
 
   // Approximation: the projection onto the local quadrics of each point's own side (twice where the data
@@ -1396,6 +1411,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     std::vector<double> d(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) d[i] = norm(p[i] - before[i]);
     rep.moved = median(d);
+    lap("projection");
   }
 
   std::vector<double> nn(p.size()), local(p.size());
@@ -1445,6 +1461,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   }
   out.set_aside = std::move(set_aside);
   rep.thinned = p.size() - out.points.size();
+  lap("thinning");
   rep.kept = out.points.size();
   rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   if (report) *report = rep;

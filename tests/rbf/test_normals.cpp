@@ -5,7 +5,10 @@
 #include "vitri/io/io.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/normals.hpp"
+#include "vitri/rbf/point_index.hpp"
 #include "vitri/rbf/rbf.hpp"
+
+#include "normals_detail.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -229,6 +232,39 @@ TEST_CASE("normals: orient_normals restores random flips; threads and duplicates
   CHECK(nd.back() == nd[17]);
   const auto nu = estimate_oriented_normals(s.points);
   CHECK(std::vector<Point3>(nd.begin(), nd.end() - 1) == nu);
+}
+
+TEST_CASE("normals: the orientation from neighbour rows already known is orient_normals', bit for bit",
+          "[rbf][normals]") {
+  // prepare_scan hands its own neighbour lists (rows of 20 here, of which k = 12 are used) to the
+  // orientation instead of letting it query them again: the same tree, the same signs, the same report.
+  const Samples s = mesh_vertices("bunny.off");
+  std::vector<Point3> given = estimate_normals(s.points);  // unoriented: signs by the largest component
+  const std::size_t stride = 20;
+  const PointIndex index(s.points);
+  std::vector<std::uint32_t> rows(s.points.size() * stride);
+  std::vector<PointIndex::Id> found;
+  for (std::size_t u = 0; u < s.points.size(); ++u) {
+    index.nearest(s.points[u], stride + 1, found);
+    std::size_t c = 0;
+    for (const PointIndex::Id v : found)
+      if (v != u && c < stride) rows[u * stride + c++] = v;
+    REQUIRE(c == stride);
+  }
+  NormalOptions o;
+  o.strict = false;
+  std::vector<Point3> a = given, b = given;
+  const OrientationReport ra = orient_normals(s.points, a, o);
+  const OrientationReport rb = rbf_detail::orient_distinct_normals(s.points, rows.data(), stride, b, o);
+  CHECK(a == b);
+  CHECK(ra.flipped == rb.flipped);
+  CHECK(ra.ambiguous == rb.ambiguous);
+  CHECK(ra.components == rb.components);
+  CHECK(ra.weakest_link == rb.weakest_link);
+  CHECK(ra.flipped > 100);  // the signs did have to be decided
+  CHECK(wrong_sides(b, s.normals) < s.points.size() / 100);
+  o.k = stride + 1;  // more than the rows hold
+  CHECK_THROWS_AS(rbf_detail::orient_distinct_normals(s.points, rows.data(), stride, b, o), InvalidArgument);
 }
 
 TEST_CASE("normals: bad input gets a clear error naming the point", "[rbf][normals]") {

@@ -15,6 +15,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vitri {
@@ -98,6 +99,11 @@ struct ScanReport {
   bool viewpoint_rejected = false;
   std::string viewpoint_note;
   double seconds = 0;  ///< wall time of prepare_scan()
+  /// Where that time went, step by step in the order run (name, wall seconds): "duplicates",
+  /// "dequantize", "neighbours" (the lists, the fits, the choice of k), "outliers" (every round),
+  /// "orientation", "layers" (misregistered layers merged), "projection", "thinning". A step that did
+  /// not run is absent.
+  std::vector<std::pair<std::string, double>> steps;
 };
 
 /// Oriented points ready for constraints_from_oriented_points(), with what the mesher needs to follow

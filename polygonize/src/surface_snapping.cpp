@@ -114,13 +114,13 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
   }
 }
 
-// The stars, fans and snap targets of first[from, from + kLookaheadChunk): they depend on the
+// The stars, fans and snap targets of first[from, from + lookahead_chunk(threads)): they depend on the
 // triangulation, the polygons, the crossings and the function only, not on any decision, so slices of
 // the chunk run on the threads and the serial pass reads what it would have computed. The targets join
 // the cache (the evaluations the serial pass would have made: same vertices, same calls of f).
 void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<VertexId>& first, std::size_t from,
                                 const AnchoredCorners* at, SnapLookahead& look) {
-  const std::size_t n = std::min(kLookaheadChunk, first.size() - from);
+  const std::size_t n = std::min(lookahead_chunk(resolve_thread_count(in.threads)), first.size() - from);
   look.begin = from;
   look.end = from + n;
   const std::size_t slices = polygonizer_detail::slice_count(in.threads, n, kLookaheadSlice);

@@ -77,10 +77,15 @@ class SurfaceTracker {
  public:
   static constexpr std::uint32_t kNone = 0xffffffffu;
   /// From this many first offers on, the collapse decisions look ahead (TrackerInput::snap_lookahead),
-  /// in chunks of kLookaheadChunk offers cut in slices of at least kLookaheadSlice per thread.
+  /// in chunks of lookahead_chunk(threads) offers cut in slices of at least kLookaheadSlice per thread.
+  /// A chunk's fans take about a kilobyte per offer (about ten triangles of 96 bytes), so a chunk holds
+  /// two slices per thread, no more (a chunk of 2^15 offers on two threads was 75 MB of the 264 MB peak
+  /// of the shared laser_room scan); what a chunk computes does not depend on its size.
   static constexpr std::size_t kLookaheadMin = std::size_t(1) << 12;
-  static constexpr std::size_t kLookaheadChunk = std::size_t(1) << 15;
   static constexpr std::size_t kLookaheadSlice = std::size_t(1) << 11;
+  static std::size_t lookahead_chunk(std::size_t threads) {
+    return std::min(std::size_t(1) << 15, std::max(kLookaheadMin, 2 * threads * kLookaheadSlice));
+  }
   /// Stars the lookahead walks together (Triangulation::incident_tetrahedra of several vertices).
   static constexpr std::size_t kStarChunk = 64;
 

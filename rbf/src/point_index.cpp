@@ -437,6 +437,27 @@ std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::si
   return count;
 }
 
+bool PointIndex::ball_up_to(const Point3& center, double radius2, std::size_t limit, std::vector<Id>& out) const {
+  out.clear();
+  if (size_ == 0) return true;
+  NodeStack stack;
+  stack.push(0);
+  while (!stack.empty()) {
+    const Node& n = nodes_[stack.pop()];
+    if (!(box_distance2(n.lo, n.hi, center) < radius2)) continue;
+    if (n.leaf()) {
+      const Entry* b = bucket_begin(n);
+      for (std::uint32_t k = 0; k < n.bucket.count; ++k)
+        if (squared_distance(b[k].p, center) < radius2) out.push_back(b[k].id);
+      if (out.size() > limit) return false;
+    } else {
+      stack.push(n.child + 1);
+      stack.push(n.child);
+    }
+  }
+  return true;
+}
+
 void PointIndex::close_pairs(double radius2, const std::function<void(Id, Id)>& visit) const {
   if (size_ == 0) return;
   const double inf = std::numeric_limits<double>::infinity();

@@ -1018,15 +1018,31 @@ std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>
       }
     });
   } else {
-    struct Scratch {
-      std::vector<double> same, keep;
-    };
-    sweep_nearest(p, index, kMergeNeighbours, threads, only,
-                  [&](std::size_t i, const std::vector<Id>& near, const std::vector<double>& d2) {
-                    thread_local Scratch t;
-                    reach[i] = d2.empty() ? 0.0 : std::sqrt(d2.back());
-                    examine(i, near, t.same, t.keep);
-                  });
+    // Every point of the cylinder lies within sqrt(rc^2 + half^2) = sqrt(20) h of the point. When that
+    // ball (widened far beyond the rounding of the cylinder's test) holds at most kMergeNeighbours points,
+    // the point itself included, they are all among its kMergeNeighbours nearest, so the ball's points
+    // give the same cylinder as the nearest would: a ball query (about 63 points on one layer, 126 in an
+    // overlap of two) instead of a selection of the 96 nearest. The reach is then the ball's radius (no
+    // point farther out can change what the point examines). Fuller balls (a sparse point beside a dense
+    // region, overlaps) take the 96 nearest as before.
+    const std::vector<std::size_t> order = detail::spatial_order(p);
+    rbf_detail::parallel_chunks(order.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
+      std::vector<Id> near;
+      std::vector<double> d2, same, keep;
+      for (std::size_t o = b; o < e; ++o) {
+        const std::size_t i = order[o];
+        if (only && !(*only)[i]) continue;
+        const double h = std::max(spacing[i], floor);
+        const double r = std::sqrt(20.0) * h * (1.0 + 1e-9);
+        if (index.ball_up_to(p[i], r * r, kMergeNeighbours, near)) {
+          reach[i] = r;
+        } else {
+          index.nearest(p[i], kMergeNeighbours, near, &d2);
+          reach[i] = d2.empty() ? 0.0 : std::sqrt(d2.back());
+        }
+        examine(i, near, same, keep);
+      }
+    });
   }
   std::size_t moved = 0;
   for (const double d : shift) moved += d != 0.0;

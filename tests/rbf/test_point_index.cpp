@@ -71,6 +71,17 @@ void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rn
     index.ball(c, r2, got);
     REQUIRE(got == brute.ball(c, r2));
     REQUIRE(index.count_ball(c, r2) == got.size());
+    {  // ball_up_to: the ball's points (any order) when at most `limit`, else false
+      const std::vector<Id> all = got;
+      std::vector<Id> capped;
+      for (const std::size_t limit : {std::size_t(0), all.size() / 2, all.size(), all.size() + 5}) {
+        const bool whole = index.ball_up_to(c, r2, limit, capped);
+        REQUIRE(whole == (all.size() <= limit));
+        if (!whole) continue;
+        std::sort(capped.begin(), capped.end());
+        REQUIRE(capped == all);
+      }
+    }
     // Kept sorted up to 24, selected from a buffer of 2k beyond (cut at 2k, 4k... candidates: 97 and
     // 200 cut it several times, among the 40 coincident points too).
     for (std::size_t k : {1u, 7u, 24u, 25u, 33u, 64u, 65u, 97u, 200u}) {

@@ -67,6 +67,9 @@ class PointIndex {
   /// exceeds `limit` (the answer is then limit + 1), so that "more than n?" costs O(log size() + n).
   std::size_t count_ball(const Point3& center, double radius2,
                          std::size_t limit = static_cast<std::size_t>(-1)) const;
+  /// ball() when it holds at most `limit` points: their ids, in no particular order, and true; false as
+  /// soon as more are found (`out` then holds some of them). O(log size() + limit) like count_ball().
+  bool ball_up_to(const Point3& center, double radius2, std::size_t limit, std::vector<Id>& out) const;
   /// Calls visit(i, j), i < j, once for every pair of points closer than sqrt(radius2) (squared distance
   /// < radius2) and every pair of coincident points whatever radius2, in no particular order. Meant for
   /// small radii (near-duplicate checks): pairs inside one leaf are compared directly and only points

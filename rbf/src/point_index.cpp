@@ -397,48 +397,8 @@ void PointIndex::erase(Id id) {
   --size_;
 }
 
-void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out) const {
-  out.clear();
-  if (size_ == 0) return;
-  NodeStack stack;
-  stack.push(0);
-  while (!stack.empty()) {
-    const Node& n = nodes_[stack.pop()];
-    if (!(box_distance2(n.lo, n.hi, center) < radius2)) continue;
-    if (n.leaf()) {
-      const Entry* b = bucket_begin(n);
-      for (std::uint32_t k = 0; k < n.bucket.count; ++k)
-        if (squared_distance(b[k].p, center) < radius2) out.push_back(b[k].id);
-    } else {
-      stack.push(n.child + 1);
-      stack.push(n.child);
-    }
-  }
-  std::sort(out.begin(), out.end());
-}
-
-std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::size_t limit) const {
-  if (size_ == 0) return 0;
-  std::size_t count = 0;
-  NodeStack stack;
-  stack.push(0);
-  while (!stack.empty()) {
-    const Node& n = nodes_[stack.pop()];
-    if (!(box_distance2(n.lo, n.hi, center) < radius2)) continue;
-    if (n.leaf()) {
-      const Entry* b = bucket_begin(n);
-      for (std::uint32_t k = 0; k < n.bucket.count; ++k) count += squared_distance(b[k].p, center) < radius2;
-      if (count > limit) return limit + 1;
-    } else {
-      stack.push(n.child + 1);
-      stack.push(n.child);
-    }
-  }
-  return count;
-}
-
-bool PointIndex::ball_up_to(const Point3& center, double radius2, std::size_t limit, std::vector<Id>& out) const {
-  out.clear();
+template <class Leaf>
+bool PointIndex::visit_ball_leaves(const Point3& center, double radius2, Leaf&& leaf) const {
   if (size_ == 0) return true;
   NodeStack stack;
   stack.push(0);
@@ -446,16 +406,41 @@ bool PointIndex::ball_up_to(const Point3& center, double radius2, std::size_t li
     const Node& n = nodes_[stack.pop()];
     if (!(box_distance2(n.lo, n.hi, center) < radius2)) continue;
     if (n.leaf()) {
-      const Entry* b = bucket_begin(n);
-      for (std::uint32_t k = 0; k < n.bucket.count; ++k)
-        if (squared_distance(b[k].p, center) < radius2) out.push_back(b[k].id);
-      if (out.size() > limit) return false;
+      if (!leaf(bucket_begin(n), n.bucket.count)) return false;
     } else {
       stack.push(n.child + 1);
       stack.push(n.child);
     }
   }
   return true;
+}
+
+void PointIndex::ball(const Point3& center, double radius2, std::vector<Id>& out) const {
+  out.clear();
+  visit_ball_leaves(center, radius2, [&](const Entry* b, std::uint32_t count) {
+    for (std::uint32_t k = 0; k < count; ++k)
+      if (squared_distance(b[k].p, center) < radius2) out.push_back(b[k].id);
+    return true;
+  });
+  std::sort(out.begin(), out.end());
+}
+
+std::size_t PointIndex::count_ball(const Point3& center, double radius2, std::size_t limit) const {
+  std::size_t count = 0;
+  const bool whole = visit_ball_leaves(center, radius2, [&](const Entry* b, std::uint32_t n) {
+    for (std::uint32_t k = 0; k < n; ++k) count += squared_distance(b[k].p, center) < radius2;
+    return count <= limit;
+  });
+  return whole ? count : limit + 1;
+}
+
+bool PointIndex::ball_up_to(const Point3& center, double radius2, std::size_t limit, std::vector<Id>& out) const {
+  out.clear();
+  return visit_ball_leaves(center, radius2, [&](const Entry* b, std::uint32_t count) {
+    for (std::uint32_t k = 0; k < count; ++k)
+      if (squared_distance(b[k].p, center) < radius2) out.push_back(b[k].id);
+    return out.size() <= limit;
+  });
 }
 
 void PointIndex::close_pairs(double radius2, const std::function<void(Id, Id)>& visit) const {

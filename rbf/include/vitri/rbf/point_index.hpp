@@ -144,6 +144,10 @@ class PointIndex {
   void split_leaf(std::uint32_t node);
   void ensure_id(Id id);
   const Entry* bucket_begin(const Node& n) const { return buckets_.data() + n.bucket.begin; }
+  /// leaf(entries, count) for every leaf whose box meets the open ball, depth first; stops and returns
+  /// false as soon as a call returns false (ball(), count_ball(), ball_up_to()).
+  template <class Leaf>
+  bool visit_ball_leaves(const Point3& center, double radius2, Leaf&& leaf) const;
   /// close_pairs below `node`, whose region (from the splits above it) is [lo, hi].
   void close_pairs_below(std::uint32_t node, Point3 lo, Point3 hi, double radius2,
                          const std::function<void(Id, Id)>& visit) const;

@@ -1,6 +1,7 @@
 // prepare_scan(): noise absorbed, outliers set aside, orientation from normals, a viewpoint or the data,
 // nothing refused for the data's defects (docs/scans.md).
 #include "vitri/core/error.hpp"
+#include "vitri/io/io.hpp"
 #include "vitri/rbf/point_index.hpp"
 #include "vitri/rbf/scan.hpp"
 
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <cstdint>
 #include <random>
+#include <string>
 #include <vector>
 
 using vitri::Point3;
@@ -131,6 +133,38 @@ TEST_CASE("prepare_scan: misregistered layers are merged to their middle; a thin
   }
   CHECK(inner > 1000);
   CHECK(moved_inward == 0);
+}
+
+TEST_CASE("prepare_scan: a clean sample of a real model has no misregistered layers to merge", "[scan]") {
+  // 30,000 area-uniform samples of elephant.off, no noise, no normals. On one clean sheet the heights
+  // in a point's cylinder can still split in two clusters by chance where the surface bends away at a
+  // crease of the model (the far cluster at the rim on one side): 66 points moved, by up to 2.7
+  // spacings, before the clusters had to be centred on the line where the noise is below the gap.
+  const vitri::TriangleMesh m = vitri::read_mesh(std::string(VITRI_DATA_DIR) + "/elephant.off");
+  std::vector<double> cumulative;
+  double total = 0;
+  const auto corner = [&](Eigen::Index f, int k) {
+    return Point3{m.V(m.F(f, k), 0), m.V(m.F(f, k), 1), m.V(m.F(f, k), 2)};
+  };
+  for (Eigen::Index f = 0; f < m.F.rows(); ++f) {
+    total += 0.5 * vitri::norm(vitri::cross(corner(f, 1) - corner(f, 0), corner(f, 2) - corner(f, 0)));
+    cumulative.push_back(total);
+  }
+  Gauss g(11);
+  std::vector<Point3> p;
+  for (int i = 0; i < 30000; ++i) {
+    const auto f = static_cast<Eigen::Index>(std::lower_bound(cumulative.begin(), cumulative.end(), g.uniform() * total) -
+                                             cumulative.begin());
+    double u = g.uniform(), v = g.uniform();
+    if (u + v > 1) u = 1 - u, v = 1 - v;
+    const Point3 a = corner(f, 0), b = corner(f, 1), c = corner(f, 2);
+    p.push_back(a + (b - a) * u + (c - a) * v);
+  }
+  vitri::ScanReport r;
+  vitri::prepare_scan(p, {}, {}, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.outliers == 0);
+  CHECK(r.merged <= 15);  // 5 measured (0.02%)
 }
 
 TEST_CASE("prepare_scan: a noisy part of a clean scan is thinned to its own resolution, the rest kept",

@@ -236,9 +236,11 @@ void bind_blocks(py::module_& m) {
           BlockOptions o;
           o.mesher = mesher_options_from(kw, "refine_block");
           o.precision = precision;
-          const std::vector<Point3> pts = points_arg(points, "points");
+          // A block may see no point at all (a cell of the split far from the data, with its halo): its
+          // result is empty, as in mesh_in_blocks, never an error.
+          const std::vector<Point3> pts = points_arg(points, "points", /*allow_empty=*/true);
           std::vector<Point3> nrm;
-          if (!normals.is_none()) nrm = points_arg(normals, "normals");
+          if (!normals.is_none()) nrm = points_arg(normals, "normals", /*allow_empty=*/true);
           if (!nrm.empty() && nrm.size() != pts.size())
             throw InvalidArgument("refine_block: " + std::to_string(nrm.size()) + " normals for " +
                                   std::to_string(pts.size()) + " points");

@@ -514,15 +514,7 @@ Surface local_surface(const std::string& name, const Constraints& c, const std::
   s.fit_seconds = now() - t0;
   s.owned = std::move(f);
   s.f = s.owned.get();
-  s.constraints = c.size();
-  for (const Point3& p : c.points) s.shape_box.extend(p);
-  s.domain = Polygonizer::domain_for(c.points, 2.0);
-  s.seeds = c.points;
-  s.seed_values = c.values;
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < c.size(); ++i)
-    if (c.values[i] < c.values[best]) best = i;
-  s.inside = c.points[best];
+  set_constraint_surface(s, c);
   return s;
 }
 

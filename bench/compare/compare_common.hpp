@@ -129,6 +129,21 @@ inline Surface analytic_torus() {
   return s;
 }
 
+/// The part of a Surface that follows from the constraints its function was fitted to: the shape box,
+/// the domain (2x the constraints' box), the constraints as seeds with their values, and an inside point
+/// (the constraint of the smallest value). Shared by the global (rbf_surface) and local RBF surfaces.
+inline void set_constraint_surface(Surface& s, const Constraints& c) {
+  s.constraints = c.size();
+  for (const Point3& p : c.points) s.shape_box.extend(p);
+  s.domain = Polygonizer::domain_for(c.points, 2.0);
+  s.seeds = c.points;
+  s.seed_values = c.values;
+  std::size_t best = 0;
+  for (std::size_t i = 1; i < c.size(); ++i)
+    if (c.values[i] < c.values[best]) best = i;
+  s.inside = c.points[best];
+}
+
 inline Surface rbf_surface(const std::string& name, const Constraints& c, const std::string& source,
                            unsigned threads) {
   Surface s;
@@ -143,15 +158,7 @@ inline Surface rbf_surface(const std::string& name, const Constraints& c, const 
   s.residual = rbf->report().relative_residual;
   s.owned = std::move(rbf);
   s.f = s.owned.get();
-  s.constraints = c.size();
-  for (const Point3& p : c.points) s.shape_box.extend(p);
-  s.domain = Polygonizer::domain_for(c.points, 2.0);
-  s.seeds = c.points;
-  s.seed_values = c.values;
-  std::size_t best = 0;
-  for (std::size_t i = 1; i < c.size(); ++i)
-    if (c.values[i] < c.values[best]) best = i;
-  s.inside = c.points[best];
+  set_constraint_surface(s, c);
   return s;
 }
 

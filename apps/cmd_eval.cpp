@@ -125,8 +125,9 @@ int run_eval(const Args& args) {
     mo.function = choose_function(c.size(), mo);  // resolved by the scan path already
   } else {
     ConstraintBuildReport merged;
+    // The far field as a batch `vitri mesh` settles it (a closed mesh's winding number).
     c = constraints_for_function(std::move(data), input, mo.constraint_build, mo.function, mo.auto_local_above,
-                                 merged);
+                                 merged, &mo.local);
   }
   std::unique_ptr<ImplicitFunction> f;
   if (mo.function == FunctionKind::Local) {

@@ -575,6 +575,7 @@ struct MeshPlan {
   /// vertex budget, a mesh meshed as a scan interpolated.
   MesherOptions options;
   bool scan_input = false;         ///< the input went through the scan path (docs/scans.md)
+  bool mesh_far_side = false;      ///< a closed mesh whose winding number settles the local far field
   std::size_t input_points = 0;    ///< a scan's points as read (the memory warning counts against them)
   /// No --precision: the levels use the data's resolution, and the refinement's vertex budget gives a
   /// coarser mesh with a warning instead of an error.
@@ -660,8 +661,12 @@ std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPl
   MesherOptions& options = plan.options;
   phases.start("constraints");
   ConstraintBuildReport merged;
+  // A batch run on a closed mesh settles the local function's far field with the mesh's winding number
+  // (as Mesher::from_mesh); an editing session keeps the planes.
+  const bool settle = !options.polygonizer.keep_history && !options.local.far_side;
   Constraints constraints = constraints_for_function(std::move(data), c.input, options.constraint_build,
-                                                     options.function, options.auto_local_above, merged);
+                                                     options.function, options.auto_local_above, merged,
+                                                     settle ? &options.local : nullptr, &plan.mesh_far_side);
   if (!c.quiet) print_build_report(merged, options.constraint_build);
   if (plan.default_precision) {
     // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
@@ -783,6 +788,10 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
     }
   }
   if (plan.scan_input && mesher.stats().far_jump > 0 && !c.quiet) print_far_field(mesher);
+  if (plan.mesh_far_side && !c.quiet)
+    if (const LocalRbf* local = mesher.local_function())
+      std::fprintf(stderr, "far field: the mesh's winding number settled %zu of %zu patches\n",
+                   local->report().far_settled, local->report().patches);
   if (mesher.size() >= kFitProgressConstraints && !c.quiet) {
     std::fprintf(stderr, "fit done in %.1f s\n", mesher.stats().fit_seconds);
     if (const LocalRbf* local = mesher.local_function()) print_fit_split(local->report());

@@ -1,6 +1,7 @@
 #include "input.hpp"
 
 #include "vitri/core/error.hpp"
+#include "vitri/rbf/winding.hpp"
 
 #include <cstdio>
 #include <optional>
@@ -88,12 +89,23 @@ std::size_t input_points(const Input& in) {
 
 Constraints constraints_for_function(Input in, const std::string& name, ConstraintBuildOptions& build,
                                      FunctionKind& function, std::size_t auto_local_above,
-                                     ConstraintBuildReport& report) {
+                                     ConstraintBuildReport& report, LocalRbfOptions* local, bool* settled) {
+  // A closed mesh's triangles, kept for its winding number when the function may be the local one.
+  std::optional<TriangleMesh> mesh;
+  if (local && in.kind == InputKind::Mesh && function != FunctionKind::Global) mesh = in.mesh;
+  if (settled) *settled = false;
+  auto settle = [&](Constraints c) {
+    if (mesh && function == FunctionKind::Local && report.offset > 0) {
+      const bool done = settle_far_field_by_mesh(*local, mesh->V, mesh->F, report.offset);
+      if (settled) *settled = done;
+    }
+    return c;
+  };
   if (function == FunctionKind::Global) build.off_surface_spacing = 0.0;
   if (function != FunctionKind::Auto || in.kind == InputKind::Constraints || build.off_surface_spacing == 0.0) {
     Constraints c = constraints_of(std::move(in), name, build, &report);
     function = choose_function(function, c.size(), auto_local_above);
-    return c;
+    return settle(std::move(c));
   }
   // A global choice needs at most auto_local_above constraints, hence as many surface points after the
   // merge: keep a copy of a small input to build them again without the spacing.
@@ -101,7 +113,7 @@ Constraints constraints_for_function(Input in, const std::string& name, Constrai
   if (choose_function(function, input_points(in), auto_local_above) == FunctionKind::Global) copy = in;
   Constraints c = constraints_of(std::move(in), name, build, &report);
   function = choose_function(function, c.size() + report.spaced_out, auto_local_above);
-  if (function == FunctionKind::Local) return c;
+  if (function == FunctionKind::Local) return settle(std::move(c));
   build.off_surface_spacing = 0.0;
   return constraints_of(copy ? std::move(*copy) : read_input(name), name, build, &report);
 }

@@ -56,9 +56,12 @@ Constraints constraints_of(Input in, const std::string& name, const ConstraintBu
 /// input gets): `function` becomes Local (more than `auto_local_above` constraints) or Global, and for
 /// Global the constraints are built without the spacing (build.off_surface_spacing is set to 0). `name`
 /// is the input's path (read again in the rare case where a large input merges down to a global fit).
-/// @throws as constraints_of.
+/// `local`, when given (a batch run), gets for a closed mesh whose function resolves to Local the mesh's
+/// own inside/outside far from it (settle_far_field_by_mesh, as Mesher::from_mesh); `settled`, when
+/// given, says whether it did. @throws as constraints_of.
 Constraints constraints_for_function(Input in, const std::string& name, ConstraintBuildOptions& build,
                                      FunctionKind& function, std::size_t auto_local_above,
-                                     ConstraintBuildReport& report);
+                                     ConstraintBuildReport& report, LocalRbfOptions* local = nullptr,
+                                     bool* settled = nullptr);
 
 }  // namespace vitri::cli

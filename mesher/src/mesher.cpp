@@ -43,11 +43,6 @@ namespace vitri {
 
 namespace {
 
-/// A scan encloses a volume (an object, not a single view or a room seen from inside) when its winding
-/// number's level at the data exceeds this share of its jump (WindingSides: 1/2 for a closed object;
-/// measured 0.14 on a single view of a hippo, 0.02-0.04 on airborne ones, -0.13 to -0.46 on indoor scans).
-constexpr double kEnclosingLevel = 0.35;
-
 using Clock = std::chrono::steady_clock;
 double now_seconds() { return std::chrono::duration<double>(Clock::now().time_since_epoch()).count(); }
 
@@ -326,7 +321,7 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
     // An editing session (history kept) keeps the planes, as it keeps the uniform precision: edits move
     // constraints away from the scan, whose winding number would then answer for a shape that is gone
     // (a patch inside a new bump told "outside" would open a hole in it).
-    if (sides->level() > kEnclosingLevel * sides->jump() && !o.polygonizer.keep_history)
+    if (sides->encloses() && !o.polygonizer.keep_history)
       o.local.far_side = [sides](const Point3& x) { return (*sides)(x); };
   }
   return fit;
@@ -360,7 +355,18 @@ Mesher Mesher::from_scan(ScanFit fit) {
 }
 
 Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options) {
-  return Mesher(constraints_from_mesh(V, F, with_threads_applied(options).constraint_build), options);
+  MesherOptions o = with_threads_applied(options);
+  ConstraintBuildReport built;
+  const Constraints c = constraints_from_mesh(V, F, o.constraint_build, &built);
+  // Far from the mesh the local function's patches are planes through the nearest constraints' values,
+  // which can close a bubble of the zero set there (a far blob); the mesh's own winding number settles
+  // them in a batch run, as a scan's does (an editing session keeps the planes, as from_scan).
+  const bool settle = choose_function(c.size(), o) == FunctionKind::Local && !o.local.far_side &&
+                      built.offset > 0 && !o.polygonizer.keep_history;
+  const bool settled = settle && settle_far_field_by_mesh(o.local, V, F, built.offset);
+  Mesher m(c, o);
+  m.stats_.far_side = settled;
+  return m;
 }
 
 Mesher::Mesher(Mesher&&) noexcept = default;

@@ -258,7 +258,7 @@ void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s, std::uint32_t ball
   // the rim of its support still overshot inside it: past the elephant's trunk tip (30,000 noisy
   // points) a ball of f = -0.25, a tenth of the diagonal across, from a patch whose 15 constraints lay
   // at 0.96-1 of its radius.
-  if (opt.far_side) {
+  if (opt.far_side && opt.far_side_anchors) {
     double nearest2 = std::numeric_limits<double>::infinity();
     for (const Point3& q : s.points) nearest2 = std::min(nearest2, squared_norm(q - cell.center));
     if (nearest2 > 0.25 * r2) {

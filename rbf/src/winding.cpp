@@ -6,6 +6,8 @@
 #include "vitri/core/error.hpp"
 
 #include <algorithm>
+#include <memory>
+#include <string>
 #include <cmath>
 
 namespace vitri {
@@ -166,6 +168,69 @@ int WindingSides::operator()(const Point3& x) const {
   if (w > level_ + 0.25 * jump_) return -1;
   if (w < level_ - 0.25 * jump_) return 1;
   return 0;
+}
+
+WindingSides mesh_winding_sides(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double offset) {
+  if (F.cols() != 3 || V.cols() != 3) throw InvalidArgument("mesh_winding_sides: V and F must have 3 columns");
+  if (!(offset > 0) || !std::isfinite(offset)) throw InvalidArgument("WindingSides: offset must be > 0");
+  for (Eigen::Index r = 0; r < V.rows(); ++r)
+    if (!V.row(r).allFinite())
+      throw InvalidPoint(static_cast<std::size_t>(r), "mesh_winding_sides: non-finite vertex position");
+  struct Face {
+    Point3 p0, e1, e2, normal;
+    double area;
+  };
+  std::vector<Face> faces;
+  faces.reserve(static_cast<std::size_t>(F.rows()));
+  double total = 0;  // samples at the offset's size
+  for (Eigen::Index t = 0; t < F.rows(); ++t) {
+    Point3 p[3];
+    for (int k = 0; k < 3; ++k) {
+      const int v = F(t, k);
+      if (v < 0 || v >= V.rows())
+        throw InvalidArgument("mesh_winding_sides: triangle " + std::to_string(t) + " names vertex " +
+                              std::to_string(v) + ", not a row of V (" + std::to_string(V.rows()) + " rows)");
+      p[k] = {V(v, 0), V(v, 1), V(v, 2)};
+    }
+    const Point3 n = cross(p[1] - p[0], p[2] - p[0]);
+    const double twice = norm(n);
+    if (!(twice > 0)) continue;
+    faces.push_back({p[0], p[1] - p[0], p[2] - p[0], n / twice, 0.5 * twice});
+    total += std::max(1.0, 2.0 * faces.back().area / (offset * offset));
+  }
+  if (faces.empty()) throw InvalidArgument("mesh_winding_sides: no triangle of positive area");
+  // A triangle is one dipole only when it is small beside the offset at which the calibration reads w
+  // (a large one seen from its centroid at the offset reads far more than its solid angle): each is cut
+  // into k x k similar triangles of side about the offset (k <= 64, at most about 4 x 10^6 samples).
+  const double size = offset * std::max(1.0, std::sqrt(total / 4e6));
+  std::vector<Point3> points, normals;
+  std::vector<double> areas;
+  for (const Face& f : faces) {
+    const int k = static_cast<int>(std::min(64.0, std::ceil(std::sqrt(2.0 * f.area) / size)));
+    const double a = f.area / (static_cast<double>(k) * k);
+    auto at = [&](double u, double v) { return f.p0 + f.e1 * (u / k) + f.e2 * (v / k); };
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; i + j < k; ++j) {
+        points.push_back(at(i + 1.0 / 3, j + 1.0 / 3));  // the triangle (i, j) (i + 1, j) (i, j + 1)
+        normals.push_back(f.normal);
+        areas.push_back(a);
+        if (i + j + 1 < k) {  // and (i + 1, j) (i + 1, j + 1) (i, j + 1)
+          points.push_back(at(i + 2.0 / 3, j + 2.0 / 3));
+          normals.push_back(f.normal);
+          areas.push_back(a);
+        }
+      }
+  }
+  return WindingSides(points, normals, areas, offset);
+}
+
+bool settle_far_field_by_mesh(LocalRbfOptions& local, const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                              double offset) {
+  auto sides = std::make_shared<const WindingSides>(mesh_winding_sides(V, F, offset));
+  if (!sides->encloses()) return false;
+  local.far_side = [sides](const Point3& x) { return (*sides)(x); };
+  local.far_side_anchors = false;
+  return true;
 }
 
 }  // namespace vitri

@@ -12,6 +12,7 @@
 #include "vitri/testing/mesh_metrics.hpp"
 #include "vitri/polygonize/polygonizer.hpp"
 #include "vitri/rbf/point_index.hpp"
+#include "vitri/rbf/winding.hpp"
 
 #include <algorithm>
 #include <array>
@@ -472,4 +473,59 @@ TEST_CASE("from_scan: a component among more set-aside outliers than its points 
   ScanFit fewer = fit;
   fewer.prepared.set_aside.assign(cloud.begin(), cloud.begin() + 100);
   CHECK(components(fewer) == 2);
+}
+
+// Far from a closed mesh the local function's patches are planes through the nearest constraints' values;
+// on bunny's 2,400 constraints they closed a bubble of the zero set 0.17 of the diagonal from the mesh
+// (f < 0 at its centre, f > 0 on every ray to the data: a second component the certified mode found,
+// docs/benchmarks.md). A batch run settles the far patches with the mesh's winding number
+// (Mesher::from_mesh, settle_far_field_by_mesh): f > 0 at every grid point outside the mesh and far from it.
+TEST_CASE("from_mesh: the mesh's winding number settles the local far field, no bubble away from the mesh",
+          "[mesher][local]") {
+  const TriangleMesh bunny = read_mesh(kData + "/bunny.off");
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  o.constraint_build.max_constraints = 2400;
+  o.threads = 2;
+  o.polygonizer.keep_history = false;
+  const Mesher m = Mesher::from_mesh(bunny.V, bunny.F, o);
+  CHECK(m.stats().far_side);
+  REQUIRE(m.local_function());
+  CHECK(m.local_function()->report().far_settled > 0);
+  // Grid points clearly outside the mesh (its own winding number) and farther than 0.1 x the diagonal
+  // from every on-surface constraint.
+  const Constraints& c = m.constraints();
+  Box3 box;
+  for (const Point3& p : c.points) box.extend(p);
+  const double diag = box.diagonal(), far = 0.1 * diag;
+  const WindingSides sides = mesh_winding_sides(bunny.V, bunny.F, 0.005 * diag);
+  const Box3 grid = box.scaled(1.5);
+  const int n = 48;
+  std::vector<Point3> outside;
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      for (int k = 0; k < n; ++k) {
+        const Point3 e = grid.extent();
+        const Point3 x{grid.lo.x + e.x * (i + 0.5) / n, grid.lo.y + e.y * (j + 0.5) / n,
+                       grid.lo.z + e.z * (k + 0.5) / n};
+        bool near = false;
+        for (std::size_t q = 0; q < c.size() && !near; ++q)
+          near = c.values[q] == 0 && squared_distance(c.points[q], x) < far * far;
+        if (!near && sides(x) == 1) outside.push_back(x);
+      }
+  REQUIRE(outside.size() > 1000);
+  std::vector<double> f(outside.size());
+  m.function().values(outside.data(), outside.size(), f.data());
+  std::size_t negative = 0;
+  std::size_t worst = 0;
+  for (std::size_t q = 0; q < f.size(); ++q) {
+    if (f[q] <= 0) ++negative;
+    if (f[q] < f[worst]) worst = q;
+  }
+  INFO(outside.size() << " points outside; lowest f " << f[worst] << " at " << outside[worst].x << " "
+                      << outside[worst].y << " " << outside[worst].z);
+  CHECK(negative == 0);
+  // An editing session keeps the planes (its edits move constraints away from the mesh).
+  o.polygonizer.keep_history = true;
+  CHECK_FALSE(Mesher::from_mesh(bunny.V, bunny.F, o).stats().far_side);
 }

@@ -1,7 +1,7 @@
 // vitri::WindingNumber and WindingSides (winding.hpp): 1 inside and 0 outside a sampled sphere, the sign
 // flipped with the normals, an open cap; the calibration (level, jump) for a closed object, a room seen
 // from inside, wrong areas and a single view; LocalRbfOptions::far_side settling the far patches of a
-// function whose off-surface values are wrong on a cap; bad input.
+// function whose off-surface values are wrong on a cap; bad input; the sides of a triangle mesh.
 #include "vitri/core/error.hpp"
 #include "vitri/rbf/constraints.hpp"
 #include "vitri/rbf/local_rbf.hpp"
@@ -188,4 +188,47 @@ TEST_CASE("LocalRbfOptions::far_side settles far patches that disagree", "[windi
   settled.add_constraint(Point3{0, 0, 1.02}, 0.02);
   CHECK(negatives(settled) == 0);
   settled.validate();
+}
+
+// mesh_winding_sides / settle_far_field_by_mesh: a closed mesh's triangles as samples (centroid, right-hand normal,
+// area): an octahedron encloses (inside -1, outside +1, whatever its size); the same faces wound the other
+// way read as a room seen from inside, and an open half have no far side; bad input names the culprit.
+TEST_CASE("mesh_winding_sides: a closed mesh encloses, inside out or open it gives no far side", "[winding]") {
+  Eigen::MatrixXd V(6, 3);
+  V << 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1;
+  Eigen::MatrixXi F(8, 3);  // counter-clockwise seen from outside
+  F << 0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5;
+  for (double scale : {1e-3, 1.0, 1e4}) {
+    const Eigen::MatrixXd S = V * scale;
+    const WindingSides sides = vitri::mesh_winding_sides(S, F, 0.05 * scale);
+    CHECK(sides.encloses());
+    CHECK(std::abs(sides.jump() - 1.0) < 0.3);
+    CHECK(sides(Point3{0.1, -0.05, 0.02} * scale) == -1);
+    CHECK(sides(Point3{3, 1, -2} * scale) == 1);
+    vitri::LocalRbfOptions local;
+    REQUIRE(vitri::settle_far_field_by_mesh(local, S, F, 0.05 * scale));
+    REQUIRE(local.far_side);
+    CHECK_FALSE(local.far_side_anchors);
+    CHECK(local.far_side(Point3{0, 0, 0}) == -1);
+    CHECK(local.far_side(Point3{0, 0, 5 * scale}) == 1);
+  }
+  Eigen::MatrixXi inverted = F;
+  inverted.col(1).swap(inverted.col(2));
+  CHECK_FALSE(vitri::mesh_winding_sides(V, inverted, 0.05).encloses());
+  vitri::LocalRbfOptions local;
+  CHECK_FALSE(vitri::settle_far_field_by_mesh(local, V, inverted, 0.05));
+  const Eigen::MatrixXi upper = F.topRows(4);  // the half above z = 0: a single view
+  CHECK_FALSE(vitri::settle_far_field_by_mesh(local, V, upper, 0.05));
+  CHECK_FALSE(local.far_side);  // left as it was
+  CHECK(local.far_side_anchors);
+  Eigen::MatrixXi bad = F;
+  bad(3, 1) = 6;
+  CHECK_THROWS_WITH(vitri::mesh_winding_sides(V, bad, 0.05), Catch::Contains("triangle 3"));
+  Eigen::MatrixXd nan = V;
+  nan(4, 2) = std::nan("");
+  CHECK_THROWS_AS(vitri::mesh_winding_sides(nan, F, 0.05), vitri::InvalidPoint);
+  Eigen::MatrixXi flat(1, 3);
+  flat << 0, 0, 1;
+  CHECK_THROWS_WITH(vitri::mesh_winding_sides(V, flat, 0.05), Catch::Contains("no triangle of positive area"));
+  CHECK_THROWS_AS(vitri::mesh_winding_sides(V, F, 0.0), vitri::InvalidArgument);
 }

@@ -213,7 +213,8 @@ struct MesherStats {
   std::size_t memory_thinned = 0;
   std::size_t memory_stride = 1;
   /// from_scan() with the local function: the winding number's calibration (ScanFit::far_level and
-  /// far_jump; 0 when not measured) and whether its far side was given to the fit (a scan of an object).
+  /// far_jump; 0 when not measured) and whether its far side was given to the fit (a scan of an object;
+  /// from_mesh(): the mesh's winding number, level and jump not recorded).
   double far_level = 0, far_jump = 0;
   bool far_side = false;
 };
@@ -306,7 +307,10 @@ class Mesher {
   /// from_scan() on points already prepared by prepare_scan_fit() (its constraints, options and data).
   static Mesher from_scan(ScanFit fit);
   /// Normal constraints from a closed, consistently oriented triangle mesh (V #V x 3, F #F x 3;
-  /// constraints_from_mesh), then as above. @throws InvalidArgument for an open or non-manifold mesh.
+  /// constraints_from_mesh), then as above. With the local function and no history kept (a batch run),
+  /// the far patches take their sign from the mesh's winding number (settle_far_field_by_mesh;
+  /// stats().far_side).
+  /// @throws InvalidArgument for an open or non-manifold mesh.
   static Mesher from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options = {});
 
   Mesher(Mesher&&) noexcept;

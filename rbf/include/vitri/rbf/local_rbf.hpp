@@ -67,6 +67,13 @@ struct LocalRbfOptions {
   /// Mesher::from_scan sets it from the scan's winding number (vitri::WindingNumber, docs/scans.md).
   /// Called from the fit's threads (it must be thread-safe), and by edits for the patches they refit.
   std::function<int(const Point3&)> far_side;
+  /// With far_side: an RBF patch whose centre lies in empty space (at least half its radius from every
+  /// constraint it fits: beside a thin part, past its tip) is also fitted with anchors there at far_side's
+  /// answer (docs/local_rbf.md "Far side"), against the overshoot of noisy scans. false settles the far
+  /// patches only: what a closed mesh's exact constraints want (settle_far_field_by_mesh; with anchors the
+  /// shared turbine's Euler characteristic came out -52 at the CLI's default precision, -20 = the model's
+  /// without).
+  bool far_side_anchors = true;
   /// Threads of the fit (over patches) and of the batch evaluation: 0 = every available CPU
   /// (vitri::available_cpus).
   unsigned threads = 0;

@@ -40,6 +40,13 @@ std::string describe_scan(const ScanFit& fit, bool given) {
   return (v.empty() ? v : v + "\n") + describe(fit.report);
 }
 
+void drop_degenerate_triangles(Input& in, const std::string& name, const char* command) {
+  if (in.kind != InputKind::Mesh) return;
+  if (const std::size_t n = vitri::drop_degenerate_triangles(in.mesh.F))
+    std::fprintf(stderr, "%s: warning: %s: %zu triangle%s that repeat%s a vertex (no area) left out\n", command,
+                 name.c_str(), n, n == 1 ? "" : "s", n == 1 ? "s" : "");
+}
+
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
                            ConstraintBuildReport* report, const ScanOptions& scan, ScanFit* fit) {
   switch (in.kind) {

@@ -39,6 +39,10 @@ std::string viewpoint_line(const ScanOptions& scan, bool given);
 /// "viewpoint X Y Z (from the input)\n<describe(report)>". `given`: the viewpoint came from --viewpoint.
 std::string describe_scan(const ScanFit& fit, bool given);
 
+/// A mesh's triangles that name one vertex twice (no area: an edge or a point drawn as a triangle) are
+/// left out, with a warning on stderr naming `command`, the file and the count; other inputs are left.
+void drop_degenerate_triangles(Input& in, const std::string& name, const char* command);
+
 /// The constraints of an input: as read (.xyzv), built from a closed mesh as Mesher::from_mesh builds
 /// them, or for points (with or without normals) through the scan path of scan_of() with `scan` (so
 /// that every command reads points as `vitri mesh` does; the constraints follow `build`: the off-surface

@@ -306,6 +306,19 @@ std::string MeshDefects::describe() const {
   return "closed, consistently oriented mesh";
 }
 
+std::size_t drop_degenerate_triangles(Eigen::MatrixXi& F) {
+  if (F.cols() != 3) return 0;
+  Eigen::Index kept = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2)) continue;
+    if (kept != f) F.row(kept) = F.row(f);
+    ++kept;
+  }
+  const auto dropped = static_cast<std::size_t>(F.rows() - kept);
+  if (dropped) F.conservativeResize(kept, 3);
+  return dropped;
+}
+
 MeshDefects mesh_defects(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   if (V.cols() != 3 || F.cols() != 3) throw InvalidArgument("mesh: V and F must have 3 columns");
   if (F.rows() == 0) throw InvalidArgument("mesh has no triangle");
@@ -317,7 +330,8 @@ MeshDefects mesh_defects(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
                               std::to_string(F(f, k)) + " out of range (" + std::to_string(nv) +
                               " vertices)");
     if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 0) == F(f, 2))
-      throw InvalidArgument("mesh triangle " + std::to_string(f) + " repeats a vertex");
+      throw InvalidArgument("mesh triangle " + std::to_string(f) +
+                            " repeats a vertex (drop_degenerate_triangles removes such triangles)");
   }
   // Every undirected edge of a closed oriented manifold is used by exactly two triangles, once in each
   // direction.

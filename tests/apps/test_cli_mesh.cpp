@@ -386,7 +386,8 @@ TEST_CASE("vitri mesh: unoriented points that cannot be oriented, and a fit too 
   }
 }
 
-TEST_CASE("vitri mesh: a mesh with holes is meshed as a scan of its surface, with a warning", "[cli][mesh]") {
+TEST_CASE("vitri mesh: a mesh with holes is meshed as a scan of its surface, with a warning; triangles without "
+          "area are left out", "[cli][mesh]") {
   // A sphere of radius 1 (a latitude-longitude mesh of 18 rings) with the rings below `kept` left out: a
   // boundary loop at z = cos(kept / 18 pi). A small hole is closed (--surface auto: the data surround
   // the body), a hemisphere stays open where the data end.
@@ -432,6 +433,27 @@ TEST_CASE("vitri mesh: a mesh with holes is meshed as a scan of its surface, wit
     CHECK(mm.closed_manifold());
     CHECK(mm.euler_characteristic == 2);
     CHECK(on_sphere_above(m, -0.7) < 0.02);  // where the input has its surface
+  }
+  SECTION("a closed mesh with triangles that repeat a vertex: those left out with a warning, the rest closed") {
+    const std::string clean = std::string(VITRI_DATA_DIR) + "/bunny.off";
+    const std::string in = kDir + "/mesh_degenerate_bunny.off";
+    const std::string out = kDir + "/mesh_degenerate_bunny.ply", ref = kDir + "/mesh_clean_bunny.ply";
+    TriangleMesh m = read_mesh(clean);
+    REQUIRE(compute_mesh_metrics(m.V, m.F).closed_manifold());
+    const Eigen::Index n = m.F.rows();
+    m.F.conservativeResize(n + 2, 3);
+    m.F.row(n) << 0, 0, 1;  // an edge drawn as a triangle, as exporters leave them
+    m.F.row(n + 1) << 5, 7, 5;
+    write_mesh(in, m);
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(e);
+    CHECK(e.find("2 triangles that repeat a vertex (no area) left out") != std::string::npos);
+    CHECK(e.find("not a closed mesh") == std::string::npos);  // interpolated as the closed mesh it is
+    std::string o2, e2;
+    REQUIRE(run(clean + " -o " + ref, o2, e2) == 0);
+    const TriangleMesh a = read_mesh(out), b = read_mesh(ref);
+    CHECK(a.V == b.V);  // the same mesh as the clean input's
+    CHECK(a.F == b.F);
   }
   SECTION("a hemisphere: open where the data end") {
     const std::string in = kDir + "/mesh_hemisphere.off", out = kDir + "/mesh_hemisphere.ply";

@@ -225,6 +225,15 @@ TEST_CASE("mesh defects counted without throwing; surface samples of an open mes
   Eigen::MatrixXi bad = F;
   bad(2, 1) = 7;
   CHECK_THROWS_WITH(mesh_defects(V, bad), Catch::Contains("triangle 2") && Catch::Contains("out of range"));
+  // A triangle that names a vertex twice (no area): refused by mesh_defects, removed by
+  // drop_degenerate_triangles, which keeps the others in order: the tetrahedron is closed again.
+  Eigen::MatrixXi degenerate(F.rows() + 2, 3);
+  degenerate << F.topRows(2), Eigen::RowVector3i(1, 1, 3), F.bottomRows(F.rows() - 2), Eigen::RowVector3i(2, 0, 2);
+  CHECK_THROWS_WITH(mesh_defects(V, degenerate), Catch::Contains("triangle 2") && Catch::Contains("repeats a vertex"));
+  CHECK(drop_degenerate_triangles(degenerate) == 2);
+  CHECK(degenerate == F);
+  CHECK(mesh_defects(V, degenerate).closed());
+  CHECK(drop_degenerate_triangles(degenerate) == 0);
 
   // Samples: every vertex, then at least min_points in all, each on one of the triangles, with the outward
   // normal of the tetrahedron's face it lies on; the same samples on a second call.

@@ -139,6 +139,11 @@ struct MeshDefects {
   std::string describe() const;
 };
 
+/// Removes the triangles of F (#F x 3) that name one vertex twice (an edge or a point drawn as a
+/// triangle: no area, no side; exporters and decimators leave them), keeping the others in order.
+/// Returns how many were removed. Indices are not checked here (mesh_defects does).
+std::size_t drop_degenerate_triangles(Eigen::MatrixXi& F);
+
 /// The defects of a triangle mesh (V #V x 3, F #F x 3), without throwing for them.
 /// @throws InvalidArgument for what is not a triangle mesh at all: columns other than 3, no triangle, a
 ///         triangle with an out-of-range or repeated vertex index (named).

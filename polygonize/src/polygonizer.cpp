@@ -74,6 +74,10 @@ constexpr std::size_t kCreatedSliceMin = std::size_t(1) << 12;   // of classify_
 
 }  // namespace
 
+namespace {
+constexpr double kMinSide = 0.05;  // domain_for: thinnest side of the box before scaling, x its diagonal
+}  // namespace
+
 Box3 Polygonizer::domain_for(const std::vector<Point3>& points, double factor) {
   if (points.empty()) throw InvalidArgument("domain_for: no point");
   if (!(factor > 1.0) || !std::isfinite(factor)) throw InvalidArgument("domain_for: factor must be > 1");
@@ -82,9 +86,12 @@ Box3 Polygonizer::domain_for(const std::vector<Point3>& points, double factor) {
     if (!is_finite(points[i])) throw InvalidPoint(i, "coordinates are not finite");
     b.extend(points[i]);
   }
-  // Pad flat directions so the box has volume.
+  // Pad thin directions to kMinSide x the diagonal: the box has volume, and where the data are flat (a
+  // planar patch, a wall seen from one side) the box's faces across them lie far enough from the data
+  // for an open surface's trim to tell them from it (with 1e-3 x the diagonal, a flat square's scan came
+  // out with a second sheet: the box face 3 spacings below the data, kept as data-supported).
   const double diag = b.diagonal();
-  const double pad = diag > 0.0 ? 1e-3 * diag : 1.0;
+  const double pad = diag > 0.0 ? kMinSide * diag : 1.0;
   for (std::size_t k = 0; k < 3; ++k) {
     if (b.hi[k] - b.lo[k] < pad) {
       const double c = 0.5 * (b.lo[k] + b.hi[k]);

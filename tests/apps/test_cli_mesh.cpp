@@ -9,8 +9,10 @@
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
+#include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -729,4 +731,33 @@ TEST_CASE("vitri mesh: a scan too large for one piece under --memory is meshed w
   // --blocks auto on a closed mesh (not points): refused as --blocks N is.
   REQUIRE(run(one + " -o " + kDir + "/mesh_budget_again.ply --blocks auto", o, e) == 1);
   CHECK(e.find("--blocks meshes points") != std::string::npos);
+}
+
+// A flat scan (a unit square sampled at 20,000 points, normals +z): one open sheet on the data's plane.
+// The domain box was padded to 1e-3 of the diagonal across the plane, and its face 3 spacings below the
+// data came out as a second sheet the trim kept (Polygonizer::domain_for now pads to 0.05).
+TEST_CASE("vitri mesh: a flat scan gives one sheet on its plane", "[cli][mesh]") {
+  const std::string in = kDir + "/mesh_flat.pwn", out = kDir + "/mesh_flat.ply";
+  {
+    std::ofstream f(in);
+    f.precision(17);
+    std::uint64_t state = 7;
+    auto uniform = [&state] {  // splitmix64: the same points on every platform
+      std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+      z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+      return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+    };
+    for (int i = 0; i < 20000; ++i) f << uniform() << ' ' << uniform() << " 0 0 0 1\n";
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out, o, e) == 0);
+  INFO(e);
+  CHECK(e.find("surface: open") != std::string::npos);
+  const TriangleMesh m = read_mesh(out);
+  const MeshMetrics mm = compute_mesh_metrics(m.V, m.F);
+  CHECK(mm.components == 1);
+  double farthest = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) farthest = std::max(farthest, std::abs(m.V(i, 2)));
+  CHECK(farthest < 1e-3);  // the spacing is about 0.0033
 }

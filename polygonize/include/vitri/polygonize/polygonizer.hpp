@@ -291,8 +291,10 @@ class Polygonizer {
   Polygonizer(const Polygonizer&) = delete;
   Polygonizer& operator=(const Polygonizer&) = delete;
 
-  /// The bounding box of `points` scaled by `factor` about its center (paper 3.2.2: factor 2). A flat or
-  /// single-point set is padded to a cube of side 1e-3 of its diagonal (or 1 when everything is one point).
+  /// The bounding box of `points` scaled by `factor` about its center (paper 3.2.2: factor 2), each side
+  /// first padded to at least 0.05 of the box's diagonal (a flat set: the box's faces across it then lie
+  /// far enough from the data for an open surface's trim; before 2026-12-04 1e-3, and a flat scan kept the
+  /// face below it as a second sheet), or to 1 when everything is one point.
   /// @throws InvalidArgument when points is empty or factor <= 1; InvalidPoint(i) when point i is not finite.
   static Box3 domain_for(const std::vector<Point3>& points, double factor = 2.0);
 

@@ -4,6 +4,7 @@
 #include "common.hpp"
 
 #include "vitri/mesher.hpp"
+#include "vitri/rbf/constraints.hpp"
 
 
 #include <algorithm>
@@ -459,10 +460,17 @@ Options as reconstruct() (those of point inputs do not apply).)");
                     for (std::size_t i = 0; i < v.size(); ++i) V.row(Eigen::Index(i)) << v[i].x, v[i].y, v[i].z;
                     for (std::size_t i = 0; i < f.size(); ++i)
                       F.row(Eigen::Index(i)) << int(f[i][0]), int(f[i][1]), int(f[i][2]);
+                    // As `vitri mesh`: triangles that name a vertex twice (no area) are left out, with a warning.
+                    if (const std::size_t n = drop_degenerate_triangles(F)) {
+                      const std::string what = "faces: " + std::to_string(n) +
+                                               " triangle(s) that repeat a vertex (no area) left out";
+                      if (PyErr_WarnEx(PyExc_RuntimeWarning, what.c_str(), 1) != 0) throw py::error_already_set();
+                    }
                     return build(kw, "from_mesh", [&](const MesherOptions& o) { return Mesher::from_mesh(V, F, o); });
                   },
                   py::arg("vertices"), py::arg("faces"),
-                  "Normal constraints of a closed, consistently oriented triangle mesh.")
+                  "Normal constraints of a closed, consistently oriented triangle mesh (triangles that repeat a "
+                  "vertex are left out with a RuntimeWarning).")
       .def("refine",
            [](PyMesher& s, double precision, bool relative, py::object callback) {
              Progress progress(callback);

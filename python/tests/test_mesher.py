@@ -45,6 +45,21 @@ def test_from_mesh():
     assert euler_characteristic(V, F) == 2
 
 
+def test_from_mesh_leaves_out_triangles_without_area():
+    # A triangle that names a vertex twice (exporters leave them): left out with a warning, as `vitri mesh`
+    # does; the rest of the closed mesh gives the same mesh as without it (it was refused before).
+    sphere = vitri.reconstruct(sphere_points(300)[0], precision=0.1)
+    faces = np.vstack([sphere.faces, [[0, 0, 1]]])
+    with pytest.warns(RuntimeWarning, match="1 triangle"):
+        m = vitri.Mesher.from_mesh(sphere.vertices, faces)
+    m.refine(0.08, relative=True)
+    clean = vitri.Mesher.from_mesh(sphere.vertices, sphere.faces)
+    clean.refine(0.08, relative=True)
+    V, F, _ = m.mesh()
+    V0, F0, _ = clean.mesh()
+    assert np.array_equal(V, V0) and np.array_equal(F, F0)
+
+
 def test_edits_equal_a_fresh_fit():
     pts, vals = sphere_constraints(100)
     m = vitri.Mesher(pts, vals, function="global")

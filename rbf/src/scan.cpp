@@ -761,7 +761,9 @@ std::size_t vote_signs(const std::vector<Point3>& p, const Neighbours& nb, std::
 /// (airborne data, a facade, a table top seen from one side) one layer at each place, except at walls,
 /// edges and trees. Up to 2000 of the part's points whose normals are within 37 degrees of the axis are
 /// examined: layered when another point of the part lies within 2 local spacings of its line along the
-/// axis but more than 4 local spacings away along it. More than half layered: a closed thin object.
+/// axis but more than 4 local spacings away along it, or more than 1.5 away with its normal opposite
+/// (the tree oriented the faces apart; two layers of one sign so close may be a misregistered overlap).
+/// More than half layered: a closed thin object.
 bool layered_along(const std::vector<Point3>& p, const std::vector<Point3>& n, const Neighbours& nb,
                    const std::vector<Id>& members, const Point3& axis) {
   const Eigen::Vector3d a = axis.eigen().normalized();
@@ -788,7 +790,8 @@ bool layered_along(const std::vector<Point3>& p, const std::vector<Point3>& n, c
     index.ball(flat[m], 4 * h * h, ball);
     const double height = dot(p[i], axis);
     for (const Id o : ball)
-      if (std::abs(dot(p[members[o]], axis) - height) > 4 * h) {
+      if (const double gap = std::abs(dot(p[members[o]], axis) - height);
+          gap > 4 * h || (gap > 1.5 * h && dot(n[members[o]], n[i]) < -0.5)) {
         ++layered;
         break;
       }

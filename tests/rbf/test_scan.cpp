@@ -429,9 +429,12 @@ TEST_CASE("prepare_scan: an unoriented thin closed disc is oriented outward on b
   // faces and rim: over 90% of its normals lie along its axis, as on a sheet seen from one side (the rule
   // that orients airborne data and facades turned every normal one way: half the points inward; the
   // turbine wheel of ../shared/data was 48.7% oriented). Its faces are layered along the axis: closed.
-  for (const int axis : {0, 2}) {
+  // Thinner, 0.045 (about 2.5 spacings: the side of the area per point; the tree orients its faces
+  // apart, but they are too close for layers of one sign to be told from misregistered ones): its faces
+  // face apart. Until session 44 it was taken as a sheet, every normal turned one way.
+  for (const auto& [axis, half] : {std::pair{0, 0.1}, std::pair{2, 0.1}, std::pair{2, 0.0225}}) {
     Gauss g(7 + static_cast<std::uint64_t>(axis));
-    const double half = 0.1, face = kPi, rim = 2 * kPi * 2 * half;
+    const double face = kPi, rim = 2 * kPi * 2 * half;
     std::vector<Point3> p, truth;
     auto put = [&](double a, double b, double c, double na, double nb, double nc) {
       // (a: along the axis; b, c across it)
@@ -449,8 +452,10 @@ TEST_CASE("prepare_scan: an unoriented thin closed disc is oriented outward on b
     }
     vitri::ScanReport rep;
     const vitri::ScanPoints s = vitri::prepare_scan(p, {}, {}, &rep);
-    INFO("axis " << axis << ": " << vitri::describe(rep));
-    REQUIRE(s.points.size() > 19000);
+    INFO("axis " << axis << ", thickness " << 2 * half << ": " << vitri::describe(rep));
+    // (the thin one's wider neighbourhoods hold both faces, read as noise of 0.7 spacings: thinned by
+    // about 16%, docs/scans.md, Limits)
+    REQUIRE(s.points.size() > (half > 0.05 ? 19000u : 15000u));
     std::size_t out = 0;
     const vitri::PointIndex index(p);
     std::vector<vitri::PointIndex::Id> ids;

@@ -347,6 +347,7 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_noise"] = s.scan.noise;
   d["scan_thinned"] = s.scan.thinned;  // points thinned to the resolution (whole scan or noisy regions)
   d["scan_merged"] = s.scan.merged;    // points moved to the middle of misregistered layers
+  d["scan_widened"] = s.scan.widened;  // points projected over wider neighbourhoods (noisy regions)
   d["scan_dequantized"] = s.scan.dequantized;  // points moved within their depth step (quantized depth)
   d["scan_far_side"] = s.far_side;     // the winding number settles the far field (a scan of an object)
   d["memory_thinned"] = s.memory_thinned;  // input points left out to fit the memory limit

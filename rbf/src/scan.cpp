@@ -138,16 +138,18 @@ struct LocalFit {
 /// the neighbours on the point's own side of the surface (n_j . n_i > 0.3): the two sheets of a thin part
 /// face away from each other, and a neighbourhood that straddles them must not fit one surface between.
 LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, std::size_t i,
-                           const std::vector<Point3>* side = nullptr, std::size_t nb_row = kNoRow) {
-  // (the rows of a subset: point i's neighbours in row nb_row)
+                           const std::vector<Point3>* side = nullptr, std::size_t nb_row = kNoRow,
+                           std::size_t use = 0) {
+  // (the rows of a subset: point i's neighbours in row nb_row; `use`: only the first `use` of the row)
   const std::size_t row = nb_row == kNoRow ? i : nb_row;
+  const std::size_t count = use ? std::min(use, nb.k) : nb.k;
   LocalFit out;
   const Point3 o = p[i];
   // The neighbours used (relative positions and distances), the point itself first.
   thread_local std::vector<std::pair<Eigen::Vector3d, double>> near;
   near.clear();
   near.push_back({Eigen::Vector3d::Zero(), 0.0});
-  for (std::size_t c = 0; c < nb.k; ++c) {
+  for (std::size_t c = 0; c < count; ++c) {
     const Id j = nb.at(row, c);
     if (side && dot((*side)[j], (*side)[i]) < 0.3) continue;
     near.push_back({(p[j] - o).eigen(), nb.d(row, c)});
@@ -935,6 +937,10 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
 constexpr std::size_t kMergeNeighbours = 96;
 /// The widest neighbourhood the noise can ask for (ScanOptions::k = 0).
 constexpr std::size_t kMaxNeighbours = 96;
+/// The projection widens a noisy region's neighbourhoods only where the wider fit's residual is at most
+/// this many times the k-point fit's: noise, not shape (chosen on the samples of
+/// bench/scans/noise_topology.py; docs/scans.md, step 7).
+constexpr double kWideningGrowth = 2.5;
 
 /// Misregistered layers: the overlap of two views registered a little apart gives two sheets of the
 /// same surface, with normals of the same sign, a few spacings apart; the offsets of one (+-D along
@@ -1440,16 +1446,64 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     };
     int passes = 1;
     for (std::size_t i = 0; i < p.size(); ++i) passes = std::max(passes, passes_at(i));
+    // Wider neighbourhoods where the region is noisy against the scan's k (the rule that chose k, step 2,
+    // applied per region: a misregistered overlap or a grazing part of a clean scan): the point's fits
+    // see up to kMaxNeighbours, as many as its region's noise asks for.
+    std::vector<std::size_t> wide_row(p.size(), kNoRow), wide_use(p.size(), 0);
+    Neighbours wide;
+    if (options.k == 0) {
+      std::vector<std::uint8_t> flagged(p.size(), 0);
+      std::size_t rows = 0, kw = 0;
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        const double rho = region_noise[i] / std::max(nb.d(i, nb.k - 1), 1e-300);
+        const double want = 16.0 * (rho / 0.06) * (rho / 0.06);
+        if (!(want >= 1.5 * static_cast<double>(nb.k))) continue;
+        if (!(region_noise[i] > 2 * rep.noise)) continue;  // not where the whole scan is as noisy
+        if (!(region_noise[i] > 0.1 * region_nn[i])) continue;  // nor where it is clean (step 7's passes)
+        const std::size_t use = clamp_k(static_cast<std::size_t>(std::min(double(kMaxNeighbours), std::ceil(want))));
+        if (use <= nb.k) continue;
+        flagged[i] = 1;
+        wide_row[i] = rows++;
+        wide_use[i] = use;
+        kw = std::max(kw, use);
+      }
+      if (rows) {
+        const PointIndex now(p, threads);
+        wide.k = kw;
+        wide.ids.resize(rows * kw);
+        wide.dist.resize(rows * kw);
+        sweep_nearest(p, now, kw + 1, threads, &flagged,
+                      [&](std::size_t i, const std::vector<Id>& ids, const std::vector<double>& d2) {
+                        fill_row(wide_row[i], ids, d2, wide, i);
+                      });
+      }
+    }
+    auto fit_at = [&](std::size_t i) {
+      return wide_row[i] == kNoRow ? fit_neighbourhood(p, nb, i, &n)
+                                   : fit_neighbourhood(p, wide, i, &n, wide_row[i], wide_use[i]);
+    };
     for (int pass = 0; pass < passes; ++pass) {
       rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i)
-          if (pass < passes_at(i)) fit[i] = fit_neighbourhood(p, nb, i, &n);
+        for (std::size_t i = b; i < e; ++i) {
+          if (!(pass < passes_at(i))) continue;
+          fit[i] = fit_at(i);
+          if (pass == 0 && wide_row[i] != kNoRow) {
+            // Noise keeps its scale when the neighbourhood widens; shape (an edge, a corner, clutter)
+            // fits worse the wider it is seen: there the point keeps its k.
+            const LocalFit own = fit_neighbourhood(p, nb, i, &n);
+            if (fit[i].noise > kWideningGrowth * own.noise) {
+              wide_row[i] = kNoRow;
+              fit[i] = own;
+            }
+          }
+        }
       });
       for (std::size_t i = 0; i < p.size(); ++i)
         if (pass < passes_at(i)) p[i] = fit[i].projected;
     }
+    for (const std::size_t r : wide_row) rep.widened += r != kNoRow;
     rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
-      for (std::size_t i = b; i < e; ++i) fit[i] = fit_neighbourhood(p, nb, i, &n);
+      for (std::size_t i = b; i < e; ++i) fit[i] = fit_at(i);
     });
     for (std::size_t i = 0; i < p.size(); ++i) n[i] = fit[i].normal;
     std::vector<double> d(p.size());
@@ -1527,6 +1581,7 @@ std::string describe(const ScanReport& r) {
     s << ", " << r.dequantized << " moved within their depth step (" << r.quantized << " quantized in " << r.levels
       << " levels, steps " << r.step_min << " to " << r.step_max << ")";
   if (r.merged) s << ", " << r.merged << " moved to the middle of misregistered layers";
+  if (r.widened) s << ", " << r.widened << " projected over wider neighbourhoods (noisy regions)";
   if (r.thinned) s << ", " << r.thinned << " thinned to the resolution " << r.resolution;
   s << "; normals from " << source;
   if (r.repaired) s << ", " << r.repaired << " given normals repaired";

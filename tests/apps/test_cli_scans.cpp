@@ -10,6 +10,7 @@
 #include <catch2/catch.hpp>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -39,7 +40,9 @@ std::string slurp(const std::string& path) {
 }
 
 int run(const std::string& args, std::string& out, std::string& err) {
-  const std::string o = kDir + "/scan_stdout.txt", e = kDir + "/scan_stderr.txt";
+  // (per process: ctest runs this binary's fast and [slow] tests side by side in one folder)
+  const std::string tag = std::to_string(::getpid());
+  const std::string o = kDir + "/scan_stdout_" + tag + ".txt", e = kDir + "/scan_stderr_" + tag + ".txt";
   const int rc = std::system((std::string(VITRI_CLI) + " mesh " + args + " > " + o + " 2> " + e).c_str());
   out = slurp(o);
   err = slurp(e);

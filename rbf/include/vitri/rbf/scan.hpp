@@ -70,6 +70,9 @@ struct ScanReport {
   /// Points moved to the middle of two misregistered layers (sheets of one orientation a few spacings
   /// apart: docs/scans.md) before the projection.
   std::size_t merged = 0;
+  /// Points whose projection fitted a wider neighbourhood than k: their region's noise asked for more
+  /// (docs/scans.md, step 7).
+  std::size_t widened = 0;
   /// Depth quantization found (ScanOptions::dequantize): the measure ("x", "y", "z": the offset from
   /// the viewpoint along that axis, or "range"), its distinct values (levels), the smallest and largest
   /// step between neighbouring levels, and the points moved within their step (empty measure: none).

@@ -248,6 +248,33 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   return out;
 }
 
+/// Whether the wider neighbourhood (row `row` of `wide`, of point i) holds a second sheet parallel to the
+/// point's own, on one side: at least 3 neighbours within the k-point neighbourhood's radius `r` of the
+/// point's normal line (its k-point fit's), off its sheet by more than max(4 x that fit's residual, r / 2),
+/// all on one side, their offsets spread by under a fifth of their mean (a parallel face: the other side
+/// of a thin part, not vegetation over ground or clutter). The wider fit's residual there is not structure
+/// between the scales (step 2) but that face.
+bool second_sheet(const std::vector<Point3>& p, const Neighbours& wide, std::size_t row, std::size_t i,
+                  const LocalFit& own, double r) {
+  const double off = std::max(4 * own.noise, 0.5 * r);
+  std::size_t count = 0, up = 0;
+  double sum = 0, sum2 = 0;
+  for (std::size_t c = 0; c < wide.k; ++c) {
+    const Point3 v = p[wide.at(row, c)] - p[i];
+    const double h = dot(v, own.normal);
+    if (std::abs(h) > off && norm(v - h * own.normal) < r) {
+      ++count;
+      up += h > 0;
+      sum += std::abs(h);
+      sum2 += h * h;
+    }
+  }
+  if (count < 3 || (up != 0 && up != count)) return false;
+  const double mean = sum / static_cast<double>(count);
+  const double var = std::max(0.0, sum2 / static_cast<double>(count) - mean * mean);
+  return std::sqrt(var) < 0.2 * mean;
+}
+
 /// Directions averaged by dequantize_depth() (the office capture: Euler characteristic -425 without the
 /// average, -239 with 32 of the point's own or a neighbouring level).
 constexpr std::size_t kDequantizeSmooth = 32;
@@ -1156,7 +1183,9 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     // Two signs that 16 neighbours are too few: noise large against their radius (the plane residual
     // grows with the noise, the radius with sqrt(k)), or structure between their scale and 3x it that a
     // quadric does not follow (depth quantized into layers: each small neighbourhood lies in one layer,
-    // and the residual grows with the scale). Sharp edges also grow it, but on few points: medians.
+    // and the residual grows with the scale). Sharp edges also grow it, but on few points: medians. A
+    // point whose wider neighbourhood holds a parallel second face (a thin part: second_sheet) counts
+    // its k-point residual.
     std::vector<double> ratio(p.size()), small(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) {
       ratio[i] = fit[i].noise / std::max(nb.d(i, k - 1), 1e-300);
@@ -1192,7 +1221,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
           for (std::size_t r = b; r < e; ++r) {
             index.nearest(p[r * stride], k3 + 1, ids, &d2);
             fill_row(r, ids, d2, sample, r * stride);
-            above[r] = fit_neighbourhood(p, sample, r * stride, nullptr, r).noise > threshold;
+            above[r] = fit_neighbourhood(p, sample, r * stride, nullptr, r).noise > threshold &&
+                       !second_sheet(p, sample, r, r * stride, fit[r * stride], nb.d(r * stride, k - 1));
           }
         });
         std::size_t count = 0;
@@ -1208,7 +1238,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
           for (std::size_t i = b; i < e; ++i) wide_fit[i] = fit_neighbourhood(p, wide, i);
         });
         std::vector<double> big(p.size());
-        for (std::size_t i = 0; i < p.size(); ++i) big[i] = wide_fit[i].noise;
+        for (std::size_t i = 0; i < p.size(); ++i)
+          big[i] = second_sheet(p, wide, i, i, fit[i], nb.d(i, k - 1)) ? fit[i].noise : wide_fit[i].noise;
         if (median(big) > threshold) {
           k = k2 = k3;  // these neighbourhoods and fits are the ones wanted: kept, not computed again
           nb = std::move(wide);

@@ -969,6 +969,10 @@ constexpr std::size_t kMaxNeighbours = 96;
 /// bench/scans/noise_topology.py; docs/scans.md, step 7).
 constexpr double kWideningGrowth = 2.5;
 
+/// The neighbours a neighbourhood needs to see a surface through noise `rho` times its k-th neighbour's
+/// distance (step 2: above 0.06 the neighbourhood widens, its radius growing as sqrt(k)), not rounded.
+double neighbours_wanted(double rho) { return 16.0 * (rho / 0.06) * (rho / 0.06); }
+
 /// Misregistered layers: the overlap of two views registered a little apart gives two sheets of the
 /// same surface, with normals of the same sign, a few spacings apart; the offsets of one (+-D along
 /// its normal) then contradict the other's, and the interpolant folds between them (handles, blobs).
@@ -1192,7 +1196,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       small[i] = fit[i].noise;
     }
     const double rho = median(ratio), noise_small = median(small);
-    const double want = 16.0 * (rho / 0.06) * (rho / 0.06);
+    const double want = neighbours_wanted(rho);
     std::size_t k2 = clamp_k(static_cast<std::size_t>(std::min(double(kMaxNeighbours), std::max(16.0, std::ceil(want)))));
     if (k2 < 48 && p.size() > 64) {
       const std::size_t k3 = clamp_k(48);
@@ -1487,7 +1491,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       std::size_t rows = 0, kw = 0;
       for (std::size_t i = 0; i < p.size(); ++i) {
         const double rho = region_noise[i] / std::max(nb.d(i, nb.k - 1), 1e-300);
-        const double want = 16.0 * (rho / 0.06) * (rho / 0.06);
+        const double want = neighbours_wanted(rho);
         if (!(want >= 1.5 * static_cast<double>(nb.k))) continue;
         if (!(region_noise[i] > 2 * rep.noise)) continue;  // not where the whole scan is as noisy
         if (!(region_noise[i] > 0.1 * region_nn[i])) continue;  // nor where it is clean (step 7's passes)

@@ -57,6 +57,7 @@ def simulate(model_off, base, views, res, noise, misreg, seed):
     mesh = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(v), o3d.utility.Vector3iVector(f))
     o3d.io.write_triangle_mesh(f"{base}-truth.off", mesh)
     mesh.compute_triangle_normals()  # (after the OFF, which cannot hold them)
+    o3d.utility.random.seed(seed)  # Open3D's own generator draws the dense sample: seeded too
     dense = mesh.sample_points_uniformly(number_of_points=3_000_000, use_triangle_normal=True)
     S, SN = np.asarray(dense.points), np.asarray(dense.normals)
     half = 0.55 / 2.0  # tan of half the field of view: 1.1 wide at distance 2, where the unit model fits

@@ -107,7 +107,7 @@ def away_fraction(v, f, points, rng, spacings=10.0, n=20000):
     return float(np.mean(d > spacings * step))
 
 
-def cases(models, seeds):
+def cases(models, seeds, model_seed=1):
     out = []
     for noise in (1, 2):
         for seed in range(1, seeds + 1):
@@ -116,10 +116,10 @@ def cases(models, seeds):
         v, f = read_off(SHARED / f"{m}.off")
         chi, _, _ = topology(f)
         for noise in (0, 1, 2):
-            out.append((f"{m}-n{noise}", m, noise, 1, chi))
-        out.append((f"{m}-misreg", m, "misreg", 1, chi))
-        out.append((f"{m}-misreg-noisy", m, "misreg-noisy", 1, chi))
-        out.append((f"{m}-density10", m, "density10", 1, chi))
+            out.append((f"{m}-n{noise}", m, noise, model_seed, chi))
+        out.append((f"{m}-misreg", m, "misreg", model_seed, chi))
+        out.append((f"{m}-misreg-noisy", m, "misreg-noisy", model_seed, chi))
+        out.append((f"{m}-density10", m, "density10", model_seed, chi))
     return out
 
 
@@ -165,6 +165,7 @@ def main():
     ap.add_argument("--work", default="/tmp/vitri-noise-topology")
     ap.add_argument("--models", default="bunny")
     ap.add_argument("--seeds", type=int, default=4)
+    ap.add_argument("--model-seed", type=int, default=1, help="seed of the models' samples and noise")
     ap.add_argument("--only", default=None, help="comma-separated prefixes of case names")
     ap.add_argument("--extra", default="", help="more CLI options, e.g. '--threads 1'")
     a = ap.parse_args()
@@ -173,7 +174,7 @@ def main():
     models = [m for m in a.models.split(",") if m]
     print("| case | truth chi | chi | components | loops | away % | noise line | s |")
     print("|---|---|---|---|---|---|---|---|")
-    for name, model, noise, seed, truth in cases(models, a.seeds):
+    for name, model, noise, seed, truth in cases(models, a.seeds, a.model_seed):
         if a.only and not any(name.startswith(x) for x in a.only.split(",")):
             continue
         xyz = generate(name, model, noise, seed, work)

@@ -280,17 +280,20 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
   // The data-following distance (offset_spacings > 0) is then set here, absolute: max(offset_spacings x
   // the scan's spacing (before the projection, which clusters points), 3 x its noise), at most
   // offset x the diagonal as the builder caps it.
+  Box3 box;
+  for (const Point3& q : prepared.points) box.extend(q);
   if (o.constraint_build.offset_spacings > 0 && report.spacing > 0) {
-    Box3 box;
-    for (const Point3& q : prepared.points) box.extend(q);
     const double spaced = std::min(o.constraint_build.offset * box.diagonal(),
                                    o.constraint_build.offset_spacings * report.spacing);
     o.constraint_build.offset = std::max(spaced, 3 * report.noise) / box.diagonal();
     o.constraint_build.offset_spacings = 0;
   }
   // Thin parts are told by the normals: the prepared points keep what noise the projection left, and
-  // same-sheet neighbours within D of p +- D n must not halve D (docs/scans.md).
+  // same-sheet neighbours within D of p +- D n must not halve D; nor is D halved below the noise, where
+  // a constraint's side is a guess (docs/scans.md, "Thin parts told by the normals").
   o.constraint_build.thin_opposite_only = true;
+  if (box.diagonal() > 0 && o.constraint_build.offset_floor == 0)
+    o.constraint_build.offset_floor = report.noise / box.diagonal();
   ConstraintBuildOptions build = o.constraint_build;
   Constraints& c = fit.constraints;
   if (choose_function(prepared.points.size(), o) == FunctionKind::Local) o.function = FunctionKind::Local;

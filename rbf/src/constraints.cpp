@@ -101,12 +101,13 @@ double spacing_median(const PointIndex& index, const std::vector<Point3>& points
 /// The signed offset of each off-surface constraint: for kept point k and side s (0: +d outside, 1: -d
 /// inside), offsets[2k + s] is the distance used (d0 halved until no surface point lies within 0.999 x
 /// it of the constraint, up to 4 times, while 0.999 d > tol: a constraint is never a near-duplicate of a
-/// surface point), 0 when the side is not wanted or every try was too close.
+/// surface point, and while d >= floor: never inside the data's noise), 0 when the side is not wanted or
+/// every try was too close.
 /// Each point is independent: the queries run on the threads (PointIndex is const-queryable).
 std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                                         const std::vector<std::size_t>& keep, const PointIndex& surface,
                                         const std::vector<Point3>& surface_normals, double d0, double tol,
-                                        const ConstraintBuildOptions& opt) {
+                                        double floor, const ConstraintBuildOptions& opt) {
   std::vector<double> offsets(2 * keep.size(), 0.0);
   // Queries in the index's spatial order: consecutive queries visit the same kd-tree leaves.
   std::vector<Point3> kept_points(keep.size());
@@ -130,7 +131,7 @@ std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const
         const double side = s == 0 ? 1.0 : -1.0;
         if ((s == 0 && opt.sides == OffSurface::Inside) || (s == 1 && opt.sides == OffSurface::Outside)) continue;
         double d = d0;
-        for (int tries = 0; tries < 5 && 0.999 * d > tol; ++tries, d *= 0.5) {
+        for (int tries = 0; tries < 5 && 0.999 * d > tol && (tries == 0 || d >= floor); ++tries, d *= 0.5) {
           const Point3 q = points[i] + (side * d) * n;
           // Too close to another surface point: the constraint would contradict that part of the surface.
           // (p_i itself lies at distance d, outside the strict ball.)
@@ -227,6 +228,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
     throw InvalidArgument("constraint offset_spacings must be a finite number >= 0 (0: offset alone)");
   if (!(opt.off_surface_spacing >= 0) || !std::isfinite(opt.off_surface_spacing))
     throw InvalidArgument("constraint off_surface_spacing must be a finite number >= 0 (0: every point)");
+  if (!(opt.offset_floor >= 0) || !std::isfinite(opt.offset_floor))
+    throw InvalidArgument("constraint offset_floor must be a finite fraction >= 0 of the diagonal (0: no floor)");
   if (!(opt.merge_tolerance >= 0) || !std::isfinite(opt.merge_tolerance))
     throw InvalidArgument("constraint merge_tolerance must be a finite fraction >= 0 of the diagonal");
   const std::size_t per = opt.sides == OffSurface::Both ? 3 : 2;
@@ -271,7 +274,8 @@ Constraints constraints_from_oriented_points(const std::vector<Point3>& points,
   rep.offset = d;
   rep.median_spacing = spacing;
   if (opt.max_constraints) subsample(keep, opt.max_constraints / per, opt.seed);
-  std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, surf_normals, d, tol, opt);
+  std::vector<double> offsets = off_surface_offsets(points, normals, keep, surface, surf_normals, d, tol,
+                                                 opt.offset_floor * box.diagonal(), opt);
   if (opt.off_surface_spacing > 0)
     rep.spaced_out = space_off_surface(offsets, points, keep, d, opt.off_surface_spacing, opt);
   Constraints c;

@@ -61,6 +61,16 @@ void unit_tetrahedron(Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
   F << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3;
 }
 
+// Two parallel 5x5 grids of spacing 0.25, 0.02 apart (z = 0 and z = 0.02), normals pointing away from
+// each other.
+void thin_slab(std::vector<Point3>& p, std::vector<Point3>& n) {
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j) {
+      p.push_back({i * 0.25, j * 0.25, 0.0}), n.push_back({0, 0, -1});
+      p.push_back({i * 0.25, j * 0.25, 0.02}), n.push_back({0, 0, 1});
+    }
+}
+
 }  // namespace
 
 TEST_CASE("constraints from oriented points: values, offsets, subsampling", "[rbf][constraints]") {
@@ -100,17 +110,52 @@ TEST_CASE("constraints: a thin slab shrinks the offset instead of crossing to th
           "[rbf][constraints]") {
   // Two parallel 5x5 grids 0.02 apart, normals pointing away from each other; d = 1% of ~1.4 > 0.01.
   std::vector<Point3> p, n;
-  for (int i = 0; i < 5; ++i)
-    for (int j = 0; j < 5; ++j) {
-      p.push_back({i * 0.25, j * 0.25, 0.0}), n.push_back({0, 0, -1});
-      p.push_back({i * 0.25, j * 0.25, 0.02}), n.push_back({0, 0, 1});
-    }
+  thin_slab(p, n);
   const Constraints c = constraints_from_oriented_points(p, n, {});
   for (std::size_t i = 0; i < c.size(); ++i) {
     if (c.values[i] >= 0) continue;  // inside constraints lie between the sheets
     CHECK(c.points[i].z > 0.0);
     CHECK(c.points[i].z < 0.02);
   }
+}
+
+TEST_CASE("constraints: offset_floor stops the halving above the floor and drops the side instead",
+          "[rbf][constraints]") {
+  // The thin slab above: sheets 0.02 apart, d0 = 1% of the diagonal (about 0.0141). Inside, d0 reaches
+  // within 0.006 of the other sheet (contradicted); d0 / 2 (about 0.0071) clears it.
+  std::vector<Point3> p, n;
+  thin_slab(p, n);
+  Box3 box;
+  for (const Point3& q : p) box.extend(q);
+  const double diag = box.diagonal(), d0 = 0.01 * diag;
+  auto count = [&](double floor_abs, std::size_t& inside, std::size_t& outside, double& smallest) {
+    ConstraintBuildOptions o;
+    o.offset_floor = floor_abs / diag;
+    const Constraints c = constraints_from_oriented_points(p, n, o);
+    inside = outside = 0;
+    smallest = d0;
+    for (std::size_t i = 0; i < c.size(); ++i) {
+      if (c.values[i] < 0) ++inside, smallest = std::min(smallest, -c.values[i]);
+      if (c.values[i] > 0) {
+        ++outside;
+        CHECK(c.values[i] == Approx(d0));  // nothing in the way outside: the full distance
+      }
+    }
+  };
+  std::size_t inside = 0, outside = 0;
+  double smallest = 0;
+  count(0.5 * 0.5 * d0, inside, outside, smallest);  // the floor below d0 / 2: halved once, as without it
+  CHECK(inside == p.size());
+  CHECK(outside == p.size());
+  CHECK(smallest == Approx(0.5 * d0));
+  count(0.6 * d0, inside, outside, smallest);  // d0 / 2 below the floor: the inside side is dropped
+  CHECK(inside == 0);
+  CHECK(outside == p.size());
+  ConstraintBuildOptions bad;
+  bad.offset_floor = -0.1;
+  CHECK_THROWS_AS(constraints_from_oriented_points(p, n, bad), InvalidArgument);
+  bad.offset_floor = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(constraints_from_oriented_points(p, n, bad), InvalidArgument);
 }
 
 TEST_CASE("constraints: thin_opposite_only keeps the full offset on a noisy sheet, still halves on a thin slab",

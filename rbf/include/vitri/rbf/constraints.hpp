@@ -44,6 +44,13 @@ struct ConstraintBuildOptions {
   /// puts the off-surface constraints inside the noise, where those of neighbouring points cross (tunnels
   /// and handles). false (the library's default) counts every point; Mesher::from_scan sets it.
   bool thin_opposite_only = false;
+  /// The thin-part halving of `offset` stops at this distance, a fraction of the same diagonal: a side
+  /// still contradicted at the smallest distance allowed is dropped. 0 (the library's default): halved
+  /// down to d / 16 as above. An off-surface constraint closer to its point than the noise of the data
+  /// lies within that noise, on the wrong side of the true surface as often as not, where neighbouring
+  /// points' constraints cross (tunnels and handles through a noisy thin part); Mesher::from_scan sets
+  /// it to the scan's measured noise (docs/scans.md, "Thin parts told by the normals").
+  double offset_floor = 0.0;
   /// Off-surface constraints per point; see OffSurface.
   OffSurface sides = OffSurface::Both;
   /// When > 0, only some surface points get off-surface constraints, about off_surface_spacing x d

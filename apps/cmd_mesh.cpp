@@ -817,10 +817,13 @@ QualityOptions level_quality(const MeshCommand& c, const MeshPlan& plan, const M
 
 /// What a scan's surface became (stderr): open or closed, and the components dropped.
 void print_scan_surface(const MesherStats& st, SurfaceKind surface) {
+  const std::string layers = st.scan_layer_components
+                                 ? " (" + std::to_string(st.scan_layer_components) + " of them layers of a larger one's noise)"
+                                 : std::string();
   std::fprintf(stderr, "surface: %s (%.1f%% of the closed surface's area away from the data%s); %zu small or "
-               "unsupported components dropped%s\n", st.open ? "open, trimmed to the data" : "closed",
+               "unsupported components dropped%s%s\n", st.open ? "open, trimmed to the data" : "closed",
                100 * st.unsupported_area,
-               surface == SurfaceKind::Auto ? ", --surface auto" : "", st.scan_small_components,
+               surface == SurfaceKind::Auto ? ", --surface auto" : "", st.scan_small_components, layers.c_str(),
                st.open ? (", " + std::to_string(st.trimmed_triangles) + " triangles trimmed").c_str() : "");
 }
 

@@ -595,6 +595,7 @@ void Mesher::finish_scan_surface() {
   mesh_ = scan_->finish(std::move(mesh_), precision_, options_.surface, options_.polygonizer.keep_history, &r,
                         quality_ != nullptr);
   stats_.scan_small_components = r.small_components;
+  stats_.scan_layer_components = r.layer_components;
   stats_.open = r.open;
   stats_.unsupported_area = r.unsupported_area;
   stats_.trimmed_triangles = r.trimmed_triangles;

@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <memory>
 #include <numeric>
 
 namespace vitri {
@@ -30,6 +32,11 @@ constexpr std::size_t kMinComponentPoints = 30;
 /// ... or nearest to more set-aside outliers than this many times its data points (a blob grown around
 /// the few outliers of a cloud that read as a surface, among the many set aside).
 constexpr std::size_t kMaxAsidePerPoint = 1;
+
+/// A thin component whose data lie within this many resolutions (median) of a larger one is a layer of it
+/// (drop_layers); the nearest this many mesh vertices of each of its points are searched for the other.
+constexpr double kLayerResolutions = 2.0;
+constexpr std::size_t kLayerNeighbours = 64;
 
 /// Queries per chunk of finish()'s parallel loops.
 constexpr std::size_t kQueryGrain = 4096;
@@ -84,6 +91,67 @@ double ScanSupport::reach(const Point3& x, double precision, double* distance_ou
                   std::max(kReachResolutions * resolution_, precision));
 }
 
+// A closed component thinner than the resolution (mean thickness 2 x volume / area) whose data lie
+// within kLayerResolutions of a larger kept component is a layer of that one's noise, not an object: the
+// points on the far side of a noisy sheet, meshed apart from it (a flake of 766 triangles, 1.0 noise
+// thick, beside a noisy knot; docs/scans.md, section 2). An object's data lie on it, farther from every
+// other component than that, and a body thinner than the resolution is not resolved as one.
+std::size_t ScanSupport::drop_layers(const SurfaceMesh& mesh, const std::vector<std::uint32_t>& comp, const std::vector<double>& area,
+                                     std::vector<std::uint8_t>& keep, const PointIndex& vertices,
+                                     const std::vector<std::uint32_t>& used_id,
+                                     const std::vector<std::uint32_t>& voted_for) const {
+  const std::size_t nv = mesh.vertices.size();
+  const auto none = static_cast<std::uint32_t>(nv);
+  std::uint32_t largest = none;
+  std::size_t kept = 0;
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (comp[v] == v && keep[v]) {
+      ++kept;
+      if (largest == none || area[v] > area[largest]) largest = v;
+    }
+  if (kept < 2) return 0;
+  std::vector<double> volume(nv, 0.0);
+  for (const auto& t : mesh.triangles) {  // about the component's root vertex: large coordinates cancel
+    const std::uint32_t c = comp[t[0]];
+    const Point3& o = mesh.vertices[c];
+    volume[c] += dot(mesh.vertices[t[0]] - o, cross(mesh.vertices[t[1]] - o, mesh.vertices[t[2]] - o)) / 6.0;
+  }
+  std::vector<std::uint32_t> slot(nv, none);  // a thin component's place in thin and away
+  std::vector<std::uint32_t> thin;
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (comp[v] == v && keep[v] && v != largest && 2 * std::abs(volume[v]) < resolution_ * area[v])
+      slot[v] = static_cast<std::uint32_t>(thin.size()), thin.push_back(v);
+  if (thin.empty()) return 0;
+  // Each thin component's data points: their distance to the nearest vertex of a larger kept component
+  // among their kLayerNeighbours nearest vertices (none there: far).
+  std::vector<std::vector<double>> away(thin.size());
+  std::vector<PointIndex::Id> ids;
+  std::vector<double> d2;
+  for (std::size_t i = 0; i < voted_for.size(); ++i) {
+    const std::uint32_t c = comp[voted_for[i]];
+    if (slot[c] == none) continue;
+    vertices.nearest(points_[i], kLayerNeighbours, ids, &d2);
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t j = 0; j < ids.size(); ++j) {
+      const std::uint32_t o = comp[used_id[ids[j]]];
+      if (o != c && keep[o] && area[o] > area[c]) {
+        best = std::sqrt(d2[j]);
+        break;
+      }
+    }
+    away[slot[c]].push_back(best);
+  }
+  std::size_t dropped = 0;
+  for (std::size_t k = 0; k < thin.size(); ++k) {
+    std::vector<double>& a = away[k];
+    if (a.empty()) continue;
+    const std::uint32_t c = thin[k];
+    std::nth_element(a.begin(), a.begin() + a.size() / 2, a.end());
+    if (a[a.size() / 2] <= kLayerResolutions * resolution_) keep[c] = 0, ++dropped;
+  }
+  return dropped;
+}
+
 SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing,
                                 ScanFinishReport* report, bool whole_triangles) {
   ScanFinishReport rep;
@@ -130,28 +198,31 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   // blob grown around a few stray points that survived the outlier rules has only their votes; the
   // set-aside outliers vote too, against: a blob among a cloud of them has more of theirs.
   std::vector<std::size_t> votes(nv, 0), aside(nv, 0);
+  std::vector<Point3> used_at;
+  std::vector<std::uint32_t> used_id;
+  std::unique_ptr<PointIndex> vertex_index;  // the used vertices (used_at), when there are any
+  std::vector<std::uint32_t> voted_for;  // each data point's nearest mesh vertex
   {
-    std::vector<Point3> used_at;
-    std::vector<std::uint32_t> used_id;
     std::vector<std::uint8_t> used(nv, 0);
     for (const auto& t : mesh.triangles) used[t[0]] = used[t[1]] = used[t[2]] = 1;
     for (std::uint32_t v = 0; v < nv; ++v)
       if (used[v]) used_at.push_back(mesh.vertices[v]), used_id.push_back(v);
     if (!used_at.empty()) {
-      const PointIndex vertices(used_at, threads_);
+      vertex_index = std::make_unique<PointIndex>(used_at, threads_);
       // Each point's nearest vertex on the threads, then the counts in order.
       auto nearest_vertex = [&](const std::vector<Point3>& from) {
         std::vector<std::uint32_t> at(from.size());
         parallel_chunks(from.size(), threads_, kQueryGrain, [&](std::size_t b, std::size_t e) {
           std::vector<PointIndex::Id> one;
           for (std::size_t i = b; i < e; ++i) {
-            vertices.nearest(from[i], 1, one);
+            vertex_index->nearest(from[i], 1, one);
             at[i] = used_id[one[0]];
           }
         });
         return at;
       };
-      for (const std::uint32_t v : nearest_vertex(points_)) ++votes[find(v)];
+      voted_for = nearest_vertex(points_);
+      for (const std::uint32_t v : voted_for) ++votes[find(v)];
       for (const std::uint32_t v : nearest_vertex(set_aside_)) ++aside[find(v)];
     }
   }
@@ -163,6 +234,13 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
                             aside[v] <= kMaxAsidePerPoint * votes[v]);
       rep.small_components += !keep[v];
     }
+  if (!editing && vertex_index) {
+    std::vector<std::uint32_t> comp(nv);
+    for (std::uint32_t v = 0; v < nv; ++v) comp[v] = find(v);
+    const std::size_t layers = drop_layers(mesh, comp, area, keep, *vertex_index, used_id, voted_for);
+    rep.small_components += layers;
+    rep.layer_components = layers;
+  }
   if (rep.small_components) {
     std::vector<std::array<std::uint32_t, 3>> kept;
     kept.reserve(mesh.triangles.size());

@@ -18,6 +18,7 @@ enum class SurfaceKind;
 /// What finish() did to a mesh.
 struct ScanFinishReport {
   std::size_t small_components = 0;  ///< components dropped: smaller than the data resolve, or unsupported
+  std::size_t layer_components = 0;  ///< of those, layers of a larger component's noise (drop_layers)
   bool open = false;                 ///< the mesh was trimmed to the data
   double unsupported_area = 0;       ///< fraction of the (closed) mesh's area farther than the reach
   std::size_t trimmed_triangles = 0; ///< triangles removed or clipped by the trimming
@@ -53,6 +54,14 @@ class ScanSupport {
   std::optional<bool> decided_open() const { return decided_open_; }
 
  private:
+  /// Clears keep[] of the thin components that are layers of a larger kept one (comp: each vertex's
+  /// component root; voted_for: each point's nearest vertex, an index into mesh.vertices; vertices: an
+  /// index of the used vertices, used_id its ids in mesh.vertices); returns how many.
+  std::size_t drop_layers(const SurfaceMesh& mesh, const std::vector<std::uint32_t>& comp,
+                          const std::vector<double>& area, std::vector<std::uint8_t>& keep,
+                          const PointIndex& vertices, const std::vector<std::uint32_t>& used_id,
+                          const std::vector<std::uint32_t>& voted_for) const;
+
   std::vector<Point3> points_;
   std::vector<Point3> set_aside_;  // the outliers prepare_scan set aside (ScanPoints::set_aside)
   std::vector<double> spacing_;

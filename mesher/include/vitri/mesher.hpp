@@ -205,6 +205,8 @@ struct MesherStats {
   /// whether the mesh was left open (trimmed to the data), the unsupported share of the closed mesh's
   /// area that decided it, and the triangles the trimming removed or clipped.
   std::size_t scan_small_components = 0;
+  /// Of those, thin components whose data lie on a larger one: the far side of its noise meshed apart.
+  std::size_t scan_layer_components = 0;
   bool open = false;
   double unsupported_area = 0;
   std::size_t trimmed_triangles = 0;

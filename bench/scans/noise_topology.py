@@ -6,7 +6,9 @@ Cases (generated here, seeded, numpy only):
   sphere-n{1,2}-s{seed}  6000 points on the unit sphere (Fibonacci lattice), isotropic Gaussian noise of
                          1 or 2 spacings of the clean sample; truth: chi 2, 1 component
   MODEL-n{0,1,2}         30,000 area-uniform samples of ../shared/data/MODEL.off, noise 0, 1 or 2 spacings;
-                         truth: the model's own chi (from its file)
+                         truth: the model's own chi (from its file). Not a truth for man.off, whose
+                         fingers and toes pass through each other (788 self-intersecting triangle
+                         pairs), nor quite for pig.off (open, one pair): compare their rows run to run
   MODEL-misreg           the same sample and a second sample of the 20% of largest x, shifted 2 spacings
                          along +x (a misregistered overlap); MODEL-misreg-noisy: both with noise of 0.5
   MODEL-density10        the sample, one point in 10 kept on the half x < median (10x density change)
@@ -14,6 +16,7 @@ For each: Euler characteristic chi = V - E + F of the output (vertices used by t
 boundary loops, the percentage of the output's area farther than 10 median input spacings from every input
 point ("away": blobs and sheets where there is no data), seconds. Prints a markdown table. Usage:
   python3 bench/scans/noise_topology.py [--vitri build-release/apps/vitri] [--models bunny] [--seeds 4]
+                                        [--model-seed 1]   (the seed of the models' samples and noise)
 """
 import argparse
 import os

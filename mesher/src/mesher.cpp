@@ -324,8 +324,10 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
     // An editing session (history kept) keeps the planes, as it keeps the uniform precision: edits move
     // constraints away from the scan, whose winding number would then answer for a shape that is gone
     // (a patch inside a new bump told "outside" would open a hole in it).
-    if (sides->encloses() && !o.polygonizer.keep_history)
+    if (sides->encloses() && !o.polygonizer.keep_history) {
       o.local.far_side = [sides](const Point3& x) { return (*sides)(x); };
+      o.local.far_sides = [sides](const Point3* x, std::size_t n, int* side) { (*sides)(x, n, side); };
+    }
   }
   return fit;
 }

@@ -266,9 +266,15 @@ void LocalRbf::Impl::fit_leaf(std::uint32_t c, FitScratch& s, std::uint32_t ball
       const double half = 0.5 * std::sqrt(nearest2);
       const Point3 offsets[7] = {{0, 0, 0},     {half, 0, 0}, {-half, 0, 0}, {0, half, 0},
                                  {0, -half, 0}, {0, 0, half}, {0, 0, -half}};
-      for (const Point3& o : offsets) {
-        const Point3 a = cell.center + o;
-        const int side = opt.far_side(a);
+      Point3 anchors[7];
+      int sides[7];
+      for (int k = 0; k < 7; ++k) anchors[k] = cell.center + offsets[k];
+      if (opt.far_sides) opt.far_sides(anchors, 7, sides);  // the same answers, one traversal
+      else
+        for (int k = 0; k < 7; ++k) sides[k] = opt.far_side(anchors[k]);
+      for (int k = 0; k < 7; ++k) {
+        const Point3 a = anchors[k];
+        const int side = sides[k];
         if (side == 0) continue;
         double d2 = std::numeric_limits<double>::infinity();
         for (std::size_t i = 0; i < data; ++i) d2 = std::min(d2, squared_norm(s.points[i] - a));

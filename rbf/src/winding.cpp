@@ -143,6 +143,66 @@ double WindingNumber::operator()(const Point3& x) const {
   return sum / kFourPi;
 }
 
+void WindingNumber::operator()(const Point3* x, std::size_t n, double* w) const {
+  for (std::size_t b = 0; b < n; b += kBatch) {
+    const std::size_t m = std::min(kBatch, n - b);
+    evaluate_batch(x + b, m, w + b);
+  }
+}
+
+// One traversal for up to kBatch points: a stack entry carries the points that opened its parent, and
+// each point decides at each node exactly as operator() does. A point's nodes are popped in the order
+// of its own traversal (the batch's depth-first order restricted to the nodes that point opens, a
+// subtree-closed set, keeps their order), so each sum adds the same terms in the same order: the
+// values are operator()'s, bit for bit.
+void WindingNumber::evaluate_batch(const Point3* x, std::size_t m, double* w) const {
+  double sum[kBatch] = {0};
+  if (nodes_.empty()) {
+    std::fill(w, w + m, 0.0);
+    return;
+  }
+  struct Entry {
+    std::uint32_t node;
+    std::uint32_t mask;  // bit k: point x[k] visits the node
+  };
+  Entry stack[8 * kMaxDepth + 8];
+  int top = 0;
+  stack[top++] = {0, (1u << m) - 1};
+  const double far2 = kFarFactor * kFarFactor;
+  while (top > 0) {
+    const Entry e = stack[--top];
+    const Node& nd = nodes_[e.node];
+    std::uint32_t open = 0;
+    for (std::size_t k = 0; k < m; ++k) {
+      if (!(e.mask >> k & 1u)) continue;
+      const Point3 d = nd.center - x[k];
+      const double d2 = squared_norm(d);
+      if (d2 > far2 * nd.radius2 && d2 > skip2_) sum[k] += dot(nd.dipole, d) / (d2 * std::sqrt(d2));
+      else open |= 1u << k;
+    }
+    if (!open) continue;
+    if (nd.children == 0) {
+      // The leaf's samples summed exactly for the points that opened it: samples outer, points inner
+      // (each sample read once; each point's terms still added in the samples' order).
+      std::size_t near[kBatch], count = 0;
+      for (std::size_t k = 0; k < m; ++k)
+        if (open >> k & 1u) near[count++] = k;
+      for (std::uint32_t i = nd.first; i < nd.first + nd.count; ++i) {
+        const Point3 pi = points_[i], wi = weighted_[i];
+        for (std::size_t c = 0; c < count; ++c) {
+          const std::size_t k = near[c];
+          const Point3 q = pi - x[k];
+          const double q2 = squared_norm(q);
+          if (q2 > skip2_) sum[k] += dot(wi, q) / (q2 * std::sqrt(q2));
+        }
+      }
+      continue;
+    }
+    for (std::uint32_t k = 0; k < nd.children; ++k) stack[top++] = {nd.child + k, open};
+  }
+  for (std::size_t k = 0; k < m; ++k) w[k] = sum[k] / kFourPi;
+}
+
 WindingSides::WindingSides(const std::vector<Point3>& points, const std::vector<Point3>& normals,
                            const std::vector<double>& areas, double offset)
     : w_(points, normals, areas) {
@@ -162,12 +222,28 @@ WindingSides::WindingSides(const std::vector<Point3>& points, const std::vector<
   jump_ = median(jumps);
 }
 
-int WindingSides::operator()(const Point3& x) const {
-  if (!(jump_ > 0.25)) return 0;
-  const double w = w_(x);
+int WindingSides::side_of(double w) const {
   if (w > level_ + 0.25 * jump_) return -1;
   if (w < level_ - 0.25 * jump_) return 1;
   return 0;
+}
+
+int WindingSides::operator()(const Point3& x) const {
+  if (!(jump_ > 0.25)) return 0;
+  return side_of(w_(x));
+}
+
+void WindingSides::operator()(const Point3* x, std::size_t n, int* side) const {
+  if (!(jump_ > 0.25)) {
+    std::fill(side, side + n, 0);
+    return;
+  }
+  double w[WindingNumber::kBatch];
+  for (std::size_t b = 0; b < n; b += WindingNumber::kBatch) {
+    const std::size_t m = std::min(WindingNumber::kBatch, n - b);
+    w_(x + b, m, w);
+    for (std::size_t k = 0; k < m; ++k) side[b + k] = side_of(w[k]);
+  }
 }
 
 WindingSides mesh_winding_sides(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double offset) {
@@ -229,6 +305,7 @@ bool settle_far_field_by_mesh(LocalRbfOptions& local, const Eigen::MatrixXd& V, 
   auto sides = std::make_shared<const WindingSides>(mesh_winding_sides(V, F, offset));
   if (!sides->encloses()) return false;
   local.far_side = [sides](const Point3& x) { return (*sides)(x); };
+  local.far_sides = [sides](const Point3* x, std::size_t n, int* side) { (*sides)(x, n, side); };
   local.far_side_anchors = false;
   return true;
 }

@@ -76,6 +76,40 @@ TEST_CASE("WindingNumber: 1 inside a sampled sphere, 0 outside, -1 with the norm
   CHECK(std::abs(w_cap(Point3{0, 0, 30})) < 0.01);
 }
 
+TEST_CASE("WindingNumber and WindingSides in batches: the single answers bit for bit", "[winding]") {
+  // Points near the samples (the anchors' case: clusters a fraction of a spacing across, which open the
+  // same nodes), far ones, and a sample itself (its own term skipped), in batches of every size up to
+  // past kBatch: the values must be those of the one-point traversal exactly.
+  const Samples s = sphere(3000);
+  const WindingNumber w(s.points, s.normals, s.areas);
+  const WindingSides sides(s.points, s.normals, s.areas, 0.02);
+  std::vector<Point3> x;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-0.03, 0.03);
+  int k = 0;
+  for (const Point3& d : random_directions(12, 5)) {
+    const Point3 c = d * (0.9 + 0.02 * k++);  // around the sphere, inside and outside
+    for (int j = 0; j < 3; ++j) x.push_back(c + Point3{u(rng), u(rng), u(rng)});
+  }
+  x.push_back(Point3{0, 0, 0});
+  x.push_back(Point3{4, -3, 2});
+  x.push_back(s.points[17]);
+  for (std::size_t n = 0; n <= x.size(); n += (n < 10 ? 1 : 7)) {
+    std::vector<double> batch(n, -7.0);
+    std::vector<int> side(n, 5);
+    w(x.data(), n, batch.data());
+    sides(x.data(), n, side.data());
+    for (std::size_t i = 0; i < n; ++i) {
+      CHECK(batch[i] == w(x[i]));  // exactly
+      CHECK(side[i] == sides(x[i]));
+    }
+  }
+  std::vector<double> one(1);
+  w(&s.points[17], 1, one.data());
+  CHECK(std::isfinite(one[0]));
+  CHECK(std::abs(one[0] - 0.5) < 0.05);  // on the surface: half of the jump
+}
+
 TEST_CASE("WindingSides: calibrated on the samples, closed, inside out, wrong areas, a single view",
           "[winding]") {
   SECTION("a closed sphere: level 1/2, jump 1; inside -1, outside +1") {
@@ -182,6 +216,16 @@ TEST_CASE("LocalRbfOptions::far_side settles far patches that disagree", "[windi
   CHECK(settled.report().far_settled > 0);
   CHECK(negatives(settled) == 0);
   CHECK(settled.value(Point3{0, 0, 0}) < 0);
+  // far_sides (the batch form, used for the anchors) gives the same function exactly.
+  vitri::LocalRbfOptions batched = options;
+  batched.far_sides = [sides](const Point3* x, std::size_t n, int* side) { (*sides)(x, n, side); };
+  const vitri::LocalRbf same(c, batched);
+  CHECK(same.report().far_settled == settled.report().far_settled);
+  for (const Point3& p : far_outside) CHECK(same.value(p) == settled.value(p));
+  for (std::size_t i = 0; i < c.size(); i += 13) {
+    const Point3 near = c.points[i] + Point3{0.011, -0.007, 0.013};
+    CHECK(same.value(near) == settled.value(near));
+  }
   // The constraints keep their values: far_side changes only patches without constraints.
   for (std::size_t i = 0; i < c.size(); i += 37) CHECK(std::abs(settled.value(c.points[i]) - c.values[i]) < 1e-6);
   // An edit near the cap refits patches there with the same rule.

@@ -67,6 +67,10 @@ struct LocalRbfOptions {
   /// Mesher::from_scan sets it from the scan's winding number (vitri::WindingNumber, docs/scans.md).
   /// Called from the fit's threads (it must be thread-safe), and by edits for the patches they refit.
   std::function<int(const Point3&)> far_side;
+  /// Optional: far_side's answers for n points at once (side[k] = far_side(x[k]), the same answers),
+  /// used for the anchors below when set (their seven points, close together, cost one traversal of
+  /// vitri::WindingNumber's octree instead of seven). Thread-safe as far_side.
+  std::function<void(const Point3* x, std::size_t n, int* side)> far_sides;
   /// With far_side: an RBF patch whose centre lies in empty space (at least half its radius from every
   /// constraint it fits: beside a thin part, past its tip) is also fitted with anchors there at far_side's
   /// answer (docs/local_rbf.md "Far side"), against the overshoot of noisy scans. false settles the far

@@ -36,6 +36,11 @@ class WindingNumber {
 
   /// w(x). Thread-safe (const). 0 for an empty object.
   double operator()(const Point3& x) const;
+  /// w at n points: w[k] = (*this)(x[k]) bit for bit, the points taken kBatch at a time through one
+  /// shared traversal of the octree (points close together, such as a patch's anchors, open the same
+  /// nodes: one descent instead of several). Thread-safe (const).
+  void operator()(const Point3* x, std::size_t n, double* w) const;
+  static constexpr std::size_t kBatch = 8;
 
   std::size_t size() const { return points_.size(); }
 
@@ -50,6 +55,7 @@ class WindingNumber {
     std::uint32_t child = 0, children = 0;
   };
   void build(std::uint32_t node, int depth);
+  void evaluate_batch(const Point3* x, std::size_t m, double* w) const;  // m <= kBatch
 
   std::vector<Point3> points_;   ///< in tree order
   std::vector<Point3> weighted_; ///< a_i n_i, in tree order
@@ -75,6 +81,8 @@ class WindingSides {
                const std::vector<double>& areas, double offset);
   /// -1 inside, +1 outside, 0 unclear. Thread-safe.
   int operator()(const Point3& x) const;
+  /// side[k] = (*this)(x[k]) for k < n, through WindingNumber's batch evaluation. Thread-safe.
+  void operator()(const Point3* x, std::size_t n, int* side) const;
   double level() const { return level_; }
   double jump() const { return jump_; }
   /// Whether the samples enclose a volume (an object, not a single view or a room seen from inside): the
@@ -84,6 +92,7 @@ class WindingSides {
   static constexpr double kEnclosingLevel = 0.35;
 
  private:
+  int side_of(double w) const;
   WindingNumber w_;
   double level_ = 0, jump_ = 0;
 };

@@ -779,6 +779,11 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
       std::fprintf(stderr, "%s\n", describe(sr).c_str());
       if (mesher.size() >= kFitProgressConstraints) print_scan_split(sr);
       print_build_report(mesher.stats().scan_constraints, options.constraint_build);
+      // Most signs undecided: the inside may be the outside (a few dozen points without normals).
+      if (sr.kept > 0 && 2 * sr.ambiguous > sr.kept)
+        std::fprintf(stderr, "vitri mesh: warning: the normals' signs are ambiguous at %zu of the %zu points: "
+                     "which side is inside may be wrong; give normals or --viewpoint (docs/scans.md)\n",
+                     sr.ambiguous, sr.kept);
     }
     if (plan.default_precision) {
       // The resolution the data resolve, not the raw spacing of noisy points (docs/scans.md).
@@ -882,6 +887,14 @@ double run_level(const MeshCommand& c, MeshPlan& plan, std::size_t k, double tot
   write_current(mesher, level.path, c.ply);
   phases.stop();
   if (!c.quiet && plan.scan_input) print_scan_surface(mesher.stats(), options.surface);
+  if (!c.quiet && plan.scan_input && mesher.stats().scan_kept_unresolved)
+    std::fprintf(stderr, "vitri mesh: warning: every component of the surface is smaller than the data resolve "
+                 "(fewer than 30 points nearest to it, or under 8 resolutions across): the best-supported one is "
+                 "kept; a denser scan gives a mesh to trust (docs/scans.md)\n");
+  if (!c.quiet && m.triangles.empty())
+    std::fprintf(stderr, "vitri mesh: warning: level %zu's mesh is empty: the function has no zero set the %s "
+                 "keeps (%s)\n", k, plan.scan_input ? "data support" : "refinement finds",
+                 plan.scan_input ? "docs/scans.md" : "a finer --precision may find one");
   if (!c.quiet)
     std::printf("%5zu %10.4g %9zu %10zu %11.1f %11.1f %10.1f   -> %s\n", k, level.precision, m.vertices.size(),
                 m.triangles.size(), refine_ms, extract_ms, total_ms, level.path.c_str());

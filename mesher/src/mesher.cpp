@@ -598,6 +598,7 @@ void Mesher::finish_scan_surface() {
                         quality_ != nullptr);
   stats_.scan_small_components = r.small_components;
   stats_.scan_layer_components = r.layer_components;
+  stats_.scan_kept_unresolved = r.kept_unresolved;
   stats_.open = r.open;
   stats_.unsupported_area = r.unsupported_area;
   stats_.trimmed_triangles = r.trimmed_triangles;

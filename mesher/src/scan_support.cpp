@@ -234,6 +234,24 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
                             aside[v] <= kMaxAsidePerPoint * votes[v]);
       rep.small_components += !keep[v];
     }
+  // A small input (a few dozen points) can make every component fall below what its data resolve: the
+  // surface is then the best-supported component, kept with the report's warning rather than an empty
+  // mesh (the absolute sizes above judge blobs beside a surface, not the only surface there is).
+  if (!editing && rep.small_components > 0) {
+    std::uint32_t best = nv;
+    bool any = false;
+    for (std::uint32_t v = 0; v < nv; ++v) {
+      if (!(root[v] == v && area[v] > 0)) continue;
+      any = any || keep[v];
+      if (!supported[v] || votes[v] == 0) continue;
+      if (best == nv || votes[v] > votes[best] || (votes[v] == votes[best] && area[v] > area[best])) best = v;
+    }
+    if (!any && best != nv) {
+      keep[best] = 1;
+      --rep.small_components;
+      rep.kept_unresolved = true;
+    }
+  }
   if (!editing && vertex_index) {
     std::vector<std::uint32_t> comp(nv);
     for (std::uint32_t v = 0; v < nv; ++v) comp[v] = find(v);

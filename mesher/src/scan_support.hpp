@@ -19,6 +19,9 @@ enum class SurfaceKind;
 struct ScanFinishReport {
   std::size_t small_components = 0;  ///< components dropped: smaller than the data resolve, or unsupported
   std::size_t layer_components = 0;  ///< of those, layers of a larger component's noise (drop_layers)
+  /// Every component was below what the data resolve (a few dozen points): the best-supported one (most
+  /// data points nearest to it) was kept all the same.
+  bool kept_unresolved = false;
   bool open = false;                 ///< the mesh was trimmed to the data
   double unsupported_area = 0;       ///< fraction of the (closed) mesh's area farther than the reach
   std::size_t trimmed_triangles = 0; ///< triangles removed or clipped by the trimming

@@ -1171,7 +1171,14 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // Neighbourhoods: k from the data. 16 neighbours first; where the noise is large against their
   // radius, more (the plane residual grows with the noise, the radius with sqrt(k)).
   const unsigned threads = options.threads;
-  auto clamp_k = [&](std::size_t k) { return std::min(k, p.size() - 1); };
+  // A neighbourhood is local: at most half the points (and at least 6) unless options.k says otherwise.
+  // On a few dozen points, 16 neighbours of 20 span the whole object: their planes and quadrics are no
+  // tangent planes, the noise reads as half a spacing and the two sides as misregistered layers (20
+  // points of a sphere gave a box-shaped blob).
+  auto clamp_k = [&](std::size_t k) {
+    const std::size_t local = options.k ? p.size() - 1 : std::max<std::size_t>(6, p.size() / 2);
+    return std::min({k, local, p.size() - 1});
+  };
   std::size_t k = clamp_k(options.k ? std::max<std::size_t>(6, options.k) : 16);
   PointIndex index(p, threads);
   Neighbours nb = nearest_neighbours(p, index, k, threads);

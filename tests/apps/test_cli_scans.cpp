@@ -203,6 +203,37 @@ TEST_CASE("vitri mesh, scan defaults: a noisy sphere with outliers gives one clo
   CHECK(s.vertices <= 2 * pts.size());
 }
 
+TEST_CASE("vitri mesh, scan defaults: a few dozen points give a mesh and a warning, never an empty file",
+          "[cli][scan]") {
+  // 20 and 24 points of the unit sphere, no normals: every component is below what so few points resolve
+  // (fewer than 30 nearest to it); the best-supported one is kept with a warning (an empty mesh before),
+  // and the neighbourhoods stay local (at most half the points: with 16 of 20 the planes spanned the
+  // whole sphere and the mesh was a box-shaped blob along the domain's walls).
+  for (const std::size_t n : {std::size_t(20), std::size_t(24)}) {
+    const std::string in = kDir + "/scan_few" + std::to_string(n) + ".xyz",
+                      out = kDir + "/scan_few" + std::to_string(n) + ".ply";
+    write_noisy_sphere(in, n, 0.0, 0, 11 + n);
+    std::string o, e;
+    REQUIRE(run(in + " -o " + out, o, e) == 0);
+    INFO(o << e);
+    CHECK(e.find("warning: every component of the surface is smaller than the data resolve") != std::string::npos);
+    CHECK(e.find("mesh is empty") == std::string::npos);
+    const Shape s = shape_of(out);
+    CHECK(s.components == 1);
+    CHECK(s.boundary_edges == 0);
+    CHECK(s.nonmanifold_edges == 0);
+    CHECK(s.euler == 2);
+    // A blob of the sphere, not of the domain box: its volume within a factor 2 of the sphere's, outward.
+    double volume = 0;
+    for (const auto& t : s.f) {
+      const Point3 &a = s.v[t[0]], &b = s.v[t[1]], &c = s.v[t[2]];
+      volume += vitri::dot(a, vitri::cross(b, c)) / 6;
+    }
+    CHECK(volume > 0.5 * 4 * kPi / 3);
+    CHECK(volume < 2.0 * 4 * kPi / 3);
+  }
+}
+
 TEST_CASE("vitri mesh, scan defaults: noisy spheres keep the sphere's topology (seeds, noise 1 spacing)",
           "[cli][scan]") {
   // 6000 points, radial Gaussian noise of one spacing, no outliers, 4 seeds: before the normal-aware

@@ -107,3 +107,38 @@ TEST_CASE("scan support: a thin component on a larger one's data is dropped as a
   CHECK(editing.layer_components == 0);
   CHECK(metrics_of(kept).components == 4);
 }
+
+TEST_CASE("scan support: when every component is below what the data resolve, the best-supported one stays",
+          "[mesher][scan]") {
+  // Two small boxes, each with fewer than the 30 points a component needs: the one with more data points
+  // nearest to it is kept (and reported), the other dropped; with a third box of enough points, the rule
+  // of small components applies as usual and both small ones go.
+  const double res = 0.1;
+  SurfaceMesh mesh;
+  ScanPoints data;
+  add_box(mesh, {0, 0, 0}, {0.3, 0.3, 0.3}, res);
+  add_points(data, 2, 0.3, 0.0, 0.3, 0.0, 0.3, res);  // 16 points on its top
+  add_box(mesh, {2, 0, 0}, {2.3, 0.3, 0.3}, res);
+  add_points(data, 2, 0.3, 2.0, 2.2, 0.0, 0.2, res);  // 9 points on its top
+  REQUIRE(data.points.size() == 25);
+  ScanSupport support(data, res, 2);
+  ScanFinishReport report;
+  const SurfaceMesh out = support.finish(mesh, res, SurfaceKind::Closed, false, &report);
+  CHECK(report.kept_unresolved);
+  CHECK(report.small_components == 1);
+  const MeshMetrics mm = metrics_of(out);
+  CHECK(mm.components == 1);
+  CHECK(mm.closed_manifold());
+  for (const Point3& v : out.vertices) CHECK(v.x < 1.0);  // the first box, the better supported
+
+  SurfaceMesh more = mesh;
+  ScanPoints dense = data;
+  add_box(more, {5, 0, 0}, {7, 2, 2}, res);
+  add_points(dense, 2, 2.0, 5.0, 7.0, 0.0, 2.0, res);  // 441 points on its top
+  ScanSupport support2(dense, res, 2);
+  ScanFinishReport report2;
+  const SurfaceMesh out2 = support2.finish(more, res, SurfaceKind::Closed, false, &report2);
+  CHECK_FALSE(report2.kept_unresolved);
+  CHECK(report2.small_components == 2);
+  CHECK(metrics_of(out2).components == 1);
+}

@@ -207,6 +207,9 @@ struct MesherStats {
   std::size_t scan_small_components = 0;
   /// Of those, thin components whose data lie on a larger one: the far side of its noise meshed apart.
   std::size_t scan_layer_components = 0;
+  /// Every component was smaller than the data resolve (too few points: fewer than 30 nearest to it, or
+  /// less than 8 resolutions across): the best-supported one was kept rather than none, and the CLI warns.
+  bool scan_kept_unresolved = false;
   bool open = false;
   double unsupported_area = 0;
   std::size_t trimmed_triangles = 0;

@@ -238,7 +238,7 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
   // surface is then the best-supported component, kept with the report's warning rather than an empty
   // mesh (the absolute sizes above judge blobs beside a surface, not the only surface there is).
   if (!editing && rep.small_components > 0) {
-    std::uint32_t best = nv;
+    std::size_t best = nv;
     bool any = false;
     for (std::uint32_t v = 0; v < nv; ++v) {
       if (!(root[v] == v && area[v] > 0)) continue;

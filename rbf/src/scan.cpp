@@ -129,8 +129,15 @@ struct LocalFit {
   Point3 projected;   ///< the point moved onto the quadric along the frame's normal
   double noise = 0;   ///< weighted RMS residual of the neighbourhood to the quadric
   double plane = 0;   ///< RMS residual to the least-squares plane (curvature included)
+  /// The neighbourhood's second variance over its largest (PCA): about 1 for a disc of neighbours, near
+  /// 0 for a line of them (a sparse scan's rings, a scan line), whose plane, hence normal, is arbitrary.
+  double spread = 0;
   bool collinear = false;
 };
+
+/// Below this spread (LocalFit::spread) a neighbourhood is a line of points: its normal says nothing of
+/// the surface (the neighbourhood is 7 times longer than wide or more).
+constexpr double kLinearSpread = 0.02;
 
 /// Fits point i's neighbourhood (itself included): PCA plane, then the weighted quadric height field
 /// z = a + b x + c y + d x^2 + e xy + f y^2 in the plane's frame (Wendland weights over the neighbourhood
@@ -166,6 +173,7 @@ LocalFit fit_neighbourhood(const std::vector<Point3>& p, const Neighbours& nb, s
   Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(cov);
   const Eigen::Vector3d ev = solver.eigenvalues();
   out.collinear = m < 3 || !(ev(1) > 1e-6 * ev(2));
+  out.spread = ev(2) > 0 ? std::max(0.0, ev(1)) / ev(2) : 0.0;
   out.plane = std::sqrt(std::max(0.0, ev(0)) / static_cast<double>(m));
   const Eigen::Vector3d nrm = solver.eigenvectors().col(0).normalized();
   const Eigen::Vector3d e1 = solver.eigenvectors().col(2).normalized();
@@ -740,17 +748,21 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Poin
 }
 
 /// Fraction of neighbour pairs along the surface whose normals point to opposite sides.
-double disagreement(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Point3>& n) {
+double disagreement(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Point3>& n,
+                    const std::vector<LocalFit>& fit) {
   std::size_t along = 0, opposite = 0;
-  for (std::size_t i = 0; i < p.size(); ++i)
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    if (fit[i].spread < kLinearSpread) continue;  // a line of neighbours: its normal is arbitrary
     for (std::size_t c = 0; c < nb.k; ++c) {
       const Id j = nb.at(i, c);
+      if (fit[j].spread < kLinearSpread) continue;
       const Point3 e = p[j] - p[i];
       const double half = 0.5 * norm(e);
       if (std::abs(dot(n[i], e)) > half || std::abs(dot(n[j], e)) > half) continue;
       ++along;
       opposite += dot(n[i], n[j]) < 0;
     }
+  }
   return along ? static_cast<double>(opposite) / static_cast<double>(along) : 0.0;
 }
 
@@ -1385,11 +1397,14 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       no.strict = false;
       rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, own, no);
       settle_components(p, nb, own, threads);
-      std::size_t same = 0;
-      for (std::size_t i = 0; i < p.size(); ++i) same += dot(own[i], n[i]) > 0;
-      agree = static_cast<double>(same) / static_cast<double>(p.size());
+      // (Points whose neighbours lie on a line are not counted: their normals, hence signs, are
+      // arbitrary under either orientation: the rings of a terrestrial scan's sparse far ground.)
+      std::size_t same = 0, counted = 0;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        if (fit[i].spread >= kLinearSpread) same += dot(own[i], n[i]) > 0, ++counted;
+      agree = counted ? static_cast<double>(same) / static_cast<double>(counted) : 1.0;
     }
-    const double dis = disagreement(p, nb, n);
+    const double dis = disagreement(p, nb, n, fit);
     if (dis > 0.05 || std::max(agree, 1 - agree) < 0.9) {
       rep.viewpoint_rejected = true;
       std::ostringstream why;

@@ -956,9 +956,12 @@ std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb
     const Part& q = part[find(static_cast<Id>(i))];
     bool flip = false;
     if (q.verdict == 2) {
+      // Normals across the axis (a wall of a scene seen from above) keep the tree's sign, which is
+      // consistent along the wall, until the vote: the sign of their small component along the axis is
+      // the noise's (a terrestrial scan's building front came out in patches of both signs, foam).
       const double c = dot(n[i], q.axis);
-      flip = c < 0;
       if (std::abs(c) < 0.2) undecided[i] = 1, sheets = true;
+      else flip = c < 0;
     } else if (q.verdict != 0) {
       flip = q.verdict < 0;
     } else {

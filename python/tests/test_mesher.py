@@ -165,3 +165,18 @@ def test_stable_constraint_ids():
         m.set_value(10**9, 0.0)
     V, F, _ = m.mesh()
     assert_closed_manifold(V, F)
+
+
+def test_a_few_points_keep_their_best_component():
+    # 20 points of a sphere in a batch run (vitri.reconstruct, as the CLI): every component is below what
+    # they resolve (fewer than 30 nearest to it); the best-supported one is kept, not an empty mesh
+    # (docs/scans.md). An editing Mesher judges no component by the data: the flag stays False there.
+    p, _ = sphere_points(20)
+    V, F, _ = vitri.reconstruct(p)
+    assert len(F) > 0
+    assert_closed_manifold(V, F)
+    assert euler_characteristic(V, F) == 2
+    m = vitri.Mesher.from_scan(p)
+    m.refine(0.05, relative=True)
+    m.mesh()
+    assert m.stats()["scan_kept_unresolved"] is False

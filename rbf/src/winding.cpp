@@ -116,31 +116,9 @@ void WindingNumber::build(std::uint32_t node, int depth) {
 }
 
 double WindingNumber::operator()(const Point3& x) const {
-  if (nodes_.empty()) return 0.0;
-  double sum = 0;
-  std::uint32_t stack[8 * kMaxDepth + 8];
-  int top = 0;
-  stack[top++] = 0;
-  const double far2 = kFarFactor * kFarFactor;
-  while (top > 0) {
-    const Node& n = nodes_[stack[--top]];
-    const Point3 d = n.center - x;
-    const double d2 = squared_norm(d);
-    if (d2 > far2 * n.radius2 && d2 > skip2_) {
-      sum += dot(n.dipole, d) / (d2 * std::sqrt(d2));
-      continue;
-    }
-    if (n.children == 0) {
-      for (std::uint32_t i = n.first; i < n.first + n.count; ++i) {
-        const Point3 e = points_[i] - x;
-        const double e2 = squared_norm(e);
-        if (e2 > skip2_) sum += dot(weighted_[i], e) / (e2 * std::sqrt(e2));
-      }
-      continue;
-    }
-    for (std::uint32_t k = 0; k < n.children; ++k) stack[top++] = n.child + k;
-  }
-  return sum / kFourPi;
+  double w;
+  evaluate_batch(&x, 1, &w);
+  return w;
 }
 
 void WindingNumber::operator()(const Point3* x, std::size_t n, double* w) const {
@@ -153,8 +131,8 @@ void WindingNumber::operator()(const Point3* x, std::size_t n, double* w) const 
 // One traversal for up to kBatch points: a stack entry carries the points that opened its parent, and
 // each point decides at each node exactly as operator() does. A point's nodes are popped in the order
 // of its own traversal (the batch's depth-first order restricted to the nodes that point opens, a
-// subtree-closed set, keeps their order), so each sum adds the same terms in the same order: the
-// values are operator()'s, bit for bit.
+// subtree-closed set, keeps their order), so each sum adds the same terms in the same order: a point's
+// value does not depend on the others in its batch, bit for bit (operator() is a batch of one).
 void WindingNumber::evaluate_batch(const Point3* x, std::size_t m, double* w) const {
   double sum[kBatch] = {0};
   if (nodes_.empty()) {

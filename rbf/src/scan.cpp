@@ -139,6 +139,17 @@ struct LocalFit {
 /// the surface (the neighbourhood is 7 times longer than wide or more).
 constexpr double kLinearSpread = 0.02;
 
+/// A viewpoint outside the data's box is accepted when the orientation it gives agrees with the data's own
+/// on at least this share of the points (one view of a scene or object; a merged multi-view cloud reads
+/// far lower). From kViewpointSampleMin points on, the share is first measured on a sample
+/// (sampled_agreement) and taken when farther than kViewpointBand from the limit: the shipped views read
+/// 0.99-1.00 on a sample and on all points alike.
+constexpr double kViewpointAgree = 0.9;
+constexpr double kViewpointBand = 0.05;
+constexpr std::size_t kViewpointSampleMin = 40000;
+constexpr double kViewpointSampleRadius = 2.25;
+constexpr std::size_t kViewpointSampleNeighbours = 16;
+
 /// Fits point i's neighbourhood (itself included): PCA plane, then the weighted quadric height field
 /// z = a + b x + c y + d x^2 + e xy + f y^2 in the plane's frame (Wendland weights over the neighbourhood
 /// radius); a plane when the quadric is ill-conditioned. `side`, when given (oriented normals), keeps only
@@ -749,21 +760,27 @@ std::vector<std::uint8_t> find_outliers(const std::vector<Point3>& p, const Poin
 
 /// Fraction of neighbour pairs along the surface whose normals point to opposite sides.
 double disagreement(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Point3>& n,
-                    const std::vector<LocalFit>& fit) {
-  std::size_t along = 0, opposite = 0;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    if (fit[i].spread < kLinearSpread) continue;  // a line of neighbours: its normal is arbitrary
-    for (std::size_t c = 0; c < nb.k; ++c) {
-      const Id j = nb.at(i, c);
-      if (fit[j].spread < kLinearSpread) continue;
-      const Point3 e = p[j] - p[i];
-      const double half = 0.5 * norm(e);
-      if (std::abs(dot(n[i], e)) > half || std::abs(dot(n[j], e)) > half) continue;
-      ++along;
-      opposite += dot(n[i], n[j]) < 0;
-    }
-  }
-  return along ? static_cast<double>(opposite) / static_cast<double>(along) : 0.0;
+                    const std::vector<LocalFit>& fit, unsigned threads) {
+  const std::size_t chunks = (p.size() + kGrain - 1) / kGrain;
+  std::vector<std::size_t> along(chunks, 0), opposite(chunks, 0);  // per chunk of kGrain points
+  rbf_detail::parallel_chunks(chunks, threads, 1, [&](std::size_t cb, std::size_t ce) {
+    for (std::size_t chunk = cb; chunk < ce; ++chunk)
+      for (std::size_t i = chunk * kGrain; i < std::min(p.size(), (chunk + 1) * kGrain); ++i) {
+        if (fit[i].spread < kLinearSpread) continue;  // a line of neighbours: its normal is arbitrary
+        for (std::size_t c = 0; c < nb.k; ++c) {
+          const Id j = nb.at(i, c);
+          if (fit[j].spread < kLinearSpread) continue;
+          const Point3 e = p[j] - p[i];
+          const double half = 0.5 * norm(e);
+          if (std::abs(dot(n[i], e)) > half || std::abs(dot(n[j], e)) > half) continue;
+          ++along[chunk];
+          opposite[chunk] += dot(n[i], n[j]) < 0;
+        }
+      }
+  });
+  const std::size_t a = std::accumulate(along.begin(), along.end(), std::size_t(0));
+  const std::size_t o = std::accumulate(opposite.begin(), opposite.end(), std::size_t(0));
+  return a ? static_cast<double>(o) / static_cast<double>(a) : 0.0;
 }
 
 /// One vote: a point whose sign disagrees with a clear majority (weighted by |n_i . n_j|, pairs along the
@@ -1126,6 +1143,46 @@ std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>
   return moved;
 }
 
+/// The share of the points (those whose neighbours lie on a line not counted: their normals, hence
+/// signs, are arbitrary under either orientation: the rings of a terrestrial scan's sparse far ground)
+/// whose signs agree between two orientations of the same normals.
+double sign_agreement(const std::vector<Point3>& a, const std::vector<Point3>& b, const std::vector<LocalFit>& fit) {
+  std::size_t same = 0, counted = 0;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (fit[i].spread >= kLinearSpread) same += dot(a[i], b[i]) > 0, ++counted;
+  return counted ? static_cast<double>(same) / static_cast<double>(counted) : 1.0;
+}
+
+/// sign_agreement() of the viewpoint's orientation `n` with the data's own (the spanning tree, closed
+/// parts settled outward), measured on an even sample of the points: a Poisson-disk subset at
+/// kViewpointSampleRadius median spacings (about one point in 8 of an even scan; a sparser region keeps
+/// more of its points), with its own neighbourhoods (the subset's kViewpointSampleNeighbours nearest) and
+/// the points' normals as the viewpoint oriented them.
+double sampled_agreement(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Point3>& n,
+                         const std::vector<LocalFit>& fit, std::size_t k, unsigned threads, std::size_t& sample) {
+  std::vector<double> nearest(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) nearest[i] = nb.d(i, 0);
+  const double spacing = median(nearest);
+  const std::vector<char> kept =
+      rbf_detail::spaced_subset(p, detail::spatial_order(p), kViewpointSampleRadius * spacing);
+  std::vector<Point3> q, qn;
+  std::vector<LocalFit> qfit;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (kept[i]) q.push_back(p[i]), qn.push_back(n[i]), qfit.push_back(fit[i]);
+  sample = q.size();
+  if (q.size() < 64) return 1.0;
+  const PointIndex index(q, threads);
+  const Neighbours qnb = nearest_neighbours(q, index, std::min({k, kViewpointSampleNeighbours, q.size() - 1}), threads);
+  std::vector<Point3> own = qn;
+  NormalOptions no;
+  no.k = std::min<std::size_t>(qnb.k, 12);
+  no.threads = threads;
+  no.strict = false;
+  rbf_detail::orient_distinct_normals(q, qnb.ids.data(), qnb.k, own, no);
+  settle_components(q, qnb, own, threads);
+  return sign_agreement(own, qn, qfit);
+}
+
 }  // namespace
 
 ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Point3>& normals,
@@ -1391,24 +1448,36 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     bool outside = false;
     if (options.sensors.empty())
       for (std::size_t a = 0; a < 3; ++a) outside = outside || (*options.viewpoint)[a] < lo[a] || (*options.viewpoint)[a] > hi[a];
-    std::vector<Point3> own = n;
-    double agree = 1.0;
-    if (outside) {
+    std::vector<Point3> own;
+    auto own_orientation = [&]() {  // the data's own orientation of every point: its agreement with n
+      own = n;
       NormalOptions no;
       no.k = std::min<std::size_t>(k, 12);
       no.threads = threads;
       no.strict = false;
       rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, own, no);
       settle_components(p, nb, own, threads);
-      // (Points whose neighbours lie on a line are not counted: their normals, hence signs, are
-      // arbitrary under either orientation: the rings of a terrestrial scan's sparse far ground.)
-      std::size_t same = 0, counted = 0;
-      for (std::size_t i = 0; i < p.size(); ++i)
-        if (fit[i].spread >= kLinearSpread) same += dot(own[i], n[i]) > 0, ++counted;
-      agree = counted ? static_cast<double>(same) / static_cast<double>(counted) : 1.0;
+      return sign_agreement(own, n, fit);
+    };
+    // The agreement, first on a sample of the points when they are many: it answers when clearly away
+    // from the limit (kViewpointBand); near it, or when the viewpoint is rejected (`own` then orients
+    // the points, and the message gives the whole's share), every point's.
+    double agree = 1.0;
+    if (outside && p.size() >= kViewpointSampleMin) {
+      agree = sampled_agreement(p, nb, n, fit, k, threads, rep.viewpoint_sample);
+      if (rep.viewpoint_sample < 64 || std::abs(std::max(agree, 1 - agree) - kViewpointAgree) < kViewpointBand)
+        agree = own_orientation();
+    } else if (outside) {
+      agree = own_orientation();
     }
-    const double dis = disagreement(p, nb, n, fit);
-    if (dis > 0.05 || std::max(agree, 1 - agree) < 0.9) {
+    const double dis = disagreement(p, nb, n, fit, threads);
+    bool rejected = dis > 0.05 || std::max(agree, 1 - agree) < kViewpointAgree;
+    if (rejected && outside && own.empty()) {
+      agree = own_orientation();
+      rejected = dis > 0.05 || std::max(agree, 1 - agree) < kViewpointAgree;
+    }
+    if (!own.empty()) rep.viewpoint_sample = 0;  // every point's orientation decided
+    if (rejected) {
       rep.viewpoint_rejected = true;
       std::ostringstream why;
       why << "the " << (options.sensors.empty() ? "viewpoint" : "sensor positions") << " orient only "

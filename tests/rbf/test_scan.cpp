@@ -395,6 +395,34 @@ TEST_CASE("prepare_scan: a single view is oriented toward its viewpoint; a contr
   CHECK(outward(s.points, s.normals) == s.points.size());
 }
 
+TEST_CASE("prepare_scan: a large single view's viewpoint is accepted from a sample; a large closed object's is not",
+          "[scan]") {
+  // From 40,000 points on, the data's own orientation (which decides whether a viewpoint outside the box
+  // is believed) is computed first on a sample; every point's when the viewpoint is rejected.
+  std::vector<Point3> half;
+  for (const Point3& q : noisy_sphere(120000, 0.002, 7))
+    if (q.z > 0.3) half.push_back(q);
+  REQUIRE(half.size() > 40000);
+  vitri::ScanOptions o;
+  o.viewpoint = Point3{0, 0, 5};
+  vitri::ScanReport r;
+  vitri::ScanPoints s = vitri::prepare_scan(half, {}, o, &r);
+  INFO(vitri::describe(r));
+  CHECK_FALSE(r.viewpoint_rejected);
+  CHECK(r.orientation == vitri::OrientationSource::Viewpoint);
+  CHECK(r.viewpoint_sample > 2000);
+  CHECK(r.viewpoint_sample < half.size() / 4);
+  CHECK(outward(s.points, s.normals) == s.points.size());
+  // The whole sphere seen from the same outside point: rejected, oriented by the data (outward).
+  const std::vector<Point3> whole = noisy_sphere(50000, 0.002, 7);
+  s = vitri::prepare_scan(whole, {}, o, &r);
+  INFO(vitri::describe(r));
+  CHECK(r.viewpoint_rejected);
+  CHECK(r.viewpoint_sample == 0);
+  CHECK(r.orientation == vitri::OrientationSource::Estimated);
+  CHECK(outward(s.points, s.normals) >= s.points.size() * 995 / 1000);
+}
+
 TEST_CASE("prepare_scan: a terrestrial scan's sparse rings do not make its own viewpoint rejected", "[scan]") {
   // A scanner 2 m above the ground at the origin, rays every degree (azimuth 0-360, elevation -60 to
   // +5), 1 cm of range noise: the ground out to 60 m and a wall at x = 6. Beyond about 10 m the ground's

@@ -101,6 +101,10 @@ struct ScanReport {
   /// estimated); viewpoint_note says why.
   bool viewpoint_rejected = false;
   std::string viewpoint_note;
+  /// The points of the sample whose own orientation decided that a viewpoint outside the data's box is
+  /// accepted (docs/scans.md, step 4); 0 when every point's did (fewer than 40,000 points, a share near
+  /// the limit, or the viewpoint rejected).
+  std::size_t viewpoint_sample = 0;
   double seconds = 0;  ///< wall time of prepare_scan()
   /// Where that time went, step by step in the order run (name, wall seconds): "duplicates",
   /// "dequantize", "neighbours" (the lists, the fits, the choice of k), "outliers" (every round),

@@ -50,7 +50,10 @@ const char* const kUsage =
     "                with holes or flipped triangles (a warning says so): its surface sampled (vertices,\n"
     "                at least 20000 points) and meshed as a scan without smoothing (open or closed)\n"
     "        points: .pwn / 6-column .xyz (with normals), 3-column .xyz, .pcd, .ply / .off / .obj\n"
-    "                without faces: a scan (docs/scans.md): duplicates and outliers set aside, the\n"
+    "                without faces, text exports (.xyzn .xyzrgb .pts .txt .csv .asc: blanks, commas or\n"
+    "                semicolons; a header line naming x y z [nx ny nz]; colours and other columns\n"
+    "                skipped, said on stderr; docs/formats.md); a scan (docs/scans.md): duplicates and\n"
+    "                outliers set aside, the\n"
     "                noise measured and absorbed (local quadric projection; with a viewpoint, depth\n"
     "                stored in steps is spread within them), normals from the input\n"
     "                (checked), the viewpoint (--viewpoint, PCD VIEWPOINT, NAME.viewpoint beside the\n"
@@ -731,6 +734,8 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
   options.max_memory_bytes = c.memory ? c.memory : default_memory_limit();
   phases.start("read", "reading " + c.input);
   Input data = read_input(c.input);
+  if (!c.quiet && !data.points.columns.empty())
+    std::fprintf(stderr, "%s: %s\n", c.input.c_str(), data.points.columns.c_str());
   open_mesh_as_points(data, c, options);
   // Scanned points (with or without normals) go through the scan path (docs/scans.md): noise, outliers,
   // orientation, open or closed. Constraints (.xyzv) and closed meshes are interpolated as they are.
@@ -1152,6 +1157,8 @@ int run_mesh(const Args& args) {
     options.max_memory_bytes = command.memory ? command.memory : default_memory_limit();
     phases.start("read", "reading " + command.input);
     Input data = read_input(command.input);
+    if (!command.quiet && !data.points.columns.empty())
+      std::fprintf(stderr, "%s: %s\n", command.input.c_str(), data.points.columns.c_str());
     open_mesh_as_points(data, command, options);
     if (!is_scan(data))
       throw InvalidArgument(command.input + ": --blocks meshes points (a scan); this input is " +

@@ -11,6 +11,8 @@
 #include <algorithm>
 #include <array>
 #include <cctype>
+#include <charconv>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -151,45 +153,227 @@ void write_xyzv(const std::string& path, const PointValues& c) {
 }
 
 // ------------------------------------------------------------------ xyz / pwn
+namespace {
+
+/// A token of a point file as a double: NaN allowed (an organized export's hole), infinity refused.
+double point_value(const LineScanner& s, std::string_view t) {
+  double v = 0;
+  const char* b = t.data();
+  const char* e = t.data() + t.size();
+  if (b != e && *b == '+') ++b;
+  const auto r = std::from_chars(b, e, v);
+  if (r.ec != std::errc() || r.ptr != e) s.fail("not a number: '" + std::string(t) + "'");
+  if (std::isinf(v)) s.fail("non-finite number: '" + std::string(t) + "'");
+  return v;
+}
+
+bool is_number(std::string_view t) {
+  double v = 0;
+  const char* b = t.data();
+  const char* e = t.data() + t.size();
+  if (b != e && *b == '+') ++b;
+  const auto r = std::from_chars(b, e, v);
+  return r.ec == std::errc() && r.ptr == e;
+}
+
+/// A header's column name: lower case, without the leading "//" of CloudCompare's exports.
+std::string column_name(std::string_view t) {
+  while (!t.empty() && t.front() == '/') t.remove_prefix(1);
+  std::string n(t);
+  for (char& c : n) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return n;
+}
+
+std::string column_range(std::size_t first, std::size_t count) {  // 1-based, as a person counts
+  return count == 1 ? std::to_string(first + 1)
+                    : std::to_string(first + 1) + "-" + std::to_string(first + count);
+}
+
+}  // namespace
+
 OrientedPoints parse_points(std::string_view text, const std::string& name, bool require_normals) {
-  LineScanner s(text, name);
-  OrientedPoints p;
+  LineScanner s(text, name, true, ",;");
+  const std::string ext = file_extension(name);
   std::size_t columns = 0;
+  std::vector<std::string> header;  // the column names, when the file has a header line
+  std::size_t header_line = 0;
+  std::vector<double> values;       // every row's columns, row-major (the layouts but direct())
+  std::vector<Point3> direct_rows, direct_normals;  // direct(): columns 1-3 and 4-6 of every row
+  auto direct = [&]() { return header.empty() && (columns == 3 || columns == 6); };
+  // Count lines: the file's first data line, or (Leica PTS: scans one after another) any line holding one
+  // integer, declares how many rows follow it before the next count line or the end.
   long long declared = -1;
-  std::size_t declared_line = 0;
-  bool first = true;
+  std::size_t declared_line = 0, block_start = 0, blocks = 0;
+  auto rows = [&]() { return direct() ? direct_rows.size() : columns ? values.size() / columns : 0; };
+  auto close_block = [&](bool at_end) {
+    if (declared < 0 || static_cast<std::size_t>(declared) == rows() - block_start) return;
+    const std::size_t have = rows() - block_start;
+    throw ParseError(name, declared_line,
+                     "declares " + std::to_string(declared) + " points, " +
+                         (at_end && blocks == 1 ? "file has " + std::to_string(have)
+                                                : std::to_string(have) + " follow it before the next count"));
+  };
   while (s.next_data_line()) {
-    const std::size_t nt = s.tokens().size();
-    if (first && nt == 1) {  // optional point count
+    const auto& t = s.tokens();
+    const std::size_t nt = t.size();
+    if (nt == 1 && (rows() > 0 || header.empty()) && is_number(t[0])) {  // a count line
+      close_block(false);
       declared = s.integer(0, 0, std::numeric_limits<long long>::max());
       declared_line = s.line();
-      first = false;
+      block_start = rows();
+      ++blocks;
       continue;
     }
-    first = false;
+    if (columns == 0 && header.empty() && !std::all_of(t.begin(), t.end(), is_number)) {
+      for (const std::string_view c : t) header.push_back(column_name(c));  // a header line: names
+      header_line = s.line();
+      continue;
+    }
     if (columns == 0) {
-      if (nt != 3 && nt != 6)
-        s.fail("expected 3 (x y z) or 6 (x y z nx ny nz) numbers, got " + std::to_string(nt));
+      if (nt < 3) s.fail("expected at least 3 numbers (x y z) per line, got " + std::to_string(nt));
       if (require_normals && nt != 6)
-        s.fail("expected 6 numbers 'x y z nx ny nz' (points with normals), got 3");
+        s.fail("expected 6 numbers 'x y z nx ny nz' (points with normals), got " + std::to_string(nt));
+      if (!header.empty() && header.size() != nt)
+        throw ParseError(name, header_line,
+                         "the header names " + std::to_string(header.size()) + " columns, line " +
+                             std::to_string(s.line()) + " has " + std::to_string(nt) + " numbers");
       columns = nt;
     } else if (nt != columns) {
       s.fail("expected " + std::to_string(columns) + " numbers like the previous lines, got " +
              std::to_string(nt));
     }
-    p.points.push_back({s.number(0), s.number(1), s.number(2)});
-    if (columns == 6) p.normals.push_back({s.number(3), s.number(4), s.number(5)});
+    if (direct()) {  // the common layouts, stored as points (and normals) right away
+      direct_rows.push_back({point_value(s, t[0]), point_value(s, t[1]), point_value(s, t[2])});
+      if (columns == 6) direct_normals.push_back({point_value(s, t[3]), point_value(s, t[4]), point_value(s, t[5])});
+    } else {
+      for (const std::string_view v : t) values.push_back(point_value(s, v));
+    }
   }
-  if (p.points.empty()) throw ParseError(name, 0, "no point in file");
-  if (declared >= 0 && static_cast<std::size_t>(declared) != p.points.size())
-    throw ParseError(name, declared_line,
-                     "header declares " + std::to_string(declared) + " points, file has " +
-                         std::to_string(p.points.size()));
+  close_block(true);
+  const std::size_t n = rows();
+  if (n == 0) throw ParseError(name, 0, "no point in file");
+
+  // The layout: where x, y, z and the normals are (column indices), and what the other columns are.
+  std::size_t at[3] = {0, 1, 2};
+  long normal = -1;  // first column of nx ny nz, or none
+  std::string skipped;  // what the columns not read are, for the note
+  auto value = [&](std::size_t r, std::size_t c) {  // row r's column c
+    if (!direct()) return values[r * columns + c];
+    const Point3& q = c < 3 ? direct_rows[r] : direct_normals[r];
+    return q[c % 3];
+  };
+  auto unit_rows = [&](std::size_t c) {  // rows whose columns c..c+2 are a unit vector (within 1%)
+    std::size_t u = 0;
+    for (std::size_t r = 0; r < n; ++r) {
+      const double v[3] = {value(r, c), value(r, c + 1), value(r, c + 2)};
+      const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+      u += len > 0.99 && len < 1.01;
+    }
+    return u;
+  };
+  auto colours = [&](std::size_t c) {  // every value of columns c..c+2 an 8-bit integer, some above 1,
+    bool bytes = true, above_one = false, unit = true;  // or all in [0, 1] and mostly not unit vectors
+    for (std::size_t r = 0; r < n; ++r)
+      for (std::size_t a = 0; a < 3; ++a) {
+        const double v = value(r, c + a);
+        if (!(v >= 0 && v <= 255 && v == std::floor(v))) bytes = false;
+        if (v > 1) above_one = true;
+        if (!(v >= 0 && v <= 1)) unit = false;
+      }
+    return (bytes && above_one) || (unit && 2 * unit_rows(c) < n);
+  };
+  if (!header.empty()) {
+    const char* names[3] = {"x", "y", "z"};
+    for (std::size_t a = 0; a < 3; ++a) {
+      const auto it = std::find(header.begin(), header.end(), names[a]);
+      if (it == header.end()) {
+        std::string all;
+        for (const std::string& h : header) all += (all.empty() ? "" : " ") + h;
+        throw ParseError(name, header_line, "the header names no '" + std::string(names[a]) + "' column (" + all + ")");
+      }
+      at[a] = static_cast<std::size_t>(it - header.begin());
+    }
+    for (const auto& triple : {std::array<const char*, 3>{"nx", "ny", "nz"},
+                               std::array<const char*, 3>{"normal_x", "normal_y", "normal_z"},
+                               std::array<const char*, 3>{"normalx", "normaly", "normalz"}}) {
+      const auto x = std::find(header.begin(), header.end(), triple[0]);
+      if (x == header.end()) continue;
+      const std::size_t c = static_cast<std::size_t>(x - header.begin());
+      if (c + 2 < columns && header[c + 1] == triple[1] && header[c + 2] == triple[2]) normal = static_cast<long>(c);
+      break;
+    }
+    for (std::size_t c = 0; c < columns; ++c) {
+      const bool used = c == at[0] || c == at[1] || c == at[2] ||
+                        (normal >= 0 && c >= static_cast<std::size_t>(normal) && c < static_cast<std::size_t>(normal) + 3);
+      if (!used) skipped += (skipped.empty() ? "" : " ") + header[c];
+    }
+  } else if (columns == 6 && (ext == "xyzrgb" || (!require_normals && colours(3)))) {
+    skipped = "columns 4-6 (colours: " +
+              std::string(ext == "xyzrgb" ? "the .xyzrgb layout" : "8-bit integers or values in [0, 1], not unit vectors") + ")";
+  } else if (columns == 6) {
+    normal = 3;
+  } else if (columns > 3) {
+    // No header: normals where three adjacent columns after x y z hold unit vectors on 99% of the rows
+    // (x y z nx ny nz curvature, x y z r g b nx ny nz); x y z intensity, PTS's x y z i r g b: none.
+    for (std::size_t c = 3; c + 3 <= columns && normal < 0; ++c)
+      if (100 * unit_rows(c) >= 99 * n) normal = static_cast<long>(c);
+    if (normal < 0) {
+      skipped = "columns " + column_range(3, columns - 3) + " (no three of them unit vectors: not normals)";
+    } else {
+      std::string rest;
+      if (normal > 3) rest = column_range(3, static_cast<std::size_t>(normal) - 3);
+      if (static_cast<std::size_t>(normal) + 3 < columns)
+        rest += (rest.empty() ? "" : ", ") + column_range(static_cast<std::size_t>(normal) + 3, columns - static_cast<std::size_t>(normal) - 3);
+      skipped = "columns " + rest;
+    }
+  }
+
+  OrientedPoints p;
+  std::size_t holes = 0;
+  if (direct()) {
+    p.points = std::move(direct_rows);
+    if (normal >= 0) p.normals = std::move(direct_normals);
+    direct_normals = {};
+  } else {
+    p.points.resize(n);
+    if (normal >= 0) p.normals.resize(n);
+    for (std::size_t r = 0; r < n; ++r) {
+      const double* v = &values[r * columns];
+      p.points[r] = {v[at[0]], v[at[1]], v[at[2]]};
+      if (normal >= 0) p.normals[r] = {v[normal], v[normal + 1], v[normal + 2]};
+    }
+    values = {};
+  }
+  // NaN: a hole of an organized export, the row skipped (in place, order kept).
+  std::size_t kept = 0;
+  for (std::size_t r = 0; r < p.points.size(); ++r) {
+    if (!is_finite(p.points[r]) || (normal >= 0 && !is_finite(p.normals[r]))) {
+      ++holes;
+      continue;
+    }
+    p.points[kept] = p.points[r];
+    if (normal >= 0) p.normals[kept] = p.normals[r];
+    ++kept;
+  }
+  p.points.resize(kept);
+  if (normal >= 0) p.normals.resize(kept);
+  if (p.points.empty()) throw ParseError(name, 0, "no point in file: every row's position or normal is NaN");
+  if (!header.empty() || !skipped.empty() || holes || blocks > 1) {
+    std::ostringstream note;
+    note << (header.empty() ? "no header" : "header on line " + std::to_string(header_line)) << ": x y z from columns "
+         << at[0] + 1 << ' ' << at[1] + 1 << ' ' << at[2] + 1;
+    if (normal >= 0) note << ", normals from columns " << column_range(static_cast<std::size_t>(normal), 3);
+    if (!skipped.empty()) note << "; skipped " << skipped;
+    if (holes) note << "; " << holes << " rows with a NaN position or normal skipped";
+    if (blocks > 1) note << "; " << blocks << " blocks, each after its point count";
+    p.columns = note.str();
+  }
   return p;
 }
 
 OrientedPoints read_points(const std::string& path) {
-  return parse_points(io_detail::slurp(path), path, file_extension(path) == "pwn");
+  const std::string e = file_extension(path);
+  return parse_points(io_detail::slurp(path), path, e == "pwn" || e == "xyzn");
 }
 
 void write_points(const std::string& path, const OrientedPoints& p) {
@@ -398,14 +582,20 @@ Input point_cloud(TriangleMesh m) {
 
 }  // namespace
 
+bool is_point_text(const std::string& extension) {
+  for (const char* e : {"xyz", "pwn", "xyzn", "xyzrgb", "pts", "txt", "csv", "asc"})
+    if (extension == e) return true;
+  return false;
+}
+
 Input parse_input(std::string_view bytes, const std::string& name) {
   const std::string e = file_extension(name);
   Input in;
   if (e == "xyzv") {
     in.kind = InputKind::Constraints;
     in.constraints = parse_xyzv(bytes, name);
-  } else if (e == "xyz" || e == "pwn") {
-    in.points = parse_points(bytes, name, e == "pwn");
+  } else if (is_point_text(e)) {
+    in.points = parse_points(bytes, name, e == "pwn" || e == "xyzn");
     in.kind = in.points.has_normals() ? InputKind::OrientedPoints : InputKind::Points;
   } else if (e == "pcd") {
     in.points = parse_pcd(bytes, name);
@@ -423,14 +613,15 @@ Input parse_input(std::string_view bytes, const std::string& name) {
   } else {
     throw ParseError(
         name, 0,
-        "unknown input extension '." + e + "' (expected .xyzv, .xyz, .pwn, .pcd, .off, .obj or .ply)");
+        "unknown input extension '." + e +
+            "' (expected .xyzv, .xyz, .pwn, .xyzn, .xyzrgb, .pts, .txt, .csv, .asc, .pcd, .off, .obj or .ply)");
   }
   return in;
 }
 
 Input read_input(const std::string& path) {
   const std::string e = file_extension(path);
-  if (e != "xyzv" && e != "xyz" && e != "pwn" && e != "pcd" && e != "off" && e != "obj" && e != "ply")
+  if (e != "xyzv" && !is_point_text(e) && e != "pcd" && e != "off" && e != "obj" && e != "ply")
     return parse_input({}, path);  // the unknown-extension error, before the file is opened
   Input in = parse_input(io_detail::slurp(path), path);
   if ((in.kind == InputKind::Points || in.kind == InputKind::OrientedPoints) && !in.points.viewpoint) {

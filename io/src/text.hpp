@@ -4,6 +4,7 @@
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <cstddef>
@@ -20,8 +21,12 @@ namespace vitri::io_detail {
 /// on blanks. Lines with no token are skipped by next_data_line().
 class LineScanner {
  public:
-  LineScanner(std::string_view text, std::string name, bool comments = true)
-      : text_(text), name_(std::move(name)), comments_(comments) {}
+  /// `separators`: characters that separate tokens besides blanks (point files: "," and ";").
+  LineScanner(std::string_view text, std::string name, bool comments = true, std::string_view separators = {})
+      : text_(text), name_(std::move(name)), comments_(comments) {
+    for (const char c : std::string_view(" \t\r\v\f")) separator_[static_cast<unsigned char>(c)] = true;
+    for (const char c : separators) separator_[static_cast<unsigned char>(c)] = true;
+  }
 
   /// Advances to the next line holding a token; false at the end of the text.
   bool next_data_line() {
@@ -93,17 +98,18 @@ class LineScanner {
     tokens_.clear();
     std::size_t i = 0;
     while (i < line.size()) {
-      while (i < line.size() && is_blank(line[i])) ++i;
+      while (i < line.size() && separates(line[i])) ++i;
       const std::size_t b = i;
-      while (i < line.size() && !is_blank(line[i])) ++i;
+      while (i < line.size() && !separates(line[i])) ++i;
       if (i > b) tokens_.push_back(line.substr(b, i - b));
     }
   }
-  static bool is_blank(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+  bool separates(char c) const { return separator_[static_cast<unsigned char>(c)]; }
 
   std::string_view text_;
   std::string name_;
   bool comments_;
+  std::array<bool, 256> separator_{};  // blanks and the extra separators
   std::size_t pos_ = 0;
   std::size_t line_no_ = 0;
   std::vector<std::string_view> tokens_;

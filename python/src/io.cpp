@@ -46,6 +46,7 @@ py::object read(const std::string& path) {
       d["normals"] = normals ? py::object(points_out(std::move(p.normals))) : py::object(py::none());
       d["viewpoint"] = p.viewpoint ? py::object(points_out({*p.viewpoint}).attr("reshape")(3)) : py::object(py::none());
       d["sensors"] = sensors ? py::object(points_out(std::move(p.sensors))) : py::object(py::none());
+      d["columns"] = p.columns;  // how a text export's columns were read ("" when plain)
       return namespace_of(d);
     }
   }

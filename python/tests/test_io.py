@@ -47,6 +47,25 @@ def test_constraints_and_points_round_trip(tmp_path):
     assert q.normals is None and np.array_equal(q.points, p)
 
 
+def test_text_exports_with_colours_and_headers(tmp_path):
+    """A CloudCompare-style export (header, commas, colours before the normals) reads its normals; an
+    x y z r g b file keeps its colours out of the normals; `columns` says what was read."""
+    p, n = sphere_points(50)
+    rgb = np.tile([200, 17, 3], (50, 1))
+    table = np.hstack([p, rgb, n])
+    path = tmp_path / "cc.txt"
+    with open(path, "w") as f:
+        f.write("//X,Y,Z,R,G,B,Nx,Ny,Nz\n")
+        for row in table:
+            f.write(",".join(repr(float(x)) for x in row) + "\n")
+    q = vitri.read(str(path))
+    assert np.array_equal(q.points, p) and np.array_equal(q.normals, n)
+    assert "skipped r g b" in q.columns
+    np.savetxt(tmp_path / "c.xyz", np.hstack([p, rgb]), fmt="%.17g")
+    q = vitri.read(str(tmp_path / "c.xyz"))
+    assert q.normals is None and np.array_equal(q.points, p) and "colours" in q.columns
+
+
 def test_bundled_models(data_dir):
     hand = vitri.read(data_dir + "/hand.off")
     assert euler_characteristic(hand.vertices, hand.faces) == 2

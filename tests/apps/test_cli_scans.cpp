@@ -556,3 +556,30 @@ TEST_CASE("vitri mesh, scan defaults: noisy and misregistered samples of a close
     mesh_closed_near_data(p, "scan_bunny_misreg", e);
   }
 }
+
+TEST_CASE("vitri mesh: a scanner's x y z r g b text export meshes like its x y z, its colours not read as normals",
+          "[cli][scan]") {
+  // 3000 points of the unit sphere written twice: as x y z, and as a CloudCompare-style .txt (a header,
+  // commas, 8-bit colours). Before, the 6-column file was read as oriented points whose "normals" were
+  // the colours (all in one octant): the orientation came from them. Now the same mesh as from x y z.
+  const std::string plain = kDir + "/scan_rgb_plain.xyz", coloured = kDir + "/scan_rgb.txt";
+  const std::vector<Point3> p = write_noisy_sphere(plain, 3000, 0.0, 0, 21);
+  {
+    std::ofstream f(coloured);
+    f.precision(17);
+    f << "//X,Y,Z,R,G,B\n";
+    for (std::size_t i = 0; i < p.size(); ++i)
+      f << p[i].x << ',' << p[i].y << ',' << p[i].z << ',' << (i * 7) % 256 << ",200,13\n";
+  }
+  std::string o, e, o2, e2;
+  REQUIRE(run(plain + " -o " + kDir + "/scan_rgb_plain.ply", o, e) == 0);
+  REQUIRE(run(coloured + " -o " + kDir + "/scan_rgb.ply", o2, e2) == 0);
+  INFO(e2);
+  CHECK(e2.find("skipped r g b") != std::string::npos);
+  CHECK(e2.find("estimated (spanning tree)") != std::string::npos);  // no normals from the colours
+  const Shape a = shape_of(kDir + "/scan_rgb_plain.ply"), b = shape_of(kDir + "/scan_rgb.ply");
+  CHECK(b.components == 1);
+  CHECK(b.euler == 2);
+  CHECK(a.v == b.v);  // the same points read: the same mesh
+  CHECK(a.f == b.f);
+}

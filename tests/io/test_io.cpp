@@ -19,6 +19,7 @@
 #include <sstream>
 #include <cstring>
 #include <cmath>
+#include <tuple>
 
 using namespace vitri;
 
@@ -412,4 +413,110 @@ TEST_CASE("io: numbers are written exactly as printf's %.17g", "[io]") {
     w.flush();
   }
   REQUIRE(stream.str() == expected);
+}
+
+// Text point exports as scanners and CloudCompare / Open3D / Leica tools write them (docs/formats.md):
+// separators, header lines, colours and other columns, counted blocks, NaN holes.
+TEST_CASE("io: text point exports: separators, headers, colours and extra columns", "[io]") {
+  const std::vector<Point3> pts = {{0, 0, 0}, {1, 0.5, -2}, {3, 4, 5.25}};
+  const std::vector<Point3> nrm = {{0, 0, 1}, {1, 0, 0}, {0, -0.6, 0.8}};
+  auto rows = [&](const std::string& sep, auto extra) {
+    std::string t;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      t += io_detail::num(pts[i].x) + sep + io_detail::num(pts[i].y) + sep + io_detail::num(pts[i].z);
+      for (const std::string& v : extra(i)) t += sep + v;
+      t += "\n";
+    }
+    return t;
+  };
+  auto none = [](std::size_t) { return std::vector<std::string>{}; };
+  auto normals = [&](std::size_t i) { return std::vector<std::string>{io_detail::num(nrm[i].x), io_detail::num(nrm[i].y), io_detail::num(nrm[i].z)}; };
+  auto rgb = [](std::size_t i) { return std::vector<std::string>{std::to_string(10 * i), "255", "7"}; };
+
+  // The same points whatever the separator, header or extension.
+  for (const std::string& sep : std::vector<std::string>{" ", "\t", ",", ";", ", "}) {
+    for (const std::string& head : std::vector<std::string>{"", "//X" + sep + "Y" + sep + "Z\n", "x" + sep + "y" + sep + "z\n"}) {
+      for (const char* name : {"p.xyz", "p.txt", "p.csv", "p.asc"}) {
+        INFO(name << " [" << sep << "] " << head);
+        const Input in = parse_input(head + rows(sep, none), name);
+        CHECK(in.kind == InputKind::Points);
+        CHECK(in.points.points == pts);
+        CHECK(in.points.columns.empty() == head.empty());
+      }
+    }
+  }
+  // Six columns: normals as before; 8-bit colours are skipped, said in `columns`.
+  OrientedPoints p = parse_points(rows(" ", normals), "n.xyz");
+  CHECK(p.normals == nrm);
+  CHECK(p.columns.empty());
+  p = parse_points(rows(" ", rgb), "c.xyz");
+  CHECK(p.points == pts);
+  CHECK(p.normals.empty());
+  CHECK_THAT(p.columns, Catch::Contains("colours"));
+  // Colours as values in [0, 1] (not unit vectors), and the .xyzrgb layout whatever the values.
+  p = parse_points(rows(",", [](std::size_t i) { return std::vector<std::string>{"0.5", io_detail::num(0.1 * double(i)), "0.25"}; }), "f.csv");
+  CHECK(p.normals.empty());
+  CHECK(parse_points(rows(" ", normals), "o3d.xyzrgb").normals.empty());
+  CHECK(parse_input(rows(" ", normals), "o3d.xyzn").points.normals == nrm);
+  // Other counts: the normals are the three adjacent columns that hold unit vectors.
+  p = parse_points(rows(" ", [&](std::size_t i) {
+                     auto v = rgb(i);
+                     for (const std::string& n : normals(i)) v.push_back(n);
+                     return v;
+                   }),
+                   "cc.txt");
+  CHECK(p.normals == nrm);
+  CHECK_THAT(p.columns, Catch::Contains("normals from columns 7-9") && Catch::Contains("skipped columns 4-6"));
+  p = parse_points(rows(" ", [&](std::size_t i) {
+                     auto v = normals(i);
+                     v.push_back("0.0125");  // curvature
+                     return v;
+                   }),
+                   "pcl.xyz");
+  CHECK(p.normals == nrm);
+  p = parse_points(rows(" ", [](std::size_t) { return std::vector<std::string>{"-1200"}; }), "intensity.xyz");
+  CHECK(p.normals.empty());
+  CHECK_THAT(p.columns, Catch::Contains("skipped columns 4 "));
+  // A header names the columns, in any order; unknown names are skipped.
+  std::string reordered = "nx ny nz intensity X Y Z\n";
+  for (std::size_t i = 0; i < pts.size(); ++i)
+    reordered += io_detail::num(nrm[i].x) + " " + io_detail::num(nrm[i].y) + " " + io_detail::num(nrm[i].z) + " 17 " + io_detail::num(pts[i].x) + " " +
+                 io_detail::num(pts[i].y) + " " + io_detail::num(pts[i].z) + "\n";
+  p = parse_points(reordered, "h.txt");
+  CHECK(p.points == pts);
+  CHECK(p.normals == nrm);
+  CHECK_THAT(p.columns, Catch::Contains("x y z from columns 5 6 7") && Catch::Contains("skipped intensity"));
+  // Leica PTS: a count before each scan's rows; x y z intensity r g b.
+  const std::string block = "0 0 0 -5 1 2 3\n1 0 0 -5 1 2 3\n";
+  p = parse_points("2\n" + block + "1\n0 1 0 -5 1 2 3\n", "two.pts");
+  CHECK(p.points.size() == 3);
+  CHECK(p.normals.empty());
+  CHECK_THAT(p.columns, Catch::Contains("2 blocks"));
+  // NaN positions (an organized export's holes) are skipped; infinity is refused.
+  p = parse_points("nan nan nan\n0 0 0\n1 0 0\n", "holes.xyz");
+  CHECK(p.points.size() == 2);
+  CHECK_THAT(p.columns, Catch::Contains("1 rows with a NaN"));
+}
+
+TEST_CASE("io: text point exports that cannot be read name the file and the line", "[io][errors]") {
+  const std::vector<std::tuple<std::string, std::string, std::size_t, std::string>> cases = {
+      {"x y\n0 0\n", "a.xyz", 2, "at least 3 numbers"},
+      {"x y w\n0 0 0\n", "b.xyz", 1, "no 'z' column"},
+      {"x y z nx\n0 0 0\n", "c.csv", 1, "the header names 4 columns, line 2 has 3"},
+      {"3\n0 0 0 1\n1 0 0 1\n1\n0 1 0 1\n", "d.pts", 1, "declares 3 points, 2 follow it"},
+      {"0 0 0\n1 0 inf\n", "e.txt", 2, "non-finite number"},
+      {"0 0 0\n1 0 zero\n", "f.asc", 2, "not a number: 'zero'"},
+      {"0 0 0\n1 0 0\n", "g.xyzn", 1, "6 numbers"},
+      {"nan 0 0\n", "h.xyz", 0, "every row's position or normal is NaN"},
+  };
+  for (const auto& [text, name, line, message] : cases) {
+    INFO(name << ": " << text);
+    try {
+      (void)parse_input(text, name);
+      FAIL("accepted");
+    } catch (const ParseError& e) {
+      CHECK(e.line() == line);
+      CHECK_THAT(e.what(), Catch::Contains(message) && Catch::StartsWith(name));
+    }
+  }
 }

@@ -2,7 +2,8 @@
 /// @file io.hpp
 /// Reading and writing the files vitri consumes and produces (formats in docs/formats.md):
 /// - constraints `.xyzv`: `x y z value` per line;
-/// - points `.xyz` (3 columns: positions; 6 columns: positions and normals) and `.pwn` (6 columns);
+/// - points `.xyz` (3 columns: positions; 6 columns: positions and normals, or colours), `.pwn` (6 columns)
+///   and other text point exports (`.xyzn`, `.xyzrgb`, `.pts`, `.txt`, `.csv`, `.asc`: parse_points());
 /// - point clouds `.pcd` (PCL's format: ascii, binary, binary_compressed), read only;
 /// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little-endian) in;
 ///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known;
@@ -50,6 +51,10 @@ struct OrientedPoints {
   std::optional<Point3> viewpoint{};
   /// Empty, or one sensor position per point (PLY vertex properties vx vy vz).
   std::vector<Point3> sensors{};
+  /// How a text file's columns were read, when not plainly `x y z` or `x y z nx ny nz` (a header line,
+  /// columns skipped as colours or other values, rows with NaN skipped, several counted blocks); empty
+  /// otherwise and for the other formats. The CLI prints it.
+  std::string columns{};
   /// True when every point has a normal.
   bool has_normals() const { return !normals.empty() && normals.size() == points.size(); }
   /// True when every point has its own sensor position.
@@ -85,12 +90,20 @@ PointValues read_xyzv(const std::string& path);
 void write_xyzv(const std::string& path, const PointValues& c);
 
 // ----- points -----
-/// Parses `.xyz` / `.pwn` text: every data line has 3 (positions) or 6 (positions, normals) numbers,
-/// the same count on every line; `#` comments and blank lines allowed; an optional first line holding a
-/// single integer (the point count) is checked and skipped. `require_normals` makes 3 columns an error.
+/// Parses a text point file (`.xyz`, `.pwn`, `.xyzn`, `.xyzrgb`, `.pts`, `.txt`, `.csv`, `.asc`; the
+/// layouts in docs/formats.md): numbers separated by blanks, commas or semicolons, the same count (at
+/// least 3) on every line; `#` comments and blank lines allowed; a line holding a single integer (the
+/// point count of the rows after it, the first line or one per block of a PTS file) is checked and
+/// skipped. An optional header line before the numbers (`//X Y Z R G B`, `x,y,z,nx,ny,nz`) names the
+/// columns: x, y, z and nx ny nz (or normal_x ..., normalx ...) are read, the others skipped. Without a
+/// header: 3 columns are x y z; 6 are x y z nx ny nz, unless the last three are colours (8-bit integers,
+/// or values in [0, 1] that are not unit vectors; always in `.xyzrgb`); other counts are x y z followed
+/// by values, of which three adjacent columns holding unit vectors on 99% of the rows are the normals.
+/// Rows whose position or normal is NaN are skipped (infinity is an error). `columns` tells what was
+/// read. `require_normals` (`.pwn`, `.xyzn`) makes anything but 6 columns an error.
 OrientedPoints parse_points(std::string_view text, const std::string& name = "<memory>",
                             bool require_normals = false);
-/// Reads `.xyz` (3 or 6 columns) or `.pwn` (6 columns required).
+/// Reads a text point file (parse_points(); `.pwn` and `.xyzn` require 6 columns).
 OrientedPoints read_points(const std::string& path);
 /// Writes 3 columns, or 6 when normals are present (viewpoint and sensors are not written).
 void write_points(const std::string& path, const OrientedPoints& p);
@@ -168,6 +181,8 @@ Input read_input(const std::string& path);
 /// file's contents, and the `.viewpoint` file beside it. @throws as read_input.
 Input parse_input(std::string_view bytes, const std::string& name);
 
+/// Whether a (lower-case) extension is one of the text point formats of parse_points().
+bool is_point_text(const std::string& extension);
 /// Lower-case extension of path without the dot ("" when none).
 std::string file_extension(const std::string& path);
 

@@ -1,4 +1,4 @@
-// PLY reader (ascii 1.0, binary_little_endian 1.0).
+// PLY reader (ascii 1.0, binary_little_endian 1.0, binary_big_endian 1.0).
 //
 // The header is parsed into elements with their properties; the vertex element gives x y z (and nx ny
 // nz, and the sensor positions vx vy vz, each when all three are present), the face element a list named
@@ -73,11 +73,11 @@ PlyType parse_type(const LineScanner& s, std::string_view t) {
   s.fail("unknown PLY property type '" + std::string(t) + "'");
 }
 
-// Bounds-checked little-endian reader over the binary payload.
+// Bounds-checked reader over the binary payload, in the file's byte order.
 class BinaryReader {
  public:
-  BinaryReader(std::string_view bytes, std::size_t offset, const std::string& name)
-      : bytes_(bytes), pos_(offset), name_(name), swap_(!io_detail::host_little_endian()) {}
+  BinaryReader(std::string_view bytes, std::size_t offset, const std::string& name, bool big_endian)
+      : bytes_(bytes), pos_(offset), name_(name), swap_(big_endian == io_detail::host_little_endian()) {}
 
   double read(PlyType t, const char* what, std::size_t index) {
     const std::size_t n = type_size(t);
@@ -157,7 +157,7 @@ TriangleMesh io_detail::parse_ply_with_sensors(std::string_view bytes, const std
   LineScanner s(bytes, name, /*comments=*/false);
   if (!s.next_data_line() || s.tokens()[0] != "ply")
     throw ParseError(name, 1, "not a PLY file (missing 'ply')");
-  bool binary = false, have_format = false;
+  bool binary = false, big_endian = false, have_format = false;
   std::vector<PlyElement> elements;
   for (;;) {
     if (!s.next_data_line()) s.fail("header ends without 'end_header'");
@@ -171,7 +171,7 @@ TriangleMesh io_detail::parse_ply_with_sensors(std::string_view bytes, const std
       else if (t[1] == "binary_little_endian")
         binary = true;
       else if (t[1] == "binary_big_endian")
-        s.fail("binary_big_endian PLY is not supported (convert to ascii or little endian)");
+        binary = big_endian = true;  // (older scanners' and tools' files: byte-swapped as read)
       else
         s.fail("unknown PLY format '" + std::string(t[1]) + "'");
       have_format = true;
@@ -264,7 +264,7 @@ TriangleMesh io_detail::parse_ply_with_sensors(std::string_view bytes, const std
   if (normals) n.reserve(3 * ve->count);
   if (with_sensors) sensors.reserve(ve->count);
   std::vector<double> rec;
-  BinaryReader br(bytes, s.offset(), name);
+  BinaryReader br(bytes, s.offset(), name, big_endian);
   for (const auto& e : elements) {
     const bool is_v = &e == ve, is_f = &e == fe;
     for (std::size_t r = 0; r < e.count; ++r) {

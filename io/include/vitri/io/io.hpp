@@ -5,7 +5,7 @@
 /// - points `.xyz` (3 columns: positions; 6 columns: positions and normals, or colours), `.pwn` (6 columns)
 ///   and other text point exports (`.xyzn`, `.xyzrgb`, `.pts`, `.txt`, `.csv`, `.asc`: parse_points());
 /// - point clouds `.pcd` (PCL's format: ascii, binary, binary_compressed), read only;
-/// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little-endian) in;
+/// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little- or big-endian) in;
 ///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known;
 /// - sensor positions: `.viewpoint` files (`x y z`), read beside point inputs by read_input().
 ///
@@ -128,9 +128,9 @@ TriangleMesh parse_off(std::string_view text, const std::string& name = "<memory
 /// OBJ: `v`, `vn`, `f` (forms `a`, `a/t`, `a//n`, `a/t/n`, negative = relative); other keywords are
 /// ignored; polygons are fan-triangulated. Normals are kept when each vertex gets a single normal.
 TriangleMesh parse_obj(std::string_view text, const std::string& name = "<memory>");
-/// PLY ascii 1.0 or binary_little_endian 1.0: element vertex (x, y, z, optional nx, ny, nz, any other
-/// properties skipped) and element face (a list property named vertex_indices or vertex_index);
-/// other elements are skipped. Big-endian files are rejected with a ParseError.
+/// PLY ascii 1.0, binary_little_endian 1.0 or binary_big_endian 1.0: element vertex (x, y, z, optional
+/// nx, ny, nz, any other properties skipped) and element face (a list property named vertex_indices or
+/// vertex_index); other elements are skipped.
 TriangleMesh parse_ply(std::string_view bytes, const std::string& name = "<memory>");
 /// Reads a mesh by extension: .off, .obj, .ply (case-insensitive).
 TriangleMesh read_mesh(const std::string& path);

@@ -1183,6 +1183,78 @@ double sampled_agreement(const std::vector<Point3>& p, const Neighbours& nb, con
   return sign_agreement(own, qn, qfit);
 }
 
+/// The first k columns of every row (k <= nb.k): the k nearest, when nb's lists are sorted (nearest()).
+Neighbours prefix(const Neighbours& nb, std::size_t k) {
+  Neighbours out;
+  out.k = k;
+  const std::size_t n = nb.k ? nb.ids.size() / nb.k : 0;
+  out.ids.resize(n * k);
+  out.dist.resize(n * k);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t c = 0; c < k; ++c) {
+      out.ids[i * k + c] = nb.ids[i * nb.k + c];
+      out.dist[i * k + c] = nb.dist[i * nb.k + c];
+    }
+  return out;
+}
+
+/// prepare_scan()'s test for wider neighbourhoods, put to every stride-th point (kStructureSample of
+/// them at most): their k3 nearest, and per row what the verdict needs but the threshold (the k-point
+/// fit's residual, the wider fit's, whether the wider neighbourhood holds a second sheet). Computed before
+/// the k nearest of every point: `foresees_wider` tells whether the threshold the sample itself gives
+/// (its own medians, those of every point deciding later) puts the verdict at "wider" or "every point's".
+struct StructureSample {
+  Neighbours rows;                 ///< row r: the k3 nearest of point r x stride
+  std::vector<double> wide_noise;  ///< row r: the residual of its k3-point fit
+  std::vector<std::uint8_t> sheet; ///< row r: its k3 neighbours hold a second sheet (second_sheet)
+  bool foresees_wider = false;
+  /// +1 wider, -1 not, 0 every point's median decides (the rows' share of wider residuals above the
+  /// threshold, kStructureBand standard errors from a half).
+  int verdict(double threshold) const {
+    const std::size_t n = wide_noise.size();
+    std::size_t count = 0;
+    for (std::size_t r = 0; r < n; ++r) count += wide_noise[r] > threshold && !sheet[r];
+    const double share = static_cast<double>(count) / static_cast<double>(n);
+    const double band = kStructureBand * 0.5 / std::sqrt(static_cast<double>(n));
+    return share > 0.5 + band ? 1 : share < 0.5 - band ? -1 : 0;
+  }
+};
+
+StructureSample structure_sample(const std::vector<Point3>& p, const PointIndex& index, std::size_t k,
+                                 std::size_t k3, std::size_t stride, unsigned threads) {
+  StructureSample s;
+  const std::size_t rows = (p.size() + stride - 1) / stride;
+  s.rows.k = k3;
+  s.rows.ids.resize(rows * k3);
+  s.rows.dist.resize(rows * k3);
+  s.wide_noise.resize(rows);
+  s.sheet.resize(rows);
+  std::vector<LocalFit> own(rows);  // the k-point fits (the row's prefix: the k nearest)
+  rbf_detail::parallel_chunks(rows, threads, kGrain, [&](std::size_t b, std::size_t e) {
+    std::vector<Id> ids;
+    std::vector<double> d2;
+    for (std::size_t r = b; r < e; ++r) {
+      const std::size_t i = r * stride;
+      index.nearest(p[i], k3 + 1, ids, &d2);
+      fill_row(r, ids, d2, s.rows, i);
+      own[r] = fit_neighbourhood(p, s.rows, i, nullptr, r, k);
+      s.wide_noise[r] = fit_neighbourhood(p, s.rows, i, nullptr, r).noise;
+      s.sheet[r] = second_sheet(p, s.rows, r, i, own[r], s.rows.d(r, k - 1));
+    }
+  });
+  // The forecast: prepare_scan()'s rule on the sample's own medians.
+  std::vector<double> ratio(rows), small(rows), dist;
+  for (std::size_t r = 0; r < rows; ++r) {
+    ratio[r] = own[r].noise / std::max(s.rows.d(r, k - 1), 1e-300);
+    small[r] = own[r].noise;
+    for (std::size_t c = 0; c < k; ++c) dist.push_back(s.rows.d(r, c));
+  }
+  const double want = neighbours_wanted(median(ratio));
+  const double threshold = std::max(1.5 * median(small), 0.05 * median(dist));
+  s.foresees_wider = std::ceil(want) < static_cast<double>(k3) && s.verdict(threshold) >= 0;
+  return s;
+}
+
 }  // namespace
 
 ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Point3>& normals,
@@ -1253,7 +1325,21 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   };
   std::size_t k = clamp_k(options.k ? std::max<std::size_t>(6, options.k) : 16);
   PointIndex index(p, threads);
-  Neighbours nb = nearest_neighbours(p, index, k, threads);
+  // The wider test below (the 48 nearest) asks a sample first (a large scan: every stride-th point).
+  // Its rows are computed here, and when the sample foresees the wider neighbourhoods (a depth-quantized
+  // or noisy scan), so are the 48 nearest of every point, the k nearest being their prefix (both lists
+  // sorted by distance, ties by id: the same lists as their own query), instead of a second query of
+  // every point. What is decided below is the same either way; a wrong forecast costs time only.
+  const std::size_t k3 = clamp_k(48);
+  const std::size_t stride = (p.size() + kStructureSample - 1) / kStructureSample;
+  const bool sampled = options.k == 0 && k < k3 && p.size() > 64 && stride > 1;
+  StructureSample sample;
+  Neighbours wide_all;  // the k3 nearest of every point, when foreseen (else empty)
+  if (sampled) {
+    sample = structure_sample(p, index, k, k3, stride, threads);
+    if (sample.foresees_wider) wide_all = nearest_neighbours(p, index, k3, threads);
+  }
+  Neighbours nb = wide_all.k ? prefix(wide_all, k) : nearest_neighbours(p, index, k, threads);
   std::vector<LocalFit> fit(p.size());
   auto fit_all = [&](const std::vector<Point3>& pts) {
     fit.assign(pts.size(), LocalFit{});
@@ -1278,7 +1364,6 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     const double want = neighbours_wanted(rho);
     std::size_t k2 = clamp_k(static_cast<std::size_t>(std::min(double(kMaxNeighbours), std::max(16.0, std::ceil(want)))));
     if (k2 < 48 && p.size() > 64) {
-      const std::size_t k3 = clamp_k(48);
       // Only structure that matters against the spacing (a clean curved surface also fits a quadric a
       // little worse at a larger scale): the wider fits' median residual above `threshold`.
       const double threshold = std::max(1.5 * noise_small, 0.05 * median(nb.dist));
@@ -1289,33 +1374,10 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       // wider queries and fits of all were 9.6 of the preparation's 25 s); near a half (a scan at the
       // threshold, such as the quantized office capture), every point's, as on a small scan: the same
       // answer as the whole's median but with a chance of about 10^-6.
-      const std::size_t stride = (p.size() + kStructureSample - 1) / kStructureSample;
       int verdict = 0;  // +1 wider, -1 not, 0 every point's median decides
-      if (stride > 1) {
-        const std::size_t rows = (p.size() + stride - 1) / stride;
-        Neighbours sample;  // row r: point r x stride
-        sample.k = k3;
-        sample.ids.resize(rows * k3);
-        sample.dist.resize(rows * k3);
-        std::vector<std::uint8_t> above(rows);
-        rbf_detail::parallel_chunks(rows, threads, kGrain, [&](std::size_t b, std::size_t e) {
-          std::vector<Id> ids;
-          std::vector<double> d2;
-          for (std::size_t r = b; r < e; ++r) {
-            index.nearest(p[r * stride], k3 + 1, ids, &d2);
-            fill_row(r, ids, d2, sample, r * stride);
-            above[r] = fit_neighbourhood(p, sample, r * stride, nullptr, r).noise > threshold &&
-                       !second_sheet(p, sample, r, r * stride, fit[r * stride], nb.d(r * stride, k - 1));
-          }
-        });
-        std::size_t count = 0;
-        for (const std::uint8_t a : above) count += a;
-        const double share = static_cast<double>(count) / static_cast<double>(rows);
-        const double band = kStructureBand * 0.5 / std::sqrt(static_cast<double>(rows));
-        verdict = share > 0.5 + band ? 1 : share < 0.5 - band ? -1 : 0;
-      }
+      if (sampled) verdict = sample.verdict(threshold);
       if (verdict == 0) {
-        Neighbours wide = nearest_neighbours(p, index, k3, threads);
+        Neighbours wide = wide_all.k ? std::move(wide_all) : nearest_neighbours(p, index, k3, threads);
         std::vector<LocalFit> wide_fit(p.size());
         rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
           for (std::size_t i = b; i < e; ++i) wide_fit[i] = fit_neighbourhood(p, wide, i);
@@ -1330,7 +1392,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
         }
       } else if (verdict > 0) {
         k = k2 = k3;
-        nb = nearest_neighbours(p, index, k, threads);
+        nb = wide_all.k ? std::move(wide_all) : nearest_neighbours(p, index, k, threads);
         fit_all(p);
       }
     }
@@ -1340,6 +1402,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       fit_all(p);
     }
   }
+  wide_all = Neighbours{};  // (a forecast the verdict did not follow: its lists given back)
+  sample = StructureSample{};
   rep.k = k;
   lap("neighbours");
 

@@ -224,7 +224,7 @@ OrientedPoints parse_points(std::string_view text, const std::string& name, bool
       ++blocks;
       continue;
     }
-    if (columns == 0 && header.empty() && !std::all_of(t.begin(), t.end(), is_number)) {
+    if (columns == 0 && header.empty() && !is_number(t[0])) {  // (a row with a bad token later: an error)
       for (const std::string_view c : t) header.push_back(column_name(c));  // a header line: names
       header_line = s.line();
       continue;
@@ -307,6 +307,8 @@ OrientedPoints parse_points(std::string_view text, const std::string& name, bool
                         (normal >= 0 && c >= static_cast<std::size_t>(normal) && c < static_cast<std::size_t>(normal) + 3);
       if (!used) skipped += (skipped.empty() ? "" : " ") + header[c];
     }
+    if (require_normals && normal < 0)
+      throw ParseError(name, header_line, "the header names no normals (nx ny nz), which this format requires");
   } else if (columns == 6 && (ext == "xyzrgb" || (!require_normals && colours(3)))) {
     skipped = "columns 4-6 (colours: " +
               std::string(ext == "xyzrgb" ? "the .xyzrgb layout" : "8-bit integers or values in [0, 1], not unit vectors") + ")";

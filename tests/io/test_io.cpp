@@ -507,6 +507,8 @@ TEST_CASE("io: text point exports that cannot be read name the file and the line
       {"0 0 0\n1 0 zero\n", "f.asc", 2, "not a number: 'zero'"},
       {"0 0 0\n1 0 0\n", "g.xyzn", 1, "6 numbers"},
       {"nan 0 0\n", "h.xyz", 0, "every row's position or normal is NaN"},
+      {"1 2 3 abc\n", "i.xyz", 1, "not a number: 'abc'"},  // a row, not a header: its first token is a number
+      {"x y z a b c\n0 0 0 1 2 3\n", "j.pwn", 1, "names no normals"},
   };
   for (const auto& [text, name, line, message] : cases) {
     INFO(name << ": " << text);

@@ -23,6 +23,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)vitri::parse_points(text, "fuzz.xyz");
 #elif defined(VITRI_FUZZ_pcd)
     (void)vitri::parse_input(text, "fuzz.pcd");
+#elif defined(VITRI_FUZZ_las)
+    (void)vitri::parse_input(text, "fuzz.las");
 #endif
   } catch (const vitri::Error&) {
   }

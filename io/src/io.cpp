@@ -602,6 +602,9 @@ Input parse_input(std::string_view bytes, const std::string& name) {
   } else if (e == "pcd") {
     in.points = parse_pcd(bytes, name);
     in.kind = in.points.has_normals() ? InputKind::OrientedPoints : InputKind::Points;
+  } else if (e == "las" || e == "laz") {
+    in.points = parse_las(bytes, name);  // (a .laz is refused there, saying how to decompress it)
+    in.kind = InputKind::Points;
   } else if (e == "off" || e == "obj" || e == "ply") {
     in.kind = InputKind::Mesh;
     std::vector<Point3> sensors;
@@ -616,14 +619,15 @@ Input parse_input(std::string_view bytes, const std::string& name) {
     throw ParseError(
         name, 0,
         "unknown input extension '." + e +
-            "' (expected .xyzv, .xyz, .pwn, .xyzn, .xyzrgb, .pts, .txt, .csv, .asc, .pcd, .off, .obj or .ply)");
+            "' (expected .xyzv, .xyz, .pwn, .xyzn, .xyzrgb, .pts, .txt, .csv, .asc, .pcd, .las, .off, .obj or .ply)");
   }
   return in;
 }
 
 Input read_input(const std::string& path) {
   const std::string e = file_extension(path);
-  if (e != "xyzv" && !is_point_text(e) && e != "pcd" && e != "off" && e != "obj" && e != "ply")
+  if (e != "xyzv" && !is_point_text(e) && e != "pcd" && e != "las" && e != "laz" && e != "off" && e != "obj" &&
+      e != "ply")
     return parse_input({}, path);  // the unknown-extension error, before the file is opened
   Input in = parse_input(io_detail::slurp(path), path);
   if ((in.kind == InputKind::Points || in.kind == InputKind::OrientedPoints) && !in.points.viewpoint) {

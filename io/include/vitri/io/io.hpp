@@ -4,7 +4,7 @@
 /// - constraints `.xyzv`: `x y z value` per line;
 /// - points `.xyz` (3 columns: positions; 6 columns: positions and normals, or colours), `.pwn` (6 columns)
 ///   and other text point exports (`.xyzn`, `.xyzrgb`, `.pts`, `.txt`, `.csv`, `.asc`: parse_points());
-/// - point clouds `.pcd` (PCL's format: ascii, binary, binary_compressed), read only;
+/// - point clouds `.pcd` (PCL's format: ascii, binary, binary_compressed) and `.las` (LiDAR), read only;
 /// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little- or big-endian) in;
 ///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known;
 /// - sensor positions: `.viewpoint` files (`x y z`), read beside point inputs by read_input().
@@ -115,6 +115,11 @@ void write_points(const std::string& path, const OrientedPoints& p);
 /// normals are dropped. `viewpoint` is set to the VIEWPOINT line's translation when the header has one.
 /// Header errors carry the line; data errors line 0 and the point index or byte offset.
 OrientedPoints parse_pcd(std::string_view bytes, const std::string& name = "<memory>");
+/// Parses a LAS file (ASPRS LiDAR, versions 1.0-1.4, point record formats 0-10, little-endian): the
+/// points' x y z (scaled and offset as the header says); points classified as noise (classes 7 and 18)
+/// or withheld are left out, and `columns` says so with the version, format and count. LAZ (compressed)
+/// data is refused with a ParseError saying how to decompress it. Errors carry line 0.
+OrientedPoints parse_las(std::string_view bytes, const std::string& name = "<memory>");
 /// Reads a sensor-position file (`.viewpoint`): one line `x y z` of finite numbers; `#` comments and
 /// blank lines allowed. @throws ParseError naming the file otherwise.
 Point3 read_viewpoint(const std::string& path);
@@ -168,7 +173,8 @@ struct Input {
   TriangleMesh mesh;
 };
 
-/// Reads any supported input, detected by extension (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply). A mesh
+/// Reads any supported input, detected by extension (.xyzv, the text point formats, .pcd, .las, .off,
+/// .obj, .ply). A mesh
 /// file with no face (a PLY point cloud, an OFF with 0 faces) is read as points, with normals when its
 /// vertices have them (PLY nx ny nz, NOFF, OBJ vn), and per-point sensor positions from PLY vx vy vz.
 /// When the result is points (kind Points or OrientedPoints) without a viewpoint from the file itself,

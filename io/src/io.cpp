@@ -155,25 +155,26 @@ void write_xyzv(const std::string& path, const PointValues& c) {
 // ------------------------------------------------------------------ xyz / pwn
 namespace {
 
-/// A token of a point file as a double: NaN allowed (an organized export's hole), infinity refused.
-double point_value(const LineScanner& s, std::string_view t) {
-  double v = 0;
-  const char* b = t.data();
-  const char* e = t.data() + t.size();
-  if (b != e && *b == '+') ++b;
-  const auto r = std::from_chars(b, e, v);
-  if (r.ec != std::errc() || r.ptr != e) s.fail("not a number: '" + std::string(t) + "'");
-  if (std::isinf(v)) s.fail("non-finite number: '" + std::string(t) + "'");
-  return v;
-}
-
-bool is_number(std::string_view t) {
-  double v = 0;
+/// Whether t is a whole number (from_chars: no locale, an optional leading '+'), its value in v.
+bool read_number(std::string_view t, double& v) {
   const char* b = t.data();
   const char* e = t.data() + t.size();
   if (b != e && *b == '+') ++b;
   const auto r = std::from_chars(b, e, v);
   return r.ec == std::errc() && r.ptr == e;
+}
+
+bool is_number(std::string_view t) {
+  double v;
+  return read_number(t, v);
+}
+
+/// A token of a point file as a double: NaN allowed (an organized export's hole), infinity refused.
+double point_value(const LineScanner& s, std::string_view t) {
+  double v = 0;
+  if (!read_number(t, v)) s.fail("not a number: '" + std::string(t) + "'");
+  if (std::isinf(v)) s.fail("non-finite number: '" + std::string(t) + "'");
+  return v;
 }
 
 /// A header's column name: lower case, without the leading "//" of CloudCompare's exports.

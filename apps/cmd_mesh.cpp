@@ -37,7 +37,7 @@ const char* const kUsage =
     "usage: vitri mesh INPUT -o OUT.obj [--precision P [--precision P2 ...]] [--edits SCRIPT]\n"
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
-    "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z]\n"
+    "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z] [--handles L]\n"
     "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
     "                  [--threads N] [--memory M] [--blocks N|NxMxK|auto] [--spill DIR] [--ascii] [-q]\n"
     "\n"
@@ -128,6 +128,9 @@ const char* const kUsage =
     "                       closed surface's area is away from the data, e.g. a single view)\n"
     "  --viewpoint X Y Z    points: the sensor's position; normals are oriented toward it (checked\n"
     "                       against the data). Default: the input's (PCD VIEWPOINT, NAME.viewpoint)\n"
+    "  --handles L          points: handles of the mesh that a cycle of edges shorter than L data\n"
+    "                       resolutions goes around are cut and closed (the noise's; default 6.28,\n"
+    "                       2 pi; 0 keeps every handle; not with --certify or the quality mode)\n"
     "  --function F         the implicit function: global (one dense RBF: smoothest, O(N^2) memory,\n"
     "                       O(N^3) fit), local (partition of unity of local RBF patches: O(N) memory and\n"
     "                       fit, local edits, no surface far from the data) or auto (default: global up\n"
@@ -487,6 +490,11 @@ std::string parse_mesh_args(const Args& args, MeshCommand& c) {
       else if (v == "auto") options.surface = SurfaceKind::Auto;
       else return "--surface must be closed, open or auto, got '" + v + "'";
       c.surface_given = true;
+    } else if (a == "--handles") {
+      double h;
+      if (!value(v) || !parse_double(v, h) || !(h >= 0.0) || !std::isfinite(h))
+        return "--handles needs a number >= 0 (resolutions)";
+      options.handle_loop_resolutions = h;
     } else if (a == "--viewpoint") {
       double xyz[3];
       for (double& x : xyz) {
@@ -831,10 +839,14 @@ void print_scan_surface(const MesherStats& st, SurfaceKind surface) {
   const std::string layers = st.scan_layer_components
                                  ? " (" + std::to_string(st.scan_layer_components) + " of them layers of a larger one's noise)"
                                  : std::string();
+  const std::string handles = st.scan_handles_cut
+                                  ? "; " + std::to_string(st.scan_handles_cut) + " handles of the noise cut (see --handles)"
+                                  : std::string();
   std::fprintf(stderr, "surface: %s (%.1f%% of the closed surface's area away from the data%s); %zu small or "
-               "unsupported components dropped%s%s\n", st.open ? "open, trimmed to the data" : "closed",
+               "unsupported components dropped%s%s%s\n", st.open ? "open, trimmed to the data" : "closed",
                100 * st.unsupported_area,
                surface == SurfaceKind::Auto ? ", --surface auto" : "", st.scan_small_components, layers.c_str(),
+               handles.c_str(),
                st.open ? (", " + std::to_string(st.trimmed_triangles) + " triangles trimmed").c_str() : "");
 }
 
@@ -1120,8 +1132,8 @@ void run_blocks(const MeshCommand& c, MesherOptions options, Input data, std::ar
               "halo), stitch %.1f s; precision %.4g (%.4g of the diagonal)\n", st.pass1_seconds, st.pass2_seconds,
               st.merged_again, st.stitch_seconds, st.precision, st.precision / box.diagonal());
   std::printf("  %zu outliers set aside; %zu zero vertices collapsed, %zu left at their offset; surface %s, "
-              "%zu small or unsupported components dropped\n", st.outliers, st.snapped, st.offset,
-              st.open ? "open, trimmed to the data" : "closed", st.small_components);
+              "%zu small or unsupported components dropped, %zu handles of the noise cut\n", st.outliers, st.snapped,
+              st.offset, st.open ? "open, trimmed to the data" : "closed", st.small_components, st.handles_cut);
   std::printf("  per block (points seen: pass 1 s + pass 2 s):");
   for (std::size_t b = 0; b < st.block_inputs.size(); ++b)
     std::printf("%s %zu: %.1f + %.1f", b ? ";" : "", st.block_inputs[b], st.pass1_block_seconds[b],

@@ -775,7 +775,7 @@ SurfaceMesh stitch_blocks(std::vector<BlockSurface> surfaces, BlockStats* stats)
 // ---- Finishing and the whole run --------------------------------------------------------------------
 
 SurfaceMesh finish_blocks(SurfaceMesh mesh, const std::vector<const BlockSeeds*>& seeds, SurfaceKind kind,
-                          unsigned threads, BlockStats* stats) {
+                          unsigned threads, BlockStats* stats, double handle_loop_resolutions) {
   ScanPoints all;
   std::vector<double> resolutions, precisions;
   for (const BlockSeeds* s : seeds) {
@@ -794,8 +794,10 @@ SurfaceMesh finish_blocks(SurfaceMesh mesh, const std::vector<const BlockSeeds*>
   const double precision = precisions[precisions.size() / 2];
   ScanSupport support(all, resolution, resolve_thread_count(threads));
   ScanFinishReport report;
-  mesh = support.finish(std::move(mesh), precision, kind, false, &report);
+  mesh = support.finish(std::move(mesh), precision, kind, false, &report, false,
+                        handle_loop_resolutions > 0 ? handle_loop_resolutions * resolution : 0.0);
   if (stats) {
+    stats->handles_cut = report.handles_cut;
     stats->small_components = report.small_components;
     stats->open = report.open;
     stats->unsupported_area = report.unsupported_area;
@@ -1086,7 +1088,8 @@ SurfaceMesh mesh_in_blocks(const std::vector<Point3>& points, const std::vector<
     }
     st.spilled_bytes = store.bytes_written();
   }
-  mesh = finish_blocks(std::move(mesh), ptrs, options.mesher.surface, options.mesher.threads, &st);
+  mesh = finish_blocks(std::move(mesh), ptrs, options.mesher.surface, options.mesher.threads, &st,
+                       options.mesher.handle_loop_resolutions);
   if (stats) *stats = st;
   return mesh;
 }

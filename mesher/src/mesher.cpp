@@ -594,14 +594,17 @@ void Mesher::finish_scan_surface() {
   if (!scan_ || !std::isfinite(precision_)) return;
   ScanFinishReport r;
   // The quality mode's mesh is trimmed by whole triangles: its angles hold up to the boundary.
+  // Handles of the noise cut on the fast mode's meshes only (MesherOptions::handle_loop_resolutions).
+  const bool cut_handles = quality_ == nullptr && !options_.polygonizer.certify && options_.handle_loop_resolutions > 0;
   mesh_ = scan_->finish(std::move(mesh_), precision_, options_.surface, options_.polygonizer.keep_history, &r,
-                        quality_ != nullptr);
+                        quality_ != nullptr, cut_handles ? options_.handle_loop_resolutions * scan_->resolution() : 0.0);
   stats_.scan_small_components = r.small_components;
   stats_.scan_layer_components = r.layer_components;
   stats_.scan_kept_unresolved = r.kept_unresolved;
   stats_.open = r.open;
   stats_.unsupported_area = r.unsupported_area;
   stats_.trimmed_triangles = r.trimmed_triangles;
+  stats_.scan_handles_cut = r.handles_cut;
 }
 
 void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { to_eigen(surface(), V, F, &N); }

@@ -2,6 +2,7 @@
 
 #include "vitri/core/parallel.hpp"
 #include "vitri/mesher.hpp"
+#include "vitri/polygonize/mesh_handles.hpp"
 #include "vitri/polygonize/mesh_trim.hpp"
 
 #include <algorithm>
@@ -153,7 +154,7 @@ std::size_t ScanSupport::drop_layers(const SurfaceMesh& mesh, const std::vector<
 }
 
 SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing,
-                                ScanFinishReport* report, bool whole_triangles) {
+                                ScanFinishReport* report, bool whole_triangles, double max_handle_loop) {
   ScanFinishReport rep;
   const std::size_t nv = mesh.vertices.size();
   std::vector<double> s(nv, 0.0);  // distance to the data minus the reach: <= 0 supported
@@ -275,6 +276,29 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
     open = *decided_open_;
   }
   rep.open = open;
+  // Handles of the noise (mesh_handles.hpp), on the closed mesh before any trimming (where it will be
+  // open, only those through a vertex the trimming keeps); the copies and the fans' centres get their
+  // own support.
+  if (!editing && max_handle_loop > 0) {
+    HandleOptions ho;
+    ho.max_loop = max_handle_loop;
+    ho.threads = threads_;
+    std::vector<std::uint8_t> kept;
+    if (open) {
+      kept.resize(nv);
+      for (std::size_t v = 0; v < nv; ++v) kept[v] = s[v] <= 0;
+      ho.region = &kept;
+    }
+    HandleReport hr;
+    mesh = cut_short_handles(std::move(mesh), ho, &hr);
+    rep.handles_cut = hr.cut;
+    s.resize(mesh.vertices.size());
+    for (std::size_t v = nv; v < mesh.vertices.size(); ++v) {
+      double d = 0;
+      const double r = reach(mesh.vertices[v], precision, &d);
+      s[v] = d - r;
+    }
+  }
   if (open) {
     // Clipped along the zero level of s (marching triangles on the surface, trim_mesh): a clean open
     // 2-manifold whose boundary follows where the data end, not the mesh's edges.
@@ -284,11 +308,11 @@ SurfaceMesh ScanSupport::finish(SurfaceMesh mesh, double precision, SurfaceKind 
     mesh = trim_mesh(mesh, s, to, &trim);
     rep.trimmed_triangles = trim.removed_triangles + trim.clipped_triangles;
     rep.small_components += trim.removed_components;
-  } else if (rep.small_components) {
+  } else if (rep.small_components || rep.handles_cut) {
     // Unreferenced vertices out (what trim_mesh does for an open mesh).
-    std::vector<std::uint32_t> renumber(nv, 0xffffffffu);
+    std::vector<std::uint32_t> renumber(mesh.vertices.size(), 0xffffffffu);
     std::vector<Point3> vertices, normals;
-    const bool with_normals = mesh.normals.size() == nv;
+    const bool with_normals = mesh.normals.size() == mesh.vertices.size();
     for (auto& t : mesh.triangles)
       for (auto& c : t) {
         if (renumber[c] == 0xffffffffu) {

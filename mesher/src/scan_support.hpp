@@ -25,6 +25,7 @@ struct ScanFinishReport {
   bool open = false;                 ///< the mesh was trimmed to the data
   double unsupported_area = 0;       ///< fraction of the (closed) mesh's area farther than the reach
   std::size_t trimmed_triangles = 0; ///< triangles removed or clipped by the trimming
+  std::size_t handles_cut = 0;       ///< handles shorter than max_handle_loop cut (cut_short_handles)
 };
 
 class ScanSupport {
@@ -46,8 +47,12 @@ class ScanSupport {
   /// the scan's data (the Mesher's own support filter, on the current zero constraints, still applies).
   /// `whole_triangles`: an open mesh is trimmed by whole triangles (TrimOptions::snap 0.5: the cut runs
   /// along edges, every triangle kept as it was; the quality mode's angles hold up to the boundary).
+  /// `max_handle_loop` > 0 (absolute): the handles of the closed mesh that a non-separating cycle shorter
+  /// than it goes around are cut before the trimming (cut_short_handles; not when `editing`).
   SurfaceMesh finish(SurfaceMesh mesh, double precision, SurfaceKind kind, bool editing, ScanFinishReport* report,
-                     bool whole_triangles = false);
+                     bool whole_triangles = false, double max_handle_loop = 0);
+
+  double resolution() const { return resolution_; }
 
   /// The reach of the data at x: a mesh vertex within it of a point is supported (finish()); sets the
   /// distance from x to the data in `distance` when given.

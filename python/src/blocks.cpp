@@ -322,6 +322,7 @@ void bind_blocks(py::module_& m) {
           d["nonmanifold_edges"] = st.nonmanifold_edges;
           d["precision"] = st.precision;
           d["small_components"] = st.small_components;
+          d["handles_cut"] = st.handles_cut;
           d["open"] = st.open;
           d["trimmed_triangles"] = st.trimmed_triangles;
           return py::make_tuple(mesh_out(std::move(mesh)), d);

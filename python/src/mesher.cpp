@@ -351,6 +351,7 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_dequantized"] = s.scan.dequantized;  // points moved within their depth step (quantized depth)
   d["scan_far_side"] = s.far_side;     // the winding number settles the far field (a scan of an object)
   d["scan_small_components"] = s.scan_small_components;  // components dropped (too small, unsupported)
+  d["scan_handles_cut"] = s.scan_handles_cut;            // handles of the noise cut (handle_loop_resolutions)
   d["scan_kept_unresolved"] = s.scan_kept_unresolved;    // every one too small: the best-supported kept
   d["memory_thinned"] = s.memory_thinned;  // input points left out to fit the memory limit
   d["uncertified"] = s.polygonizer.uncertified;  // certify: tetrahedra left uncertified (0: certified)

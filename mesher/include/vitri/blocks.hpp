@@ -227,6 +227,7 @@ struct BlockStats {
   bool open = false;
   double unsupported_area = 0;
   std::size_t trimmed_triangles = 0;
+  std::size_t handles_cut = 0;
   double pass1_seconds = 0, pass2_seconds = 0, stitch_seconds = 0;
   std::size_t spilled_bytes = 0;     ///< written to BlockOptions::spill_directory (0: held in memory)
   std::vector<double> block_seconds; ///< pass 1 + pass 2 per block
@@ -240,9 +241,11 @@ struct BlockStats {
 SurfaceMesh stitch_blocks(std::vector<BlockSurface> surfaces, BlockStats* stats = nullptr);
 
 /// The scan's finishing on the stitched mesh (docs/scans.md): components without data or smaller than
-/// the data resolve dropped, open or closed as `kind` says (Auto decides from the whole mesh).
+/// the data resolve dropped, handles of the noise cut (MesherOptions::handle_loop_resolutions, in the
+/// blocks' median resolution), open or closed as `kind` says (Auto decides from the whole mesh).
 SurfaceMesh finish_blocks(SurfaceMesh mesh, const std::vector<const BlockSeeds*>& seeds, SurfaceKind kind,
-                          unsigned threads, BlockStats* stats = nullptr);
+                          unsigned threads, BlockStats* stats = nullptr,
+                          double handle_loop_resolutions = kHandleLoopResolutions);
 
 /// The split a memory limit asks for (`vitri mesh --blocks auto`, or a scan too large for one piece;
 /// docs/blocks.md "Memory"): the coarsest grid (cells as near cubes as the domain allows, at most 64 per

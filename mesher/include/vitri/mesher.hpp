@@ -68,6 +68,9 @@ enum class MeshMode {
 };
 
 /// Options of the Mesher.
+/// The default of MesherOptions::handle_loop_resolutions: 2 pi.
+inline constexpr double kHandleLoopResolutions = 6.283185307179586;
+
 struct MesherOptions {
   /// Threads of every phase: the constraints and normals, the scan preparation, the fit, the Delaunay
   /// insertion, the refinement and the extraction. Non-zero: that many everywhere (it overrides
@@ -102,6 +105,14 @@ struct MesherOptions {
   ScanOptions scan;
   /// from_scan(): closed, open (trimmed to the data) or decided from the data. Other constructors: Closed.
   SurfaceKind surface = SurfaceKind::Auto;
+  /// from_scan(): a handle of each finished mesh that a non-separating cycle of edges shorter than this
+  /// many resolutions (ScanReport::resolution) goes around is cut and both sides closed
+  /// (cut_short_handles, mesh_handles.hpp): the handles of the noise, whose cycles are a few resolutions
+  /// long, where those of the shape are longer (docs/scans.md, "Handles of the noise"). The default, 2 pi,
+  /// is the cycle around a tunnel or bridge as wide as the noise band (2 resolutions). 0 keeps every
+  /// handle. Not in an editing session (history kept), the quality mode or the certified mode (whose
+  /// meshes are the function's zero set as it is).
+  double handle_loop_resolutions = kHandleLoopResolutions;
   /// Fit and edit options of the RBF.
   RbfOptions rbf;
   /// Normal constraints built by from_oriented_points() and from_mesh() (off-surface distance, ...).
@@ -213,6 +224,8 @@ struct MesherStats {
   bool open = false;
   double unsupported_area = 0;
   std::size_t trimmed_triangles = 0;
+  /// from_scan(), last surface(): handles cut (MesherOptions::handle_loop_resolutions).
+  std::size_t scan_handles_cut = 0;
   /// from_scan() under MesherOptions::max_memory_bytes: input points left out to fit the limit (every
   /// memory_stride-th point kept; 0 and 1 when none was left out).
   std::size_t memory_thinned = 0;

@@ -1,0 +1,915 @@
+// Short handles found and cut (mesh_handles.hpp).
+//
+// A brief explanation. Topology: edges numbered by sorting the triangles' half-edges; each edge knows
+// its (at most two) triangles and each triangle its three edges ("edge k" joins corners k and k + 1);
+// an edge with more than two triangles, or two running the same way, is bad and never crossed. A vertex
+// is regular when its triangles form one closed fan through good edges. Components through good edges,
+// each with its genus from Euler's formula and its boundary loops.
+//
+// Search (per seed vertex s of a component of positive genus, on the threads): Dijkstra from s along
+// the edges up to radius R = max_loop / 2 (a cycle of length L lies within L / 2 of each of its
+// vertices); K = the triangles whose three vertices are in the ball. The shortest-path tree T spans the
+// ball; the edges of K outside T are taken longest loop first (loop = d(a) + |ab| + d(b)) and each joins
+// its two sides in a union-find over K's triangles plus one node for everything outside K (a maximum
+// spanning co-tree); an edge whose sides are already joined closes a cycle that is non-separating in K
+// with its outside glued into one piece. That glue can make a separating cycle look non-separating (a
+// thin rod's meridian, the rod's two ends outside the ball), so every candidate is checked against the
+// whole mesh before it is cut. The cycle is the two tree paths from the edge's ends up to their lowest
+// common ancestor, and the edge.
+//
+// Cutting (sequentially, shortest candidate first): a candidate touching a vertex already cut or found
+// separating this round waits for the next round. The check: a search over triangles from both sides of
+// the cycle's first edge, alternating, never crossing the cycle or an edge cut earlier this round (the
+// stale adjacency across those is exactly what the cuts removed): the sides meet (non-separating: cut)
+// or one side runs out (separating: leave it). The cut: at each cycle vertex c_i, the triangles on the
+// left of c_i -> c_(i+1) (those holding that half-edge's orientation, and their fan up to c_(i-1) -> c_i)
+// get a new vertex; the left loop is closed by triangles (c'_(i+1), c'_i, centre), the right one by
+// (c_i, c_(i+1), centre'), which keeps the orientation.
+#include "vitri/polygonize/mesh_handles.hpp"
+
+#include "vitri/core/parallel.hpp"
+#include "vitri/core/predicates.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <numeric>
+#include <optional>
+#include <queue>
+#include <unordered_map>
+#include <unordered_set>
+#include <utility>
+
+namespace vitri {
+namespace {
+
+using Tri = std::array<std::uint32_t, 3>;
+constexpr std::uint32_t kNone = 0xffffffffu;
+/// Seeds are at most this fraction of max_loop from every vertex (see cut_short_handles).
+constexpr double kCoverFraction = 0.25;
+/// busy[] of a cycle's vertices once it was cut (other values: refused this round).
+constexpr std::uint8_t kBusyCut = 2;
+/// Each side of a cut moves this fraction of the cycle's mean radius along its axis.
+constexpr double kCapShift = 0.25;
+
+constexpr int next3(int k) {
+  return k == 2 ? 0 : k + 1;
+}
+constexpr int prev3(int k) {
+  return k == 0 ? 2 : k - 1;
+}
+
+/// The mesh's adjacency (see the file's comment).
+struct Topology {
+  std::vector<std::array<std::uint32_t, 2>> edge_v;  // ends
+  std::vector<std::array<std::uint32_t, 2>> edge_t;  // triangles (kNone where fewer than two)
+  std::vector<std::uint8_t> edge_good;               // one or two triangles, opposite directions
+  std::vector<double> edge_len;
+  std::vector<std::array<std::uint32_t, 3>> tri_e;   // edge k joins corners k and k + 1
+  std::vector<std::uint32_t> ve_start, ve;           // vertex -> edges (CSR)
+  std::vector<std::uint32_t> vt_start, vt;           // vertex -> triangles (CSR)
+  std::vector<std::uint8_t> regular;                 // one closed fan through good edges
+  std::vector<std::uint32_t> tri_comp;               // component of each triangle
+  std::vector<long> comp_genus;
+
+  std::uint32_t edge_between(std::uint32_t a, std::uint32_t b) const {
+    for (std::uint32_t i = ve_start[a]; i < ve_start[a + 1]; ++i) {
+      const auto& v = edge_v[ve[i]];
+      if ((v[0] == a && v[1] == b) || (v[0] == b && v[1] == a)) return ve[i];
+    }
+    return kNone;
+  }
+};
+
+std::uint32_t find_root(std::vector<std::uint32_t>& p, std::uint32_t x) {
+  while (p[x] != x) x = p[x] = p[p[x]];
+  return x;
+}
+
+Topology build_topology(const SurfaceMesh& mesh) {
+  Topology g;
+  const std::size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+  // Half-edges grouped by edge: counted by lower vertex, then each vertex's bucket (its degree) sorted by
+  // (higher vertex, half-edge).
+  std::vector<std::uint32_t> start(nv + 1, 0);
+  auto ends = [&](std::uint32_t h, std::uint32_t& lo, std::uint32_t& hi) {
+    const std::uint32_t a = mesh.triangles[h / 3][h % 3], b = mesh.triangles[h / 3][next3(static_cast<int>(h % 3))];
+    lo = std::min(a, b), hi = std::max(a, b);
+  };
+  std::uint32_t lo = 0, hi = 0;
+  for (std::uint32_t h = 0; h < 3 * nt; ++h) ends(h, lo, hi), ++start[lo + 1];
+  std::partial_sum(start.begin(), start.end(), start.begin());
+  std::vector<std::uint64_t> items(3 * nt);  // higher vertex << 32 | half-edge
+  {
+    std::vector<std::uint32_t> at(start.begin(), start.end() - 1);
+    for (std::uint32_t h = 0; h < 3 * nt; ++h) ends(h, lo, hi), items[at[lo]++] = (std::uint64_t{hi} << 32) | h;
+  }
+  g.tri_e.assign(nt, {kNone, kNone, kNone});
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    const auto first = items.begin() + start[v], last = items.begin() + start[v + 1];
+    std::sort(first, last);
+    for (auto i = first; i != last;) {
+      auto j = i;
+      while (j != last && (*j >> 32) == (*i >> 32)) ++j;
+      const std::uint32_t e = static_cast<std::uint32_t>(g.edge_v.size());
+      g.edge_v.push_back({v, static_cast<std::uint32_t>(*i >> 32)});
+      std::array<std::uint32_t, 2> ts{kNone, kNone};
+      bool good = j - i <= 2;
+      if (j - i == 2) {
+        // Opposite directions: the first corners of the two half-edges differ.
+        const std::uint32_t h0 = static_cast<std::uint32_t>(*i), h1 = static_cast<std::uint32_t>(*(i + 1));
+        good = mesh.triangles[h0 / 3][h0 % 3] != mesh.triangles[h1 / 3][h1 % 3];
+      }
+      for (auto m = i; m != j; ++m) {
+        const std::uint32_t h = static_cast<std::uint32_t>(*m);
+        g.tri_e[h / 3][h % 3] = e;
+        if (m - i < 2) ts[static_cast<std::size_t>(m - i)] = h / 3;
+      }
+      g.edge_t.push_back(ts);
+      g.edge_good.push_back(good ? 1 : 0);
+      g.edge_len.push_back(distance(mesh.vertices[v], mesh.vertices[*i >> 32]));
+      i = j;
+    }
+  }
+  const std::size_t ne = g.edge_v.size();
+  g.ve_start.assign(nv + 1, 0);
+  for (const auto& v : g.edge_v) ++g.ve_start[v[0] + 1], ++g.ve_start[v[1] + 1];
+  std::partial_sum(g.ve_start.begin(), g.ve_start.end(), g.ve_start.begin());
+  g.ve.resize(2 * ne);
+  {
+    std::vector<std::uint32_t> at(g.ve_start.begin(), g.ve_start.end() - 1);
+    for (std::uint32_t e = 0; e < ne; ++e) g.ve[at[g.edge_v[e][0]]++] = e, g.ve[at[g.edge_v[e][1]]++] = e;
+  }
+  g.vt_start.assign(nv + 1, 0);
+  for (const auto& t : mesh.triangles)
+    for (const std::uint32_t c : t) ++g.vt_start[c + 1];
+  std::partial_sum(g.vt_start.begin(), g.vt_start.end(), g.vt_start.begin());
+  g.vt.resize(3 * nt);
+  {
+    std::vector<std::uint32_t> at(g.vt_start.begin(), g.vt_start.end() - 1);
+    for (std::uint32_t t = 0; t < nt; ++t)
+      for (const std::uint32_t c : mesh.triangles[t]) g.vt[at[c]++] = t;
+  }
+  // Regular vertices: as many good two-triangle edges as triangles, and one fan walked around them.
+  g.regular.assign(nv, 0);
+  for (std::uint32_t v = 0; v < nv; ++v) {
+    const std::uint32_t deg = g.vt_start[v + 1] - g.vt_start[v];
+    if (deg < 3 || g.ve_start[v + 1] - g.ve_start[v] != deg) continue;
+    bool ok = true;
+    for (std::uint32_t i = g.ve_start[v]; i < g.ve_start[v + 1] && ok; ++i)
+      ok = g.edge_good[g.ve[i]] && g.edge_t[g.ve[i]][1] != kNone;
+    if (!ok) continue;
+    // Walk: in triangle t with v at corner k, cross edge k (v -> next) to the other triangle.
+    std::uint32_t t = g.vt[g.vt_start[v]], steps = 0;
+    do {
+      int k = 0;
+      while (mesh.triangles[t][static_cast<std::size_t>(k)] != v) ++k;
+      const std::uint32_t e = g.tri_e[t][static_cast<std::size_t>(k)];
+      t = g.edge_t[e][0] == t ? g.edge_t[e][1] : g.edge_t[e][0];
+      ++steps;
+    } while (t != g.vt[g.vt_start[v]] && steps <= deg);
+    g.regular[v] = steps == deg ? 1 : 0;
+  }
+  // Components through good edges; genus from V - E + F and the boundary loops.
+  std::vector<std::uint32_t> p(nt);
+  std::iota(p.begin(), p.end(), 0u);
+  for (std::uint32_t e = 0; e < ne; ++e)
+    if (g.edge_good[e] && g.edge_t[e][1] != kNone) {
+      const std::uint32_t a = find_root(p, g.edge_t[e][0]), b = find_root(p, g.edge_t[e][1]);
+      if (a != b) p[std::max(a, b)] = std::min(a, b);
+    }
+  g.tri_comp.assign(nt, 0);
+  std::vector<std::uint32_t> comp_of_root(nt, kNone);
+  std::uint32_t nc = 0;
+  for (std::uint32_t t = 0; t < nt; ++t) {
+    const std::uint32_t r = find_root(p, t);
+    if (comp_of_root[r] == kNone) comp_of_root[r] = nc++;
+    g.tri_comp[t] = comp_of_root[r];
+  }
+  std::vector<long> V(nc, 0), E(nc, 0), F(nc, 0), B(nc, 0);
+  for (std::uint32_t t = 0; t < nt; ++t) ++F[g.tri_comp[t]];
+  for (std::uint32_t e = 0; e < ne; ++e) ++E[g.tri_comp[g.edge_t[e][0]]];
+  {
+    std::vector<std::uint32_t> seen(nv, kNone);
+    for (std::uint32_t t = 0; t < nt; ++t)
+      for (const std::uint32_t c : mesh.triangles[t])
+        if (seen[c] != g.tri_comp[t]) seen[c] = g.tri_comp[t], ++V[g.tri_comp[t]];
+  }
+  // Boundary loops: the edges with one triangle, joined through shared vertices.
+  std::vector<std::uint32_t> q(nv);
+  std::iota(q.begin(), q.end(), 0u);
+  std::vector<std::uint8_t> on_boundary(nv, 0);
+  for (std::uint32_t e = 0; e < ne; ++e)
+    if (g.edge_t[e][1] == kNone) {
+      const std::uint32_t a = find_root(q, g.edge_v[e][0]), b = find_root(q, g.edge_v[e][1]);
+      on_boundary[g.edge_v[e][0]] = on_boundary[g.edge_v[e][1]] = 1;
+      if (a != b) q[std::max(a, b)] = std::min(a, b);
+    }
+  for (std::uint32_t v = 0; v < nv; ++v)
+    if (on_boundary[v] && find_root(q, v) == v) ++B[g.tri_comp[g.vt[g.vt_start[v]]]];
+  g.comp_genus.assign(nc, 0);
+  for (std::uint32_t c = 0; c < nc; ++c) g.comp_genus[c] = std::max(0L, (2 - (V[c] - E[c] + F[c]) - B[c]) / 2);
+  return g;
+}
+
+struct Candidate {
+  double length = 0;
+  std::vector<std::uint32_t> cycle;  // vertices in order; the cycle closes from the last to the first
+};
+
+/// Per-thread storage of the search, reset by stamps.
+struct Search {
+  std::vector<std::uint32_t> vstamp, ustamp, tstamp, estamp, anc;
+  std::vector<std::pair<double, std::uint32_t>> heap;  // Dijkstra's (a binary heap by std::push_heap)
+  std::vector<double> dist;
+  std::vector<std::uint32_t> parent_e, local_t, settled;
+  std::vector<std::uint8_t> done;
+  std::uint32_t stamp = 0;
+  std::vector<std::uint32_t> ball, tris, uf;
+  std::vector<std::pair<double, std::uint32_t>> edges;
+
+  void resize(std::size_t nv, std::size_t nt, std::size_t ne) {
+    vstamp.assign(nv, 0), ustamp.assign(nv, 0), anc.assign(nv, 0), dist.assign(nv, 0), parent_e.assign(nv, kNone), done.assign(nv, 0);
+    tstamp.assign(nt, 0), local_t.assign(nt, 0), estamp.assign(ne, 0);
+  }
+};
+
+/// The non-separating cycles (in K: the triangles within `radius` of seed s, their outside glued) through
+/// s no longer than max_loop; at most
+/// `keep` of them, shortest first.
+void search_seed(const SurfaceMesh& mesh, const Topology& g, std::uint32_t s, double radius, double max_loop,
+                 Search& w, std::size_t keep, std::vector<Candidate>& out) {
+  const std::uint32_t st = ++w.stamp;
+  using Item = std::pair<double, std::uint32_t>;
+  auto& heap = w.heap;
+  heap.clear();
+  const std::greater<Item> later;
+  w.ball.clear();
+  w.vstamp[s] = st, w.dist[s] = 0, w.parent_e[s] = kNone, w.done[s] = 0;
+  heap.push_back({0.0, s});
+  while (!heap.empty()) {
+    std::pop_heap(heap.begin(), heap.end(), later);
+    const auto [d, v] = heap.back();
+    heap.pop_back();
+    if (w.done[v] || d > w.dist[v]) continue;
+    w.done[v] = 1;
+    w.ball.push_back(v);
+    for (std::uint32_t i = g.ve_start[v]; i < g.ve_start[v + 1]; ++i) {
+      const std::uint32_t e = g.ve[i];
+      const std::uint32_t u = g.edge_v[e][0] == v ? g.edge_v[e][1] : g.edge_v[e][0];
+      const double nd = d + g.edge_len[e];
+      if (nd > radius) continue;
+      if (w.vstamp[u] != st) {
+        w.vstamp[u] = st, w.done[u] = 0;
+      } else if (w.done[u] || nd >= w.dist[u]) {
+        continue;
+      }
+      w.dist[u] = nd, w.parent_e[u] = e;
+      heap.push_back({nd, u});
+      std::push_heap(heap.begin(), heap.end(), later);
+    }
+  }
+  auto in_ball = [&](std::uint32_t v) { return w.vstamp[v] == st && w.done[v]; };
+  w.tris.clear();
+  for (const std::uint32_t v : w.ball)
+    for (std::uint32_t i = g.vt_start[v]; i < g.vt_start[v + 1]; ++i) {
+      const std::uint32_t t = g.vt[i];
+      if (w.tstamp[t] == st) continue;
+      const Tri& tri = mesh.triangles[t];
+      if (in_ball(tri[0]) && in_ball(tri[1]) && in_ball(tri[2])) {
+        w.tstamp[t] = st;
+        w.local_t[t] = static_cast<std::uint32_t>(w.tris.size());
+        w.tris.push_back(t);
+      }
+    }
+  // Euler's characteristic of K first: a disk (1), or a sphere (2), has no cycle to find.
+  long chi = static_cast<long>(w.tris.size());
+  for (const std::uint32_t t : w.tris)
+    for (const std::uint32_t v : mesh.triangles[t])
+      if (w.ustamp[v] != st) w.ustamp[v] = st, ++chi;
+  w.edges.clear();
+  for (const std::uint32_t t : w.tris)
+    for (const std::uint32_t e : g.tri_e[t]) {
+      if (w.estamp[e] == st) continue;
+      w.estamp[e] = st;
+      --chi;
+      if (!g.edge_good[e]) continue;
+      const std::uint32_t a = g.edge_v[e][0], b = g.edge_v[e][1];
+      if (w.parent_e[a] == e || w.parent_e[b] == e) continue;  // a tree edge
+      w.edges.push_back({w.dist[a] + g.edge_len[e] + w.dist[b], e});
+    }
+  if (chi >= 1) return;
+  std::sort(w.edges.begin(), w.edges.end(), [](const Item& x, const Item& y) {
+    return x.first != y.first ? x.first > y.first : x.second < y.second;
+  });
+  const std::uint32_t outside = static_cast<std::uint32_t>(w.tris.size());
+  w.uf.resize(w.tris.size() + 1);
+  std::iota(w.uf.begin(), w.uf.end(), 0u);
+  auto node = [&](std::uint32_t t) { return t != kNone && w.tstamp[t] == st ? w.local_t[t] : outside; };
+  std::vector<Candidate> found;
+  for (const auto& [loop, e] : w.edges) {
+    const std::uint32_t x = find_root(w.uf, node(g.edge_t[e][0])), y = find_root(w.uf, node(g.edge_t[e][1]));
+    if (x != y) {
+      w.uf[std::max(x, y)] = std::min(x, y);
+      continue;
+    }
+    if (loop > max_loop) continue;
+    // The cycle: a's path up to the lowest common ancestor, then down to b, and the edge back to a.
+    const std::uint32_t a = g.edge_v[e][0], b = g.edge_v[e][1];
+    const std::uint32_t mark = st;
+    for (std::uint32_t v = a;;) {
+      w.anc[v] = mark;
+      if (w.parent_e[v] == kNone) break;
+      v = g.edge_v[w.parent_e[v]][0] == v ? g.edge_v[w.parent_e[v]][1] : g.edge_v[w.parent_e[v]][0];
+    }
+    std::vector<std::uint32_t> down;  // b up to (not including) the ancestor
+    std::uint32_t lca = b;
+    while (w.anc[lca] != mark) {
+      down.push_back(lca);
+      const std::uint32_t pe = w.parent_e[lca];
+      lca = g.edge_v[pe][0] == lca ? g.edge_v[pe][1] : g.edge_v[pe][0];
+    }
+    Candidate c;
+    for (std::uint32_t v = a; v != lca;) {
+      c.cycle.push_back(v);
+      const std::uint32_t pe = w.parent_e[v];
+      v = g.edge_v[pe][0] == v ? g.edge_v[pe][1] : g.edge_v[pe][0];
+    }
+    c.cycle.push_back(lca);
+    for (auto it = down.rbegin(); it != down.rend(); ++it) c.cycle.push_back(*it);
+    // Clear the marks for the next edge (anc is shared by the seed's edges).
+    for (std::uint32_t v = a;;) {
+      w.anc[v] = 0;
+      if (w.parent_e[v] == kNone) break;
+      v = g.edge_v[w.parent_e[v]][0] == v ? g.edge_v[w.parent_e[v]][1] : g.edge_v[w.parent_e[v]][0];
+    }
+    if (c.cycle.size() < 3) continue;
+    c.length = loop - 2 * w.dist[lca];
+    found.push_back(std::move(c));
+  }
+  std::sort(found.begin(), found.end(), [](const Candidate& x, const Candidate& y) { return x.length < y.length; });
+  if (found.size() > keep) found.resize(keep);
+  for (auto& c : found) out.push_back(std::move(c));
+}
+
+/// Whether removing the cycle's edges (and `walls`) keeps the triangles on its two sides connected: a
+/// search from both sides, alternating, until they meet or one runs out.
+bool non_separating(const Topology& g, const std::vector<std::uint32_t>& cycle_edges,
+                    const std::vector<std::uint8_t>& wall, std::vector<std::uint32_t>& seen, std::uint32_t& stamp) {
+  const std::uint32_t e0 = cycle_edges[0];
+  if (g.edge_t[e0][1] == kNone) return false;
+  const std::uint32_t side[2] = {++stamp, ++stamp};
+  std::vector<std::uint32_t> queue[2] = {{g.edge_t[e0][0]}, {g.edge_t[e0][1]}};
+  std::size_t head[2] = {0, 0};
+  seen[queue[0][0]] = side[0], seen[queue[1][0]] = side[1];
+  while (head[0] < queue[0].size() && head[1] < queue[1].size()) {
+    for (int k = 0; k < 2; ++k) {
+      const std::uint32_t t = queue[k][head[k]++];
+      for (const std::uint32_t e : g.tri_e[t]) {
+        if (wall[e] || !g.edge_good[e] || g.edge_t[e][1] == kNone) continue;
+        const std::uint32_t u = g.edge_t[e][0] == t ? g.edge_t[e][1] : g.edge_t[e][0];
+        if (seen[u] == side[1 - k]) return true;
+        if (seen[u] == side[k]) continue;
+        seen[u] = side[k];
+        queue[k].push_back(u);
+      }
+      if (head[k] >= queue[k].size()) return false;
+    }
+  }
+  return false;
+}
+
+/// The triangle holding the half-edge a -> b.
+std::uint32_t left_of(const SurfaceMesh& mesh, const Topology& g, std::uint32_t e, std::uint32_t a, std::uint32_t b) {
+  for (const std::uint32_t t : g.edge_t[e]) {
+    if (t == kNone) continue;
+    for (int k = 0; k < 3; ++k)
+      if (mesh.triangles[t][static_cast<std::size_t>(k)] == a && mesh.triangles[t][static_cast<std::size_t>(next3(k))] == b)
+        return t;
+  }
+  return kNone;
+}
+
+
+// ---- Planning a cut and checking it -----------------------------------------------------------------
+
+/// Triangles by the cells of grids their bounding boxes overlap (hashes of cell keys): level k has cells
+/// kLevelRatio^k times the finest, and a triangle goes to the finest level where its box spans at most
+/// kSpan cells along every axis (the coarse sheets that close an open scan go to coarser levels). At the
+/// finest level only the triangles in `wanted` cells are kept (where cuts may happen).
+class TriangleGrid {
+ public:
+  using Key = std::uint64_t;
+  TriangleGrid(const SurfaceMesh& mesh, double cell, std::unordered_set<Key> wanted)
+      : cell_(cell > 0 ? cell : 1.0), wanted_(std::move(wanted)) {
+    for (std::uint32_t t = 0; t < mesh.triangles.size(); ++t) insert(mesh, t, true);
+  }
+  static Key key(std::int64_t x, std::int64_t y, std::int64_t z) {
+    return (static_cast<Key>(x) * 73856093u) ^ (static_cast<Key>(y) * 19349663u) ^ (static_cast<Key>(z) * 83492791u);
+  }
+  /// The cell of side `cell` holding x.
+  static std::array<std::int64_t, 3> cell_of(const Point3& x, double cell) {
+    return {static_cast<std::int64_t>(std::floor(x.x / cell)), static_cast<std::int64_t>(std::floor(x.y / cell)),
+            static_cast<std::int64_t>(std::floor(x.z / cell))};
+  }
+  void insert(const SurfaceMesh& mesh, std::uint32_t t, bool filtered = false) {
+    const Tri& tri = mesh.triangles[t];
+    Point3 lo = mesh.vertices[tri[0]], hi = lo;
+    for (const std::uint32_t c : tri)
+      for (std::size_t k = 0; k < 3; ++k)
+        lo[k] = std::min(lo[k], mesh.vertices[c][k]), hi[k] = std::max(hi[k], mesh.vertices[c][k]);
+    std::size_t level = 0;
+    double size = cell_;
+    while (level + 1 < kLevels && (hi.x - lo.x > kSpan * size || hi.y - lo.y > kSpan * size || hi.z - lo.z > kSpan * size))
+      ++level, size *= kLevelRatio;
+    if (level == 0 && filtered) {
+      bool any = false;
+      visit(0, lo, hi, [&](Key k) { any = any || wanted_.count(k) > 0; });
+      if (!any) return;
+    }
+    visit(level, lo, hi, [&](Key k) { levels_[level][k].push_back(t); });
+  }
+  /// Every triangle whose cells meet the box [lo, hi], at every level (with repeats).
+  void query(const Point3& lo, const Point3& hi, std::vector<std::uint32_t>& out) {
+    for (std::size_t level = 0; level < kLevels; ++level)
+      visit(level, lo, hi, [&](Key k) {
+        const auto it = levels_[level].find(k);
+        if (it != levels_[level].end()) out.insert(out.end(), it->second.begin(), it->second.end());
+      });
+  }
+
+ private:
+  static constexpr std::size_t kLevels = 8;
+  static constexpr double kSpan = 2;
+  static constexpr double kLevelRatio = 8;
+  template <class F>
+  void visit(std::size_t level, const Point3& lo, const Point3& hi, F f) const {
+    const double size = cell_ * std::pow(kLevelRatio, static_cast<double>(level));
+    std::array<std::int64_t, 3> a{}, b{};
+    for (std::size_t k = 0; k < 3; ++k)
+      a[k] = static_cast<std::int64_t>(std::floor(lo[k] / size)), b[k] = static_cast<std::int64_t>(std::floor(hi[k] / size));
+    for (std::int64_t x = a[0]; x <= b[0]; ++x)
+      for (std::int64_t y = a[1]; y <= b[1]; ++y)
+        for (std::int64_t z = a[2]; z <= b[2]; ++z) f(key(x, y, z));
+  }
+  double cell_;
+  std::unordered_set<Key> wanted_;
+  std::array<std::unordered_map<Key, std::vector<std::uint32_t>>, kLevels> levels_;
+};
+
+/// A cut before it is made: the triangles it changes (their new corners) and adds, and the new
+/// positions. Vertex ids at or above `first_new` are the vertices it adds (positions in `added`).
+struct CutPlan {
+  std::vector<std::uint32_t> changed;        // triangles whose corners or corner positions change
+  std::vector<Tri> changed_to;               // their new corners
+  std::vector<Tri> added;                    // the two fans
+  std::vector<std::pair<std::uint32_t, Point3>> moved;  // existing vertices moved (the right side)
+  std::vector<Point3> new_points;            // positions of ids first_new, first_new + 1, ...
+  std::vector<std::uint32_t> copied_from;    // the vertex each new point copies (kNone: a fan's centre)
+  std::uint32_t first_new = 0;
+};
+
+void plan_cut(const SurfaceMesh& mesh, const Topology& g, const std::vector<std::uint32_t>& cycle,
+              const std::vector<std::vector<std::uint32_t>>& left, const Point3& shift, CutPlan& plan) {
+  const std::size_t n = cycle.size();
+  plan = CutPlan{};
+  plan.first_new = static_cast<std::uint32_t>(mesh.vertices.size());
+  std::vector<std::uint32_t> copy(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    copy[i] = plan.first_new + static_cast<std::uint32_t>(i);
+    plan.new_points.push_back(mesh.vertices[cycle[i]] + shift);
+    plan.copied_from.push_back(cycle[i]);
+    plan.moved.push_back({cycle[i], mesh.vertices[cycle[i]] - shift});
+  }
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::uint32_t j = g.vt_start[cycle[i]]; j < g.vt_start[cycle[i] + 1]; ++j) {
+      const std::uint32_t t = g.vt[j];
+      if (std::find(plan.changed.begin(), plan.changed.end(), t) != plan.changed.end()) continue;
+      Tri to = mesh.triangles[t];
+      for (std::size_t m = 0; m < n; ++m)
+        if (std::find(left[m].begin(), left[m].end(), t) != left[m].end())
+          for (auto& corner : to)
+            if (corner == cycle[m]) corner = copy[m];
+      plan.changed.push_back(t);
+      plan.changed_to.push_back(to);
+    }
+  {  // changed sorted (plan_crosses searches it), changed_to alongside
+    std::vector<std::size_t> order(plan.changed.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) { return plan.changed[x] < plan.changed[y]; });
+    std::vector<std::uint32_t> changed;
+    std::vector<Tri> changed_to;
+    for (const std::size_t o : order) changed.push_back(plan.changed[o]), changed_to.push_back(plan.changed_to[o]);
+    plan.changed.swap(changed);
+    plan.changed_to.swap(changed_to);
+  }
+  for (int side = 0; side < 2; ++side) {
+    Point3 centre{};
+    for (std::size_t i = 0; i < n; ++i)
+      centre = centre + (side == 0 ? plan.new_points[i] : plan.moved[i].second);
+    const std::uint32_t ci = plan.first_new + static_cast<std::uint32_t>(plan.new_points.size());
+    plan.new_points.push_back(centre / static_cast<double>(n));
+    plan.copied_from.push_back(kNone);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t j = (i + 1) % n;
+      plan.added.push_back(side == 0 ? Tri{copy[j], copy[i], ci} : Tri{cycle[i], cycle[j], ci});
+    }
+  }
+}
+
+/// The two coordinates a plane through a, b, c is projected on without losing it (the normal's largest
+/// component dropped); the projection keeps coplanar points' incidences exactly.
+std::pair<int, int> plane_axes(const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 n = cross(b - a, c - a);
+  const double x = std::abs(n.x), y = std::abs(n.y), z = std::abs(n.z);
+  if (x >= y && x >= z) return {1, 2};
+  if (y >= z) return {2, 0};
+  return {0, 1};
+}
+
+/// In the plane (i, j): whether the closed segments pq and ab meet.
+bool segments_meet_2d(const Point3& p, const Point3& q, const Point3& a, const Point3& b, int i, int j) {
+  const Sign s1 = orient2d(p, q, a, i, j), s2 = orient2d(p, q, b, i, j);
+  const Sign s3 = orient2d(a, b, p, i, j), s4 = orient2d(a, b, q, i, j);
+  if (s1 == Sign::Zero && s2 == Sign::Zero) {  // collinear: overlapping extents
+    const auto si = static_cast<std::size_t>(i), sj = static_cast<std::size_t>(j);
+    for (const std::size_t k : {si, sj})
+      if (std::max(p[k], q[k]) < std::min(a[k], b[k]) || std::max(a[k], b[k]) < std::min(p[k], q[k])) return false;
+    return true;
+  }
+  return s1 != s2 && s3 != s4;
+}
+
+/// In the plane (i, j): whether point x lies in the closed triangle abc.
+bool inside_2d(const Point3& x, const Point3& a, const Point3& b, const Point3& c, int i, int j) {
+  const Sign s1 = orient2d(a, b, x, i, j), s2 = orient2d(b, c, x, i, j), s3 = orient2d(c, a, x, i, j);
+  const bool pos = s1 == Sign::Positive || s2 == Sign::Positive || s3 == Sign::Positive;
+  const bool neg = s1 == Sign::Negative || s2 == Sign::Negative || s3 == Sign::Negative;
+  return !(pos && neg);
+}
+
+/// Whether segment pq meets the closed triangle abc (exact).
+bool segment_meets(const Point3& p, const Point3& q, const Point3& a, const Point3& b, const Point3& c) {
+  const Sign sp = orient3d(a, b, c, p), sq = orient3d(a, b, c, q);
+  if (sp == sq && sp != Sign::Zero) return false;  // both on one side
+  if (sp == Sign::Zero && sq == Sign::Zero) {      // in the triangle's plane
+    const auto [i, j] = plane_axes(a, b, c);
+    return inside_2d(p, a, b, c, i, j) || inside_2d(q, a, b, c, i, j) || segments_meet_2d(p, q, a, b, i, j) ||
+           segments_meet_2d(p, q, b, c, i, j) || segments_meet_2d(p, q, c, a, i, j);
+  }
+  const Sign s1 = orient3d(p, q, a, b), s2 = orient3d(p, q, b, c), s3 = orient3d(p, q, c, a);
+  const bool has_pos = s1 == Sign::Positive || s2 == Sign::Positive || s3 == Sign::Positive;
+  const bool has_neg = s1 == Sign::Negative || s2 == Sign::Negative || s3 == Sign::Negative;
+  return !(has_pos && has_neg);
+}
+
+/// Whether triangles x and y (corner ids and positions) cross beyond what they share: a shared edge
+/// allows nothing but that edge (folding onto each other crosses), a shared corner nothing but that
+/// point. Degenerate (zero-area) triangles are never made here: the cuts' triangles have corners apart.
+bool triangles_cross(const Tri& x, const std::array<Point3, 3>& px, const Tri& y, const std::array<Point3, 3>& py) {
+  int shared = 0;
+  int xs[3] = {-1, -1, -1};  // x's corner k is y's corner xs[k]
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (x[static_cast<std::size_t>(i)] == y[static_cast<std::size_t>(j)]) xs[i] = j, ++shared;
+  if (shared >= 3) return true;  // a duplicate
+  if (shared == 2) {
+    // Coplanar with the far corners on the same side of the shared edge: folded onto each other.
+    int ox = 0, oy = 0;
+    while (xs[ox] >= 0) ++ox;
+    for (int j = 0; j < 3; ++j)
+      if (xs[0] != j && xs[1] != j && xs[2] != j) oy = j;
+    const int e0 = ox == 0 ? 1 : 0, e1 = 3 - ox - e0;
+    const Point3& a = px[static_cast<std::size_t>(e0)];
+    const Point3& b = px[static_cast<std::size_t>(e1)];
+    const Point3& c = px[static_cast<std::size_t>(ox)];
+    const Point3& d = py[static_cast<std::size_t>(oy)];
+    if (orient3d(a, b, c, d) != Sign::Zero) return false;
+    const auto [i, j] = plane_axes(a, b, c);
+    return orient2d(a, b, c, i, j) == orient2d(a, b, d, i, j);
+  }
+  // Edges of each against the other. With a shared corner s: the edge away from s as usual; an edge from
+  // s to o meets the other triangle beyond s only when o lies in its plane and the edge enters its angle
+  // at s (or runs along one of its edges).
+  for (int pass = 0; pass < 2; ++pass) {
+    const Tri& a = pass == 0 ? x : y;
+    const auto& pa = pass == 0 ? px : py;
+    const auto& pb = pass == 0 ? py : px;
+    const Tri& b = pass == 0 ? y : x;
+    for (int k = 0; k < 3; ++k) {
+      const std::size_t u = static_cast<std::size_t>(k), w = static_cast<std::size_t>(next3(k));
+      const auto bu = std::find(b.begin(), b.end(), a[u]), bw = std::find(b.begin(), b.end(), a[w]);
+      if (bu == b.end() && bw == b.end()) {
+        if (segment_meets(pa[u], pa[w], pb[0], pb[1], pb[2])) return true;
+        continue;
+      }
+      const std::size_t si = static_cast<std::size_t>((bu != b.end() ? bu : bw) - b.begin());
+      const Point3& o = bu != b.end() ? pa[w] : pa[u];
+      if (orient3d(pb[0], pb[1], pb[2], o) != Sign::Zero) continue;
+      const Point3& s0 = pb[si];
+      const Point3& b1 = pb[(si + 1) % 3];
+      const Point3& b2 = pb[(si + 2) % 3];
+      const auto [i, j] = plane_axes(pb[0], pb[1], pb[2]);
+      // Within the closed angle b1 s0 b2 (counter-clockwise from b1 to b2 in b's own orientation).
+      const Sign turn = orient2d(s0, b1, b2, i, j);
+      const Sign s1 = orient2d(s0, b1, o, i, j), s2 = orient2d(s0, o, b2, i, j);
+      if (s1 != -turn && s2 != -turn) return true;
+    }
+  }
+  return false;
+}
+
+/// Whether the plan's triangles cross each other or a triangle near them.
+bool plan_crosses(const SurfaceMesh& mesh, const CutPlan& plan, TriangleGrid& grid) {
+  auto pos = [&](std::uint32_t v) -> Point3 {
+    if (v >= plan.first_new) return plan.new_points[v - plan.first_new];
+    for (const auto& m : plan.moved)
+      if (m.first == v) return m.second;
+    return mesh.vertices[v];
+  };
+  std::vector<Tri> mine(plan.changed_to);
+  mine.insert(mine.end(), plan.added.begin(), plan.added.end());
+  std::vector<std::array<Point3, 3>> at(mine.size());
+  Point3 lo{}, hi{};
+  for (std::size_t i = 0; i < mine.size(); ++i)
+    for (std::size_t k = 0; k < 3; ++k) {
+      at[i][k] = pos(mine[i][k]);
+      if (i == 0 && k == 0) lo = hi = at[i][k];
+      for (std::size_t d = 0; d < 3; ++d) lo[d] = std::min(lo[d], at[i][k][d]), hi[d] = std::max(hi[d], at[i][k][d]);
+    }
+  // Boxes first: a pair whose boxes are apart cannot cross.
+  auto box_of = [](const std::array<Point3, 3>& p) {
+    std::array<Point3, 2> b{p[0], p[0]};
+    for (std::size_t k = 1; k < 3; ++k)
+      for (std::size_t d = 0; d < 3; ++d) b[0][d] = std::min(b[0][d], p[k][d]), b[1][d] = std::max(b[1][d], p[k][d]);
+    return b;
+  };
+  auto apart = [](const std::array<Point3, 2>& a, const std::array<Point3, 2>& b) {
+    for (std::size_t d = 0; d < 3; ++d)
+      if (a[1][d] < b[0][d] || b[1][d] < a[0][d]) return true;
+    return false;
+  };
+  std::vector<std::array<Point3, 2>> boxes(mine.size());
+  for (std::size_t i = 0; i < mine.size(); ++i) boxes[i] = box_of(at[i]);
+  for (std::size_t i = 0; i < mine.size(); ++i)
+    for (std::size_t j = i + 1; j < mine.size(); ++j)
+      if (!apart(boxes[i], boxes[j]) && triangles_cross(mine[i], at[i], mine[j], at[j])) return true;
+  std::vector<std::uint32_t> near;
+  grid.query(lo, hi, near);
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  for (const std::uint32_t t : near) {
+    if (std::binary_search(plan.changed.begin(), plan.changed.end(), t)) continue;
+    const Tri& tri = mesh.triangles[t];
+    const std::array<Point3, 3> pt{mesh.vertices[tri[0]], mesh.vertices[tri[1]], mesh.vertices[tri[2]]};
+    const std::array<Point3, 2> box = box_of(pt);
+    if (apart(box, {lo, hi})) continue;
+    for (std::size_t i = 0; i < mine.size(); ++i)
+      if (!apart(boxes[i], box) && triangles_cross(mine[i], at[i], tri, pt)) return true;
+  }
+  return false;
+}
+
+void apply_cut(SurfaceMesh& mesh, const CutPlan& plan, TriangleGrid& grid) {
+  const bool with_normals = mesh.normals.size() == mesh.vertices.size();
+  for (std::size_t i = 0; i < plan.new_points.size(); ++i) {
+    mesh.vertices.push_back(plan.new_points[i]);
+    if (with_normals) mesh.normals.push_back(plan.copied_from[i] != kNone ? mesh.normals[plan.copied_from[i]] : Point3{});
+  }
+  for (const auto& m : plan.moved) mesh.vertices[m.first] = m.second;
+  for (std::size_t i = 0; i < plan.changed.size(); ++i) mesh.triangles[plan.changed[i]] = plan.changed_to[i];
+  const std::size_t first_added = mesh.triangles.size();
+  for (const Tri& t : plan.added) mesh.triangles.push_back(t);
+  for (std::size_t t = first_added; t < mesh.triangles.size(); ++t) grid.insert(mesh, static_cast<std::uint32_t>(t));
+  for (const std::uint32_t t : plan.changed) grid.insert(mesh, t);  // moved: its new cells too
+  if (with_normals)
+    for (int side = 0; side < 2; ++side) {  // the centres' normals: their fan's
+      Point3 normal{};
+      const std::size_t half = plan.added.size() / 2;
+      for (std::size_t i = side * half; i < (side + 1) * half; ++i) {
+        const Tri& t = plan.added[i];
+        normal = normal + cross(mesh.vertices[t[1]] - mesh.vertices[t[0]], mesh.vertices[t[2]] - mesh.vertices[t[0]]);
+      }
+      const double len = norm(normal);
+      mesh.normals[plan.added[side * half][2]] = len > 0 ? normal / len : Point3{0, 0, 1};
+    }
+}
+
+}  // namespace
+
+long mesh_genus(const SurfaceMesh& mesh) {
+  const Topology g = build_topology(mesh);
+  return std::accumulate(g.comp_genus.begin(), g.comp_genus.end(), 0L);
+}
+
+SurfaceMesh cut_short_handles(SurfaceMesh mesh, const HandleOptions& options, HandleReport* report) {
+  HandleReport rep;
+  const unsigned threads = resolve_thread_count(options.threads);
+  bool first = true;
+  // After the first round, only where a candidate waited for a cut beside it (kRetry) is searched again:
+  // elsewhere every candidate was cut or refused, and would be again.
+  std::vector<std::uint8_t> retry;
+  for (int round = 0; round < options.rounds; ++round) {
+    const Topology g = build_topology(mesh);
+    const long genus = std::accumulate(g.comp_genus.begin(), g.comp_genus.end(), 0L);
+    if (first) rep.genus_before = genus, first = false;
+    rep.genus_after = genus;
+    if (genus == 0 || !(options.max_loop > 0)) break;
+    const std::size_t nv = mesh.vertices.size(), nt = mesh.triangles.size(), ne = g.edge_v.size();
+    // Seeds: the regular vertices of components of positive genus.
+    std::vector<std::uint8_t> in_genus(nv, 0);
+    for (std::uint32_t t = 0; t < nt; ++t)
+      if (g.comp_genus[g.tri_comp[t]] > 0)
+        for (const std::uint32_t c : mesh.triangles[t])
+          in_genus[c] = g.regular[c] && (round == 0 || retry[c]) &&
+                        (!options.region || (c < options.region->size() && (*options.region)[c]));
+    // Seeds a net of them: every vertex within `cover` of one (a greedy cover, Dijkstra), so that a
+    // cycle no longer than max_loop has a seed within `cover` of it, and lies in that seed's ball of
+    // radius max_loop / 2 + cover; the cycle found through the seed is at most 2 cover longer.
+    const double cover = kCoverFraction * options.max_loop;
+    std::vector<std::uint32_t> seeds;
+    {
+      std::vector<double> reach(nv, -1.0);  // >= 0: covered, the distance to its seed
+      using Item = std::pair<double, std::uint32_t>;
+      std::priority_queue<Item, std::vector<Item>, std::greater<Item>> heap;
+      std::vector<std::uint32_t> touched;
+      for (std::uint32_t v = 0; v < nv; ++v) {
+        if (!in_genus[v] || reach[v] >= 0) continue;
+        seeds.push_back(v);
+        reach[v] = 0;
+        heap.push({0.0, v});
+        while (!heap.empty()) {
+          const auto [d, x] = heap.top();
+          heap.pop();
+          if (d > reach[x]) continue;
+          for (std::uint32_t i = g.ve_start[x]; i < g.ve_start[x + 1]; ++i) {
+            const std::uint32_t e = g.ve[i];
+            const std::uint32_t u = g.edge_v[e][0] == x ? g.edge_v[e][1] : g.edge_v[e][0];
+            const double nd = d + g.edge_len[e];
+            if (nd <= cover && (reach[u] < 0 || nd < reach[u])) reach[u] = nd, heap.push({nd, u});
+          }
+        }
+      }
+    }
+    const std::size_t workers = std::max<std::size_t>(1, std::min<std::size_t>(threads, 8));
+    std::vector<Search> scratch(workers);
+    std::vector<std::vector<Candidate>> found(seeds.size());
+    std::vector<std::uint8_t> sized(workers, 0);
+    const std::size_t per = (seeds.size() + workers - 1) / workers;
+    run_tasks(workers, [&](std::size_t k) {
+      Search& w = scratch[k];
+      w.resize(nv, nt, ne);
+      for (std::size_t i = k * per; i < std::min(seeds.size(), (k + 1) * per); ++i)
+        search_seed(mesh, g, seeds[i], 0.5 * options.max_loop + cover, options.max_loop, w, 3, found[i]);
+    });
+    scratch.clear();
+    std::vector<Candidate> all;
+    for (auto& f : found)
+      for (auto& c : f) all.push_back(std::move(c));
+    found.clear();
+    std::stable_sort(all.begin(), all.end(), [](const Candidate& x, const Candidate& y) { return x.length < y.length; });
+    std::vector<std::uint8_t> busy(nv, 0), wall(ne, 0), retry_next(nv, 0);
+    std::vector<std::uint32_t> seen(nt, 0);
+    std::uint32_t stamp = 0;
+    std::size_t cut_now = 0;
+    std::vector<std::uint32_t> cycle_edges;
+    std::vector<long> comp_genus = g.comp_genus;
+    if (all.empty()) break;
+    std::optional<TriangleGrid> grid;  // made when the first cycle to cut is found
+    for (const Candidate& c : all) {
+      const std::size_t n = c.cycle.size();
+      bool ok = comp_genus[g.tri_comp[g.vt[g.vt_start[c.cycle[0]]]]] > 0;
+      bool waits = false;  // on a cut made this round: searched again next round
+      for (std::size_t i = 0; i < n && ok; ++i) {
+        ok = !busy[c.cycle[i]] && g.regular[c.cycle[i]];
+        waits = waits || busy[c.cycle[i]] == kBusyCut;
+      }
+      if (!ok) {
+        if (waits)
+          for (const std::uint32_t v : c.cycle) retry_next[v] = 1;
+        continue;
+      }
+      cycle_edges.clear();
+      for (std::size_t i = 0; i < n && ok; ++i) {
+        const std::uint32_t e = g.edge_between(c.cycle[i], c.cycle[(i + 1) % n]);
+        ok = e != kNone && !wall[e];
+        cycle_edges.push_back(e);
+      }
+      if (!ok) continue;
+      for (const std::uint32_t e : cycle_edges) wall[e] = 1;
+      if (!non_separating(g, cycle_edges, wall, seen, stamp)) {
+        for (const std::uint32_t e : cycle_edges) wall[e] = 0;
+        for (const std::uint32_t v : c.cycle) busy[v] = 1;  // its neighbours' candidates wait too
+        continue;
+      }
+      // Left fans: from the triangle holding c_i -> c_(i+1) around c_i, not crossing the cycle.
+      std::vector<std::vector<std::uint32_t>> left(n);
+      for (std::size_t i = 0; i < n && ok; ++i) {
+        const std::uint32_t v = c.cycle[i];
+        const std::uint32_t start = left_of(mesh, g, cycle_edges[i], v, c.cycle[(i + 1) % n]);
+        const std::uint32_t end = left_of(mesh, g, cycle_edges[(i + n - 1) % n], c.cycle[(i + n - 1) % n], v);
+        if (start == kNone || end == kNone) {
+          ok = false;
+          break;
+        }
+        // Around v against the orientation: in triangle t with v at corner k, cross edge k - 1 (prev -> v).
+        std::uint32_t t = start;
+        for (std::uint32_t steps = 0;; ++steps) {
+          left[i].push_back(t);
+          if (t == end) break;
+          int k = 0;
+          while (mesh.triangles[t][static_cast<std::size_t>(k)] != v) ++k;
+          const std::uint32_t e = g.tri_e[t][static_cast<std::size_t>(prev3(k))];
+          if (wall[e] || steps > g.vt_start[v + 1] - g.vt_start[v]) {
+            ok = false;
+            break;
+          }
+          t = g.edge_t[e][0] == t ? g.edge_t[e][1] : g.edge_t[e][0];
+        }
+      }
+      if (!ok) {
+        for (const std::uint32_t e : cycle_edges) wall[e] = 0;
+        for (const std::uint32_t v : c.cycle) busy[v] = 1;
+        continue;
+      }
+      // Cut: copies for the left fans; each side moved along the cycle's axis (the normal of its plane)
+      // toward its own triangles, so that the two fans that close them do not coincide; then the fans.
+      // Planned first and checked: no triangle it makes or moves may cross one near it (exact
+      // predicates); a quarter, then a tenth of the cycle's mean radius, else the handle stays.
+      Point3 mid{}, axis{}, side_l{}, side_r{};
+      for (std::size_t i = 0; i < n; ++i) mid = mid + mesh.vertices[c.cycle[i]];
+      mid = mid / static_cast<double>(n);
+      double radius = 0;
+      for (std::size_t i = 0; i < n; ++i) {
+        const Point3& p = mesh.vertices[c.cycle[i]];
+        axis = axis + cross(p - mid, mesh.vertices[c.cycle[(i + 1) % n]] - mid);
+        radius += distance(p, mid) / static_cast<double>(n);
+        for (std::uint32_t j = g.vt_start[c.cycle[i]]; j < g.vt_start[c.cycle[i] + 1]; ++j) {
+          const std::uint32_t t = g.vt[j];
+          const bool l = std::find(left[i].begin(), left[i].end(), t) != left[i].end();
+          for (const std::uint32_t u : mesh.triangles[t]) {
+            Point3& sum = l ? side_l : side_r;
+            sum = sum + (mesh.vertices[u] - mid);
+          }
+        }
+      }
+      const double axis_len = norm(axis);
+      if (axis_len > 0) axis = axis / axis_len;
+      // The shift stays well inside the triangles around the cycle: at most a third of its shortest
+      // edge leaving the cycle (a large cycle among small triangles would otherwise fold them).
+      double room = radius;
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::uint32_t j = g.ve_start[c.cycle[i]]; j < g.ve_start[c.cycle[i] + 1]; ++j) {
+          const std::uint32_t e = g.ve[j];
+          if (e != cycle_edges[i] && e != cycle_edges[(i + n - 1) % n]) room = std::min(room, g.edge_len[e] / 3);
+        }
+      // The side whose triangles lie further along the axis goes that way, the other the other way.
+      const double way = dot(side_l, axis) >= dot(side_r, axis) ? 1.0 : -1.0;
+      CutPlan plan;
+      bool clean = false;
+      for (const double factor : {kCapShift, 0.4 * kCapShift, 2 * kCapShift, 0.1 * kCapShift, 4 * kCapShift}) {
+        if (!(axis_len > 0)) break;
+        plan_cut(mesh, g, c.cycle, left, (way * std::min(factor * radius, room)) * axis, plan);
+        if (!grid) {
+          // Cells within max_loop of a candidate's cycle: where a cut, and a triangle it could cross, may be.
+          std::unordered_set<TriangleGrid::Key> wanted;
+          for (const Candidate& other : all)
+            for (const std::uint32_t v : other.cycle) {
+              const Point3& x = mesh.vertices[v];
+              const auto a = TriangleGrid::cell_of(x - Point3{options.max_loop, options.max_loop, options.max_loop}, options.max_loop);
+              const auto b = TriangleGrid::cell_of(x + Point3{options.max_loop, options.max_loop, options.max_loop}, options.max_loop);
+              for (std::int64_t i = a[0]; i <= b[0]; ++i)
+                for (std::int64_t j = a[1]; j <= b[1]; ++j)
+                  for (std::int64_t k = a[2]; k <= b[2]; ++k) wanted.insert(TriangleGrid::key(i, j, k));
+            }
+          grid.emplace(mesh, options.max_loop, std::move(wanted));
+        }
+        if (!plan_crosses(mesh, plan, *grid)) {
+          clean = true;
+          break;
+        }
+      }
+      if (!clean) {
+        for (const std::uint32_t e : cycle_edges) wall[e] = 0;
+        for (const std::uint32_t v : c.cycle) busy[v] = 1;
+        ++rep.kept_crossing;
+        continue;
+      }
+      apply_cut(mesh, plan, *grid);
+      for (const std::uint32_t v : c.cycle) busy[v] = kBusyCut;
+      --comp_genus[g.tri_comp[g.vt[g.vt_start[c.cycle[0]]]]];
+      rep.lengths.push_back(c.length);
+      ++cut_now;
+    }
+    rep.cut += cut_now;
+    if (cut_now == 0) break;
+    retry = std::move(retry_next);
+    retry.resize(mesh.vertices.size(), 0);
+    if (round + 1 == options.rounds) rep.genus_after = mesh_genus(mesh);
+  }
+  if (report) *report = rep;
+  return mesh;
+}
+
+}  // namespace vitri

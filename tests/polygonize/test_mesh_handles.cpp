@@ -1,0 +1,235 @@
+// Tests of vitri/polygonize/mesh_handles.hpp on meshes of analytic surfaces: a torus keeps its handle
+// below the length of its meridian and loses it (one cut, a closed sphere-like mesh, no triangles
+// crossing) above it; a thin finger's short cycle separates, so it is never cut; each component is
+// judged alone; the region option and the thread count; an open mesh survives.
+#include "vitri/polygonize/mesh_handles.hpp"
+
+#include "support/mesh_checks.hpp"
+#include "vitri/polygonize/polygonizer.hpp"
+#include "vitri/testing/analytic.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+using namespace vitri;
+
+namespace {
+
+using test::metrics_of;
+using test::require_closed;
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Distance to the segment ab minus r: a capsule (a finger).
+class CapsuleFunction final : public ImplicitFunction {
+ public:
+  CapsuleFunction(const Point3& a, const Point3& b, double r) : a_(a), b_(b), r_(r) {}
+  double value(const Point3& p) const override {
+    Point3 g;
+    return value_gradient(p, g);
+  }
+  double value_gradient(const Point3& p, Point3& gradient) const override {
+    const Point3 ab = b_ - a_;
+    const double t = std::clamp(dot(p - a_, ab) / dot(ab, ab), 0.0, 1.0);
+    const Point3 d = p - (a_ + t * ab);
+    const double n = norm(d);
+    gradient = n > 0 ? d / n : Point3{0, 0, 1};
+    return n - r_;
+  }
+
+ private:
+  Point3 a_, b_;
+  double r_;
+};
+
+SurfaceMesh mesh_of(const ImplicitFunction& f, const Box3& box, double precision) {
+  Polygonizer poly(f, box);
+  REQUIRE(poly.refine(precision));
+  return poly.extract();
+}
+
+/// Whether segment pq crosses triangle abc (Moller-Trumbore, floating point: an independent check).
+bool segment_crosses(const Point3& p, const Point3& q, const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 d = q - p, e1 = b - a, e2 = c - a;
+  const Point3 h = cross(d, e2);
+  const double det = dot(e1, h);
+  if (std::abs(det) < 1e-300) return false;
+  const Point3 s = p - a;
+  const double u = dot(s, h) / det;
+  if (u < 0 || u > 1) return false;
+  const Point3 qq = cross(s, e1);
+  const double v = dot(d, qq) / det;
+  if (v < 0 || u + v > 1) return false;
+  const double t = dot(e2, qq) / det;
+  return t >= 0 && t <= 1;
+}
+
+/// Pairs of triangles without a common corner that cross (brute force with boxes).
+std::size_t crossing_pairs(const SurfaceMesh& m) {
+  const std::size_t n = m.triangles.size();
+  std::vector<std::array<Point3, 2>> box(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    box[t] = {m.vertices[m.triangles[t][0]], m.vertices[m.triangles[t][0]]};
+    for (const std::uint32_t c : m.triangles[t])
+      for (std::size_t k = 0; k < 3; ++k)
+        box[t][0][k] = std::min(box[t][0][k], m.vertices[c][k]), box[t][1][k] = std::max(box[t][1][k], m.vertices[c][k]);
+  }
+  // Sweep along x: boxes sorted by their low x, each compared with those starting before its high x.
+  std::vector<std::size_t> order(n);
+  for (std::size_t t = 0; t < n; ++t) order[t] = t;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return box[a][0].x < box[b][0].x; });
+  std::size_t count = 0;
+  for (std::size_t oi = 0; oi < n; ++oi)
+    for (std::size_t oj = oi + 1; oj < n && box[order[oj]][0].x <= box[order[oi]][1].x; ++oj) {
+      const std::size_t i = order[oi], j = order[oj];
+      bool apart = false;
+      for (std::size_t k = 0; k < 3 && !apart; ++k) apart = box[i][1][k] < box[j][0][k] || box[j][1][k] < box[i][0][k];
+      if (apart) continue;
+      const auto& x = m.triangles[i];
+      const auto& y = m.triangles[j];
+      bool share = false;
+      for (const std::uint32_t a : x) share = share || std::find(y.begin(), y.end(), a) != y.end();
+      if (share) continue;
+      bool cross_found = false;
+      for (int k = 0; k < 3 && !cross_found; ++k) {
+        const std::size_t a = static_cast<std::size_t>(k), b = static_cast<std::size_t>((k + 1) % 3);
+        cross_found = segment_crosses(m.vertices[x[a]], m.vertices[x[b]], m.vertices[y[0]], m.vertices[y[1]], m.vertices[y[2]]) ||
+                      segment_crosses(m.vertices[y[a]], m.vertices[y[b]], m.vertices[x[0]], m.vertices[x[1]], m.vertices[x[2]]);
+      }
+      count += cross_found;
+    }
+  return count;
+}
+
+const Box3 kBox{{-1.6, -1.6, -1.6}, {1.6, 1.6, 1.6}};
+
+}  // namespace
+
+TEST_CASE("mesh_handles: a torus keeps its handle below its meridian's length and loses it above", "[mesh_handles]") {
+  const TorusFunction f({0.0, 0.0, 0.05}, 1.0, 0.3);  // meridian 2 pi 0.3 = 1.885; inner equator 4.4
+  const SurfaceMesh torus = mesh_of(f, kBox, 0.05);
+  require_closed(torus, 0, 1);
+  REQUIRE(mesh_genus(torus) == 1);
+  REQUIRE(crossing_pairs(torus) == 0);
+
+  HandleOptions o;
+  HandleReport r;
+  SECTION("shorter than the meridian: nothing changes") {
+    o.max_loop = 1.5;
+    const SurfaceMesh m = cut_short_handles(torus, o, &r);
+    CHECK(r.cut == 0);
+    CHECK(r.genus_before == 1);
+    CHECK(r.genus_after == 1);
+    CHECK(m.vertices == torus.vertices);
+    CHECK(m.triangles == torus.triangles);
+  }
+  SECTION("longer: one cut along a meridian, a closed genus-0 mesh, nothing crossing") {
+    o.max_loop = 2.4;
+    const SurfaceMesh m = cut_short_handles(torus, o, &r);
+    REQUIRE(r.cut == 1);
+    CHECK(r.genus_before == 1);
+    CHECK(r.genus_after == 0);
+    REQUIRE(r.lengths.size() == 1);
+    CHECK(r.lengths[0] > 2 * kPi * 0.3 * 0.95);  // a polygon around the tube, not shorter than it
+    CHECK(r.lengths[0] <= 2.4);
+    require_closed(m, 2, 1);
+    CHECK(mesh_genus(m) == 0);
+    CHECK(crossing_pairs(m) == 0);
+    // Only the cycle's vertices moved (each side a little along the tube).
+    std::size_t moved = 0;
+    for (std::size_t v = 0; v < torus.vertices.size(); ++v) moved += !(m.vertices[v] == torus.vertices[v]);
+    CHECK(moved >= 3);
+    CHECK(m.vertices.size() == torus.vertices.size() + moved + 2);  // a copy per cycle vertex, two centres
+  }
+}
+
+TEST_CASE("mesh_handles: a thin finger's short cycle separates and is never cut", "[mesh_handles]") {
+  const TorusFunction torus({0.0, 0.0, 0.0}, 1.0, 0.3);
+  const CapsuleFunction finger({1.0, 0.0, 0.2}, {1.0, 0.0, 1.0}, 0.09);  // its cycles: 2 pi 0.09 = 0.57
+  const UnionFunction f(torus, finger);
+  const SurfaceMesh m0 = mesh_of(f, kBox, 0.03);
+  require_closed(m0, 0, 1);
+  HandleOptions o;
+  o.max_loop = 1.2;  // above the finger's cycles, below the torus's meridian
+  HandleReport r;
+  const SurfaceMesh m = cut_short_handles(m0, o, &r);
+  CHECK(r.cut == 0);
+  CHECK(r.genus_after == 1);
+  CHECK(m.triangles == m0.triangles);
+}
+
+TEST_CASE("mesh_handles: each component by its own cycles; the region; any thread count", "[mesh_handles]") {
+  const TorusFunction big({0.0, 0.0, 0.0}, 1.0, 0.3);
+  const TorusFunction small({0.0, 0.0, 0.0} , 0.25, 0.08);  // meridian 0.50, inner equator 1.07
+  struct Shifted final : ImplicitFunction {
+    const ImplicitFunction& f;
+    Point3 by;
+    Shifted(const ImplicitFunction& g, const Point3& d) : f(g), by(d) {}
+    double value(const Point3& p) const override { return f.value(p - by); }
+    double value_gradient(const Point3& p, Point3& g) const override { return f.value_gradient(p - by, g); }
+  } moved(small, {2.2, 0.0, 0.0});
+  const UnionFunction f(big, moved);
+  const SurfaceMesh m0 = mesh_of(f, Box3{{-1.6, -1.6, -1.0}, {2.8, 1.6, 1.0}}, 0.025);
+  require_closed(m0, 0, 2);
+  REQUIRE(mesh_genus(m0) == 2);
+
+  HandleOptions o;
+  o.max_loop = 0.8;
+  SECTION("the small torus's meridian is cut, the big one kept") {
+    HandleReport r;
+    o.threads = 1;
+    const SurfaceMesh one = cut_short_handles(m0, o, &r);
+    CHECK(r.cut == 1);
+    CHECK(r.genus_after == 1);
+    require_closed(one, 2, 2);
+    CHECK(crossing_pairs(one) == 0);
+    o.threads = 4;
+    const SurfaceMesh four = cut_short_handles(m0, o);
+    CHECK(four.vertices == one.vertices);
+    CHECK(four.triangles == one.triangles);
+  }
+  SECTION("a region without the small torus: nothing is cut") {
+    std::vector<std::uint8_t> region(m0.vertices.size());
+    for (std::size_t v = 0; v < region.size(); ++v) region[v] = m0.vertices[v].x < 1.5;
+    o.region = &region;
+    HandleReport r;
+    const SurfaceMesh m = cut_short_handles(m0, o, &r);
+    CHECK(r.cut == 0);
+    CHECK(m.triangles == m0.triangles);
+  }
+}
+
+TEST_CASE("mesh_handles: an open mesh keeps its boundary; a cycle through it is never cut", "[mesh_handles]") {
+  const TorusFunction f({0.0, 0.0, 0.05}, 1.0, 0.3);
+  SurfaceMesh m0 = mesh_of(f, kBox, 0.05);
+  // A hole: the triangles with a corner within 0.15 of a point on the outer equator.
+  const Point3 at{1.3, 0.0, 0.05};
+  std::vector<std::array<std::uint32_t, 3>> kept;
+  for (const auto& t : m0.triangles) {
+    bool near = false;
+    for (const std::uint32_t c : t) near = near || norm(m0.vertices[c] - at) < 0.15;
+    if (!near) kept.push_back(t);
+  }
+  m0.triangles.swap(kept);
+  const auto before = metrics_of(m0);
+  REQUIRE(before.boundary_edges > 0);
+  HandleOptions o;
+  o.max_loop = 2.4;
+  HandleReport r;
+  const SurfaceMesh m = cut_short_handles(m0, o, &r);
+  CHECK(r.cut == 1);  // a meridian away from the hole
+  const auto after = metrics_of(m);
+  CHECK(after.boundary_edges == before.boundary_edges);
+  CHECK(after.non_manifold_edges == 0);
+  CHECK(after.inconsistent_edges == 0);
+  CHECK(after.non_manifold_vertices == 0);
+  CHECK(after.components == 1);
+  CHECK(after.euler_characteristic == before.euler_characteristic + 2);
+  CHECK(crossing_pairs(m) == 0);
+}

@@ -218,86 +218,151 @@ struct Candidate {
   std::vector<std::uint32_t> cycle;  // vertices in order; the cycle closes from the last to the first
 };
 
-/// Per-thread storage of the search, reset by stamps.
-struct Search {
-  std::vector<std::uint32_t> vstamp, ustamp, tstamp, estamp, anc;
-  std::vector<std::pair<double, std::uint32_t>> heap;  // Dijkstra's (a binary heap by std::push_heap)
-  std::vector<double> dist;
-  std::vector<std::uint32_t> parent_e, local_t, settled;
-  std::vector<std::uint8_t> done;
-  std::uint32_t stamp = 0;
-  std::vector<std::uint32_t> ball, tris, uf;
-  std::vector<std::pair<double, std::uint32_t>> edges;
-
-  void resize(std::size_t nv, std::size_t nt, std::size_t ne) {
-    vstamp.assign(nv, 0), ustamp.assign(nv, 0), anc.assign(nv, 0), dist.assign(nv, 0), parent_e.assign(nv, kNone), done.assign(nv, 0);
-    tstamp.assign(nt, 0), local_t.assign(nt, 0), estamp.assign(ne, 0);
+/// Global ids to small local indices (0, 1, 2, ... in the order inserted), for one seed's ball: open
+/// addressing, cleared per seed in O(entries). Its size follows the ball, not the mesh (a search's
+/// memory does not grow with the mesh: 10^7 vertices would be 250 MB per thread in full arrays).
+class LocalIds {
+ public:
+  /// The local index of `key`, kNone when absent.
+  std::uint32_t find(std::uint32_t key) const {
+    if (keys_.empty()) return kNone;
+    for (std::size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (keys_[i] == key) return values_[i];
+      if (keys_[i] == kNone) return kNone;
+    }
   }
+  /// The local index of `key`, given the next one when new (`added` says which).
+  std::uint32_t insert(std::uint32_t key, bool* added = nullptr) {
+    if (2 * (used_.size() + 1) > keys_.size()) grow();
+    for (std::size_t i = slot(key);; i = (i + 1) & mask_) {
+      if (keys_[i] == key) {
+        if (added) *added = false;
+        return values_[i];
+      }
+      if (keys_[i] == kNone) {
+        keys_[i] = key;
+        values_[i] = static_cast<std::uint32_t>(used_.size());
+        used_.push_back(static_cast<std::uint32_t>(i));
+        if (added) *added = true;
+        return values_[i];
+      }
+    }
+  }
+  std::size_t size() const { return used_.size(); }
+  void clear() {
+    for (const std::uint32_t i : used_) keys_[i] = kNone;
+    used_.clear();
+  }
+
+ private:
+  std::size_t slot(std::uint32_t key) const { return (key * 2654435761u) & mask_; }
+  void grow() {
+    std::vector<std::uint32_t> keys(std::max<std::size_t>(64, 2 * keys_.size()), kNone), values(keys.size());
+    mask_ = keys.size() - 1;
+    std::vector<std::uint32_t> used;
+    for (const std::uint32_t i : used_) {
+      std::size_t j = slot(keys_[i]);
+      while (keys[j] != kNone) j = (j + 1) & mask_;
+      keys[j] = keys_[i], values[j] = values_[i];
+      used.push_back(static_cast<std::uint32_t>(j));
+    }
+    // used_ stays in insertion order (values are their positions).
+    std::vector<std::uint32_t> ordered(used.size());
+    for (std::size_t k = 0; k < used.size(); ++k) ordered[values[used[k]]] = used[k];
+    keys_.swap(keys), values_.swap(values), used_.swap(ordered);
+  }
+  std::vector<std::uint32_t> keys_, values_, used_;  // used_: the slots taken, in insertion order
+  std::size_t mask_ = 0;
+};
+
+/// Per-thread storage of the search, sized by the balls (LocalIds), reused from seed to seed.
+struct Search {
+  LocalIds vertex_id, triangle_id, edge_id;
+  struct Vertex {
+    std::uint32_t global = kNone, parent_e = kNone;
+    double dist = 0;
+    bool done = false, in_k = false, marked = false;
+  };
+  std::vector<Vertex> vs;  // by local vertex id
+  std::vector<std::pair<double, std::uint32_t>> heap;  // Dijkstra's (local ids; std::push_heap)
+  std::vector<std::uint32_t> ball, tris, uf;           // ball: local ids, settled; tris: global ids
+  std::vector<std::pair<double, std::uint32_t>> edges;
 };
 
 /// The non-separating cycles (in K: the triangles within `radius` of seed s, their outside glued) through
-/// s no longer than max_loop; at most
-/// `keep` of them, shortest first.
+/// s no longer than max_loop; at most `keep` of them, shortest first.
 void search_seed(const SurfaceMesh& mesh, const Topology& g, std::uint32_t s, double radius, double max_loop,
                  Search& w, std::size_t keep, std::vector<Candidate>& out) {
-  const std::uint32_t st = ++w.stamp;
   using Item = std::pair<double, std::uint32_t>;
+  w.vertex_id.clear(), w.triangle_id.clear(), w.edge_id.clear();
+  w.vs.clear(), w.ball.clear(), w.heap.clear();
   auto& heap = w.heap;
-  heap.clear();
   const std::greater<Item> later;
-  w.ball.clear();
-  w.vstamp[s] = st, w.dist[s] = 0, w.parent_e[s] = kNone, w.done[s] = 0;
-  heap.push_back({0.0, s});
+  w.vertex_id.insert(s);
+  w.vs.push_back({s, kNone, 0.0});
+  heap.push_back({0.0, 0});
   while (!heap.empty()) {
     std::pop_heap(heap.begin(), heap.end(), later);
-    const auto [d, v] = heap.back();
+    const auto [d, lv] = heap.back();
     heap.pop_back();
-    if (w.done[v] || d > w.dist[v]) continue;
-    w.done[v] = 1;
-    w.ball.push_back(v);
+    if (w.vs[lv].done || d > w.vs[lv].dist) continue;
+    w.vs[lv].done = true;
+    w.ball.push_back(lv);
+    const std::uint32_t v = w.vs[lv].global;
     for (std::uint32_t i = g.ve_start[v]; i < g.ve_start[v + 1]; ++i) {
       const std::uint32_t e = g.ve[i];
       const std::uint32_t u = g.edge_v[e][0] == v ? g.edge_v[e][1] : g.edge_v[e][0];
       const double nd = d + g.edge_len[e];
       if (nd > radius) continue;
-      if (w.vstamp[u] != st) {
-        w.vstamp[u] = st, w.done[u] = 0;
-      } else if (w.done[u] || nd >= w.dist[u]) {
-        continue;
+      bool added = false;
+      const std::uint32_t lu = w.vertex_id.insert(u, &added);
+      if (added) {
+        w.vs.push_back({u, e, nd});
+      } else {
+        if (w.vs[lu].done || nd >= w.vs[lu].dist) continue;
+        w.vs[lu].dist = nd, w.vs[lu].parent_e = e;
       }
-      w.dist[u] = nd, w.parent_e[u] = e;
-      heap.push_back({nd, u});
+      heap.push_back({nd, lu});
       std::push_heap(heap.begin(), heap.end(), later);
     }
   }
-  auto in_ball = [&](std::uint32_t v) { return w.vstamp[v] == st && w.done[v]; };
+  auto local = [&](std::uint32_t v) { return w.vertex_id.find(v); };
+  auto in_ball = [&](std::uint32_t v) {
+    const std::uint32_t lv = local(v);
+    return lv != kNone && w.vs[lv].done;
+  };
   w.tris.clear();
-  for (const std::uint32_t v : w.ball)
+  for (const std::uint32_t lv : w.ball) {
+    const std::uint32_t v = w.vs[lv].global;
     for (std::uint32_t i = g.vt_start[v]; i < g.vt_start[v + 1]; ++i) {
       const std::uint32_t t = g.vt[i];
-      if (w.tstamp[t] == st) continue;
+      if (w.triangle_id.find(t) != kNone) continue;
       const Tri& tri = mesh.triangles[t];
       if (in_ball(tri[0]) && in_ball(tri[1]) && in_ball(tri[2])) {
-        w.tstamp[t] = st;
-        w.local_t[t] = static_cast<std::uint32_t>(w.tris.size());
+        w.triangle_id.insert(t);
         w.tris.push_back(t);
       }
     }
+  }
   // Euler's characteristic of K first: a disk (1), or a sphere (2), has no cycle to find.
   long chi = static_cast<long>(w.tris.size());
   for (const std::uint32_t t : w.tris)
-    for (const std::uint32_t v : mesh.triangles[t])
-      if (w.ustamp[v] != st) w.ustamp[v] = st, ++chi;
+    for (const std::uint32_t v : mesh.triangles[t]) {
+      auto& x = w.vs[local(v)];
+      if (!x.in_k) x.in_k = true, ++chi;
+    }
   w.edges.clear();
   for (const std::uint32_t t : w.tris)
     for (const std::uint32_t e : g.tri_e[t]) {
-      if (w.estamp[e] == st) continue;
-      w.estamp[e] = st;
+      bool added = false;
+      w.edge_id.insert(e, &added);
+      if (!added) continue;
       --chi;
       if (!g.edge_good[e]) continue;
-      const std::uint32_t a = g.edge_v[e][0], b = g.edge_v[e][1];
-      if (w.parent_e[a] == e || w.parent_e[b] == e) continue;  // a tree edge
-      w.edges.push_back({w.dist[a] + g.edge_len[e] + w.dist[b], e});
+      const auto& a = w.vs[local(g.edge_v[e][0])];
+      const auto& b = w.vs[local(g.edge_v[e][1])];
+      if (a.parent_e == e || b.parent_e == e) continue;  // a tree edge
+      w.edges.push_back({a.dist + g.edge_len[e] + b.dist, e});
     }
   if (chi >= 1) return;
   std::sort(w.edges.begin(), w.edges.end(), [](const Item& x, const Item& y) {
@@ -306,7 +371,17 @@ void search_seed(const SurfaceMesh& mesh, const Topology& g, std::uint32_t s, do
   const std::uint32_t outside = static_cast<std::uint32_t>(w.tris.size());
   w.uf.resize(w.tris.size() + 1);
   std::iota(w.uf.begin(), w.uf.end(), 0u);
-  auto node = [&](std::uint32_t t) { return t != kNone && w.tstamp[t] == st ? w.local_t[t] : outside; };
+  auto node = [&](std::uint32_t t) {
+    const std::uint32_t lt = t == kNone ? kNone : w.triangle_id.find(t);
+    return lt != kNone ? lt : outside;
+  };
+  // One step up the tree from local vertex lv (kNone at the seed).
+  auto up = [&](std::uint32_t lv) {
+    const std::uint32_t pe = w.vs[lv].parent_e;
+    if (pe == kNone) return kNone;
+    const std::uint32_t v = w.vs[lv].global;
+    return local(g.edge_v[pe][0] == v ? g.edge_v[pe][1] : g.edge_v[pe][0]);
+  };
   std::vector<Candidate> found;
   for (const auto& [loop, e] : w.edges) {
     const std::uint32_t x = find_root(w.uf, node(g.edge_t[e][0])), y = find_root(w.uf, node(g.edge_t[e][1]));
@@ -316,36 +391,18 @@ void search_seed(const SurfaceMesh& mesh, const Topology& g, std::uint32_t s, do
     }
     if (loop > max_loop) continue;
     // The cycle: a's path up to the lowest common ancestor, then down to b, and the edge back to a.
-    const std::uint32_t a = g.edge_v[e][0], b = g.edge_v[e][1];
-    const std::uint32_t mark = st;
-    for (std::uint32_t v = a;;) {
-      w.anc[v] = mark;
-      if (w.parent_e[v] == kNone) break;
-      v = g.edge_v[w.parent_e[v]][0] == v ? g.edge_v[w.parent_e[v]][1] : g.edge_v[w.parent_e[v]][0];
-    }
+    const std::uint32_t a = local(g.edge_v[e][0]), b = local(g.edge_v[e][1]);
+    for (std::uint32_t v = a; v != kNone; v = up(v)) w.vs[v].marked = true;
     std::vector<std::uint32_t> down;  // b up to (not including) the ancestor
     std::uint32_t lca = b;
-    while (w.anc[lca] != mark) {
-      down.push_back(lca);
-      const std::uint32_t pe = w.parent_e[lca];
-      lca = g.edge_v[pe][0] == lca ? g.edge_v[pe][1] : g.edge_v[pe][0];
-    }
+    while (!w.vs[lca].marked) down.push_back(lca), lca = up(lca);
     Candidate c;
-    for (std::uint32_t v = a; v != lca;) {
-      c.cycle.push_back(v);
-      const std::uint32_t pe = w.parent_e[v];
-      v = g.edge_v[pe][0] == v ? g.edge_v[pe][1] : g.edge_v[pe][0];
-    }
-    c.cycle.push_back(lca);
-    for (auto it = down.rbegin(); it != down.rend(); ++it) c.cycle.push_back(*it);
-    // Clear the marks for the next edge (anc is shared by the seed's edges).
-    for (std::uint32_t v = a;;) {
-      w.anc[v] = 0;
-      if (w.parent_e[v] == kNone) break;
-      v = g.edge_v[w.parent_e[v]][0] == v ? g.edge_v[w.parent_e[v]][1] : g.edge_v[w.parent_e[v]][0];
-    }
+    for (std::uint32_t v = a; v != lca; v = up(v)) c.cycle.push_back(w.vs[v].global);
+    c.cycle.push_back(w.vs[lca].global);
+    for (auto it = down.rbegin(); it != down.rend(); ++it) c.cycle.push_back(w.vs[*it].global);
+    for (std::uint32_t v = a; v != kNone; v = up(v)) w.vs[v].marked = false;
     if (c.cycle.size() < 3) continue;
-    c.length = loop - 2 * w.dist[lca];
+    c.length = loop - 2 * w.vs[lca].dist;
     found.push_back(std::move(c));
   }
   std::sort(found.begin(), found.end(), [](const Candidate& x, const Candidate& y) { return x.length < y.length; });
@@ -759,7 +816,6 @@ SurfaceMesh cut_short_handles(SurfaceMesh mesh, const HandleOptions& options, Ha
     const std::size_t per = (seeds.size() + workers - 1) / workers;
     run_tasks(workers, [&](std::size_t k) {
       Search& w = scratch[k];
-      w.resize(nv, nt, ne);
       for (std::size_t i = k * per; i < std::min(seeds.size(), (k + 1) * per); ++i)
         search_seed(mesh, g, seeds[i], 0.5 * options.max_loop + cover, options.max_loop, w, 3, found[i]);
     });

@@ -233,3 +233,33 @@ TEST_CASE("mesh_handles: an open mesh keeps its boundary; a cycle through it is 
   CHECK(after.euler_characteristic == before.euler_characteristic + 2);
   CHECK(crossing_pairs(m) == 0);
 }
+
+TEST_CASE("mesh_handles: triangle soups (non-manifold, repeated corners, flipped) end and change nothing they cannot",
+          "[mesh_handles]") {
+  // Random triangles over a few vertices: edges with 3+ triangles, repeated corners, inconsistent
+  // orientations. The function must end, and whatever it cuts must leave every input vertex used by
+  // some triangle and every triangle's corners valid.
+  std::uint64_t state = 12345;
+  auto next = [&]() {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<std::uint32_t>(state >> 33);
+  };
+  for (int round = 0; round < 50; ++round) {
+    SurfaceMesh m;
+    const std::uint32_t nv = 4 + next() % 40;
+    for (std::uint32_t v = 0; v < nv; ++v)
+      m.vertices.push_back({(next() % 1000) / 1000.0, (next() % 1000) / 1000.0, (next() % 1000) / 1000.0});
+    const std::uint32_t nt = 1 + next() % 120;
+    for (std::uint32_t t = 0; t < nt; ++t) m.triangles.push_back({next() % nv, next() % nv, next() % nv});
+    HandleOptions o;
+    o.max_loop = 0.5 + (next() % 100) / 50.0;
+    o.threads = 1 + next() % 3;
+    HandleReport r;
+    const SurfaceMesh out = cut_short_handles(m, o, &r);
+    REQUIRE(out.vertices.size() >= m.vertices.size());
+    REQUIRE(out.triangles.size() >= m.triangles.size());
+    for (const auto& t : out.triangles)
+      for (const std::uint32_t c : t) REQUIRE(c < out.vertices.size());
+    CHECK(r.genus_after <= r.genus_before);
+  }
+}

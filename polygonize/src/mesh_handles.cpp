@@ -6,9 +6,12 @@
 // is regular when its triangles form one closed fan through good edges. Components through good edges,
 // each with its genus from Euler's formula and its boundary loops.
 //
-// Search (per seed vertex s of a component of positive genus, on the threads): Dijkstra from s along
-// the edges up to radius R = max_loop / 2 (a cycle of length L lies within L / 2 of each of its
-// vertices); K = the triangles whose three vertices are in the ball. The shortest-path tree T spans the
+// Search (per seed of a net over the components of positive genus, seeds within max_loop / 4 of every
+// vertex; on the threads, each thread's state in maps from global to local ids sized by its balls):
+// Dijkstra from s along the edges up to radius R = max_loop / 2 + max_loop / 4 (a cycle of length L lies
+// within L / 2 of each of its vertices, and a seed within max_loop / 4 of it); K = the triangles whose
+// three vertices are in the ball; a K that is a disk or a sphere (Euler characteristic 1 or 2) holds no
+// cycle to find. Otherwise the shortest-path tree T spans the
 // ball; the edges of K outside T are taken longest loop first (loop = d(a) + |ab| + d(b)) and each joins
 // its two sides in a union-find over K's triangles plus one node for everything outside K (a maximum
 // spanning co-tree); an edge whose sides are already joined closes a cycle that is non-separating in K
@@ -23,8 +26,11 @@
 // stale adjacency across those is exactly what the cuts removed): the sides meet (non-separating: cut)
 // or one side runs out (separating: leave it). The cut: at each cycle vertex c_i, the triangles on the
 // left of c_i -> c_(i+1) (those holding that half-edge's orientation, and their fan up to c_(i-1) -> c_i)
-// get a new vertex; the left loop is closed by triangles (c'_(i+1), c'_i, centre), the right one by
-// (c_i, c_(i+1), centre'), which keeps the orientation.
+// get a new vertex; both sides move apart along the cycle's axis (a quarter of its radius, at most a
+// third of the shortest edge leaving it); the left loop is closed by triangles (c'_(i+1), c'_i, centre),
+// the right one by (c_i, c_(i+1), centre'), which keeps the orientation. Every cut is planned first and
+// made only when none of the triangles it moves or adds crosses another or a triangle near it (exact
+// predicates; the near ones from a multi-level hash grid made around the candidates), trying a few shifts.
 #include "vitri/polygonize/mesh_handles.hpp"
 
 #include "vitri/core/parallel.hpp"

@@ -106,6 +106,8 @@ Options parse_options(const py::kwargs& kw, const char* fn, bool one_call) {
       else if (s == "open") m.surface = SurfaceKind::Open;
       else if (s == "auto") m.surface = SurfaceKind::Auto;
       else throw InvalidArgument("surface must be 'closed', 'open' or 'auto', got '" + s + "'");
+    } else if (key == "handles") {  // --handles: cycles shorter than this many resolutions are cut
+      m.handle_loop_resolutions = number(v, "handles", 0.0, std::numeric_limits<double>::max(), false);
     } else if (key == "viewpoint") {
       if (!v.is_none()) m.scan.viewpoint = point_arg(v, "viewpoint");
     } else if (key == "function") {
@@ -406,6 +408,7 @@ points: (n, 3) float64/float32; normals: None or (n, 3). Options (the CLI's, by 
     Default: 2.5 x the data's resolution, within a Delaunay vertex budget (coarser, RuntimeWarning).
   function: 'global' | 'local' | 'auto' (default);  smoothing: local function regularization (0)
   threads: 0 = every available CPU;  surface: 'closed' | 'open' | 'auto';  viewpoint: (x, y, z)
+  handles: the noise's handles cut, cycles shorter than this many resolutions (2 pi; 0 keeps them)
   min_angle, max_distance, max_size: the quality mode;  offset, sides, off_surface_spacing, neighbours
   max_vertices: LimitError beyond it;  memory: bytes or '16G' (default: the machine's available
     memory less a reserve, docs/memory.md);  certify, certify_floor: certified levels (docs/certificate.md)

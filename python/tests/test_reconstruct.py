@@ -123,6 +123,31 @@ def test_unknown_and_bad_options():
         vitri.reconstruct(p, function="spline")
     with pytest.raises(vitri.LimitError):
         vitri.reconstruct(p, precision=0.001, max_vertices=2000)
+    with pytest.raises(vitri.InvalidArgument, match="handles"):
+        vitri.reconstruct(p, handles=-1)
+
+
+def test_handles_option_as_the_cli(cli, tmp_path, data_dir):
+    """handles= as --handles: a noisy elephant's mesh with the noise's handles cut (the default) or kept (0)."""
+    rng = np.random.default_rng(3)
+    model = vitri.read(os.path.join(data_dir, "elephant.off"))
+    V, F = model.vertices, model.faces
+    a, b, c = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    t = rng.choice(len(F), 20000, p=area / area.sum())
+    r1, r2 = np.sqrt(rng.random(len(t))), rng.random(len(t))
+    p = (1 - r1)[:, None] * a[t] + (r1 * (1 - r2))[:, None] * b[t] + (r1 * r2)[:, None] * c[t]
+    spacing = np.sqrt(area.sum() / len(p))
+    p += rng.normal(0.0, 0.7 * spacing, p.shape)
+    def euler(m):
+        return euler_characteristic(m.vertices, m.faces)
+    cut, kept = vitri.reconstruct(p, threads=1), vitri.reconstruct(p, threads=1, handles=0)
+    assert euler(cut) > euler(kept)  # handles of the noise were cut
+    src = tmp_path / "e.xyz"
+    np.savetxt(src, p, fmt="%.17g")
+    out = tmp_path / "e.ply"
+    subprocess.run([cli, "mesh", str(src), "-o", str(out), "-q", "--threads", "1", "--handles", "0"], check=True)
+    assert euler(vitri.read(str(out))) == euler(vitri.reconstruct(vitri.read(str(src)).points, threads=1, handles=0))
 
 
 def test_memory_limit_and_certify_options(cli, tmp_path):

@@ -108,8 +108,8 @@ struct MesherOptions {
   /// from_scan(): a handle of each finished mesh that a non-separating cycle of edges shorter than this
   /// many resolutions (ScanReport::resolution) goes around is cut and both sides closed
   /// (cut_short_handles, mesh_handles.hpp): the handles of the noise, whose cycles are a few resolutions
-  /// long, where those of the shape are longer (docs/scans.md, "Handles of the noise"). The default, 2 pi,
-  /// is the cycle around a tunnel or bridge as wide as the noise band (2 resolutions). 0 keeps every
+  /// long, where those of the shape are longer (docs/scans.md, "Finishing every extracted mesh"). The
+  /// default, 2 pi, is the cycle around a tunnel or bridge as wide as the noise band (2 resolutions). 0 keeps every
   /// handle. Not in an editing session (history kept), the quality mode or the certified mode (whose
   /// meshes are the function's zero set as it is).
   double handle_loop_resolutions = kHandleLoopResolutions;

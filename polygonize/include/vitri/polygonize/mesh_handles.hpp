@@ -42,7 +42,9 @@ struct HandleReport {
   std::size_t cut = 0;           ///< handles cut (each lowered its component's genus by one)
   long genus_before = 0;         ///< sum of the components' genus before
   long genus_after = 0;          ///< and after
-  std::size_t kept_crossing = 0; ///< handles left because closing them would make triangles cross
+  /// Cycles left because closing them would make triangles cross (counted per cycle tried: a handle
+  /// found again in a later round counts again).
+  std::size_t kept_crossing = 0;
   std::vector<double> lengths;   ///< the length of every cycle cut, in the order cut
 };
 

@@ -507,7 +507,63 @@ class Trimmer {
     for (std::size_t t = 0; t < tris_.size(); ++t)
       if (alive(t))
         out.triangles.push_back({renumber[tris_[t][0]], renumber[tris_[t][1]], renumber[tris_[t][2]]});
+    if (options_.separate_pinches > 0.0 && !origin_.empty()) separate_pinches(out, renumber);
     return out;
+  }
+
+  /// Moves every copy of a split vertex, and the vertex itself, off the shared position toward the centre
+  /// of its own fan (TrimOptions::separate_pinches), so that no two triangles without a common vertex
+  /// touch. One at a time, from the current positions; the step is halved while a triangle of the fan
+  /// would turn over (its normal against the old one) and given up after four halvings.
+  void separate_pinches(SurfaceMesh& out, const std::vector<std::uint32_t>& renumber) const {
+    std::vector<std::uint8_t> split(vertex_count(), 0);
+    for (const std::uint32_t o : origin_) split[base(o)] = 1;
+    std::vector<std::uint32_t> moved;  // output ids of the vertices of a split
+    std::vector<std::uint32_t> slot(out.vertices.size(), kNone);
+    for (std::uint32_t v = 0; v < renumber.size(); ++v)
+      if (renumber[v] != kNone && split[base(v)]) {
+        slot[renumber[v]] = static_cast<std::uint32_t>(moved.size());
+        moved.push_back(renumber[v]);
+      }
+    // Each moved vertex's triangles (a counting sort by slot).
+    std::vector<std::uint32_t> start(moved.size() + 1, 0), fan;
+    for (const Tri& t : out.triangles)
+      for (const std::uint32_t v : t)
+        if (slot[v] != kNone) ++start[slot[v] + 1];
+    std::partial_sum(start.begin(), start.end(), start.begin());
+    fan.resize(start.back());
+    std::vector<std::uint32_t> fill(start.begin(), start.end() - 1);
+    for (std::uint32_t t = 0; t < out.triangles.size(); ++t)
+      for (const std::uint32_t v : out.triangles[t])
+        if (slot[v] != kNone) fan[fill[slot[v]]++] = t;
+    const auto normal = [&](const Tri& t) {
+      const Point3 &a = out.vertices[t[0]], &b = out.vertices[t[1]], &c = out.vertices[t[2]];
+      return cross(b - a, c - a);
+    };
+    for (std::size_t i = 0; i < moved.size(); ++i) {
+      const std::uint32_t v = moved[i];
+      const Point3 p = out.vertices[v];
+      Point3 centre{0, 0, 0};
+      std::vector<Point3> before;
+      for (std::uint32_t j = start[i]; j < start[i + 1]; ++j) {
+        const Tri& t = out.triangles[fan[j]];
+        for (const std::uint32_t w : t)
+          if (w != v) centre = centre + out.vertices[w];
+        before.push_back(normal(t));
+      }
+      centre = (0.5 / static_cast<double>(start[i + 1] - start[i])) * centre;
+      for (double f = options_.separate_pinches, tries = 0; tries < 5; f *= 0.5, ++tries) {
+        out.vertices[v] = p + f * (centre - p);
+        bool turned = false;
+        for (std::uint32_t j = start[i]; j < start[i + 1] && !turned; ++j)
+          turned = dot(normal(out.triangles[fan[j]]), before[j - start[i]]) <= 0.0;
+        if (!turned) {
+          ++rep_.separated_vertices;
+          break;
+        }
+        out.vertices[v] = p;
+      }
+    }
   }
 
   const SurfaceMesh& mesh_;
@@ -547,6 +603,9 @@ SurfaceMesh trim_mesh(const SurfaceMesh& mesh, const std::vector<double>& s, con
                           std::to_string(nv) + " vertices (expected none or one per vertex)");
   if (!(options.snap >= 0.0 && options.snap <= 0.5))
     throw InvalidArgument("trim_mesh: snap must be in [0, 0.5], got " + std::to_string(options.snap));
+  if (!(options.separate_pinches >= 0.0 && options.separate_pinches <= 0.5))
+    throw InvalidArgument("trim_mesh: separate_pinches must be in [0, 0.5], got " +
+                          std::to_string(options.separate_pinches));
   if (!(options.min_component_area_fraction >= 0.0 && options.min_component_area_fraction <= 1.0))
     throw InvalidArgument("trim_mesh: min_component_area_fraction must be in [0, 1], got " +
                           std::to_string(options.min_component_area_fraction));

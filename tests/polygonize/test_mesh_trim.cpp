@@ -4,6 +4,7 @@
 // 2-manifold with boundary; bad input is reported or survived.
 #include "vitri/polygonize/mesh_trim.hpp"
 
+#include "support/mesh_checks.hpp"
 #include "support/surface_metrics.hpp"
 #include "vitri/core/error.hpp"
 
@@ -336,8 +337,28 @@ TEST_CASE("mesh_trim: regions touching at one vertex (bow-tie) are split there",
   CHECK(rep.vertex_copies == 2);
   CHECK(m.components == 2);
   CHECK(m.euler_characteristic == 2);  // two discs
-  CHECK(m.duplicate_vertices == 2);    // the copies share the poles' positions
   CHECK(rep.boundary_loops == 2);
+  // The copies and the poles are moved toward their own lune: the lunes no longer touch, each pole's
+  // copies stay within a small step (0.05 of the way to its fan's centre, a ring 15 degrees away).
+  CHECK(m.duplicate_vertices == 0);
+  CHECK(rep.separated_vertices == 4);
+  CHECK(vitri::test::crossing_pairs(out) == 0);
+  double largest_step = 0;
+  for (const Point3& p : out.vertices)
+    for (const double pole : {-1.0, 1.0})
+      if (std::abs(p.z - pole) < 0.01) largest_step = std::max(largest_step, std::hypot(p.x, p.y));
+  CHECK(largest_step > 0);
+  CHECK(largest_step < 0.05 * 2 * std::sin(kPi / 24));  // the ring's chord from the pole: 2 sin 7.5 deg
+  SECTION("separate_pinches = 0: the copies share the poles' positions, and the lunes touch there") {
+    TrimOptions options;
+    options.separate_pinches = 0;
+    TrimReport rep0;
+    const SurfaceMesh out0 = trim_mesh(sphere, s, options, &rep0);
+    check_result(sphere, s, out0, rep0, options);
+    CHECK(vitri::test::metrics_of(out0).duplicate_vertices == 2);
+    CHECK(rep0.separated_vertices == 0);
+    CHECK(vitri::test::crossing_pairs(out0) > 0);
+  }
 
   SECTION("a single triangle hanging at a vertex on the cut is dangling") {
     // Keep one more triangle of the north fan in a cut quadrant: its corners on the ring are put at s = 0,
@@ -528,6 +549,9 @@ TEST_CASE("mesh_trim: bad input is rejected with the culprit named", "[mesh_trim
   bad.snap = 0.1;
   bad.min_component_area_fraction = -1.0;
   CHECK_THROWS_AS(trim_mesh(sphere, s, bad), vitri::InvalidArgument);
+  bad.min_component_area_fraction = 0.0;
+  bad.separate_pinches = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_WITH(trim_mesh(sphere, s, bad), Catch::Contains("separate_pinches"));
   SurfaceMesh broken = sphere;
   broken.triangles[3][1] = 1000;
   CHECK_THROWS_WITH(trim_mesh(broken, s), Catch::Contains("triangle 3"));

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <vector>
 
@@ -29,6 +30,61 @@ inline std::vector<CanonicalTriangle> canonical(const SurfaceMesh& m) {
   }
   std::sort(out.begin(), out.end());
   return out;
+}
+
+/// Whether segment pq crosses triangle abc (Moller-Trumbore, floating point: an independent check).
+inline bool segment_crosses(const Point3& p, const Point3& q, const Point3& a, const Point3& b, const Point3& c) {
+  const Point3 d = q - p, e1 = b - a, e2 = c - a;
+  const Point3 h = cross(d, e2);
+  const double det = dot(e1, h);
+  if (std::abs(det) < 1e-300) return false;
+  const Point3 s = p - a;
+  const double u = dot(s, h) / det;
+  if (u < 0 || u > 1) return false;
+  const Point3 qq = cross(s, e1);
+  const double v = dot(d, qq) / det;
+  if (v < 0 || u + v > 1) return false;
+  const double t = dot(e2, qq) / det;
+  return t >= 0 && t <= 1;
+}
+
+/// Pairs of triangles without a common corner that cross or touch (an edge of one meets the other, ends
+/// and borders included: two triangles that share a position but no index count), by a sweep over their
+/// boxes along x and the floating-point test above: an independent check of the meshers' exact ones.
+inline std::size_t crossing_pairs(const SurfaceMesh& m) {
+  const std::size_t n = m.triangles.size();
+  std::vector<std::array<Point3, 2>> box(n);
+  for (std::size_t t = 0; t < n; ++t) {
+    box[t] = {m.vertices[m.triangles[t][0]], m.vertices[m.triangles[t][0]]};
+    for (const std::uint32_t c : m.triangles[t])
+      for (std::size_t k = 0; k < 3; ++k)
+        box[t][0][k] = std::min(box[t][0][k], m.vertices[c][k]), box[t][1][k] = std::max(box[t][1][k], m.vertices[c][k]);
+  }
+  // Sweep along x: boxes sorted by their low x, each compared with those starting before its high x.
+  std::vector<std::size_t> order(n);
+  for (std::size_t t = 0; t < n; ++t) order[t] = t;
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return box[a][0].x < box[b][0].x; });
+  std::size_t count = 0;
+  for (std::size_t oi = 0; oi < n; ++oi)
+    for (std::size_t oj = oi + 1; oj < n && box[order[oj]][0].x <= box[order[oi]][1].x; ++oj) {
+      const std::size_t i = order[oi], j = order[oj];
+      bool apart = false;
+      for (std::size_t k = 0; k < 3 && !apart; ++k) apart = box[i][1][k] < box[j][0][k] || box[j][1][k] < box[i][0][k];
+      if (apart) continue;
+      const auto& x = m.triangles[i];
+      const auto& y = m.triangles[j];
+      bool share = false;
+      for (const std::uint32_t a : x) share = share || std::find(y.begin(), y.end(), a) != y.end();
+      if (share) continue;
+      bool cross_found = false;
+      for (int k = 0; k < 3 && !cross_found; ++k) {
+        const std::size_t a = static_cast<std::size_t>(k), b = static_cast<std::size_t>((k + 1) % 3);
+        cross_found = segment_crosses(m.vertices[x[a]], m.vertices[x[b]], m.vertices[y[0]], m.vertices[y[1]], m.vertices[y[2]]) ||
+                      segment_crosses(m.vertices[y[a]], m.vertices[y[b]], m.vertices[x[0]], m.vertices[x[1]], m.vertices[x[2]]);
+      }
+      count += cross_found;
+    }
+  return count;
 }
 
 /// Smallest triangle area over the square of the diagonal of the mesh's bounding box (1 when empty).

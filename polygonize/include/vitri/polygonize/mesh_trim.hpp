@@ -43,6 +43,14 @@ struct TrimOptions {
   /// (in [0, 1]). The default 0.002 removes larger islands of big meshes (a few thousand triangles of a
   /// 3 x 10^6-triangle mesh) and keeps a second surface of fair size (another object in the scan).
   double min_component_area_fraction = 0.002;
+  /// Where the cleaning split a vertex into one copy per fan (a pinch: two parts of the kept surface meet
+  /// at a point), every copy, and the vertex itself, is moved this fraction of the way from the shared
+  /// position toward the centre of its own fan (the mean of the fan's other corners), so that the parts no
+  /// longer touch: the result is a 2-manifold in space too, not only in its indices (no two triangles
+  /// without a common vertex share a point). The step is halved, up to four times, while a triangle of
+  /// the fan would turn over; after that the copy stays where it was. In [0, 0.5]; 0 leaves the copies
+  /// on the shared position.
+  double separate_pinches = 0.05;
 };
 
 /// What trim_mesh() did. Input counts refer to the input triangles, result counts to the returned mesh.
@@ -58,6 +66,9 @@ struct TrimReport {
   /// into one vertex per fan.
   std::size_t nonmanifold_fixed = 0;
   std::size_t vertex_copies = 0;                ///< Vertices added by those splits (fans beyond the first).
+  /// Vertices of those splits (copies and the vertices split) moved off the shared position
+  /// (TrimOptions::separate_pinches).
+  std::size_t separated_vertices = 0;
   std::size_t removed_components = 0;           ///< Small open components removed.
   std::size_t removed_component_triangles = 0;  ///< Triangles of those components.
   std::size_t components = 0;                   ///< Connected components of the result.
@@ -78,7 +89,8 @@ struct TrimReport {
 ///    in opposite directions) is split into one vertex per fan, the first fan (in triangle order) keeping
 ///    the vertex. Splitting, not removing the smaller fan: every triangle left is supported by the data,
 ///    the split is local and final (removing a fan can pinch another vertex), and the copies' position is
-///    where the supported surface really pinches. Then the small open components are removed.
+///    where the supported surface really pinches; then the copies are moved apart
+///    (TrimOptions::separate_pinches). Then the small open components are removed.
 ///
 /// Guarantees on the result: every edge is in 1 or 2 triangles, and two triangles traverse it in opposite
 /// directions; every vertex's triangles form one fan (a disc or a half-disc); no triangle has a repeated

@@ -27,6 +27,7 @@
 #include "vitri/polygonize/mesh_trim.hpp"
 
 #include "vitri/core/error.hpp"
+#include "vitri/core/parallel.hpp"
 
 #include <algorithm>
 #include <array>
@@ -200,6 +201,41 @@ class Trimmer {
       }
   }
 
+  /// Each crossing's position and normal: where s, linear along its edge, is 0; with TrimOptions::field,
+  /// moved to where the field changes sign along the edge (bisection), kept within [snap, 1 - snap].
+  void place_crossings() {
+    const std::size_t n = cross_ends_.size();
+    cross_pos_.resize(n);
+    if (!mesh_.normals.empty()) cross_normal_.resize(n);
+    const auto& field = options_.field;
+    parallel_chunks(n, field ? std::max(1u, options_.threads) : 1u, 1024, [&](std::size_t b, std::size_t e) {
+      for (std::size_t i = b; i < e; ++i) {
+        const auto [neg, pos] = cross_ends_[i];
+        const Point3& pn = mesh_.vertices[neg];
+        const Point3 d = mesh_.vertices[pos] - pn;
+        double f = crossing_fraction(neg, pos);
+        if (field) {
+          // The ends' classes bracket the sign change: lo on the kept side, hi beyond.
+          double lo = 0.0, hi = 1.0;
+          for (unsigned step = 0; step <= options_.field_steps; ++step) {
+            (field(pn + f * d) <= 0.0 ? lo : hi) = f;
+            f = 0.5 * (lo + hi);
+          }
+          f = std::clamp(f, options_.snap, 1.0 - options_.snap);
+        }
+        cross_pos_[i] = pn + f * d;
+        if (!mesh_.normals.empty()) {
+          const Point3& nn = mesh_.normals[neg];
+          const Point3& np = mesh_.normals[pos];
+          const Point3 m = (1.0 - f) * nn + f * np;
+          const double len = norm(m);
+          // Opposite normals at the ends (a sharp fold): the nearer end's normal.
+          cross_normal_[i] = len > 1e-300 && std::isfinite(len) ? m / len : (f < 0.5 ? nn : np);
+        }
+      }
+    });
+  }
+
   /// Marching triangles: crossings numbered by first use, pieces in input order.
   void clip() {
     const auto& in = mesh_.triangles;
@@ -234,19 +270,10 @@ class Trimmer {
       const Tri& t = in[rec[i] / 3];
       const std::uint32_t a = t[rec[i] % 3], b = t[next3(rec[i] % 3)];
       const std::uint32_t n = cls_[a] < 0 ? a : b, p = cls_[a] < 0 ? b : a;
-      const double f = crossing_fraction(n, p);
-      const Point3& pn = mesh_.vertices[n];
-      cross_pos_.push_back(pn + f * (mesh_.vertices[p] - pn));
-      if (!mesh_.normals.empty()) {
-        const Point3& nn = mesh_.normals[n];
-        const Point3& np = mesh_.normals[p];
-        const Point3 m = (1.0 - f) * nn + f * np;
-        const double len = norm(m);
-        // Opposite normals at the ends (a sharp fold): the nearer end's normal.
-        cross_normal_.push_back(len > 1e-300 && std::isfinite(len) ? m / len : (f < 0.5 ? nn : np));
-      }
-      id[i] = static_cast<std::uint32_t>(nv_ + cross_pos_.size() - 1);
+      cross_ends_.push_back({n, p});
+      id[i] = static_cast<std::uint32_t>(nv_ + cross_ends_.size() - 1);
     }
+    place_crossings();
     rep_.crossing_vertices = cross_pos_.size();
     nbase_ = nv_ + cross_pos_.size();
     if (nbase_ >= kMaxIndex) throw LimitError("trim_mesh: too many vertices for 32-bit indices");
@@ -572,6 +599,7 @@ class Trimmer {
   TrimReport& rep_;
   const std::size_t nv_;
   std::vector<std::int8_t> cls_;   // -1: s < 0, 0: on the cut, 1: s > 0 (after snapping)
+  std::vector<std::array<std::uint32_t, 2>> cross_ends_;  // crossing nv_ + i: its edge's ends (s < 0, s > 0)
   std::vector<Point3> cross_pos_;  // crossing vertex nv_ + i
   std::vector<Point3> cross_normal_;
   std::size_t nbase_ = 0;              // nv_ + crossings: ids from here on are copies
@@ -606,6 +634,8 @@ SurfaceMesh trim_mesh(const SurfaceMesh& mesh, const std::vector<double>& s, con
   if (!(options.separate_pinches >= 0.0 && options.separate_pinches <= 0.5))
     throw InvalidArgument("trim_mesh: separate_pinches must be in [0, 0.5], got " +
                           std::to_string(options.separate_pinches));
+  if (options.field_steps > 60)
+    throw InvalidArgument("trim_mesh: field_steps must be at most 60, got " + std::to_string(options.field_steps));
   if (!(options.min_component_area_fraction >= 0.0 && options.min_component_area_fraction <= 1.0))
     throw InvalidArgument("trim_mesh: min_component_area_fraction must be in [0, 1], got " +
                           std::to_string(options.min_component_area_fraction));

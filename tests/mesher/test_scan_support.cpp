@@ -142,3 +142,22 @@ TEST_CASE("scan support: when every component is below what the data resolve, th
   CHECK(report2.small_components == 2);
   CHECK(metrics_of(out2).components == 1);
 }
+
+TEST_CASE("scan support: the sizing field follows sparse data, coarsening at most 4x", "[scan_support]") {
+  // The plane z = 0: x in [0, 20] sampled every 1 (the resolution), x in [30, 130] every 10 (10x sparser).
+  ScanPoints s;
+  add_points(s, 2, 0.0, 0.0, 20.0, 0.0, 100.0, 1.0);
+  add_points(s, 2, 0.0, 30.0, 130.0, 0.0, 100.0, 10.0);
+  const ScanSupport support(s, 1.0, 2);
+  CHECK(support.size_scale({10, 50, 0}) == Approx(1.0));   // on the dense data
+  CHECK(support.size_scale({10, 50, 2}) == Approx(1.0));   // within 3 spacings of it
+  CHECK(support.size_scale({10, 50, 30}) > 5.0);           // far from every point: coarse
+  // On the sparse data: coarser than the dense part, but not 10x (elements that large span gaps of the
+  // data that the trimming, at most 6 resolutions from a point, cannot resolve).
+  CHECK(support.size_scale({80, 50, 0}) == Approx(4.0));
+  CHECK(support.size_scale({85, 55, 0}) == Approx(4.0));
+  // The reach of the sparse data stays within 6 resolutions (or the precision) whatever their spacing.
+  double d = 0;
+  CHECK(support.reach({85, 55, 0}, 2.5, &d) == Approx(6.0));
+  CHECK(d == Approx(std::sqrt(50.0)));
+}

@@ -245,6 +245,67 @@ TEST_CASE("mesh_trim: a plane cut of a sphere is a disc whose boundary lies on t
   }
 }
 
+TEST_CASE("mesh_trim: with the field, the cut follows it between the vertices", "[mesh_trim]") {
+  // g = distance to the north pole - 0.9: not linear along an edge (a chord passes nearer the pole than
+  // its ends), so linear interpolation of its vertex values puts the crossings off its zero level; with
+  // TrimOptions::field they lie on it within 2^-field_steps of their edge.
+  const SurfaceMesh sphere = icosphere(2);
+  const Point3 pole{0, 0, 1};
+  const auto g = [&](const Point3& p) { return vitri::distance(p, pole) - 0.9; };
+  const auto s = field(sphere, g);
+  double longest = 0.0;
+  for (const Tri& t : sphere.triangles)
+    for (int k = 0; k < 3; ++k)
+      longest = std::max(longest, vitri::distance(sphere.vertices[t[k]], sphere.vertices[t[(k + 1) % 3]]));
+  const auto worst_crossing = [&](const SurfaceMesh& out) {
+    double worst = 0.0;
+    for (const auto& loop : vitri::boundary_loops(out))
+      for (const std::uint32_t v : loop) worst = std::max(worst, std::abs(g(out.vertices[v])));
+    return worst;
+  };
+  TrimOptions linear;
+  linear.snap = 0.0;
+  TrimReport rep_linear;
+  const SurfaceMesh out_linear = trim_mesh(sphere, s, linear, &rep_linear);
+  check_result(sphere, s, out_linear, rep_linear, linear);
+  for (const unsigned threads : {1u, 3u}) {
+    CAPTURE(threads);
+    TrimOptions options = linear;
+    options.field = g;
+    options.threads = threads;
+    TrimReport rep;
+    const SurfaceMesh out = trim_mesh(sphere, s, options, &rep);
+    check_result(sphere, s, out, rep, options);
+    // Same topology and crossings (the same edges), only placed differently.
+    CHECK(rep.crossing_vertices == rep_linear.crossing_vertices);
+    CHECK(out.triangles.size() == out_linear.triangles.size());
+    CHECK(vitri::test::metrics_of(out).euler_characteristic == 1);
+    CHECK(worst_crossing(out) <= longest / 64);
+    CHECK(worst_crossing(out_linear) > 4 * worst_crossing(out));  // the field did the work
+  }
+  SECTION("kept within [snap, 1 - snap] of their edges") {
+    TrimOptions options;
+    options.field = [](const Point3&) { return -1.0; };  // "kept" everywhere: bisection runs to the far end
+    TrimReport rep;
+    const SurfaceMesh out = trim_mesh(sphere, s, options, &rep);
+    check_result(sphere, s, out, rep, options);
+    CHECK(rep.crossing_vertices > 0);
+    double shortest = longest;
+    for (const Tri& t : sphere.triangles)
+      for (int k = 0; k < 3; ++k)
+        shortest = std::min(shortest, vitri::distance(sphere.vertices[t[k]], sphere.vertices[t[(k + 1) % 3]]));
+    std::size_t crossings = 0;
+    for (const Point3& p : out.vertices) {
+      double nearest = std::numeric_limits<double>::infinity();
+      for (const Point3& q : sphere.vertices) nearest = std::min(nearest, vitri::distance(p, q));
+      if (nearest == 0.0) continue;  // an input vertex
+      ++crossings;
+      CHECK(nearest >= (1 - 1e-9) * options.snap * shortest);
+    }
+    CHECK(crossings == rep.crossing_vertices);
+  }
+}
+
 TEST_CASE("mesh_trim: s <= 0 everywhere gives the mesh unchanged, s > 0 everywhere nothing", "[mesh_trim]") {
   const SurfaceMesh sphere = icosphere(3);
   TrimReport rep;

@@ -23,6 +23,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace vitri {
@@ -51,6 +52,16 @@ struct TrimOptions {
   /// the fan would turn over; after that the copy stays where it was. In [0, 0.5]; 0 leaves the copies
   /// on the shared position.
   double separate_pinches = 0.05;
+  /// The field s beyond the vertices, when known (e.g. the distance to the data minus its reach, which
+  /// is not linear along a long edge: an edge spanning a gap in the data passes far from it between two
+  /// ends near it). When set, each crossing is placed where `field` changes sign along its edge: from the
+  /// linear estimate, field_steps bisection steps in the bracket that the ends' classes give (an end of
+  /// class < 0 is on the kept side, whatever field says there), then kept within [snap, 1 - snap] of the
+  /// edge. Called field_steps + 1 times per crossing, from `threads` threads at once (it must be safe to
+  /// call concurrently). Empty (default): crossings where s, linear along the edge, is 0.
+  std::function<double(const Point3&)> field;
+  unsigned field_steps = 6;  ///< At most 60.
+  unsigned threads = 1;      ///< Threads placing the crossings with `field` (0 or 1: the calling thread).
 };
 
 /// What trim_mesh() did. Input counts refer to the input triangles, result counts to the returned mesh.
@@ -97,7 +108,8 @@ struct TrimReport {
 /// vertex; no dangling triangle; no open component below the TrimOptions limits (closed components, which
 /// the cut did not touch, are kept whatever their size); every vertex is used. The boundary consists of
 /// crossings and input vertices on the cut, plus the input's own boundary if it had one; with snap = 0
-/// boundary vertices of the cut lie on the zero level of the interpolated s.
+/// boundary vertices of the cut lie on the zero level of the interpolated s (with TrimOptions::field: within
+/// 2^-field_steps of their edge of where field changes sign).
 /// Order (deterministic): triangles in the order of the input triangles they come from (the two halves of
 /// a split quadrilateral consecutive); vertices: the input vertices kept, in input order, then the
 /// crossings in the order of the first input triangle cutting their edge, then the copies made by splits.

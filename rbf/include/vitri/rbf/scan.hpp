@@ -97,6 +97,9 @@ struct ScanReport {
   /// Points whose sign stayed a guess: reached across a weak link or in a small or unseeded component
   /// (OrientationReport::ambiguous), seen edge-on from the viewpoint, or decided by a vote of neighbours.
   std::size_t ambiguous = 0;
+  /// Points of regions whose sign the spanning tree had set across a sharp edge, flipped so that the
+  /// winding number of the whole is that of a closed surface (docs/scans.md, step 4: a cone's base).
+  std::size_t regions_flipped = 0;
   /// The viewpoint or sensors were given but contradicted by the data (the orientation then was
   /// estimated); viewpoint_note says why.
   bool viewpoint_rejected = false;

@@ -857,6 +857,32 @@ bool layered_along(const std::vector<Point3>& p, const std::vector<Point3>& n, c
   return examined > 0 && 2 * layered > examined;
 }
 
+/// A contiguous run of ids (a group of IdGroups).
+struct IdSpan {
+  const Id* first = nullptr;
+  const Id* last = nullptr;
+  const Id* begin() const { return first; }
+  const Id* end() const { return last; }
+  std::size_t size() const { return static_cast<std::size_t>(last - first); }
+};
+
+/// The ids 0 .. n - 1 grouped by a key in [0, n) (a union-find's roots), in compressed rows: group g is
+/// ids_[start_[g], start_[g + 1]), in increasing id. 8 bytes a point, where a vector per group took 48.
+class IdGroups {
+ public:
+  explicit IdGroups(const std::vector<Id>& key) : start_(key.size() + 1, 0), ids_(key.size()) {
+    for (const Id k : key) ++start_[k + 1];
+    std::partial_sum(start_.begin(), start_.end(), start_.begin());
+    std::vector<std::uint32_t> fill(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < key.size(); ++i) ids_[fill[key[i]]++] = static_cast<Id>(i);
+  }
+  IdSpan operator[](std::size_t g) const { return {ids_.data() + start_[g], ids_.data() + start_[g + 1]}; }
+
+ private:
+  std::vector<std::uint32_t> start_;
+  std::vector<Id> ids_;
+};
+
 /// repair_regions(): neighbours whose oriented normals lie within 45 degrees of each other share a region
 /// (points whose kRegionNear nearest all do);
 /// a region takes part when it holds kRegionShare of its component's points and kRegionMinPoints, the
@@ -911,14 +937,13 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, s
       const Id a = find(static_cast<Id>(i)), b = find(j);
       if (a != b) parent[std::max(a, b)] = std::min(a, b);
     }
-  std::vector<std::vector<Id>> region_members(count), comp_members(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    region_members[find(static_cast<Id>(i))].push_back(static_cast<Id>(i));
-    comp_members[comp[i]].push_back(static_cast<Id>(i));
-  }
+  for (std::size_t i = 0; i < count; ++i) parent[i] = find(static_cast<Id>(i));
+  const IdGroups region_members(parent), comp_members(comp);
+  // Scratch over all points, cleared after each part: 1 in a region taking part, 2 decided after.
+  std::vector<std::uint8_t> state(count, 0);
   std::size_t changed = 0;
   for (std::size_t c = 0; c < count; ++c) {
-    const std::vector<Id>& members = comp_members[c];
+    const IdSpan members = comp_members[c];
     if (members.size() < 2 * kRegionMinPoints) continue;
     double total_area = 0;
     Point3 normal_sum;
@@ -936,19 +961,18 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, s
     std::size_t m = 0;
     while (m < roots.size() && m < kRegionMax && region_members[roots[m]].size() >= least) ++m;
     if (m < 2) continue;
-    std::vector<std::uint8_t> in_region(count, 0);
     for (std::size_t r = 0; r < m; ++r)
-      for (const Id i : region_members[roots[r]]) in_region[i] = 1;
+      for (const Id i : region_members[roots[r]]) state[i] = 1;
     // The samples and their two reads, half the component's median spacing off.
     std::vector<double> hs;
     for (const Id i : members) hs.push_back(h[i]);
     const double d = 0.5 * median(hs);
     std::vector<Point3> reads;  // sample k: reads 2k (outside) and 2k + 1 (inside)
     for (std::size_t r = 0; r < m; ++r) {
-      const std::vector<Id>& rm = region_members[roots[r]];
+      const IdSpan rm = region_members[roots[r]];
       const std::size_t step = std::max<std::size_t>(1, rm.size() / kRegionSamples);
       for (std::size_t a = 0; a < rm.size(); a += step) {
-        const Id i = rm[a];
+        const Id i = rm.first[a];
         reads.push_back(p[i] + d * n[i]);
         reads.push_back(p[i] - d * n[i]);
       }
@@ -968,12 +992,15 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, s
       return level;
     };
     std::vector<std::vector<double>> g(m);
-    for (std::size_t r = 0; r < m; ++r) g[r] = levels_of(region_members[roots[r]]);
+    for (std::size_t r = 0; r < m; ++r) {
+      const IdSpan rm = region_members[roots[r]];
+      g[r] = levels_of(std::vector<Id>(rm.begin(), rm.end()));
+    }
     std::vector<double> rest(samples, 0.0);
     {
       std::vector<Id> others;
       for (const Id i : members)
-        if (!in_region[i]) others.push_back(i);
+        if (!state[i]) others.push_back(i);
       if (!others.empty()) rest = levels_of(others);
     }
     std::vector<int> sign(m, 1);
@@ -1014,35 +1041,41 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, s
     // its area, but the levels stray by 0.27 in RMS; the cone's by 0.05).
     const double rms = std::sqrt(now / static_cast<double>(samples));
     if (!(now < 0.25 * before) || !(rms < kRegionLevelRms) || std::abs(mean_level - 0.5) > 0.1 ||
-        !(norm(sum_after) < 0.3 * total_area))
+        !(norm(sum_after) < 0.3 * total_area)) {
+      for (const Id i : members) state[i] = 0;
       continue;
+    }
     for (std::size_t r = 0; r < m; ++r)
       if (sign[r] < 0)
         for (const Id i : region_members[roots[r]]) n[i] = -n[i], ++changed;
     // The points between the regions (the sharp edges, small parts) take their signs again from the
     // regions outward, layer by layer: each from its decided neighbours (weighted by |n_i . n_j|).
-    std::vector<std::uint8_t> decided = in_region;
-    for (bool progress = true; progress;) {
-      progress = false;
-      std::vector<Id> layer;
-      std::vector<std::uint8_t> flip_to;
-      for (const Id i : members) {
-        if (decided[i]) continue;
+    std::vector<Id> waiting;
+    for (const Id i : members)
+      if (!state[i]) waiting.push_back(i);
+    std::vector<Id> layer, still;
+    std::vector<std::uint8_t> flip_to;
+    while (!waiting.empty()) {
+      layer.clear(), flip_to.clear(), still.clear();
+      for (const Id i : waiting) {
         double agree = 0, against = 0;
         for (std::size_t k = 0; k < nb.k; ++k) {
           const Id j = nb.at(i, k);
-          if (!decided[j]) continue;
+          if (!state[j]) continue;
           const double w = dot(n[i], n[j]);
           (w >= 0 ? agree : against) += std::abs(w);
         }
         if (agree + against > 0) layer.push_back(i), flip_to.push_back(against > agree);
+        else still.push_back(i);
       }
+      if (layer.empty()) break;  // cut off from every decided point
       for (std::size_t a = 0; a < layer.size(); ++a) {
         if (flip_to[a]) n[layer[a]] = -n[layer[a]], ++changed;
-        decided[layer[a]] = 1;
-        progress = true;
+        state[layer[a]] = 2;
       }
+      waiting.swap(still);
     }
+    for (const Id i : members) state[i] = 0;
   }
   return changed;
 }

@@ -909,12 +909,20 @@ constexpr double kRegionLevelRms = 0.15;
 /// looks closed (normals summing to under 0.3 of its area, mean level within 0.1 of 1/2, the levels within
 /// kRegionLevelRms of 1/2 in RMS) and the error fell to a quarter: an open scan (one view, a scene) is left to settle_components. Returns the points
 /// whose sign changed.
-std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, std::vector<Point3>& n,
-                           unsigned threads) {
+std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Id>& comp,
+                           std::vector<Point3>& n, unsigned threads) {
   const std::size_t count = p.size();
-  const std::vector<Id> comp = surface_components(nb, count, nullptr);
   std::vector<double> area(count), h(count);
   for (std::size_t i = 0; i < count; ++i) h[i] = local_spacing(nb, i), area[i] = h[i] * h[i];
+  // The parts that look closed (most scans of objects) need nothing: the regions are built only when
+  // one part's normals do not sum to about 0.
+  std::vector<Point3> comp_sum(count);
+  std::vector<double> comp_area(count, 0.0);
+  for (std::size_t i = 0; i < count; ++i) comp_sum[comp[i]] = comp_sum[comp[i]] + n[i] * area[i], comp_area[comp[i]] += area[i];
+  auto looks_closed = [&](std::size_t c) { return norm(comp_sum[c]) < 0.3 * comp_area[c]; };
+  bool any = false;
+  for (std::size_t i = 0; i < count && !any; ++i) any = comp[i] == i && !looks_closed(i);
+  if (!any) return 0;
   // Regions: the component's edges whose oriented normals agree within 45 degrees.
   std::vector<Id> parent(count);
   std::iota(parent.begin(), parent.end(), Id(0));
@@ -944,11 +952,9 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, s
   std::size_t changed = 0;
   for (std::size_t c = 0; c < count; ++c) {
     const IdSpan members = comp_members[c];
-    if (members.size() < 2 * kRegionMinPoints) continue;
-    double total_area = 0;
-    Point3 normal_sum;
-    for (const Id i : members) total_area += area[i], normal_sum = normal_sum + n[i] * area[i];
-    if (norm(normal_sum) < 0.3 * total_area) continue;  // looks closed already
+    if (members.size() < 2 * kRegionMinPoints || looks_closed(c)) continue;
+    const double total_area = comp_area[c];
+    const Point3 normal_sum = comp_sum[c];
     // Its regions, largest first; those large enough take part.
     std::vector<Id> roots;
     for (const Id i : members)
@@ -1090,10 +1096,9 @@ constexpr std::size_t kSettleWindingMin = 32;
 /// negative sum is flipped whole (an unclear sum on a closed one: its winding number's level decides); an open one (no clear sign) is made to agree with a common direction:
 /// the mean normal of the largest open component, itself turned toward +z (up) when nothing else says.
 /// Returns the points whose sign changed.
-std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb, std::vector<Point3>& n,
-                              unsigned threads) {
+std::size_t settle_components(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Id>& root,
+                              std::vector<Point3>& n, unsigned threads) {
   const std::size_t count = p.size();
-  const std::vector<Id> root = surface_components(nb, count, nullptr);
   auto find = [&](Id a) { return root[a]; };
   // The sums over a part are weighted by each point's area (its local spacing squared): the integral of
   // n dA over a closed surface vanishes, the sum of unit normals of a closed surface sampled 10x more
@@ -1402,7 +1407,7 @@ double sampled_agreement(const std::vector<Point3>& p, const Neighbours& nb, con
   no.threads = threads;
   no.strict = false;
   rbf_detail::orient_distinct_normals(q, qnb.ids.data(), qnb.k, own, no);
-  settle_components(q, qnb, own, threads);
+  settle_components(q, qnb, surface_components(qnb, q.size(), nullptr), own, threads);
   return sign_agreement(own, qn, qfit);
 }
 
@@ -1743,7 +1748,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       no.threads = threads;
       no.strict = false;
       rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, own, no);
-      settle_components(p, nb, own, threads);
+      settle_components(p, nb, surface_components(nb, p.size(), nullptr), own, threads);
       return sign_agreement(own, n, fit);
     };
     // The agreement, first on a sample of the points when they are many: it answers when clearly away
@@ -1788,8 +1793,9 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     no.min_link = 0.1;
     const OrientationReport orep = rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, n, no);
     rep.ambiguous += orep.ambiguous;
-    rep.regions_flipped = repair_regions(p, nb, n, threads);
-    settle_components(p, nb, n, threads);
+    const std::vector<Id> parts = surface_components(nb, p.size(), nullptr);
+    rep.regions_flipped = repair_regions(p, nb, parts, n, threads);
+    settle_components(p, nb, parts, n, threads);
   }
   std::size_t undecided_count = 0;
   for (const std::uint8_t u : undecided) undecided_count += u;

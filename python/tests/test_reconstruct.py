@@ -29,6 +29,33 @@ def test_sphere_scan_is_a_closed_sphere():
     assert np.all(np.einsum("ij,ij->i", N, V) > 0)  # outward normals
 
 
+def cone_points(n, seed):
+    """A closed cone (base radius 0.5 at z = 0, apex at z = 1), n area-uniform samples, no normals."""
+    rng = np.random.default_rng(seed)
+    r0, h = 0.5, 1.0
+    base, side = np.pi * r0 * r0, np.pi * r0 * np.hypot(r0, h)
+    t = 2 * np.pi * rng.random(n)
+    on_base = rng.random(n) * (base + side) < base
+    s = np.sqrt(rng.random(n))  # the base: radius / r0; the side: 0 at the apex, 1 at the rim
+    z = np.where(on_base, 0.0, h * (1 - s))
+    return np.c_[r0 * s * np.cos(t), r0 * s * np.sin(t), z]
+
+
+def test_unoriented_cone_with_its_base_flipped_is_repaired():
+    # The spanning tree flips this sample's base across the sharp rim (normals 117 degrees apart); the
+    # regions repair it (docs/scans.md, step 4) and the stats say how many points it concerned.
+    p = cone_points(5000, 3)
+    m = vitri.Mesher.from_scan(p)
+    stats = m.stats()
+    assert stats["scan_regions_flipped"] > 0
+    assert stats["scan_regions_flipped"] < len(p)
+    assert stats["scan_ambiguous"] >= 0 and stats["scan_repaired"] == 0  # no given normals to repair
+    V, F, _ = vitri.reconstruct(p)
+    assert_closed_manifold(V, F)
+    assert euler_characteristic(V, F) == 2
+    assert signed_volume(V, F) > 0
+
+
 def test_outputs_own_their_memory():
     p, _ = sphere_points(300)
     V, F, N = vitri.reconstruct(p, precision=0.1)

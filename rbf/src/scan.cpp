@@ -896,21 +896,124 @@ constexpr std::size_t kRegionSamples = 128;
 constexpr std::size_t kRegionNear = 8;
 constexpr double kRegionLevelRms = 0.15;
 
+/// Smooth points: those whose tangent plane is clear, that is whose neighbourhood's quadric fits within
+/// max(kSmoothResidual x the scan's noise, kSmoothSpacing x the local spacing) (`residual`: LocalFit::noise
+/// of each point, `noise`: their median) and whose kRegionNear nearest all have normals within 45 degrees
+/// of theirs. A sharp edge's points are not: their neighbourhoods straddle the faces (residual), and the
+/// tangent planes there turn from one face's to the other's along the shorter arc, in steps the angle test
+/// alone passes (a cone's rim, 117 degrees between the faces' normals, reads as a 63-degree bend: its
+/// base and side chained into one region in 2 of 4 samples).
+constexpr double kSmoothResidual = 3.0;
+constexpr double kSmoothSpacing = 0.02;
+
+std::vector<std::uint8_t> smooth_points(const Neighbours& nb, const std::vector<double>& residual, double noise,
+                                        const std::vector<Point3>& n) {
+  const std::size_t count = n.size();
+  std::vector<std::uint8_t> smooth(count, 0);
+  for (std::size_t i = 0; i < count; ++i) {
+    bool ok = residual[i] <= std::max(kSmoothResidual * noise, kSmoothSpacing * local_spacing(nb, i));
+    for (std::size_t c = 0; c < std::min(nb.k, kRegionNear) && ok; ++c) ok = dot(n[i], n[nb.at(i, c)]) >= kRegionDot;
+    smooth[i] = ok;
+  }
+  return smooth;
+}
+
+/// Regions: the root of each point's region (the least index in it), where neighbouring smooth points
+/// of one part (`comp`) whose oriented normals agree within 45 degrees, no farther apart than 3 local
+/// spacings, share a region; a point that is not smooth is a region of its own.
+std::vector<Id> smooth_regions(const Neighbours& nb, const std::vector<Id>& comp,
+                               const std::vector<std::uint8_t>& smooth, const std::vector<Point3>& n) {
+  const std::size_t count = n.size();
+  std::vector<double> h(count);
+  for (std::size_t i = 0; i < count; ++i) h[i] = local_spacing(nb, i);
+  std::vector<Id> parent(count);
+  std::iota(parent.begin(), parent.end(), Id(0));
+  auto find = [&](Id a) {
+    while (parent[a] != a) a = parent[a] = parent[parent[a]];
+    return a;
+  };
+  for (std::size_t i = 0; i < count; ++i)
+    for (std::size_t c = 0; c < nb.k && smooth[i]; ++c) {
+      const Id j = nb.at(i, c);
+      if (!smooth[j] || comp[j] != comp[i] || dot(n[i], n[j]) < kRegionDot) continue;
+      if (nb.d(i, c) > 3.0 * std::max(h[i], h[j])) continue;
+      const Id a = find(static_cast<Id>(i)), b = find(j);
+      if (a != b) parent[std::max(a, b)] = std::min(a, b);
+    }
+  for (std::size_t i = 0; i < count; ++i) parent[i] = find(static_cast<Id>(i));
+  return parent;
+}
+
+/// Gives the `waiting` points their signs from the decided ones (state != 0) outward, layer by layer, and
+/// marks them decided (state 2): each takes the sign its decided neighbours favour, weighted by
+/// (n_i . n_j)^4, and in each layer only the points with a decided neighbour whose tangent plane is nearly
+/// theirs (|n_i . n_j| >= kRegionDot) decide, while some have one. Across a sharp edge the signs' relation
+/// is unreliable: a cone's base point, flipped, agrees with the side's normals (+0.45 each at a rim of 63
+/// degrees) about as much as its right sign agrees with its base neighbours; weighted by |n_i . n_j| and
+/// decided in plain layers, 115 points within 5 spacings of a clean cone's rim (40,000 points, its base
+/// flipped by the tree and repaired) kept the wrong sign: lips below the base, 4 handles in its mesh.
+/// Returns the points whose sign changed.
+
+std::size_t propagate_signs(const Neighbours& nb, std::vector<Id> waiting, std::vector<std::uint8_t>& state,
+                            std::vector<Point3>& n) {
+  std::size_t changed = 0;
+  std::vector<Id> layer, still;
+  std::vector<std::uint8_t> flip_to, strong;
+  while (!waiting.empty()) {
+    layer.clear(), flip_to.clear(), still.clear(), strong.clear();
+    bool any_strong = false;
+    for (const Id i : waiting) {
+      double agree = 0, against = 0, best = 0;
+      for (std::size_t k = 0; k < nb.k; ++k) {
+        const Id j = nb.at(i, k);
+        if (!state[j]) continue;
+        const double w = dot(n[i], n[j]), w2 = w * w;
+        (w >= 0 ? agree : against) += w2 * w2;
+        best = std::max(best, std::abs(w));
+      }
+      if (agree + against > 0) {
+        layer.push_back(i), flip_to.push_back(against > agree), strong.push_back(best >= kRegionDot);
+        any_strong = any_strong || best >= kRegionDot;
+      } else {
+        still.push_back(i);
+      }
+    }
+    if (any_strong) {  // the weak ones wait for a later layer
+      std::size_t kept = 0;
+      for (std::size_t a = 0; a < layer.size(); ++a) {
+        if (strong[a]) layer[kept] = layer[a], flip_to[kept] = flip_to[a], ++kept;
+        else still.push_back(layer[a]);
+      }
+      layer.resize(kept), flip_to.resize(kept);
+    }
+    if (layer.empty()) break;  // cut off from every decided point
+    for (std::size_t a = 0; a < layer.size(); ++a) {
+      if (flip_to[a]) n[layer[a]] = -n[layer[a]], ++changed;
+      state[layer[a]] = 2;
+    }
+    waiting.swap(still);
+  }
+  return changed;
+}
+
 /// Repairs, within each connected component of the neighbour graph that does not look closed (its
 /// normals, area-weighted, do not sum to about 0), the signs of whole regions that the spanning tree set
 /// across a sharp edge: a cone's base meets its side at 63 degrees, the normals there are 117 degrees
 /// apart, and Hoppe's tree, which keeps the sign along an edge whose normals agree, flips the base whole.
-/// A region is a part of the component whose neighbouring normals stay within 45 degrees (no sharp edge
-/// inside). Each region's normals give it a winding number (WindingNumber of its points), and the level of
-/// the whole (the mean of w just inside and just outside a point) is 1/2 on every point of a consistently
+/// A region is a part of the component whose smooth points (smooth_points, from each point's fit
+/// `residual` and the scan's `noise`) have neighbouring normals within 45 degrees (no sharp edge inside).
+/// Each region's normals give it a winding number (WindingNumber of its points), and the level of the
+/// whole (the mean of w just inside and just outside a point) is 1/2 on every point of a consistently
 /// oriented closed surface: a region flipped wrongly lowers or raises the level at the points of the
 /// others (not at its own: its own jump follows its normals). The regions' signs are chosen greedily to
-/// bring the levels nearest 1/2 (least squares over the samples), and kept only when the component then
-/// looks closed (normals summing to under 0.3 of its area, mean level within 0.1 of 1/2, the levels within
-/// kRegionLevelRms of 1/2 in RMS) and the error fell to a quarter: an open scan (one view, a scene) is left to settle_components. Returns the points
-/// whose sign changed.
+/// bring the levels nearest 1/2 (least squares over the samples); the points between the regions then
+/// take their signs from them (propagate_signs), and the result is kept only when the component, as it
+/// then is, looks closed (normals summing to under 0.3 of its area, mean level within 0.1 of 1/2, the
+/// levels within kRegionLevelRms of 1/2 in RMS) and the error fell to a quarter: an open scan (one view,
+/// a scene) is left to settle_components. Returns the points whose sign changed.
 std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, const std::vector<Id>& comp,
-                           std::vector<Point3>& n, unsigned threads) {
+                           const std::vector<double>& residual, double noise, std::vector<Point3>& n,
+                           unsigned threads) {
   const std::size_t count = p.size();
   std::vector<double> area(count), h(count);
   for (std::size_t i = 0; i < count; ++i) h[i] = local_spacing(nb, i), area[i] = h[i] * h[i];
@@ -923,29 +1026,7 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, c
   bool any = false;
   for (std::size_t i = 0; i < count && !any; ++i) any = comp[i] == i && !looks_closed(i);
   if (!any) return 0;
-  // Regions: the component's edges whose oriented normals agree within 45 degrees.
-  std::vector<Id> parent(count);
-  std::iota(parent.begin(), parent.end(), Id(0));
-  auto find = [&](Id a) {
-    while (parent[a] != a) a = parent[a] = parent[parent[a]];
-    return a;
-  };
-  // Only points whose nearest kRegionNear all agree with them take part: on a sharp edge the tangent
-  // planes of the points between the faces turn from one face's to the other's in steps, a chain that
-  // would join the faces into one region.
-  std::vector<std::uint8_t> smooth(count, 1);
-  for (std::size_t i = 0; i < count; ++i)
-    for (std::size_t c = 0; c < std::min(nb.k, kRegionNear) && smooth[i]; ++c)
-      smooth[i] = dot(n[i], n[nb.at(i, c)]) >= kRegionDot;
-  for (std::size_t i = 0; i < count; ++i)
-    for (std::size_t c = 0; c < nb.k && smooth[i]; ++c) {
-      const Id j = nb.at(i, c);
-      if (!smooth[j] || comp[j] != comp[i] || dot(n[i], n[j]) < kRegionDot) continue;
-      if (nb.d(i, c) > 3.0 * std::max(h[i], h[j])) continue;
-      const Id a = find(static_cast<Id>(i)), b = find(j);
-      if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-  for (std::size_t i = 0; i < count; ++i) parent[i] = find(static_cast<Id>(i));
+  const std::vector<Id> parent = smooth_regions(nb, comp, smooth_points(nb, residual, noise, n), n);
   const IdGroups region_members(parent), comp_members(comp);
   // Scratch over all points, cleared after each part: 1 in a region taking part, 2 decided after.
   std::vector<std::uint8_t> state(count, 0);
@@ -954,7 +1035,6 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, c
     const IdSpan members = comp_members[c];
     if (members.size() < 2 * kRegionMinPoints || looks_closed(c)) continue;
     const double total_area = comp_area[c];
-    const Point3 normal_sum = comp_sum[c];
     // Its regions, largest first; those large enough take part.
     std::vector<Id> roots;
     for (const Id i : members)
@@ -1036,50 +1116,40 @@ std::size_t repair_regions(const std::vector<Point3>& p, const Neighbours& nb, c
       sign[best] = -sign[best];
       now = best_error;
     }
-    double mean_level = 0;
-    error(sign, &mean_level);
-    Point3 sum_after = normal_sum;
-    for (std::size_t r = 0; r < m; ++r)
-      if (sign[r] < 0)
-        for (const Id i : region_members[roots[r]]) sum_after = sum_after - 2.0 * area[i] * n[i];
-    // A closed surface consistently oriented: the level near 1/2 at (almost) every sample, not only on
-    // average (an airborne scan's walls flipped make its mean level 0.36 and its normals sum to 0.33 of
-    // its area, but the levels stray by 0.27 in RMS; the cone's by 0.05).
-    const double rms = std::sqrt(now / static_cast<double>(samples));
-    if (!(now < 0.25 * before) || !(rms < kRegionLevelRms) || std::abs(mean_level - 0.5) > 0.1 ||
-        !(norm(sum_after) < 0.3 * total_area)) {
+    if (!(now < 0.25 * before)) {
       for (const Id i : members) state[i] = 0;
       continue;
     }
+    // The regions' signs applied, the points between them (the sharp edges, small parts) take their
+    // signs again from the regions outward (propagate_signs), and the whole is judged as it then is (the
+    // points between, 12% of a cone of 5,000 points, with the tree's signs put its mean level at 0.39).
+    std::vector<Point3> saved;
+    saved.reserve(members.size());
+    for (const Id i : members) saved.push_back(n[i]);
+    std::size_t flipped = 0;
     for (std::size_t r = 0; r < m; ++r)
       if (sign[r] < 0)
-        for (const Id i : region_members[roots[r]]) n[i] = -n[i], ++changed;
-    // The points between the regions (the sharp edges, small parts) take their signs again from the
-    // regions outward, layer by layer: each from its decided neighbours (weighted by |n_i . n_j|).
+        for (const Id i : region_members[roots[r]]) n[i] = -n[i], ++flipped;
     std::vector<Id> waiting;
     for (const Id i : members)
       if (!state[i]) waiting.push_back(i);
-    std::vector<Id> layer, still;
-    std::vector<std::uint8_t> flip_to;
-    while (!waiting.empty()) {
-      layer.clear(), flip_to.clear(), still.clear();
-      for (const Id i : waiting) {
-        double agree = 0, against = 0;
-        for (std::size_t k = 0; k < nb.k; ++k) {
-          const Id j = nb.at(i, k);
-          if (!state[j]) continue;
-          const double w = dot(n[i], n[j]);
-          (w >= 0 ? agree : against) += std::abs(w);
-        }
-        if (agree + against > 0) layer.push_back(i), flip_to.push_back(against > agree);
-        else still.push_back(i);
-      }
-      if (layer.empty()) break;  // cut off from every decided point
-      for (std::size_t a = 0; a < layer.size(); ++a) {
-        if (flip_to[a]) n[layer[a]] = -n[layer[a]], ++changed;
-        state[layer[a]] = 2;
-      }
-      waiting.swap(still);
+    flipped += propagate_signs(nb, std::move(waiting), state, n);
+    const std::vector<double> level = levels_of(std::vector<Id>(members.begin(), members.end()));
+    double e = 0, mean_level = 0;
+    for (const double l : level) e += (l - 0.5) * (l - 0.5), mean_level += l;
+    mean_level /= static_cast<double>(samples);
+    Point3 sum_after;
+    for (const Id i : members) sum_after = sum_after + area[i] * n[i];
+    // A closed surface consistently oriented: the level near 1/2 at (almost) every sample, not only on
+    // average (an airborne scan's walls flipped make its mean level 0.36 and its normals sum to 0.33 of
+    // its area, but the levels stray by 0.27 in RMS; the cone's by 0.05).
+    const double rms = std::sqrt(e / static_cast<double>(samples));
+    if (!(e < 0.25 * before) || !(rms < kRegionLevelRms) || std::abs(mean_level - 0.5) > 0.1 ||
+        !(norm(sum_after) < 0.3 * total_area)) {
+      std::size_t a = 0;
+      for (const Id i : members) n[i] = saved[a++];
+    } else {
+      changed += flipped;
     }
     for (const Id i : members) state[i] = 0;
   }
@@ -1794,7 +1864,9 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     const OrientationReport orep = rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, n, no);
     rep.ambiguous += orep.ambiguous;
     const std::vector<Id> parts = surface_components(nb, p.size(), nullptr);
-    rep.regions_flipped = repair_regions(p, nb, parts, n, threads);
+    std::vector<double> residual(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) residual[i] = fit[i].noise;
+    rep.regions_flipped = repair_regions(p, nb, parts, residual, rep.noise, n, threads);
     settle_components(p, nb, parts, n, threads);
   }
   std::size_t undecided_count = 0;

@@ -690,6 +690,44 @@ TEST_CASE("prepare_scan: a cone's faces keep their signs up to its rim", "[scan]
   }
 }
 
+TEST_CASE("prepare_scan: on clean data the points along sharp edges get their own face's normal", "[scan]") {
+  // The unit cube, 24,000 uniform samples without normals (noise 0): a point within a neighbourhood of an
+  // edge fits a plane between the two faces (its normal up to 45 degrees off both). Each takes the
+  // oriented normal of the neighbour whose tangent plane passes through it (ScanReport::edge_normals):
+  // 99% of all the points within 5 degrees of their face's outward normal (99.9%; before: 92.5%), none
+  // pointing inward.
+  Gauss g(21);
+  std::vector<Point3> p;
+  std::vector<Point3> truth;
+  for (int i = 0; i < 24000; ++i) {
+    const int face = i % 6, axis = face / 2;
+    const double side = face % 2 ? 1.0 : 0.0;
+    Point3 q{g.uniform(), g.uniform(), g.uniform()};
+    q[static_cast<std::size_t>(axis)] = side;
+    Point3 nrm{0, 0, 0};
+    nrm[static_cast<std::size_t>(axis)] = side > 0 ? 1.0 : -1.0;
+    p.push_back(q), truth.push_back(nrm);
+  }
+  vitri::ScanOptions opt;
+  opt.approximate = false;  // the points where they are: the normals alone
+  vitri::ScanReport rep;
+  const vitri::ScanPoints s = vitri::prepare_scan(p, {}, opt, &rep);
+  INFO(vitri::describe(rep));
+  CHECK(rep.edge_normals > 0);
+  const vitri::PointIndex index(p);
+  std::vector<vitri::PointIndex::Id> ids;
+  std::size_t close = 0, inward = 0;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    index.nearest(s.points[i], 1, ids);
+    REQUIRE(ids.size() == 1);
+    const double c = dot(s.normals[i], truth[ids[0]]);
+    close += c > std::cos(5 * kPi / 180);
+    inward += c < 0;
+  }
+  CHECK(close >= s.points.size() * 99 / 100);
+  CHECK(inward == 0);
+}
+
 TEST_CASE("prepare_scan: an unoriented closed surface sampled 10x more sparsely on one half is oriented outward",
           "[scan]") {
   // The unit sphere, 20,000 Fibonacci points below the equator and one in ten above: the unit normals

@@ -100,6 +100,9 @@ struct ScanReport {
   /// Points of regions whose sign the spanning tree had set across a sharp edge, flipped so that the
   /// winding number of the whole is that of a closed surface (docs/scans.md, step 4: a cone's base).
   std::size_t regions_flipped = 0;
+  /// Points on sharp edges (their neighbourhood's fit straddling two faces) given the normal of the
+  /// smooth neighbour on whose tangent plane they lie (estimated normals only).
+  std::size_t edge_normals = 0;
   /// The viewpoint or sensors were given but contradicted by the data (the orientation then was
   /// estimated); viewpoint_note says why.
   bool viewpoint_rejected = false;

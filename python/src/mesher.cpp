@@ -354,6 +354,7 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_repaired"] = s.scan.repaired;  // given normals that disagreed with their neighbourhood, repaired
   d["scan_ambiguous"] = s.scan.ambiguous;  // points whose sign stayed a guess (weak links, edge-on views)
   d["scan_regions_flipped"] = s.scan.regions_flipped;  // points of regions flipped across sharp edges
+  d["scan_edge_normals"] = s.scan.edge_normals;  // points on sharp edges given their face's normal
   d["scan_far_side"] = s.far_side;     // the winding number settles the far field (a scan of an object)
   d["scan_small_components"] = s.scan_small_components;  // components dropped (too small, unsupported)
   d["scan_handles_cut"] = s.scan_handles_cut;            // handles of the noise cut (handle_loop_resolutions)

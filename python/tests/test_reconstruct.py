@@ -50,6 +50,7 @@ def test_unoriented_cone_with_its_base_flipped_is_repaired():
     assert stats["scan_regions_flipped"] > 0
     assert stats["scan_regions_flipped"] < len(p)
     assert stats["scan_ambiguous"] >= 0 and stats["scan_repaired"] == 0  # no given normals to repair
+    assert stats["scan_edge_normals"] > 0  # clean data: the points along the rim take their face's normal
     V, F, _ = vitri.reconstruct(p)
     assert_closed_manifold(V, F)
     assert euler_characteristic(V, F) == 2

@@ -906,12 +906,17 @@ constexpr double kRegionLevelRms = 0.15;
 constexpr double kSmoothResidual = 3.0;
 constexpr double kSmoothSpacing = 0.02;
 
+/// The residual a smooth point's fit stays within (smooth_points' first test).
+double residual_bound(const Neighbours& nb, std::size_t i, double noise) {
+  return std::max(kSmoothResidual * noise, kSmoothSpacing * local_spacing(nb, i));
+}
+
 std::vector<std::uint8_t> smooth_points(const Neighbours& nb, const std::vector<double>& residual, double noise,
                                         const std::vector<Point3>& n) {
   const std::size_t count = n.size();
   std::vector<std::uint8_t> smooth(count, 0);
   for (std::size_t i = 0; i < count; ++i) {
-    bool ok = residual[i] <= std::max(kSmoothResidual * noise, kSmoothSpacing * local_spacing(nb, i));
+    bool ok = residual[i] <= residual_bound(nb, i, noise);
     for (std::size_t c = 0; c < std::min(nb.k, kRegionNear) && ok; ++c) ok = dot(n[i], n[nb.at(i, c)]) >= kRegionDot;
     smooth[i] = ok;
   }
@@ -953,7 +958,6 @@ std::vector<Id> smooth_regions(const Neighbours& nb, const std::vector<Id>& comp
 /// decided in plain layers, 115 points within 5 spacings of a clean cone's rim (40,000 points, its base
 /// flipped by the tree and repaired) kept the wrong sign: lips below the base, 4 handles in its mesh.
 /// Returns the points whose sign changed.
-
 std::size_t propagate_signs(const Neighbours& nb, std::vector<Id> waiting, std::vector<std::uint8_t>& state,
                             std::vector<Point3>& n) {
   std::size_t changed = 0;
@@ -997,8 +1001,9 @@ std::size_t propagate_signs(const Neighbours& nb, std::vector<Id> waiting, std::
 }
 
 /// Gives each point that is not smooth by its residual (smooth_points' first test) the oriented normal of
-/// the decided neighbour whose tangent plane passes nearest it, when within twice the residual bound: the
-/// smooth points are decided, and the others take their normals from them outward, layer by layer. On a
+/// the decided neighbour whose tangent plane passes nearest it, when nearer than both the residual bound
+/// and half the point's own residual (the plane fits it clearly better than its own fit): the smooth
+/// points are decided, and the others take their normals from them outward, layer by layer. On a
 /// sharp edge the neighbourhood straddles the faces: the fitted plane lies between theirs and its sign
 /// disagrees with one face whichever it is, while the point's own face's plane passes through it (and the
 /// band is wider than a neighbourhood: the layers carry each face's plane up to the edge). A point that no
@@ -1020,7 +1025,7 @@ std::size_t edge_normals_from_faces(const std::vector<Point3>& p, const Neighbou
   std::vector<double> bound(p.size());
   std::vector<Id> waiting;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    bound[i] = std::max(kSmoothResidual * noise, kSmoothSpacing * local_spacing(nb, i));
+    bound[i] = residual_bound(nb, i, noise);
     if (state[i] || !(residual[i] > bound[i])) continue;
     // An edge: two of the neighbours' tangent planes more than kEdgeTurn apart (the faces'); parallel
     // ones (the two layers of a misregistered overlap, a thin part's sheets) are no edge.
@@ -1055,11 +1060,10 @@ std::size_t edge_normals_from_faces(const std::vector<Point3>& p, const Neighbou
         still.push_back(waiting[a]);
         continue;
       }
-      n[waiting[a]] = n[pick[a]];
+      n[waiting[a]] = n[pick[a]];  // (the picks were all made before: this layer reads none of these)
+      state[waiting[a]] = 1;
       ++decided;
     }
-    for (std::size_t a = 0; a < waiting.size(); ++a)
-      if (pick[a] != kNone) state[waiting[a]] = 1;
     count += decided;
     if (decided == 0) break;  // the rest keep their normals
     waiting.swap(still);
@@ -1823,10 +1827,11 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
                           " points is collinear (the points lie on a line)");
   // The noise per region: each point's residual is one neighbourhood's (itself noisy); the median over the
   // neighbourhood (the point included) is the region's. ScanReport::noise is the median over the points.
-  std::vector<double> region_noise(p.size()), region_nn(p.size());
+  // `residual`: each point's fit residual at orientation time (the smooth points, the sharp edges).
+  std::vector<double> region_noise(p.size()), region_nn(p.size()), residual(p.size());
+  for (std::size_t i = 0; i < p.size(); ++i) residual[i] = fit[i].noise;
   {
-    std::vector<double> noise(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) noise[i] = fit[i].noise;
+    const std::vector<double>& noise = residual;
     rep.noise = median(noise);
     rbf_detail::parallel_chunks(p.size(), threads, kGrain, [&](std::size_t b, std::size_t e) {
       std::vector<double> a, c;
@@ -1935,8 +1940,6 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     const OrientationReport orep = rbf_detail::orient_distinct_normals(p, nb.ids.data(), nb.k, n, no);
     rep.ambiguous += orep.ambiguous;
     const std::vector<Id> parts = surface_components(nb, p.size(), nullptr);
-    std::vector<double> residual(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) residual[i] = fit[i].noise;
     rep.regions_flipped = repair_regions(p, nb, parts, residual, rep.noise, n, threads);
     settle_components(p, nb, parts, n, threads);
   }
@@ -2000,8 +2003,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // own face's). (The residuals are the fits' before the layers' merging: on such data it moved almost
   // nothing.)
   if (rep.orientation != OrientationSource::Given) {
-    std::vector<double> residual(p.size()), nearest(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) residual[i] = fit[i].noise, nearest[i] = nb.d(i, 0);
+    std::vector<double> nearest(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) nearest[i] = nb.d(i, 0);
     if (rep.noise <= kEdgeCleanNoise * median(nearest) && rep.merged <= p.size() / 1000)
       rep.edge_normals = edge_normals_from_faces(p, nb, residual, rep.noise, n, threads);
   }

@@ -46,7 +46,9 @@ const char* const kUsage =
     "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
     "\n"
     "INPUT   .xyzv  constraints 'x y z value' (f < 0 inside, f > 0 outside, 0 on the surface)\n"
-    "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals; a mesh\n"
+    "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals, and\n"
+    "                from points on its facets where the vertices' surface misses them (large flat\n"
+    "                triangles: the facet check, docs/guide.md); a mesh\n"
     "                with holes or flipped triangles (a warning says so): its surface sampled (vertices,\n"
     "                at least 20000 points) and meshed as a scan without smoothing (open or closed)\n"
     "        points: .pwn / 6-column .xyz (with normals), 3-column .xyz, .pcd, .las (LiDAR; noise\n"
@@ -95,7 +97,8 @@ const char* const kUsage =
     "                       for .xyzv input, the file's lines; for oriented points or a mesh,\n"
     "                       the generated constraints (the count is printed first): the surface points\n"
     "                       first (f = 0; input order after merging exact duplicates, a mesh's\n"
-    "                       unreferenced vertices skipped), then the off-surface ones, per kept point in\n"
+    "                       unreferenced vertices skipped, then the facet check's points if it added\n"
+    "                       any), then the off-surface ones, per kept point in\n"
     "                       the same order its +D (outside) then its -D (inside) constraint, those that\n"
     "                       --sides or --off-surface-spacing leaves out or a thin part drops being\n"
     "                       skipped.\n"
@@ -677,24 +680,64 @@ std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPl
   // A batch run on a closed mesh settles the local function's far field with the mesh's winding number
   // (as Mesher::from_mesh); an editing session keeps the planes.
   const bool settle = !options.polygonizer.keep_history && !options.local.far_side;
-  Constraints constraints = constraints_for_function(std::move(data), c.input, options.constraint_build,
-                                                     options.function, options.auto_local_above, merged,
-                                                     settle ? &options.local : nullptr, &plan.mesh_far_side);
-  if (!c.quiet) print_build_report(merged, options.constraint_build);
-  if (plan.default_precision) {
-    // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points.
-    phases.start("precision", "median spacing");
-    Box3 box;
-    for (const Point3& p : constraints.points) box.extend(p);
-    // Measured already when the builder's off-surface distance followed the data (the same estimate).
-    const double spacing = merged.median_spacing > 0 ? merged.median_spacing : median_spacing(constraints);
-    data_precision = kSpacingFactor * spacing / box.diagonal();
-    if (!c.quiet)
-      std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", data_precision);
+  // A closed mesh is read again by the facet check (Mesher::from_mesh's): kept, with the options that
+  // the constraints' build resolves (the function, the spacing, the far field), for a second build.
+  std::optional<Input> mesh;
+  if (data.kind == InputKind::Mesh && options.check_facets) mesh = data;
+  const ConstraintBuildOptions build0 = options.constraint_build;
+  const FunctionKind function0 = options.function;
+  const LocalRbfOptions local0 = options.local;
+  auto build = [&](Input in, const MeshSamples* facets) {
+    options.constraint_build = build0;
+    options.function = function0;
+    options.local = local0;
+    Constraints built = constraints_for_function(std::move(in), c.input, options.constraint_build, options.function,
+                                                 options.auto_local_above, merged,
+                                                 settle ? &options.local : nullptr, &plan.mesh_far_side, facets);
+    if (!c.quiet) print_build_report(merged, options.constraint_build);
+    return built;
+  };
+  // The data's resolution (docs/guide.md): the median nearest-neighbour spacing of the surface points
+  // (measured already when the builder's off-surface distance followed the data: the same estimate).
+  auto spacing_of = [&](const Constraints& built) {
+    return merged.median_spacing > 0 ? merged.median_spacing : median_spacing(built);
+  };
+  auto fit = [&](const Constraints& built) {
+    if (plan.default_precision) {
+      phases.start("precision", "median spacing");
+      Box3 box;
+      for (const Point3& p : built.points) box.extend(p);
+      data_precision = kSpacingFactor * spacing_of(built) / box.diagonal();
+      if (!c.quiet)
+        std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", data_precision);
+    }
+    options.on_phase = phase_announcer(phases, built.size(), false);
+    return std::make_unique<Mesher>(built, options);
+  };
+  std::unique_ptr<Mesher> mesher;
+  double spacing = 0;
+  {
+    // The constraints are freed at the end of the block: the Mesher has its own copy.
+    const Constraints constraints = build(std::move(data), nullptr);
+    if (mesh) spacing = spacing_of(constraints);
+    mesher = fit(constraints);
   }
-  options.on_phase = phase_announcer(phases, constraints.size(), false);
-  // The constraints are freed on return: the Mesher has its own copy, 32 bytes per constraint for the rest.
-  return std::make_unique<Mesher>(constraints, options);
+  if (!mesh) return mesher;
+  phases.start("facets", "the facet check");
+  // Explicit levels: the points no closer than the coarsest level's resolution (its precision over
+  // kSpacingFactor, as the default precision is the spacing times it), so that it stays coarse.
+  const double coarsest = c.precisions.empty() ? 0.0 : c.precisions.front() * mesher->diagonal() / kSpacingFactor;
+  const FacetCheck check =
+      check_facets(mesh->mesh.V, mesh->mesh.F, mesher->function(), spacing, options.threads, 4000000, coarsest);
+  if (!c.quiet)
+    std::fprintf(stderr, "facet check: %zu samples of the facets read, %zu triangles (%.2g%% of the area) farther "
+                 "than %.4g from the vertices' surface%s (docs/guide.md \"Meshes with large facets\")\n",
+                 check.checked, check.triangles, 100 * check.missed_area, check.tolerance,
+                 check.added.points.empty() ? "" : ": the facets sampled, fitted again");
+  if (check.added.points.empty()) return mesher;
+  mesher.reset();
+  const Constraints constraints = build(std::move(*mesh), &check.added);
+  return fit(constraints);
 }
 
 /// The memory limit's thinning of a scan (stderr): the mesh is coarser than the data.

@@ -48,7 +48,8 @@ void drop_degenerate_triangles(Input& in, const std::string& name, const char* c
 }
 
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
-                           ConstraintBuildReport* report, const ScanOptions& scan, ScanFit* fit) {
+                           ConstraintBuildReport* report, const ScanOptions& scan, ScanFit* fit,
+                           const MeshSamples* facets) {
   switch (in.kind) {
     case InputKind::Constraints: {
       Constraints c;
@@ -57,7 +58,7 @@ Constraints constraints_of(Input in, const std::string& name, const ConstraintBu
       return c;
     }
     case InputKind::Mesh:
-      return constraints_from_mesh(in.mesh.V, in.mesh.F, build, report);
+      return constraints_from_mesh(in.mesh.V, in.mesh.F, build, report, facets);
     case InputKind::OrientedPoints:
     case InputKind::Points: {
       MesherOptions o;
@@ -82,12 +83,12 @@ Constraints constraints_of(Input in, const std::string& name, const ConstraintBu
 
 namespace {
 
-std::size_t input_points(const Input& in) {
+std::size_t input_points(const Input& in, const MeshSamples* facets) {
   switch (in.kind) {
     case InputKind::Constraints: return in.constraints.points.size();
     case InputKind::OrientedPoints:
     case InputKind::Points: return in.points.points.size();
-    case InputKind::Mesh: return static_cast<std::size_t>(in.mesh.V.rows());
+    case InputKind::Mesh: return static_cast<std::size_t>(in.mesh.V.rows()) + (facets ? facets->points.size() : 0);
   }
   return 0;
 }
@@ -96,7 +97,8 @@ std::size_t input_points(const Input& in) {
 
 Constraints constraints_for_function(Input in, const std::string& name, ConstraintBuildOptions& build,
                                      FunctionKind& function, std::size_t auto_local_above,
-                                     ConstraintBuildReport& report, LocalRbfOptions* local, bool* settled) {
+                                     ConstraintBuildReport& report, LocalRbfOptions* local, bool* settled,
+                                     const MeshSamples* facets) {
   // A closed mesh's triangles, kept for its winding number when the function may be the local one.
   std::optional<TriangleMesh> mesh;
   if (local && in.kind == InputKind::Mesh && function != FunctionKind::Global) mesh = in.mesh;
@@ -110,19 +112,19 @@ Constraints constraints_for_function(Input in, const std::string& name, Constrai
   };
   if (function == FunctionKind::Global) build.off_surface_spacing = 0.0;
   if (function != FunctionKind::Auto || in.kind == InputKind::Constraints || build.off_surface_spacing == 0.0) {
-    Constraints c = constraints_of(std::move(in), name, build, &report);
+    Constraints c = constraints_of(std::move(in), name, build, &report, {}, nullptr, facets);
     function = choose_function(function, c.size(), auto_local_above);
     return settle(std::move(c));
   }
   // A global choice needs at most auto_local_above constraints, hence as many surface points after the
   // merge: keep a copy of a small input to build them again without the spacing.
   std::optional<Input> copy;
-  if (choose_function(function, input_points(in), auto_local_above) == FunctionKind::Global) copy = in;
-  Constraints c = constraints_of(std::move(in), name, build, &report);
+  if (choose_function(function, input_points(in, facets), auto_local_above) == FunctionKind::Global) copy = in;
+  Constraints c = constraints_of(std::move(in), name, build, &report, {}, nullptr, facets);
   function = choose_function(function, c.size() + report.spaced_out, auto_local_above);
   if (function == FunctionKind::Local) return settle(std::move(c));
   build.off_surface_spacing = 0.0;
-  return constraints_of(copy ? std::move(*copy) : read_input(name), name, build, &report);
+  return constraints_of(copy ? std::move(*copy) : read_input(name), name, build, &report, {}, nullptr, facets);
 }
 
 }  // namespace vitri::cli

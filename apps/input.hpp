@@ -52,7 +52,7 @@ void drop_degenerate_triangles(Input& in, const std::string& name, const char* c
 /// given, receives the scan's report and the viewpoint used (its constraints and points left empty).
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
                            ConstraintBuildReport* report = nullptr, const ScanOptions& scan = {},
-                           ScanFit* fit = nullptr);
+                           ScanFit* fit = nullptr, const MeshSamples* facets = nullptr);
 
 /// constraints_of() for a run whose function may be FunctionKind::Auto, as `vitri mesh` builds them:
 /// build.off_surface_spacing serves the local function only. Auto is resolved here, on the number of
@@ -62,10 +62,11 @@ Constraints constraints_of(Input in, const std::string& name, const ConstraintBu
 /// is the input's path (read again in the rare case where a large input merges down to a global fit).
 /// `local`, when given (a batch run), gets for a closed mesh whose function resolves to Local the mesh's
 /// own inside/outside far from it (settle_far_field_by_mesh, as Mesher::from_mesh); `settled`, when
-/// given, says whether it did. @throws as constraints_of.
+/// given, says whether it did. `facets`: a closed mesh's facet samples (check_facets()), built after its
+/// vertices and counted with them. @throws as constraints_of.
 Constraints constraints_for_function(Input in, const std::string& name, ConstraintBuildOptions& build,
                                      FunctionKind& function, std::size_t auto_local_above,
                                      ConstraintBuildReport& report, LocalRbfOptions* local = nullptr,
-                                     bool* settled = nullptr);
+                                     bool* settled = nullptr, const MeshSamples* facets = nullptr);
 
 }  // namespace vitri::cli

@@ -362,15 +362,45 @@ Mesher Mesher::from_scan(ScanFit fit) {
 Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const MesherOptions& options) {
   MesherOptions o = with_threads_applied(options);
   ConstraintBuildReport built;
-  const Constraints c = constraints_from_mesh(V, F, o.constraint_build, &built);
   // Far from the mesh the local function's patches are planes through the nearest constraints' values,
   // which can close a bubble of the zero set there (a far blob); the mesh's own winding number settles
   // them in a batch run, as a scan's does (an editing session keeps the planes, as from_scan).
-  const bool settle = choose_function(c.size(), o) == FunctionKind::Local && !o.local.far_side &&
-                      built.offset > 0 && !o.polygonizer.keep_history;
-  const bool settled = settle && settle_far_field_by_mesh(o.local, V, F, built.offset);
-  Mesher m(c, o);
-  m.stats_.far_side = settled;
+  const LocalRbfOptions local = o.local;
+  auto fitted = [&](const Constraints& c) {
+    o.local = local;
+    const bool settle = choose_function(c.size(), o) == FunctionKind::Local && !o.local.far_side &&
+                        built.offset > 0 && !o.polygonizer.keep_history;
+    const bool settled = settle && settle_far_field_by_mesh(o.local, V, F, built.offset);
+    Mesher m(c, o);
+    m.stats_.far_side = settled;
+    return m;
+  };
+  Constraints c = constraints_from_mesh(V, F, o.constraint_build, &built);
+  Mesher m = fitted(c);
+  if (!o.check_facets) return m;
+  // The facet check: where the vertices' interpolant leaves the facets, points on them, fitted again.
+  double spacing = built.median_spacing;
+  if (!(spacing > 0)) {
+    std::vector<Point3> surface;
+    for (std::size_t i = 0; i < c.size(); ++i)
+      if (c.values[i] == 0) surface.push_back(c.points[i]);
+    spacing = surface.size() >= 2 ? median_spacing(surface) : 0.0;
+  }
+  // The global function (an explicit choice) keeps its constraints within auto_local_above: the facets'
+  // points are then fewer (a wider spacing), none when the vertices already reach it.
+  std::size_t surface = 0;
+  for (const double value : c.values) surface += value == 0;
+  const std::size_t room = o.function == FunctionKind::Global
+                               ? (o.auto_local_above / 3 > surface ? o.auto_local_above / 3 - surface : 0)
+                               : std::size_t(4000000);
+  const FacetCheck check = check_facets(V, F, m.function(), spacing, o.threads, room);
+  if (!check.added.points.empty()) {
+    c = constraints_from_mesh(V, F, o.constraint_build, &built, &check.added);
+    m = fitted(c);
+  }
+  m.stats_.facet_samples = check.checked;
+  m.stats_.facet_triangles = check.triangles;
+  m.stats_.facet_points = check.added.points.size();
   return m;
 }
 

@@ -356,6 +356,9 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_regions_flipped"] = s.scan.regions_flipped;  // points of regions flipped across sharp edges
   d["scan_edge_normals"] = s.scan.edge_normals;  // points on sharp edges given their face's normal
   d["scan_far_side"] = s.far_side;     // the winding number settles the far field (a scan of an object)
+  d["facet_samples"] = s.facet_samples;      // from_mesh: the facet check's samples read
+  d["facet_triangles"] = s.facet_triangles;  // triangles the vertices' surface missed
+  d["facet_points"] = s.facet_points;        // points added on the facets (0: the vertices alone)
   d["scan_small_components"] = s.scan_small_components;  // components dropped (too small, unsupported)
   d["scan_handles_cut"] = s.scan_handles_cut;            // handles of the noise cut (handle_loop_resolutions)
   d["scan_kept_unresolved"] = s.scan_kept_unresolved;    // every one too small: the best-supported kept

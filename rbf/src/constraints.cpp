@@ -448,8 +448,141 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
   return area_weighted_normals(V, F);
 }
 
+MeshSamples mesh_facet_samples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double spacing,
+                               const std::vector<std::uint8_t>* only, std::vector<Eigen::Index>* triangle,
+                               std::size_t max_points) {
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    throw InvalidArgument("mesh_facet_samples: the spacing must be > 0 and finite");
+  double flip = 1.0;
+  area_weighted_normals(V, F, &flip);
+  auto marked = [&](Eigen::Index f) { return !only || (*only)[static_cast<std::size_t>(f)]; };
+  std::vector<double> areas(static_cast<std::size_t>(F.rows()), 0.0);
+  double wanted = 0, centroids = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (!marked(f)) continue;
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    areas[static_cast<std::size_t>(f)] = 0.5 * (b - a).cross(c - a).norm();
+    wanted += areas[static_cast<std::size_t>(f)] / (spacing * spacing);
+    centroids += 1;
+  }
+  // Beyond max_points the spacing widens (the centroids stay).
+  const double room = std::max(0.0, static_cast<double>(max_points) - centroids);
+  const double scale = wanted > room && wanted > 0 ? room / wanted : 1.0;
+  std::mt19937_64 rng(0xfacE75a3b1e5ULL);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  MeshSamples out;
+  if (triangle) triangle->clear();
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (!marked(f)) continue;
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    if (!(cross.norm() > 0)) continue;  // no area: no normal, nothing between its vertices
+    const Eigen::Vector3d n = flip * cross.normalized();
+    const double expected = areas[static_cast<std::size_t>(f)] / (spacing * spacing) * scale;
+    const auto extra = static_cast<std::size_t>(std::floor(std::max(0.0, expected - 1.0) + uniform(rng)));
+    for (std::size_t s = 0; s <= extra; ++s) {
+      Eigen::Vector3d p = (a + b + c) / 3.0;
+      if (s > 0) {
+        double u = uniform(rng), v = uniform(rng);
+        if (u + v > 1) u = 1 - u, v = 1 - v;  // uniform on the triangle
+        p = a + u * (b - a) + v * (c - a);
+      }
+      out.points.push_back({p.x(), p.y(), p.z()});
+      out.normals.push_back({n.x(), n.y(), n.z()});
+      if (triangle) triangle->push_back(f);
+    }
+  }
+  return out;
+}
+
+MeshSamples mesh_facet_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double spacing,
+                              const std::vector<std::uint8_t>* flat, std::size_t max_points) {
+  if (!(spacing > 0) || !std::isfinite(spacing))
+    throw InvalidArgument("mesh_facet_points: the spacing must be > 0 and finite");
+  double flip = 1.0;
+  const Eigen::MatrixXd N = area_weighted_normals(V, F, &flip);
+  auto is_flat = [&](Eigen::Index f) { return !flat || (*flat)[static_cast<std::size_t>(f)]; };
+  double area = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    area += 0.5 * (b - a).cross(c - a).norm();
+  }
+  // Beyond max_points (about area / spacing^2 points) the step widens.
+  const double step = std::max(spacing, std::sqrt(area / std::max<double>(1.0, static_cast<double>(max_points))));
+  // Candidates: the mesh's referenced vertices first (never kept, they only keep points away), then each
+  // triangle's grid points.
+  std::vector<Point3> p;
+  std::vector<Point3> n;
+  std::vector<char> used(static_cast<std::size_t>(V.rows()), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(F(f, k))] = 1;
+  for (Eigen::Index i = 0; i < V.rows(); ++i)
+    if (used[static_cast<std::size_t>(i)]) p.push_back({V(i, 0), V(i, 1), V(i, 2)}), n.push_back({});
+  const std::size_t vertices = p.size();
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    const Eigen::Vector3d cross = (b - a).cross(c - a);
+    if (!(cross.norm() > 0)) continue;
+    const Eigen::Vector3d normal = flip * cross.normalized();
+    // A point's normal: the facet's own on a flat triangle, else its vertices' normals blended
+    // (barycentric weights), the smooth surface the vertices describe.
+    const bool own = is_flat(f);
+    const double twice = cross.norm();
+    auto normal_at = [&](const Eigen::Vector3d& r) -> Point3 {
+      if (own) return {normal.x(), normal.y(), normal.z()};
+      const double wa = (b - r).cross(c - r).norm() / twice, wb = (c - r).cross(a - r).norm() / twice;
+      const Eigen::Vector3d m = wa * N.row(F(f, 0)).normalized().transpose() +
+                                wb * N.row(F(f, 1)).normalized().transpose() +
+                                (1.0 - wa - wb) * N.row(F(f, 2)).normalized().transpose();
+      const Eigen::Vector3d unit = m.norm() > 0 && m.allFinite() ? Eigen::Vector3d(m.normalized()) : normal;
+      return {unit.x(), unit.y(), unit.z()};
+    };
+    // The frame: origin at the start of the longest edge, u along it, w across in the plane.
+    std::array<Eigen::Vector3d, 3> q{a, b, c};
+    int e = 0;
+    for (int k = 1; k < 3; ++k)
+      if ((q[(k + 1) % 3] - q[k]).norm() > (q[(e + 1) % 3] - q[e]).norm()) e = k;
+    const Eigen::Vector3d o = q[e], u = (q[(e + 1) % 3] - o).normalized(), w = cross.normalized().cross(u);
+    const Eigen::Vector3d apex = q[(e + 2) % 3] - o;
+    const double length = (q[(e + 1) % 3] - o).norm(), height = apex.dot(w);
+    // Barycentric inside test in the (u, w) plane.
+    const double ax = apex.dot(u), ay = height;  // the third corner; the others (0, 0) and (length, 0)
+    auto inside = [&](double x, double y) {
+      if (y < 0 || y > ay) return false;
+      // Left of the edges (length, 0) -> (ax, ay) and (ax, ay) -> (0, 0) of the counter-clockwise triangle.
+      const double beyond = (ax - length) * y - ay * (x - length);  // (P2 - P1) x (X - P1)
+      const double before = ay * x - ax * y;                        // (P0 - P2) x (X - P2)
+      return beyond >= 0 && before >= 0;
+    };
+    std::size_t placed = 0;
+    const auto nx = static_cast<long>(std::ceil(length / step)), ny = static_cast<long>(std::ceil(height / step));
+    for (long j = 0; j < ny; ++j)
+      for (long i = 0; i < nx; ++i) {
+        const double x = (static_cast<double>(i) + 0.5) * step, y = (static_cast<double>(j) + 0.5) * step;
+        if (!inside(x, y)) continue;
+        const Eigen::Vector3d r = o + x * u + y * w;
+        p.push_back({r.x(), r.y(), r.z()});
+        n.push_back(normal_at(r));
+        ++placed;
+      }
+    if (placed == 0) {
+      const Eigen::Vector3d r = (a + b + c) / 3.0;
+      p.push_back({r.x(), r.y(), r.z()});
+      n.push_back(normal_at(r));
+    }
+  }
+  std::vector<std::size_t> order(p.size());
+  std::iota(order.begin(), order.end(), std::size_t(0));
+  const std::vector<char> kept = rbf_detail::spaced_subset(p, order, 0.5 * step);
+  MeshSamples out;
+  for (std::size_t i = vertices; i < p.size(); ++i)
+    if (kept[i]) out.points.push_back(p[i]), out.normals.push_back(n[i]);
+  return out;
+}
+
 Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
-                                  const ConstraintBuildOptions& options, ConstraintBuildReport* report) {
+                                  const ConstraintBuildOptions& options, ConstraintBuildReport* report,
+                                  const MeshSamples* facets) {
   const Eigen::MatrixXd N = closed_mesh_vertex_normals(V, F);
   std::vector<bool> used(static_cast<std::size_t>(V.rows()), false);
   for (Eigen::Index f = 0; f < F.rows(); ++f)
@@ -469,6 +602,12 @@ Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixX
     if (!is_finite(n.back()))
       throw InvalidPoint(vi, "mesh vertex with a non-finite area-weighted normal (coordinates too large?)");
     if (!(norm(n.back()) > 0)) throw InvalidPoint(vi, "mesh vertex with a zero area-weighted normal");
+  }
+  if (facets) {
+    if (facets->normals.size() != facets->points.size())
+      throw InvalidArgument("constraints_from_mesh: facet samples need one normal per point");
+    p.insert(p.end(), facets->points.begin(), facets->points.end());
+    n.insert(n.end(), facets->normals.begin(), facets->normals.end());
   }
   return constraints_from_oriented_points(p, n, options, report);
 }

@@ -761,3 +761,37 @@ TEST_CASE("vitri mesh: a flat scan gives one sheet on its plane", "[cli][mesh]")
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) farthest = std::max(farthest, std::abs(m.V(i, 2)));
   CHECK(farthest < 1e-3);  // the spacing is about 0.0033
 }
+
+TEST_CASE("vitri mesh: a closed mesh of large facets meshes as its facets (the facet check)", "[cli][mesh]") {
+  // A cube as a CAD export writes it: 8 vertices, 12 triangles. Its vertices alone interpolate a sphere.
+  const std::string in = kDir + "/mesh_cube8.off", out = kDir + "/mesh_cube8.ply";
+  {
+    std::ofstream c(in);
+    c << "OFF\n8 12 0\n";
+    for (int i = 0; i < 8; ++i) c << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << ((i >> 2) & 1) << '\n';
+    c << "3 0 2 1\n3 1 2 3\n3 4 5 6\n3 5 7 6\n3 0 1 4\n3 1 5 4\n3 2 6 3\n3 3 6 7\n3 0 4 2\n3 2 4 6\n"
+         "3 1 3 5\n3 3 7 5\n";
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
+  INFO(o << e);
+  REQUIRE(e.find("facet check: ") != std::string::npos);
+  REQUIRE(e.find("12 triangles (1e+02% of the area)") != std::string::npos);
+  REQUIRE(e.find("the facets sampled, fitted again") != std::string::npos);
+  check_mesh(out);
+  // Every vertex on the cube's faces within 3% of its edge (the vertices' sphere: 0.3 off the faces).
+  const TriangleMesh m = read_mesh(out);
+  double worst = 0;
+  for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
+    double inside = 1, outside2 = 0;
+    bool in_cube = true;
+    for (int a = 0; a < 3; ++a) {
+      const double x = m.V(i, a);
+      inside = std::min({inside, x, 1 - x});
+      if (x < 0) in_cube = false, outside2 += x * x;
+      if (x > 1) in_cube = false, outside2 += (x - 1) * (x - 1);
+    }
+    worst = std::max(worst, in_cube ? inside : std::sqrt(outside2));
+  }
+  CHECK(worst < 0.03);
+}

@@ -117,6 +117,10 @@ struct MesherOptions {
   RbfOptions rbf;
   /// Normal constraints built by from_oriented_points() and from_mesh() (off-surface distance, ...).
   ConstraintBuildOptions constraint_build;
+  /// from_mesh() (and the CLI's closed meshes): the facet check (check_facets()): where the interpolant
+  /// of the vertices misses the mesh's facets (large flat triangles), points on those facets are added
+  /// and the function fitted again. false: the vertices alone (the paper's constraints).
+  bool check_facets = true;
   /// The Delaunay domain is the bounding box of the constraints scaled by this factor (paper 3.2.2).
   /// A constraint later added or moved outside it makes the Mesher rebuild with a new box.
   double box_factor = 2.0;
@@ -235,7 +239,41 @@ struct MesherStats {
   /// from_mesh(): the mesh's winding number, level and jump not recorded).
   double far_level = 0, far_jump = 0;
   bool far_side = false;
+  /// from_mesh() (and the CLI's closed meshes): the facet check (check_facets()): facet samples read,
+  /// triangles the vertices' interpolant passes farther than the tolerance from, and the points added on
+  /// those triangles (0: the vertices alone were fitted).
+  std::size_t facet_samples = 0, facet_triangles = 0, facet_points = 0;
 };
+
+/// The facet check of a closed mesh (docs/guide.md "Meshes with large facets"). A mesh's vertices and
+/// their normals describe its surface when its facets are small against the vertex spacing (a scanned
+/// or subdivided model); a mesh of large flat facets (CAD exports: a box of 8 vertices, a flange of long
+/// triangles, the flat cap of a cut model) does not, and the interpolant of its vertices bulges off its
+/// facets (the box became a sphere, the hand's wrist cap a dome 0.12 of its width high). `f` is the
+/// function fitted to the vertices' constraints, `spacing` their median spacing. The triangles longer
+/// than `spacing` (a smaller one lies within the vertices' own resolution) are sampled
+/// (mesh_facet_samples(), centroid first) about min(spacing, 0.01 x the mesh's diagonal) apart, and a
+/// triangle is missed when one of its samples lies farther than the tolerance min(0.5 x spacing, 0.01 x
+/// the diagonal) from the zero set (|f| / |grad f|, a first-order distance). When the missed triangles
+/// hold 1% of the area or more, points spread evenly over the whole mesh are `added`
+/// (constraints_from_mesh's `facets`): fitted with the vertices, they hold the surface on the facets;
+/// at most about `max_points` of them (a wider spacing beyond; 0: none added), at least `min_spacing`
+/// apart (an absolute length; `vitri mesh` gives its coarsest level's, so that the points do not make
+/// the coarse levels as fine as the last). `threads`: 0, every CPU.
+struct FacetCheck {
+  double spacing = 0;         ///< of the samples
+  double tolerance = 0;       ///< the distance from the zero set a facet sample may have
+  std::size_t checked = 0;    ///< samples read
+  std::size_t triangles = 0;  ///< triangles missed
+  double missed_area = 0;     ///< their share of the mesh's area
+  /// Points spread over every triangle (mesh_facet_points(): the missed ones with their facets' normals,
+  /// the others with their vertices' blended) when the missed triangles hold at least 1% of the area;
+  /// else empty (a few triangles at creases: the vertices' interpolant is kept).
+  MeshSamples added;
+};
+FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const ImplicitFunction& f,
+                        double spacing, unsigned threads = 0, std::size_t max_points = 4000000,
+                        double min_spacing = 0);
 
 /// Memory model of a run, measured at 10^6 oriented points (docs/memory.md): bytes per input point of
 /// what is not the Delaunay structure (the scan's preparation, the constraints, the local function), the

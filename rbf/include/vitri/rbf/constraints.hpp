@@ -185,8 +185,34 @@ Eigen::MatrixXd closed_mesh_vertex_normals(const Eigen::MatrixXd& V, const Eigen
 /// then constraints_from_oriented_points(). Same errors as both; InvalidPoint carries the mesh's own
 /// vertex index (row of V, unreferenced vertices included) for a non-finite coordinate or a zero or
 /// non-finite normal.
+/// `facets`, when given, adds oriented points on the facets (mesh_facet_samples(), as the facet check of
+/// Mesher::from_mesh chooses them) after the vertices: the vertices keep the surface constraints' first
+/// ids (0 .. referenced vertices - 1, in V's order), the samples follow in their order.
 Constraints constraints_from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                   const ConstraintBuildOptions& options = {},
-                                  ConstraintBuildReport* report = nullptr);
+                                  ConstraintBuildReport* report = nullptr, const MeshSamples* facets = nullptr);
+
+/// Points on the facets of a closed, consistently oriented triangle mesh for the facet check
+/// (Mesher::from_mesh, docs/guide.md "Meshes with large facets"): each triangle's centroid first, then
+/// uniform samples inside it, about one per spacing^2 of its area in all (stochastic rounding, seeded:
+/// the same mesh and spacing give the same samples), with the triangle's own normal (outward, as
+/// closed_mesh_vertex_normals() orients). Only the triangles `only` marks (null: every triangle);
+/// `triangle` receives each sample's row of F. At most `max_points` samples: a larger count widens the
+/// spacing (the centroids always come). @throws InvalidArgument for spacing <= 0 or not finite.
+MeshSamples mesh_facet_samples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double spacing,
+                               const std::vector<std::uint8_t>* only = nullptr,
+                               std::vector<Eigen::Index>* triangle = nullptr, std::size_t max_points = 4000000);
+
+/// Points spread evenly over the triangles of a closed, consistently oriented triangle mesh, `spacing`
+/// apart (the facet check's points, Mesher::from_mesh): on each triangle a square grid of that step in its
+/// plane (along its longest edge), its points inside the triangle (the centroid for a triangle too thin
+/// to hold one), then a Poisson-disk pass that keeps a point only when no vertex of the mesh and no point
+/// kept before it lies within half the spacing. Normals: outward, on the triangles `flat` marks (null:
+/// every triangle) the triangle's own, on the others the area-weighted normals of its vertices blended
+/// by the point's barycentric weights (the smooth surface they describe). Deterministic. At most about
+/// `max_points` points (a larger count widens the spacing). @throws InvalidArgument for spacing <= 0 or
+/// not finite.
+MeshSamples mesh_facet_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double spacing,
+                              const std::vector<std::uint8_t>* flat = nullptr, std::size_t max_points = 4000000);
 
 }  // namespace vitri

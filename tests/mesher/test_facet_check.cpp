@@ -1,0 +1,161 @@
+// The facet check of closed meshes (Mesher::from_mesh, check_facets, mesh_facet_points; docs/guide.md
+// "Meshes with large facets"): a mesh of large flat facets meshes as its facets, a fine mesh is left alone.
+#include <catch2/catch.hpp>
+
+#include "support/mesh_checks.hpp"
+#include "vitri/io/io.hpp"
+#include "vitri/mesher.hpp"
+#include "vitri/testing/mesh_metrics.hpp"
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+using namespace vitri;
+
+namespace {
+
+/// The cube [0, 1]^3 as 8 vertices and 12 triangles wound outwards (what a CAD export writes).
+void cube_mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+  V.resize(8, 3);
+  for (int i = 0; i < 8; ++i) V.row(i) << (i & 1), (i >> 1) & 1, (i >> 2) & 1;
+  F.resize(12, 3);
+  F << 0, 2, 1, 1, 2, 3,  // z = 0
+      4, 5, 6, 5, 7, 6,   // z = 1
+      0, 1, 4, 1, 5, 4,   // y = 0
+      2, 6, 3, 3, 6, 7,   // y = 1
+      0, 4, 2, 2, 4, 6,   // x = 0
+      1, 3, 5, 3, 7, 5;   // x = 1
+}
+
+/// Distance from p to the boundary of the unit cube.
+double cube_distance(const Point3& p) {
+  bool inside = true;
+  double out2 = 0, in = 1;
+  for (std::size_t a = 0; a < 3; ++a) {
+    const double x = p[a];
+    if (x < 0) inside = false, out2 += x * x;
+    if (x > 1) inside = false, out2 += (x - 1) * (x - 1);
+    in = std::min({in, x, 1 - x});
+  }
+  return inside ? in : std::sqrt(out2);
+}
+
+double worst_cube_distance(const SurfaceMesh& m) {
+  double worst = 0;
+  for (const Point3& v : m.vertices) worst = std::max(worst, cube_distance(v));
+  return worst;
+}
+
+MesherOptions local_options(bool check) {
+  MesherOptions o;
+  o.function = FunctionKind::Local;
+  o.threads = 2;
+  o.check_facets = check;
+  o.constraint_build.offset_spacings = 2.0;  // the off-surface distance of the CLI
+  return o;
+}
+
+}  // namespace
+
+TEST_CASE("mesh_facet_points: points on the facets, evenly spaced, with the facets' or the vertices' normals",
+          "[facets]") {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  cube_mesh(V, F);
+  const double spacing = 0.05;
+  const MeshSamples s = mesh_facet_points(V, F, spacing);
+  // Area 6 at about one point per spacing^2: 2400, fewer for the Poisson-disk pass along the diagonals.
+  REQUIRE(s.points.size() > 1500);
+  REQUIRE(s.points.size() < 3000);
+  REQUIRE(s.normals.size() == s.points.size());
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    INFO(i);
+    REQUIRE(cube_distance(s.points[i]) < 1e-12);  // on a face
+    // The face's own normal: the axis along which the point is on the boundary, outward.
+    const Point3& p = s.points[i];
+    const Point3& n = s.normals[i];
+    REQUIRE(std::abs(norm(n) - 1) < 1e-12);
+    for (std::size_t a = 0; a < 3; ++a)
+      if (std::abs(n[a]) > 0.5) REQUIRE(std::abs(p[a] - (n[a] > 0 ? 1.0 : 0.0)) < 1e-12);
+  }
+  // Pairwise at least half the spacing apart, and no point within half the spacing of a corner.
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    for (std::size_t j = i + 1; j < s.points.size(); ++j) REQUIRE(norm(s.points[i] - s.points[j]) >= 0.5 * spacing);
+    for (Eigen::Index v = 0; v < V.rows(); ++v)
+      REQUIRE(norm(s.points[i] - Point3{V(v, 0), V(v, 1), V(v, 2)}) >= 0.5 * spacing);
+  }
+  // Every point of the surface has a point (or a corner) within 1.5 spacings: even cover, no gap.
+  for (int k = 0; k < 200; ++k) {
+    const double u = (k % 20 + 0.5) / 20, w = (k / 20 + 0.5) / 10;
+    const Point3 q{u, w, 1.0};
+    double nearest = 1e300;
+    for (const Point3& p : s.points) nearest = std::min(nearest, norm(p - q));
+    REQUIRE(nearest <= 1.5 * spacing);
+  }
+  // Triangles not marked flat take their vertices' normals, blended: on the cube a corner's normal is
+  // the diagonal, so a point's normal leans off its face.
+  const std::vector<std::uint8_t> none(static_cast<std::size_t>(F.rows()), 0);
+  const MeshSamples smooth = mesh_facet_points(V, F, spacing, &none);
+  REQUIRE(smooth.points.size() == s.points.size());
+  std::size_t leaning = 0;
+  for (std::size_t i = 0; i < smooth.points.size(); ++i) leaning += dot(smooth.normals[i], s.normals[i]) < 0.99;
+  REQUIRE(leaning > smooth.points.size() / 2);
+  REQUIRE_THROWS_AS(mesh_facet_points(V, F, 0.0), InvalidArgument);
+}
+
+TEST_CASE("from_mesh: a cube of 8 vertices meshes as a cube, not the sphere its vertices interpolate",
+          "[facets]") {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  cube_mesh(V, F);
+  Mesher checked = Mesher::from_mesh(V, F, local_options(true));
+  const MesherStats& st = checked.stats();
+  REQUIRE(st.facet_triangles == 12);
+  REQUIRE(st.facet_points > 1000);
+  const double precision = 0.02 * checked.diagonal();
+  REQUIRE(checked.refine(precision));
+  const SurfaceMesh& m = checked.surface();
+  test::require_closed(m, 2, 1);
+  // Every vertex within 3% of the edge from the cube's faces (the edges and corners rounded at about the
+  // points' spacing, 0.017).
+  CHECK(worst_cube_distance(m) < 0.03);
+  // The vertices alone: a rounded blob 0.3 off the faces' middles (the check does the work).
+  Mesher plain = Mesher::from_mesh(V, F, local_options(false));
+  REQUIRE(plain.stats().facet_points == 0);
+  REQUIRE(plain.refine(precision));
+  CHECK(worst_cube_distance(plain.surface()) > 0.1);
+}
+
+TEST_CASE("from_mesh: the facet check leaves a fine mesh as its vertices alone give it", "[facets]") {
+  const TriangleMesh in = read_mesh(std::string(VITRI_DATA_DIR) + "/knot1.off");
+  Mesher checked = Mesher::from_mesh(in.V, in.F, local_options(true));
+  Mesher plain = Mesher::from_mesh(in.V, in.F, local_options(false));
+  REQUIRE(checked.stats().facet_samples > 0);
+  REQUIRE(checked.stats().facet_points == 0);
+  REQUIRE(checked.size() == plain.size());
+  const double precision = 0.02 * checked.diagonal();
+  REQUIRE(checked.refine(precision));
+  REQUIRE(plain.refine(precision));
+  const SurfaceMesh &a = checked.surface(), &b = plain.surface();
+  REQUIRE(a.vertices.size() == b.vertices.size());
+  for (std::size_t i = 0; i < a.vertices.size(); ++i) REQUIRE(a.vertices[i] == b.vertices[i]);
+}
+
+TEST_CASE("from_mesh: the global function keeps the facets' points within its size", "[facets]") {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  cube_mesh(V, F);
+  MesherOptions o;  // the library's default: the global function
+  o.threads = 2;
+  o.auto_local_above = 1200;
+  Mesher m = Mesher::from_mesh(V, F, o);
+  REQUIRE(m.stats().facet_points > 0);
+  REQUIRE(m.size() <= 1300);  // 3 constraints per point, about 400 points
+  REQUIRE(m.global_function() != nullptr);
+  REQUIRE(m.refine(0.03 * m.diagonal()));
+  test::require_closed(m.surface(), 2, 1);
+  CHECK(worst_cube_distance(m.surface()) < 0.08);
+}

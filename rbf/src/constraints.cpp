@@ -495,6 +495,9 @@ MeshSamples mesh_facet_samples(const Eigen::MatrixXd& V, const Eigen::MatrixXi& 
   return out;
 }
 
+/// mesh_facet_points(): the angle between two facets' normals above which their edge is a crease.
+constexpr double kCreaseDegrees = 30.0;
+
 MeshSamples mesh_facet_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, double spacing,
                               const std::vector<std::uint8_t>* flat, std::size_t max_points) {
   if (!(spacing > 0) || !std::isfinite(spacing))
@@ -571,6 +574,48 @@ MeshSamples mesh_facet_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
       n.push_back(normal_at(r));
     }
   }
+  // Creases: along each edge where two triangles meet at more than kCreaseDegrees, points `step` apart
+  // with the two facets' normals averaged, visited before the facets' grid points (the Poisson-disk pass
+  // keeps them, and the grid points beside them give way): the crease is held where it is, not rounded
+  // between the two faces' nearest grid points.
+  std::vector<Point3> crease_p, crease_n;
+  if (F.rows() > 0) {
+    std::vector<std::array<Eigen::Index, 3>> edges;  // (min vertex, max vertex, triangle)
+    edges.reserve(static_cast<std::size_t>(3 * F.rows()));
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::Index u = F(f, k), v = F(f, (k + 1) % 3);
+        edges.push_back({std::min(u, v), std::max(u, v), f});
+      }
+    std::sort(edges.begin(), edges.end());
+    const double cos_crease = std::cos(kCreaseDegrees * 3.14159265358979323846 / 180.0);
+    auto unit_normal = [&](Eigen::Index f) {
+      const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+      const Eigen::Vector3d cross = (b - a).cross(c - a);
+      return cross.norm() > 0 ? Eigen::Vector3d(flip * cross.normalized()) : Eigen::Vector3d::Zero();
+    };
+    for (std::size_t e = 0; e + 1 < edges.size(); ++e) {
+      if (edges[e][0] != edges[e + 1][0] || edges[e][1] != edges[e + 1][1]) continue;
+      if (e + 2 < edges.size() && edges[e + 2][0] == edges[e][0] && edges[e + 2][1] == edges[e][1]) continue;
+      const Eigen::Index f = edges[e][2], g = edges[e + 1][2];
+      if (!is_flat(f) && !is_flat(g)) continue;  // between two smooth triangles: the vertices hold it
+      const Eigen::Vector3d nf = unit_normal(f), ng = unit_normal(g);
+      if (nf.isZero() || ng.isZero() || nf.dot(ng) > cos_crease) continue;
+      const Eigen::Vector3d mean = nf + ng;
+      if (!(mean.norm() > 1e-9)) continue;  // a fold back onto itself: no outward side
+      const Eigen::Vector3d m = mean.normalized();
+      const Eigen::Vector3d a = V.row(edges[e][0]), b = V.row(edges[e][1]);
+      const auto count = static_cast<long>(std::floor((b - a).norm() / step));
+      for (long i = 1; i <= count; ++i) {
+        const Eigen::Vector3d r = a + (static_cast<double>(i) / static_cast<double>(count + 1)) * (b - a);
+        crease_p.push_back({r.x(), r.y(), r.z()});
+        crease_n.push_back({m.x(), m.y(), m.z()});
+      }
+      ++e;
+    }
+  }
+  p.insert(p.begin() + static_cast<std::ptrdiff_t>(vertices), crease_p.begin(), crease_p.end());
+  n.insert(n.begin() + static_cast<std::ptrdiff_t>(vertices), crease_n.begin(), crease_n.end());
   std::vector<std::size_t> order(p.size());
   std::iota(order.begin(), order.end(), std::size_t(0));
   const std::vector<char> kept = rbf_detail::spaced_subset(p, order, 0.5 * step);

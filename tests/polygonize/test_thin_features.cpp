@@ -50,7 +50,11 @@ long long euler_at(const Mesher& mesher, double relative, QueueOrder order, bool
 // binary, run by its own CTest entry thin_features_slow (label slow).
 TEST_CASE("thin features: hand.off has the hand's topology at 0.02, 0.015 and 0.01", "[.][slow][polygonize]") {
   const TriangleMesh in = read_mesh(std::string(VITRI_DATA_DIR) + "/hand.off");
-  const Mesher mesher = Mesher::from_mesh(in.V, in.F);
+  // The vertices' own constraints: the facet check (docs/guide.md "Meshes with large facets") would add
+  // points on the wrist's cap, and the rule is tested on the function these numbers were measured on.
+  MesherOptions o;
+  o.check_facets = false;
+  const Mesher mesher = Mesher::from_mesh(in.V, in.F, o);
   REQUIRE(mesher.size() == 3591);
   CHECK(euler_at(mesher, 0.02, QueueOrder::Fifo) == 2);
   CHECK(euler_at(mesher, 0.015, QueueOrder::Fifo) == 2);

@@ -737,7 +737,7 @@ std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPl
   const FacetCheck check =
       check_facets(mesh->mesh.V, mesh->mesh.F, mesher->function(), spacing, options.threads, 4000000, coarsest);
   if (!c.quiet)
-    std::fprintf(stderr, "facet check: %zu samples of the facets read, %zu triangles (%.2g%% of the area) farther "
+    std::fprintf(stderr, "facet check: %zu samples of the facets read, %zu triangles (%.3g%% of the area) farther "
                  "than %.4g from the vertices' surface%s (docs/guide.md \"Meshes with large facets\")\n",
                  check.checked, check.triangles, 100 * check.missed_area, check.tolerance,
                  check.added.points.empty() ? "" : ": the facets sampled, fitted again");

@@ -21,6 +21,9 @@ namespace {
 /// surface for them would only trade it for the facets' (fandisk's distance to its own mesh, p99:
 /// 0.08 -> 0.57 x 10^-3 of its diagonal, its sharp edges serrated).
 constexpr double kFacetMissedShare = 0.01;
+/// The facets' points are at most max(kFacetPointsBase, kFacetPointsPerVertex x the mesh's vertices).
+constexpr std::size_t kFacetPointsBase = 200000;
+constexpr std::size_t kFacetPointsPerVertex = 20;
 
 }  // namespace
 
@@ -47,7 +50,10 @@ FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, cons
   }
   if (!any) return out;
   std::vector<Eigen::Index> triangle;
-  const MeshSamples samples = mesh_facet_samples(V, F, out.spacing, &longer, &triangle);
+  // The samples read: every checked triangle's centroid, at most about max(kFacetPointsBase, 2 x the
+  // triangles) in all (a wider spacing beyond).
+  const std::size_t readable = std::max<std::size_t>(kFacetPointsBase, 2 * static_cast<std::size_t>(F.rows()));
+  const MeshSamples samples = mesh_facet_samples(V, F, out.spacing, &longer, &triangle, readable);
   const std::size_t n = samples.points.size();
   out.checked = n;
   std::vector<double> value(n);
@@ -83,6 +89,11 @@ FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, cons
   // Every triangle gets points (the missed ones alone left the surface between them and the others
   // uneven: a cone's side sampled, its tip not, gave ridges along the tip's rings): the missed ones
   // with their facets' normals, the others with their vertices' blended.
+  // A mesh whose vertices crowd in small details (a CAD part's fillets) has a small median spacing, and
+  // its large faces would take millions of points at it: at most max(kFacetPointsBase, kFacetPointsPerVertex
+  // x the vertices) points (a wider spacing beyond).
+  max_points = std::min<std::size_t>(
+      max_points, std::max<std::size_t>(kFacetPointsBase, kFacetPointsPerVertex * static_cast<std::size_t>(V.rows())));
   if (out.missed_area >= kFacetMissedShare && max_points > 0) {
     if (min_spacing > out.spacing && std::isfinite(min_spacing)) out.spacing = min_spacing;
     out.added = mesh_facet_points(V, F, out.spacing, &missed, max_points);

@@ -776,7 +776,7 @@ TEST_CASE("vitri mesh: a closed mesh of large facets meshes as its facets (the f
   REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
   INFO(o << e);
   REQUIRE(e.find("facet check: ") != std::string::npos);
-  REQUIRE(e.find("12 triangles (1e+02% of the area)") != std::string::npos);
+  REQUIRE(e.find("12 triangles (100% of the area)") != std::string::npos);
   REQUIRE(e.find("the facets sampled, fitted again") != std::string::npos);
   check_mesh(out);
   // Every vertex on the cube's faces within 3% of its edge (the vertices' sphere: 0.3 off the faces).

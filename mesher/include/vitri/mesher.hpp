@@ -257,7 +257,8 @@ struct MesherStats {
 /// the diagonal) from the zero set (|f| / |grad f|, a first-order distance). When the missed triangles
 /// hold 1% of the area or more, points spread evenly over the whole mesh are `added`
 /// (constraints_from_mesh's `facets`): fitted with the vertices, they hold the surface on the facets;
-/// at most about `max_points` of them (a wider spacing beyond; 0: none added), at least `min_spacing`
+/// at most about min(`max_points`, max(200,000, 20 x the vertices)) of them (a wider spacing beyond; 0:
+/// none added), at least `min_spacing`
 /// apart (an absolute length; `vitri mesh` gives its coarsest level's, so that the points do not make
 /// the coarse levels as fine as the last). `threads`: 0, every CPU.
 struct FacetCheck {

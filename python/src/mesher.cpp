@@ -106,6 +106,8 @@ Options parse_options(const py::kwargs& kw, const char* fn, bool one_call) {
       else if (s == "open") m.surface = SurfaceKind::Open;
       else if (s == "auto") m.surface = SurfaceKind::Auto;
       else throw InvalidArgument("surface must be 'closed', 'open' or 'auto', got '" + s + "'");
+    } else if (key == "vertices_only") {  // --vertices-only: a closed mesh's vertices alone, no facet check
+      m.check_facets = !v.cast<bool>();
     } else if (key == "handles") {  // --handles: cycles shorter than this many resolutions are cut
       m.handle_loop_resolutions = number(v, "handles", 0.0, std::numeric_limits<double>::max(), false);
     } else if (key == "viewpoint") {

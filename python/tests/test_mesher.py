@@ -45,6 +45,30 @@ def test_from_mesh():
     assert euler_characteristic(V, F) == 2
 
 
+def test_from_mesh_facet_check():
+    # A cube as a CAD export writes it (8 vertices): its vertices alone interpolate a blob; the facet
+    # check adds points on the faces, and the mesh lies on them (docs/guide.md "Meshes with large facets").
+    V = np.array([[i & 1, (i >> 1) & 1, (i >> 2) & 1] for i in range(8)], dtype=float)
+    F = np.array([[0, 2, 1], [1, 2, 3], [4, 5, 6], [5, 7, 6], [0, 1, 4], [1, 5, 4], [2, 6, 3], [3, 6, 7],
+                  [0, 4, 2], [2, 4, 6], [1, 3, 5], [3, 7, 5]])
+
+    def worst(m):
+        m.refine(0.03, relative=True)
+        Vout, Fout, _ = m.mesh()
+        assert_closed_manifold(Vout, Fout)
+        inside = np.minimum(Vout, 1 - Vout).min(axis=1)  # distance to the faces from inside
+        outside = np.linalg.norm(np.maximum(Vout - 1, 0) + np.maximum(-Vout, 0), axis=1)
+        return np.where(outside > 0, outside, inside).max()
+
+    m = vitri.Mesher.from_mesh(V, F, function="local", threads=2)
+    s = m.stats()
+    assert s["facet_triangles"] == 12 and s["facet_points"] > 1000 and s["facet_samples"] > 0
+    assert worst(m) < 0.03
+    plain = vitri.Mesher.from_mesh(V, F, function="local", threads=2, vertices_only=True)
+    assert plain.stats()["facet_points"] == 0
+    assert worst(plain) > 0.1
+
+
 def test_from_mesh_leaves_out_triangles_without_area():
     # A triangle that names a vertex twice (exporters leave them): left out with a warning, as `vitri mesh`
     # does; the rest of the closed mesh gives the same mesh as without it (it was refused before).

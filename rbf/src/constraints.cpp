@@ -569,9 +569,20 @@ MeshSamples mesh_facet_points(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F
         ++placed;
       }
     if (placed == 0) {
-      const Eigen::Vector3d r = (a + b + c) / 3.0;
-      p.push_back({r.x(), r.y(), r.z()});
-      n.push_back(normal_at(r));
+      // Too thin for the grid (a sliver of a fan, as a cone's tip is made): points along its spine, from
+      // the corner opposite its shortest edge to that edge's middle, `step` apart (one, the centroid's
+      // place, when shorter). The tip is then held by points up to the apex, not by the vertices alone.
+      int s = 0;  // the shortest edge runs from q[s] to q[s + 1]
+      for (int k = 1; k < 3; ++k)
+        if ((q[(k + 1) % 3] - q[k]).norm() < (q[(s + 1) % 3] - q[s]).norm()) s = k;
+      const Eigen::Vector3d from = q[(s + 2) % 3], to = 0.5 * (q[s] + q[(s + 1) % 3]);
+      const auto m = std::max<long>(1, std::lround((to - from).norm() / step));
+      for (long i = 0; i < m; ++i) {
+        const double t = m == 1 ? 2.0 / 3.0 : (static_cast<double>(i) + 0.5) / static_cast<double>(m);
+        const Eigen::Vector3d r = from + t * (to - from);
+        p.push_back({r.x(), r.y(), r.z()});
+        n.push_back(normal_at(r));
+      }
     }
   }
   // Creases: along each edge where two triangles meet at more than kCreaseDegrees, points `step` apart

@@ -735,7 +735,7 @@ std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPl
   // kSpacingFactor, as the default precision is the spacing times it), so that it stays coarse.
   const double coarsest = c.precisions.empty() ? 0.0 : c.precisions.front() * mesher->diagonal() / kSpacingFactor;
   const FacetCheck check =
-      check_facets(mesh->mesh.V, mesh->mesh.F, mesher->function(), spacing, options.threads, 4000000, coarsest);
+      check_facets(mesh->mesh.V, mesh->mesh.F, mesher->function(), spacing, 4000000, coarsest);
   if (!c.quiet)
     std::fprintf(stderr, "facet check: %zu samples of the facets read, %zu triangles (%.3g%% of the area) farther "
                  "than %.4g from the vertices' surface%s (docs/guide.md \"Meshes with large facets\")\n",

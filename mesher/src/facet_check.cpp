@@ -9,7 +9,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <thread>
 #include <vector>
 
 namespace vitri {
@@ -28,7 +27,7 @@ constexpr std::size_t kFacetPointsPerVertex = 20;
 }  // namespace
 
 FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const ImplicitFunction& f,
-                        double spacing, unsigned threads, std::size_t max_points, double min_spacing) {
+                        double spacing, std::size_t max_points, double min_spacing) {
   FacetCheck out;
   if (!(spacing > 0) || !std::isfinite(spacing) || F.rows() == 0) return out;
   Box3 box;
@@ -58,17 +57,9 @@ FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, cons
   out.checked = n;
   std::vector<double> value(n);
   std::vector<Point3> gradient(n);
-  // Batches on the threads (the functions' evaluation is const and thread-safe).
-  const unsigned hw = std::max(1u, std::thread::hardware_concurrency());
-  const std::size_t workers = std::min<std::size_t>(threads ? threads : hw, std::max<std::size_t>(1, n / 4096));
-  const std::size_t chunk = (n + workers - 1) / std::max<std::size_t>(workers, 1);
-  std::vector<std::thread> pool;
-  for (std::size_t w = 1; w < workers; ++w) {
-    const std::size_t b = w * chunk, e = std::min(n, b + chunk);
-    if (b < e) pool.emplace_back([&, b, e] { f.values_gradients(&samples.points[b], e - b, &value[b], &gradient[b]); });
-  }
-  if (n) f.values_gradients(samples.points.data(), std::min(n, chunk), value.data(), gradient.data());
-  for (std::thread& t : pool) t.join();
+  // One batch: the functions' own batch evaluation runs on their threads (the local one in a spatial
+  // order of the points).
+  if (n) f.values_gradients(samples.points.data(), n, value.data(), gradient.data());
   std::vector<std::uint8_t> missed(static_cast<std::size_t>(F.rows()), 0);
   for (std::size_t i = 0; i < n; ++i) {
     const double g = norm(gradient[i]);
@@ -86,14 +77,14 @@ FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, cons
     if (missed[static_cast<std::size_t>(t)]) missed_area += at;
   }
   out.missed_area = area > 0 ? missed_area / area : 0.0;
-  // Every triangle gets points (the missed ones alone left the surface between them and the others
-  // uneven: a cone's side sampled, its tip not, gave ridges along the tip's rings): the missed ones
-  // with their facets' normals, the others with their vertices' blended.
   // A mesh whose vertices crowd in small details (a CAD part's fillets) has a small median spacing, and
   // its large faces would take millions of points at it: at most max(kFacetPointsBase, kFacetPointsPerVertex
   // x the vertices) points (a wider spacing beyond).
   max_points = std::min<std::size_t>(
       max_points, std::max<std::size_t>(kFacetPointsBase, kFacetPointsPerVertex * static_cast<std::size_t>(V.rows())));
+  // Every triangle gets points (the missed ones alone left the surface between them and the others
+  // uneven: a cone's side sampled, its tip not, gave ridges along the tip's rings): the missed ones
+  // with their facets' normals, the others with their vertices' blended.
   if (out.missed_area >= kFacetMissedShare && max_points > 0) {
     if (min_spacing > out.spacing && std::isfinite(min_spacing)) out.spacing = min_spacing;
     out.added = mesh_facet_points(V, F, out.spacing, &missed, max_points);

@@ -379,21 +379,17 @@ Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
   Mesher m = fitted(c);
   if (!o.check_facets) return m;
   // The facet check: where the vertices' interpolant leaves the facets, points on them, fitted again.
+  std::vector<Point3> surface;  // the vertices
+  for (std::size_t i = 0; i < c.size(); ++i)
+    if (c.values[i] == 0) surface.push_back(c.points[i]);
   double spacing = built.median_spacing;
-  if (!(spacing > 0)) {
-    std::vector<Point3> surface;
-    for (std::size_t i = 0; i < c.size(); ++i)
-      if (c.values[i] == 0) surface.push_back(c.points[i]);
-    spacing = surface.size() >= 2 ? median_spacing(surface) : 0.0;
-  }
+  if (!(spacing > 0)) spacing = surface.size() >= 2 ? median_spacing(surface) : 0.0;
   // The global function (an explicit choice) keeps its constraints within auto_local_above: the facets'
   // points are then fewer (a wider spacing), none when the vertices already reach it.
-  std::size_t surface = 0;
-  for (const double value : c.values) surface += value == 0;
   const std::size_t room = o.function == FunctionKind::Global
-                               ? (o.auto_local_above / 3 > surface ? o.auto_local_above / 3 - surface : 0)
+                               ? (o.auto_local_above / 3 > surface.size() ? o.auto_local_above / 3 - surface.size() : 0)
                                : std::size_t(4000000);
-  const FacetCheck check = check_facets(V, F, m.function(), spacing, o.threads, room);
+  const FacetCheck check = check_facets(V, F, m.function(), spacing, room);
   if (!check.added.points.empty()) {
     c = constraints_from_mesh(V, F, o.constraint_build, &built, &check.added);
     m = fitted(c);

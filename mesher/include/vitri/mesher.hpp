@@ -260,7 +260,7 @@ struct MesherStats {
 /// at most about min(`max_points`, max(200,000, 20 x the vertices)) of them (a wider spacing beyond; 0:
 /// none added), at least `min_spacing`
 /// apart (an absolute length; `vitri mesh` gives its coarsest level's, so that the points do not make
-/// the coarse levels as fine as the last). `threads`: 0, every CPU.
+/// the coarse levels as fine as the last). `f` is read in one batch, on its own threads.
 struct FacetCheck {
   double spacing = 0;         ///< of the samples
   double tolerance = 0;       ///< the distance from the zero set a facet sample may have
@@ -273,8 +273,7 @@ struct FacetCheck {
   MeshSamples added;
 };
 FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const ImplicitFunction& f,
-                        double spacing, unsigned threads = 0, std::size_t max_points = 4000000,
-                        double min_spacing = 0);
+                        double spacing, std::size_t max_points = 4000000, double min_spacing = 0);
 
 /// Memory model of a run, measured at 10^6 oriented points (docs/memory.md): bytes per input point of
 /// what is not the Delaunay structure (the scan's preparation, the constraints, the local function), the

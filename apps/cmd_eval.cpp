@@ -115,7 +115,7 @@ int run_eval(const Args& args) {
   mo.constraint_build = opt;
   mo.constraint_build.off_surface_spacing = kOffSurfaceSpacing;
   Input data = read_input(input);
-  drop_degenerate_triangles(data, input, "vitri eval");
+  repair_mesh(data, input, "vitri eval");
   Constraints c;
   if (is_scan(data)) {
     mo.scan = scan;

@@ -619,7 +619,7 @@ struct MeshPlan {
 /// (docs/guide.md). Such a mesh in `data` becomes those points, with a warning; any other input is left.
 void open_mesh_as_points(Input& data, const MeshCommand& c, MesherOptions& options) {
   if (data.kind != InputKind::Mesh) return;
-  drop_degenerate_triangles(data, c.input, "vitri mesh");
+  repair_mesh(data, c.input, "vitri mesh");
   MeshDefects defects;
   try {
     defects = mesh_defects(data.mesh.V, data.mesh.F);

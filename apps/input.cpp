@@ -40,11 +40,33 @@ std::string describe_scan(const ScanFit& fit, bool given) {
   return (v.empty() ? v : v + "\n") + describe(fit.report);
 }
 
-void drop_degenerate_triangles(Input& in, const std::string& name, const char* command) {
+void repair_mesh(Input& in, const std::string& name, const char* command) {
   if (in.kind != InputKind::Mesh) return;
-  if (const std::size_t n = vitri::drop_degenerate_triangles(in.mesh.F))
+  auto defects_of = [&](const Eigen::MatrixXi& F) {
+    try {
+      return mesh_defects(in.mesh.V, F);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(name + ": " + e.what());
+    }
+  };
+  if (const std::size_t n = drop_degenerate_triangles(in.mesh.F))
     std::fprintf(stderr, "%s: warning: %s: %zu triangle%s that repeat%s a vertex (no area) left out\n", command,
                  name.c_str(), n, n == 1 ? "" : "s", n == 1 ? "s" : "");
+  const MeshDefects given = defects_of(in.mesh.F);
+  if (given.closed()) return;
+  Eigen::MatrixXi merged = in.mesh.F;
+  const std::size_t n = merge_coincident_vertices(in.mesh.V, merged);
+  if (n == 0) return;
+  const std::size_t flat = drop_degenerate_triangles(merged);
+  if (merged.rows() == 0) return;
+  const MeshDefects now = defects_of(merged);
+  if (now.boundary_edges + now.repeated_edges >= given.boundary_edges + given.repeated_edges) return;
+  const std::string dropped = flat ? ", " + std::to_string(flat) + " triangles left without area dropped" : "";
+  std::fprintf(stderr,
+               "%s: %s: %zu vertices at the same position as another merged (a triangle soup or a mesh split "
+               "along its seams)%s%s\n",
+               command, name.c_str(), n, dropped.c_str(), now.closed() ? ": a closed mesh" : "");
+  in.mesh.F = std::move(merged);
 }
 
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,
@@ -117,9 +139,13 @@ Constraints constraints_for_function(Input in, const std::string& name, Constrai
     return settle(std::move(c));
   }
   // A global choice needs at most auto_local_above constraints, hence as many surface points after the
-  // merge: keep a copy of a small input to build them again without the spacing.
+  // merge: keep a copy of a small input to build them again without the spacing. A mesh is always kept:
+  // its rows may be more than its points (a triangle soup's merged vertices), and the file as read again
+  // would lack what repair_mesh() made of it.
   std::optional<Input> copy;
-  if (choose_function(function, input_points(in, facets), auto_local_above) == FunctionKind::Global) copy = in;
+  if (in.kind == InputKind::Mesh ||
+      choose_function(function, input_points(in, facets), auto_local_above) == FunctionKind::Global)
+    copy = in;
   Constraints c = constraints_of(std::move(in), name, build, &report, {}, nullptr, facets);
   function = choose_function(function, c.size() + report.spaced_out, auto_local_above);
   if (function == FunctionKind::Local) return settle(std::move(c));

@@ -39,9 +39,13 @@ std::string viewpoint_line(const ScanOptions& scan, bool given);
 /// "viewpoint X Y Z (from the input)\n<describe(report)>". `given`: the viewpoint came from --viewpoint.
 std::string describe_scan(const ScanFit& fit, bool given);
 
-/// A mesh's triangles that name one vertex twice (no area: an edge or a point drawn as a triangle) are
-/// left out, with a warning on stderr naming `command`, the file and the count; other inputs are left.
-void drop_degenerate_triangles(Input& in, const std::string& name, const char* command);
+/// A mesh read as its file has it, made what the commands mesh: triangles that name one vertex twice (no
+/// area: an edge or a point drawn as a triangle) left out, with a warning on stderr naming `command`, the
+/// file and the count; and, when the mesh is not closed, its vertices at exactly the same position merged
+/// (merge_coincident_vertices(): a triangle soup such as an STL solid, or a mesh split along its seams),
+/// kept when that leaves fewer boundary and repeated edges, said on stderr. A closed mesh and other
+/// inputs are left as they are. @throws InvalidArgument naming the file for what is no triangle mesh.
+void repair_mesh(Input& in, const std::string& name, const char* command);
 
 /// The constraints of an input: as read (.xyzv), built from a closed mesh as Mesher::from_mesh builds
 /// them, or for points (with or without normals) through the scan path of scan_of() with `scan` (so

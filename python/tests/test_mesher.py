@@ -69,6 +69,23 @@ def test_from_mesh_facet_check():
     assert worst(plain) > 0.1
 
 
+def test_from_mesh_merges_a_triangle_soup():
+    # A triangle soup (one vertex per corner, as an STL solid has them) was refused as a mesh with a
+    # boundary; its coincident vertices are merged, and it gives the indexed mesh's function exactly.
+    sphere = vitri.reconstruct(sphere_points(300)[0], precision=0.1)
+    soup_v = sphere.vertices[sphere.faces.reshape(-1)]
+    soup_f = np.arange(soup_v.shape[0]).reshape(-1, 3)
+    m = vitri.Mesher.from_mesh(soup_v, soup_f)
+    m.refine(0.08, relative=True)
+    indexed = vitri.Mesher.from_mesh(sphere.vertices, sphere.faces)
+    indexed.refine(0.08, relative=True)
+    V, F, _ = m.mesh()
+    V0, F0, _ = indexed.mesh()
+    assert_closed_manifold(V, F)
+    assert V.shape == V0.shape and F.shape == F0.shape
+    assert np.allclose(V, V0, rtol=0, atol=1e-9 * np.ptp(V0, axis=0).max())
+
+
 def test_from_mesh_leaves_out_triangles_without_area():
     # A triangle that names a vertex twice (exporters leave them): left out with a warning, as `vitri mesh`
     # does; the rest of the closed mesh gives the same mesh as without it (it was refused before).

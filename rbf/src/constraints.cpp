@@ -25,6 +25,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <numeric>
 #include <random>
 #include <string>
@@ -321,6 +322,45 @@ std::size_t drop_degenerate_triangles(Eigen::MatrixXi& F) {
   const auto dropped = static_cast<std::size_t>(F.rows() - kept);
   if (dropped) F.conservativeResize(kept, 3);
   return dropped;
+}
+
+std::size_t merge_coincident_vertices(const Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+  if (V.cols() != 3 || F.cols() != 3) throw InvalidArgument("mesh: V and F must have 3 columns");
+  const auto nv = V.rows();
+  // The referenced vertices only (an unreferenced duplicate changes nothing), each keyed by its
+  // coordinates' bits (+ 0.0 for -0.0), the first of each position in V's order kept.
+  std::vector<std::uint8_t> used(static_cast<std::size_t>(nv), 0);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) >= 0 && F(f, k) < nv) used[static_cast<std::size_t>(F(f, k))] = 1;
+  using Key = std::array<std::uint64_t, 3>;
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const {
+      std::uint64_t h = 0x9e3779b97f4a7c15ULL;
+      for (std::uint64_t x : k) h = (h ^ x) * 0xff51afd7ed558ccdULL, h ^= h >> 32;
+      return static_cast<std::size_t>(h);
+    }
+  };
+  std::unordered_map<Key, int, KeyHash> first;
+  first.reserve(static_cast<std::size_t>(nv));
+  std::vector<int> to(static_cast<std::size_t>(nv));
+  std::size_t merged = 0;
+  for (Eigen::Index i = 0; i < nv; ++i) {
+    to[static_cast<std::size_t>(i)] = static_cast<int>(i);
+    if (!used[static_cast<std::size_t>(i)]) continue;
+    Key key;
+    for (int k = 0; k < 3; ++k) {
+      const double x = V(i, k) + 0.0;  // -0.0 + 0.0 is +0.0
+      std::memcpy(&key[static_cast<std::size_t>(k)], &x, sizeof x);
+    }
+    const auto [at, inserted] = first.emplace(key, static_cast<int>(i));
+    if (!inserted) to[static_cast<std::size_t>(i)] = at->second, ++merged;
+  }
+  if (merged)
+    for (Eigen::Index f = 0; f < F.rows(); ++f)
+      for (int k = 0; k < 3; ++k)
+        if (F(f, k) >= 0 && F(f, k) < nv) F(f, k) = to[static_cast<std::size_t>(F(f, k))];
+  return merged;
 }
 
 MeshDefects mesh_defects(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {

@@ -762,25 +762,8 @@ TEST_CASE("vitri mesh: a flat scan gives one sheet on its plane", "[cli][mesh]")
   CHECK(farthest < 1e-3);  // the spacing is about 0.0033
 }
 
-TEST_CASE("vitri mesh: a closed mesh of large facets meshes as its facets (the facet check)", "[cli][mesh]") {
-  // A cube as a CAD export writes it: 8 vertices, 12 triangles. Its vertices alone interpolate a sphere.
-  const std::string in = kDir + "/mesh_cube8.off", out = kDir + "/mesh_cube8.ply";
-  {
-    std::ofstream c(in);
-    c << "OFF\n8 12 0\n";
-    for (int i = 0; i < 8; ++i) c << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << ((i >> 2) & 1) << '\n';
-    c << "3 0 2 1\n3 1 2 3\n3 4 5 6\n3 5 7 6\n3 0 1 4\n3 1 5 4\n3 2 6 3\n3 3 6 7\n3 0 4 2\n3 2 4 6\n"
-         "3 1 3 5\n3 3 7 5\n";
-  }
-  std::string o, e;
-  REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
-  INFO(o << e);
-  REQUIRE(e.find("facet check: ") != std::string::npos);
-  REQUIRE(e.find("12 triangles (100% of the area)") != std::string::npos);
-  REQUIRE(e.find("the facets sampled, fitted again") != std::string::npos);
-  check_mesh(out);
-  // Every vertex on the cube's faces within 3% of its edge (the vertices' sphere: 0.3 off the faces).
-  const TriangleMesh m = read_mesh(out);
+/// The largest distance of a mesh's vertices to the surface of the unit cube [0, 1]^3.
+double farthest_from_unit_cube(const TriangleMesh& m) {
   double worst = 0;
   for (Eigen::Index i = 0; i < m.V.rows(); ++i) {
     double inside = 1, outside2 = 0;
@@ -793,5 +776,51 @@ TEST_CASE("vitri mesh: a closed mesh of large facets meshes as its facets (the f
     }
     worst = std::max(worst, in_cube ? inside : std::sqrt(outside2));
   }
-  CHECK(worst < 0.03);
+  return worst;
+}
+
+/// The unit cube as a CAD export writes it: 8 vertices, 12 triangles, outward ([i] = (i&1, i>>1&1, i>>2&1)).
+constexpr int kCubeTriangles[12][3] = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                                       {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+
+TEST_CASE("vitri mesh: a closed mesh of large facets meshes as its facets (the facet check)", "[cli][mesh]") {
+  // A cube as a CAD export writes it: 8 vertices, 12 triangles. Its vertices alone interpolate a sphere.
+  const std::string in = kDir + "/mesh_cube8.off", out = kDir + "/mesh_cube8.ply";
+  {
+    std::ofstream c(in);
+    c << "OFF\n8 12 0\n";
+    for (int i = 0; i < 8; ++i) c << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << ((i >> 2) & 1) << '\n';
+    for (const auto& t : kCubeTriangles) c << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
+  INFO(o << e);
+  REQUIRE(e.find("facet check: ") != std::string::npos);
+  REQUIRE(e.find("12 triangles (100% of the area)") != std::string::npos);
+  REQUIRE(e.find("the facets sampled, fitted again") != std::string::npos);
+  check_mesh(out);
+  // Every vertex on the cube's faces within 3% of its edge (the vertices' sphere: 0.3 off the faces).
+  CHECK(farthest_from_unit_cube(read_mesh(out)) < 0.03);
+}
+
+TEST_CASE("vitri mesh: a triangle soup (one vertex per corner, as STL has them) is merged into its closed mesh",
+          "[cli][mesh]") {
+  // The cube above as a soup: 36 vertex rows, each position 3 to 6 times. Unmerged it has 36 boundary
+  // edges and goes through the scan path (rounded edges); merged it is the closed cube and its facets.
+  const std::string in = kDir + "/mesh_cube_soup.obj", out = kDir + "/mesh_cube_soup.ply";
+  {
+    std::ofstream c(in);
+    for (const auto& t : kCubeTriangles)
+      for (int i : t) c << "v " << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << ((i >> 2) & 1) << '\n';
+    for (int f = 0; f < 12; ++f) c << "f " << 3 * f + 1 << ' ' << 3 * f + 2 << ' ' << 3 * f + 3 << '\n';
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("28 vertices at the same position as another merged") != std::string::npos);
+  CHECK(e.find(": a closed mesh") != std::string::npos);
+  CHECK(e.find("not a closed mesh") == std::string::npos);
+  REQUIRE(e.find("12 triangles (100% of the area)") != std::string::npos);
+  check_mesh(out);
+  CHECK(farthest_from_unit_cube(read_mesh(out)) < 0.03);
 }

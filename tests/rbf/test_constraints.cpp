@@ -246,6 +246,44 @@ TEST_CASE("closed mesh normals: outward, flipped when wound inwards; boundary an
                     Catch::Contains("boundary") && Catch::Contains("edge ("));
 }
 
+TEST_CASE("a triangle soup's coincident vertices merged: the closed tetrahedron again", "[rbf][constraints]") {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_tetrahedron(V, F);
+  // The soup: one vertex per corner (as an STL solid has them), a -0.0 for a 0.0, and one vertex 1e-12
+  // away from a corner (close is not coincident).
+  Eigen::MatrixXd S(3 * F.rows() + 1, 3);
+  Eigen::MatrixXi T(F.rows(), 3);
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      S.row(3 * f + k) = V.row(F(f, k));
+      T(f, k) = static_cast<int>(3 * f + k);
+    }
+  for (Eigen::Index i = 0; i < S.rows() - 1; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (S(i, k) == 0.0 && i % 2) S(i, k) = -0.0;
+  S.row(S.rows() - 1) = S.row(0);
+  S(S.rows() - 1, 0) += 1e-12;
+  REQUIRE(mesh_defects(S, T).boundary_edges == 12);
+  Eigen::MatrixXi M = T;
+  CHECK(merge_coincident_vertices(S, M) == 8);  // 12 corners on 4 positions (the unreferenced row counts not)
+  CHECK(mesh_defects(S, M).closed());
+  // The first vertex of each position kept, the triangles' order and orientation kept: the same
+  // triangles as the indexed tetrahedron's, corner for corner.
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      CHECK(S.row(M(f, k)) == V.row(F(f, k)));
+      CHECK(M(f, k) <= T(f, k));
+    }
+  CHECK(merge_coincident_vertices(S, M) == 0);  // nothing left to merge
+  // A corner only close to another stays its own vertex.
+  Eigen::MatrixXi N = T;
+  N(0, 0) = static_cast<int>(S.rows() - 1);
+  CHECK(merge_coincident_vertices(S, N) == 7);  // 11 corners on 4 positions, the close one alone
+  CHECK(N(0, 0) == S.rows() - 1);
+  CHECK(mesh_defects(S, N).boundary_edges == 4);
+}
+
 TEST_CASE("mesh defects counted without throwing; surface samples of an open mesh lie on its triangles",
           "[rbf][constraints]") {
   Eigen::MatrixXd V;

@@ -151,6 +151,15 @@ struct MeshDefects {
 /// Returns how many were removed. Indices are not checked here (mesh_defects does).
 std::size_t drop_degenerate_triangles(Eigen::MatrixXi& F);
 
+/// Points every triangle corner of F (#F x 3) at the first vertex of V (#V x 3) with exactly the same
+/// coordinates (0.0 and -0.0 equal), in V's order: a triangle soup (an STL file converted, one vertex per
+/// corner) or a mesh split along its texture or normal seams becomes indexed, and a closed surface closed.
+/// V is unchanged (the merged rows stay, unreferenced); F keeps its order and orientation. Triangles whose
+/// corners then coincide keep them (drop_degenerate_triangles removes them). Returns how many referenced
+/// vertices were merged into another. Vertices merely close are not merged. Indices are not checked here
+/// (mesh_defects does); a non-finite coordinate is merged only with the same bits.
+std::size_t merge_coincident_vertices(const Eigen::MatrixXd& V, Eigen::MatrixXi& F);
+
 /// The defects of a triangle mesh (V #V x 3, F #F x 3), without throwing for them.
 /// @throws InvalidArgument for what is not a triangle mesh at all: columns other than 3, no triangle, a
 ///         triangle with an out-of-range or repeated vertex index (named).

@@ -185,6 +185,7 @@ int run_studio(const Args& args) {
     constraints = default_blob();
   } else {
     Input in = read_input(sa.input);
+    repair_mesh(in, sa.input, "vitri studio");  // as vitri mesh: no-area triangles, a soup's vertices
     const bool points = is_scan(in);
     ScanFit fit;
     constraints = constraints_of(std::move(in), sa.input, build, nullptr, sa.scan, &fit);

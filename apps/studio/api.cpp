@@ -410,6 +410,7 @@ ApiResponse Api::load(const ApiRequest& r) {
   }
   // Parsed from memory: the server never opens a path a client names.
   Input in = parse_input(r.body, name);
+  cli::repair_mesh(in, name, "vitri studio");  // as vitri mesh: no-area triangles, a soup's vertices
   const bool points = cli::is_scan(in);
   ScanFit fit;
   Constraints c = cli::constraints_of(std::move(in), name, build_, nullptr, scan, &fit);

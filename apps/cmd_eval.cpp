@@ -159,7 +159,7 @@ const char* eval_usage() {
          "for each point of QUERY.xyz (3 or 6 columns; only positions are used), one line per point.\n"
          "f < 0 inside, f > 0 outside.\n"
          "\n"
-         "INPUT: constraints .xyzv (x y z value), a closed mesh .off / .obj / .ply (vertex normals\n"
+         "INPUT: constraints .xyzv (x y z value), a closed mesh .off / .obj / .ply / .stl (vertex normals\n"
          "       area-weighted, oriented outwards), or points with or\n"
          "       without normals (.xyz, .pwn, .pcd, a .ply / .off without faces): read as vitri mesh reads a\n"
          "       scan (docs/scans.md): duplicates and outliers set aside, noise absorbed, normals estimated\n"

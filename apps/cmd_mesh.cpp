@@ -47,8 +47,8 @@ const char* const kUsage =
     "the tetrahedra crossing the surface and writes the marching-tetrahedra mesh.\n"
     "\n"
     "INPUT   .xyzv  constraints 'x y z value' (f < 0 inside, f > 0 outside, 0 on the surface)\n"
-    "        .off / .obj / .ply  a closed mesh: normal constraints from its vertices and normals, and\n"
-    "                from points on its facets where the vertices' surface misses them (large flat\n"
+    "        .off / .obj / .ply / .stl  a closed mesh: normal constraints from its vertices and normals,\n"
+    "                and from points on its facets where the vertices' surface misses them (large flat\n"
     "                triangles: the facet check, docs/guide.md); a mesh\n"
     "                with holes or flipped triangles (a warning says so): its surface sampled (vertices,\n"
     "                at least 20000 points) and meshed as a scan without smoothing (open or closed)\n"
@@ -63,7 +63,7 @@ const char* const kUsage =
     "                (checked), the viewpoint (--viewpoint, PCD VIEWPOINT, NAME.viewpoint beside the\n"
     "                input, PLY vx vy vz) or estimated; then normal constraints; components the data do\n"
     "                not support dropped, an open scan trimmed to the data (--surface).\n"
-    "OUT     .obj, .ply or .off (with vertex normals where the format has them)\n"
+    "OUT     .obj, .ply, .off (with vertex normals where the format has them) or .stl (binary, float32)\n"
     "\n"
     "options:\n"
     "  -o, --output OUT     the mesh to write (required)\n"
@@ -360,7 +360,7 @@ void refine_within_budget(Mesher& mesher, double precision, bool lenient, bool q
 /// What the user asked of `vitri mesh`: the arguments as given and checked, before any file is read.
 struct MeshCommand {
   std::string input;   ///< INPUT
-  std::string output;  ///< -o OUT (.obj, .ply or .off)
+  std::string output;  ///< -o OUT (.obj, .ply, .off or .stl)
   std::string edits;   ///< --edits SCRIPT; empty: no script
   /// --precision per level, relative to the diagonal, strictly decreasing; empty: the data's resolution.
   std::vector<double> precisions;
@@ -404,8 +404,8 @@ std::string check_mesh_command(const MeshCommand& c) {
         return what.str();
       }
   const std::string ext = file_extension(c.output);
-  if (ext != "obj" && ext != "ply" && ext != "off")
-    return "output must end in .obj, .ply or .off, got '" + c.output + "'";
+  if (ext != "obj" && ext != "ply" && ext != "off" && ext != "stl")
+    return "output must end in .obj, .ply, .off or .stl, got '" + c.output + "'";
   return {};
 }
 

@@ -18,9 +18,9 @@ namespace {
 const char* const kUsage =
     "usage: vitri render MESH [MESH...] -o PICTURE.png [options]\n"
     "\n"
-    "Draws one or several triangle meshes (.off, .obj or .ply) into a PNG picture: shaded triangles, optional\n"
-    "wireframe, camera framing each mesh automatically. Several meshes are laid out as a grid of views.\n"
-    "Back faces (holes, flipped triangles, the inside) are drawn in red-brown.\n"
+    "Draws one or several triangle meshes (.off, .obj, .ply or .stl) into a PNG picture: shaded triangles,\n"
+    "optional wireframe, camera framing each mesh automatically. Several meshes are laid out as a grid of\n"
+    "views. Back faces (holes, flipped triangles, the inside) are drawn in red-brown.\n"
     "\n"
     "options:\n"
     "  -o, --output PATH     the PNG file to write (required)\n"

@@ -25,6 +25,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)vitri::parse_input(text, "fuzz.pcd");
 #elif defined(VITRI_FUZZ_las)
     (void)vitri::parse_input(text, "fuzz.las");
+#elif defined(VITRI_FUZZ_stl)
+    (void)vitri::parse_stl(text, "fuzz.stl");
 #endif
   } catch (const vitri::Error&) {
   }

@@ -195,7 +195,7 @@ Api::Api(Session& session, const ConstraintBuildOptions& build, const ScanOption
 }
 
 Api::~Api() {
-  for (const char* ext : {"xyzv", "obj", "ply", "off"}) std::remove(temp_path(ext).c_str());
+  for (const char* ext : {"xyzv", "obj", "ply", "off", "stl"}) std::remove(temp_path(ext).c_str());
   rmdir(temp_dir_.c_str());
 }
 
@@ -389,8 +389,9 @@ ApiResponse Api::load(const ApiRequest& r) {
   const std::string name = param(r, "name");
   if (name.empty() || name.size() > 200) throw BadRequest("\"name\" (the uploaded file's name) is required");
   const std::string ext = file_extension(name);
-  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "pcd" && ext != "off" && ext != "obj" && ext != "ply")
-    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply)");
+  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "pcd" && ext != "off" && ext != "obj" &&
+      ext != "ply" && ext != "stl")
+    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply, .stl)");
   if (r.body.empty()) throw BadRequest(name + ": empty file");
   // Points are read as vitri mesh reads a scan; "viewpoint=X,Y,Z" plays its --viewpoint (else the
   // file's own, a PCD VIEWPOINT).
@@ -424,14 +425,14 @@ ApiResponse Api::export_file(const ApiRequest& r) {
   if (format == "xyzv") {
     const Constraints& c = session_.mesher().constraints();
     write_xyzv(path, PointValues{c.points, c.values});
-  } else if (format == "obj" || format == "ply" || format == "off") {
+  } else if (format == "obj" || format == "ply" || format == "off" || format == "stl") {
     session_.settle();  // the target mesh, with every edit (not the preview)
     write_mesh(path, cli::view_of(session_.mesher().surface()));
   } else {
-    throw BadRequest("\"format\" must be xyzv, obj, ply or off, got '" + format + "'");
+    throw BadRequest("\"format\" must be xyzv, obj, ply, off or stl, got '" + format + "'");
   }
   ApiResponse out;
-  out.content_type = format == "ply" ? "application/octet-stream" : "text/plain";
+  out.content_type = format == "ply" || format == "stl" ? "application/octet-stream" : "text/plain";
   out.body = read_whole_file(path);
   std::remove(path.c_str());
   out.download = download_name(session_.name(), format);

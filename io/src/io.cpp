@@ -1,7 +1,8 @@
 // Readers and writers of the text formats (xyzv, xyz, pwn, OFF, OBJ), the `.viewpoint` files, and
-// read_input() (PLY: ply.cpp and mesh_writers.cpp; PCD: pcd.cpp). Every reader works on an in-memory view
-// of the file so that the fuzz targets exercise exactly the same code; counts read from a file are checked
-// against what the rest of the file can hold before anything is allocated.
+// read_input() (PLY: ply.cpp and mesh_writers.cpp; STL: stl.cpp and mesh_writers.cpp; PCD: pcd.cpp).
+// Every reader works on an in-memory view of the file so that the fuzz targets exercise exactly the same
+// code; counts read from a file are checked against what the rest of the file can hold before anything is
+// allocated.
 
 #include "vitri/io/io.hpp"
 
@@ -564,7 +565,8 @@ TriangleMesh read_mesh(const std::string& path) {
   if (e == "off") return parse_off(io_detail::slurp(path), path);
   if (e == "obj") return parse_obj(io_detail::slurp(path), path);
   if (e == "ply") return parse_ply(io_detail::slurp(path), path);
-  throw ParseError(path, 0, "unknown mesh extension '." + e + "' (expected .off, .obj or .ply)");
+  if (e == "stl") return parse_stl(io_detail::slurp(path), path);
+  throw ParseError(path, 0, "unknown mesh extension '." + e + "' (expected .off, .obj, .ply or .stl)");
 }
 
 // ------------------------------------------------------------------ any input
@@ -606,6 +608,9 @@ Input parse_input(std::string_view bytes, const std::string& name) {
   } else if (e == "las" || e == "laz") {
     in.points = parse_las(bytes, name);  // (a .laz is refused there, saying how to decompress it)
     in.kind = InputKind::Points;
+  } else if (e == "stl") {
+    in.kind = InputKind::Mesh;
+    in.mesh = parse_stl(bytes, name);  // (never without a triangle)
   } else if (e == "off" || e == "obj" || e == "ply") {
     in.kind = InputKind::Mesh;
     std::vector<Point3> sensors;
@@ -620,7 +625,8 @@ Input parse_input(std::string_view bytes, const std::string& name) {
     throw ParseError(
         name, 0,
         "unknown input extension '." + e +
-            "' (expected .xyzv, .xyz, .pwn, .xyzn, .xyzrgb, .pts, .txt, .csv, .asc, .pcd, .las, .off, .obj or .ply)");
+            "' (expected .xyzv, .xyz, .pwn, .xyzn, .xyzrgb, .pts, .txt, .csv, .asc, .pcd, .las, .off, .obj, "
+            ".ply or .stl)");
   }
   return in;
 }
@@ -628,7 +634,7 @@ Input parse_input(std::string_view bytes, const std::string& name) {
 Input read_input(const std::string& path) {
   const std::string e = file_extension(path);
   if (e != "xyzv" && !is_point_text(e) && e != "pcd" && e != "las" && e != "laz" && e != "off" && e != "obj" &&
-      e != "ply")
+      e != "ply" && e != "stl")
     return parse_input({}, path);  // the unknown-extension error, before the file is opened
   Input in = parse_input(io_detail::slurp(path), path);
   if ((in.kind == InputKind::Points || in.kind == InputKind::OrientedPoints) && !in.points.viewpoint) {

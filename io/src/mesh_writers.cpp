@@ -1,24 +1,28 @@
 /// @file mesh_writers.cpp
-/// The mesh writers (OFF, OBJ, PLY ascii and binary little-endian), written once over a row source and
-/// used for both input shapes: a TriangleMesh (Eigen arrays) and a TriangleMeshView (arrays held
-/// elsewhere, e.g. the mesher's SurfaceMesh, written without a copy: at 10^6 points the copy was 0.1 GB
-/// of the CLI's peak). A row source gives num_vertices(), num_triangles(), has_normals(), vertex(i, k),
-/// normal(i, k) and index(f, k) (a long long, checked against the vertex count before anything is
-/// written).
+/// The mesh writers (OFF, OBJ, PLY ascii and binary little-endian, binary STL), written once over a row
+/// source and used for both input shapes: a TriangleMesh (Eigen arrays) and a TriangleMeshView (arrays
+/// held elsewhere, e.g. the mesher's SurfaceMesh, written without a copy: at 10^6 points the copy was
+/// 0.1 GB of the CLI's peak). A row source gives num_vertices(), num_triangles(), has_normals(),
+/// vertex(i, k), normal(i, k) and index(f, k) (a long long, checked against the vertex count before
+/// anything is written).
 #include "text.hpp"
 #include "vitri/core/error.hpp"
 #include "vitri/io/io.hpp"
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <fstream>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace vitri {
 
 using io_detail::finish_out;
+using io_detail::num;
 using io_detail::open_out;
 using io_detail::TextWriter;
 
@@ -162,6 +166,67 @@ void ply_rows(const std::string& path, const Rows& r, PlyEncoding encoding) {
   finish_out(out, path);
 }
 
+/// Binary little-endian STL: an 80-byte header (the text "vitri" and spaces; never the word "solid" first,
+/// which readers that look at the first word take for ASCII STL), the triangle count (uint32), then per
+/// triangle its unit normal (the normalized cross product of its edges, zero for a degenerate triangle),
+/// its three corners as float32 and a zero uint16 attribute. Vertex normals are not written (STL has
+/// none). A corner coordinate beyond float32's range (or not finite) is refused before the file is opened.
+template <class Rows>
+void stl_rows(const std::string& path, const Rows& r) {
+  check_indices(r, path);
+  const std::size_t nt = r.num_triangles();
+  if (nt > std::numeric_limits<std::uint32_t>::max())
+    throw InvalidArgument(path + ": " + std::to_string(nt) +
+                          " triangles, more than binary STL's 32-bit count holds");
+  for (std::size_t f = 0; f < nt; ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto i = static_cast<std::size_t>(r.index(f, k));
+      for (int a = 0; a < 3; ++a)
+        if (!(std::fabs(r.vertex(i, a)) <= FLT_MAX))
+          throw InvalidArgument(path + ": vertex " + std::to_string(i) + " (of triangle " +
+                                std::to_string(f) + ") has the coordinate " + num(r.vertex(i, a)) +
+                                ", not a finite float32 (STL stores float32)");
+    }
+  auto out = open_out(path, true);
+  const bool swap = !io_detail::host_little_endian();
+  std::string header(80, ' ');
+  header.replace(0, 5, "vitri");
+  out.write(header.data(), 80);
+  char count[4];
+  const auto n32 = static_cast<std::uint32_t>(nt);
+  std::memcpy(count, &n32, 4);
+  if (swap) std::reverse(count, count + 4);
+  out.write(count, 4);
+  // Records are assembled in a block of about 1 MB and written at once (as TextWriter does for text).
+  constexpr std::size_t kRecord = 50, kPerBlock = 20000;
+  std::vector<char> block(kRecord * std::min(nt, kPerBlock));
+  std::size_t used = 0;
+  for (std::size_t f = 0; f < nt; ++f) {
+    double p[3][3];
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) p[k][a] = r.vertex(static_cast<std::size_t>(r.index(f, k)), a);
+    const double e1[3] = {p[1][0] - p[0][0], p[1][1] - p[0][1], p[1][2] - p[0][2]};
+    const double e2[3] = {p[2][0] - p[0][0], p[2][1] - p[0][1], p[2][2] - p[0][2]};
+    double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    for (double& c : n) c = len > 0 && std::isfinite(len) ? c / len : 0.0;
+    char* rec = block.data() + used;
+    for (int j = 0; j < 12; ++j) {  // the normal, then the corners
+      const auto v = static_cast<float>(j < 3 ? n[j] : p[j / 3 - 1][j % 3]);
+      std::memcpy(rec + 4 * j, &v, 4);
+      if (swap) std::reverse(rec + 4 * j, rec + 4 * j + 4);
+    }
+    rec[48] = rec[49] = 0;  // the attribute
+    used += kRecord;
+    if (used == block.size()) {
+      out.write(block.data(), static_cast<std::streamsize>(used));
+      used = 0;
+    }
+  }
+  out.write(block.data(), static_cast<std::streamsize>(used));
+  finish_out(out, path);
+}
+
 template <class Mesh>
 struct RowsOf;
 template <>
@@ -173,7 +238,7 @@ struct RowsOf<TriangleMeshView> {
   using type = ViewRows;
 };
 
-enum class Format { Off, Obj, Ply, ByExtension };
+enum class Format { Off, Obj, Ply, Stl, ByExtension };
 
 /// Writes `mesh` in `format` (ByExtension: from the path's); the mesh shape is checked first.
 template <class Mesh>
@@ -185,10 +250,13 @@ void write_as(const std::string& path, const Mesh& mesh, Format format, PlyEncod
     if (e == "off") format = Format::Off;
     else if (e == "obj") format = Format::Obj;
     else if (e == "ply") format = Format::Ply;
-    else throw InvalidArgument(path + ": unknown mesh extension '." + e + "' (expected .off, .obj or .ply)");
+    else if (e == "stl") format = Format::Stl;
+    else throw InvalidArgument(path + ": unknown mesh extension '." + e +
+                               "' (expected .off, .obj, .ply or .stl)");
   }
   if (format == Format::Off) return off_rows(path, rows);
   if (format == Format::Obj) return obj_rows(path, rows);
+  if (format == Format::Stl) return stl_rows(path, rows);
   ply_rows(path, rows, ply);
 }
 
@@ -200,6 +268,7 @@ void write_mesh(const std::string& path, const TriangleMesh& m, PlyEncoding ply)
 void write_off(const std::string& path, const TriangleMesh& m) { write_as(path, m, Format::Off, {}); }
 void write_obj(const std::string& path, const TriangleMesh& m) { write_as(path, m, Format::Obj, {}); }
 void write_ply(const std::string& path, const TriangleMesh& m, PlyEncoding e) { write_as(path, m, Format::Ply, e); }
+void write_stl(const std::string& path, const TriangleMesh& m) { write_as(path, m, Format::Stl, {}); }
 
 void write_mesh(const std::string& path, const TriangleMeshView& m, PlyEncoding ply) {
   write_as(path, m, Format::ByExtension, ply);
@@ -207,5 +276,6 @@ void write_mesh(const std::string& path, const TriangleMeshView& m, PlyEncoding 
 void write_off(const std::string& path, const TriangleMeshView& m) { write_as(path, m, Format::Off, {}); }
 void write_obj(const std::string& path, const TriangleMeshView& m) { write_as(path, m, Format::Obj, {}); }
 void write_ply(const std::string& path, const TriangleMeshView& m, PlyEncoding e) { write_as(path, m, Format::Ply, e); }
+void write_stl(const std::string& path, const TriangleMeshView& m) { write_as(path, m, Format::Stl, {}); }
 
 }  // namespace vitri

@@ -62,8 +62,8 @@ void write(const std::string& path, py::handle data, bool ascii) {
     obj = py::module_::import("vitri").attr("Mesh")(*seq);
   }
   if (py::hasattr(obj, "faces")) {
-    if (ext != "obj" && ext != "off" && ext != "ply")
-      throw InvalidArgument(path + ": a mesh is written as .obj, .off or .ply");
+    if (ext != "obj" && ext != "off" && ext != "ply" && ext != "stl")
+      throw InvalidArgument(path + ": a mesh is written as .obj, .off, .ply or .stl");
     const std::vector<Point3> v = points_arg(obj.attr("vertices"), "vertices", true);
     const auto f = triangles_arg(obj.attr("faces"), "faces", v.size());
     std::vector<Point3> n;

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import vitri
-from conftest import euler_characteristic, sphere_points
+from conftest import assert_closed_manifold, euler_characteristic, sphere_points
 
 
 @pytest.fixture(scope="module")
@@ -24,6 +24,23 @@ def test_mesh_round_trip(tmp_path, mesh, name, ascii):
     assert np.allclose(back.vertices, mesh.vertices, rtol=0, atol=0 if exact else 1e-6)
     if not name.endswith(".off"):
         assert np.allclose(back.normals, mesh.normals, atol=1e-6)
+
+
+def test_stl_round_trip(tmp_path, mesh):
+    """Binary STL: float32 corners, no normals; read back welded into the same indexed mesh (the vertices
+    in the order the triangles first use them)."""
+    path = str(tmp_path / "m.stl")
+    vitri.write(path, mesh)
+    with open(path, "rb") as f:
+        data = f.read()
+    assert len(data) == 84 + 50 * len(mesh.faces) and not data.startswith(b"solid")
+    back = vitri.read(path)
+    assert isinstance(back, vitri.Mesh) and back.normals is None
+    assert len(back.vertices) == len(mesh.vertices) and len(back.faces) == len(mesh.faces)
+    corners = np.asarray(mesh.vertices, dtype=np.float32)[mesh.faces]
+    assert np.array_equal(np.asarray(back.vertices)[back.faces], corners.astype(np.float64))
+    assert euler_characteristic(back.vertices, back.faces) == euler_characteristic(mesh.vertices, mesh.faces)
+    assert_closed_manifold(back.vertices, back.faces)
 
 
 def test_tuple_and_no_normals(tmp_path, mesh):
@@ -74,8 +91,8 @@ def test_bundled_models(data_dir):
 
 
 def test_write_errors(tmp_path, mesh):
-    with pytest.raises(vitri.InvalidArgument, match="obj, .off or .ply"):
-        vitri.write(str(tmp_path / "m.stl"), mesh)
+    with pytest.raises(vitri.InvalidArgument, match="obj, .off, .ply or .stl"):
+        vitri.write(str(tmp_path / "m.3mf"), mesh)
     with pytest.raises(vitri.InvalidArgument, match="out of range"):
         vitri.write(str(tmp_path / "m.obj"), (mesh.vertices[:3], mesh.faces))
     with pytest.raises(TypeError):

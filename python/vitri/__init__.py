@@ -31,11 +31,12 @@ Functions:
         The surface f = 0 of the function through f(points[i]) = values[i] (f < 0 inside), as
         ``vitri mesh`` meshes an .xyzv file; default precision: 2.5 x the median spacing.
     read(path) -> Mesh | types.SimpleNamespace
-        .off/.obj/.ply with faces: a Mesh; .xyzv: kind='constraints', points, values; .xyz/.pwn/.pcd and
-        face-less .ply/.off/.obj: kind='points', points, normals (or None), viewpoint, sensors.
+        .off/.obj/.ply with faces and .stl (corners welded): a Mesh; .xyzv: kind='constraints', points,
+        values; .xyz/.pwn/.pcd and face-less .ply/.off/.obj: kind='points', points, normals (or None),
+        viewpoint, sensors.
     write(path, data, *, ascii=False)
-        A Mesh or (V, F[, N]) to .obj/.off/.ply (PLY binary unless ascii); an object with points and
-        values to .xyzv; with points (and normals) to .xyz/.pwn.
+        A Mesh or (V, F[, N]) to .obj/.off/.ply (PLY binary unless ascii) or .stl (binary, float32, no
+        normals); an object with points and values to .xyzv; with points (and normals) to .xyz/.pwn.
 
 Classes: Mesher (refinement, levels, edits by stable constraint ids, deltas), Rbf and LocalRbf (fit,
 evaluate, edit by ids), Delaunay

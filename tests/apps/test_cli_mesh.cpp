@@ -155,12 +155,12 @@ TEST_CASE("vitri mesh: several precisions write OUT-k with growing vertex counts
   REQUIRE_FALSE(exists(out));
 }
 
-TEST_CASE("vitri mesh: .ply and .off outputs hold the same mesh as .obj", "[cli][mesh]") {
+TEST_CASE("vitri mesh: .ply, .off and .stl outputs hold the same mesh as .obj", "[cli][mesh]") {
   const std::string in = write_small_model();
   std::string o, e;
-  long n[3];
-  const char* ext[3] = {"obj", "ply", "off"};
-  for (int i = 0; i < 3; ++i) {
+  long n[4];
+  const char* ext[4] = {"obj", "ply", "off", "stl"};  // (STL: float32 corners, welded again as read)
+  for (int i = 0; i < 4; ++i) {
     const std::string out = kDir + "/mesh_fmt." + ext[i];
     std::remove(out.c_str());
     REQUIRE(run(in + " -o " + out + " --precision 0.06 -q", o, e) == 0);
@@ -169,6 +169,7 @@ TEST_CASE("vitri mesh: .ply and .off outputs hold the same mesh as .obj", "[cli]
   }
   REQUIRE(n[0] == n[1]);
   REQUIRE(n[0] == n[2]);
+  REQUIRE(n[0] == n[3]);
   // PLY is binary unless --ascii; both hold the same values.
   const auto header = [](const std::string& path) {
     std::ifstream f(path, std::ios::binary);
@@ -512,8 +513,9 @@ TEST_CASE("vitri mesh: errors exit with 1 (bad input) or 2 (usage) and say why o
     REQUIRE(run(in + " -o " + out + " --precision 0.1 --frobnicate", o, e) == 2);
     REQUIRE(e.find("--frobnicate") != std::string::npos);
     REQUIRE(run(in + " --precision 0.1", o, e) == 2);
-    REQUIRE(run(in + " -o " + kDir + "/mesh_err.stl --precision 0.1", o, e) == 2);
-    REQUIRE(e.find(".stl") != std::string::npos);
+    REQUIRE(run(in + " -o " + kDir + "/mesh_err.3mf --precision 0.1", o, e) == 2);
+    REQUIRE(e.find(".3mf") != std::string::npos);
+    REQUIRE(e.find(".obj, .ply, .off or .stl") != std::string::npos);  // what it takes
   }
   SECTION("bad edit line, with its line number") {
     const std::string script = kDir + "/mesh_bad_edits.txt";
@@ -819,6 +821,29 @@ TEST_CASE("vitri mesh: a triangle soup (one vertex per corner, as STL has them) 
   INFO(o << e);
   CHECK(e.find("28 vertices at the same position as another merged") != std::string::npos);
   CHECK(e.find(": a closed mesh") != std::string::npos);
+  CHECK(e.find("not a closed mesh") == std::string::npos);
+  REQUIRE(e.find("12 triangles (100% of the area)") != std::string::npos);
+  check_mesh(out);
+  CHECK(farthest_from_unit_cube(read_mesh(out)) < 0.03);
+}
+
+TEST_CASE("vitri mesh: an ASCII STL solid is read as its closed mesh (corners welded by the reader)",
+          "[cli][mesh]") {
+  const std::string in = kDir + "/mesh_cube.stl", out = kDir + "/mesh_cube_stl.ply";
+  {
+    std::ofstream c(in);
+    c << "solid cube\n";
+    for (const auto& t : kCubeTriangles) {
+      c << "  facet normal 0 0 0\n    outer loop\n";
+      for (int i : t) c << "      vertex " << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << ((i >> 2) & 1) << '\n';
+      c << "    endloop\n  endfacet\n";
+    }
+    c << "endsolid cube\n";
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("merged") == std::string::npos);  // nothing left for the CLI to merge
   CHECK(e.find("not a closed mesh") == std::string::npos);
   REQUIRE(e.find("12 triangles (100% of the area)") != std::string::npos);
   check_mesh(out);

@@ -169,7 +169,7 @@ TEST_CASE("studio api: refine, precision, export, load", "[studio][api]") {
 
   // Exports as downloads; each parses back to the current mesh or constraints.
   const double vertices = number(r.get("/api/stats"), "vertices");
-  for (const char* format : {"obj", "ply", "off"}) {
+  for (const char* format : {"obj", "ply", "off", "stl"}) {
     const auto e = r.client.Get((std::string("/api/export?format=") + format).c_str());
     REQUIRE(e);
     CHECK(e->status == 200);
@@ -374,7 +374,7 @@ TEST_CASE("studio api: bad requests get a 4xx JSON error and change nothing", "[
   get_error("/api/constraints?since=99999999999999999999999", 400, "since");
   get_error("/api/mesh?format=svg", 400, "format");
   get_error("/api/mesh?exact=2", 400, "exact");
-  get_error("/api/export?format=stl", 400, "format");
+  get_error("/api/export?format=3mf", 400, "format");
   get_error("/api/export", 400, "format");
   get_error("/api/nothing", 404, "no such endpoint");
   get_error("/api/edit", 405, "takes POST");

@@ -311,7 +311,7 @@ TEST_CASE("io writers and readers refuse impossible requests", "[io][errors]") {
   TriangleMesh bad = tetra(false);
   bad.F(2, 1) = 9;
   CHECK_THROWS_AS(write_mesh(tmp("bad.obj"), bad), InvalidArgument);
-  CHECK_THROWS_AS(write_mesh(tmp("bad.stl"), tetra(false)), InvalidArgument);
+  CHECK_THROWS_AS(write_mesh(tmp("bad.3mf"), tetra(false)), InvalidArgument);
   CHECK_THROWS_AS(write_off("/nonexistent_dir/x.off", tetra(false)), ParseError);
   PointValues pv{{{0, 0, 0}}, {}};
   CHECK_THROWS_AS(write_xyzv(tmp("bad.xyzv"), pv), InvalidArgument);
@@ -377,6 +377,11 @@ TEST_CASE("io regression corpus: what the hand-written error files report", "[io
   const ParseError count = refused("xyz_count_after_comments.xyz");
   CHECK(count.line() == 4);
   CHECK_THAT(count.what(), Catch::Contains("declares 5 points, file has 3"));
+  // A binary STL whose header begins with "solid", cut short: the size a binary STL of its count has.
+  const ParseError stl = refused("stl_binary_truncated.stl");
+  CHECK(stl.line() == 0);
+  CHECK_THAT(stl.what(), Catch::Contains("264 bytes") && Catch::Contains("84 + 50 x 4 = 284 bytes"));
+  CHECK(refused("stl_ascii_two_vertices.stl").line() == 6);
 }
 
 // The writers format numbers with std::to_chars (io/src/text.hpp, put_number and TextWriter); the files

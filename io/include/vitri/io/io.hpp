@@ -5,14 +5,16 @@
 /// - points `.xyz` (3 columns: positions; 6 columns: positions and normals, or colours), `.pwn` (6 columns)
 ///   and other text point exports (`.xyzn`, `.xyzrgb`, `.pts`, `.txt`, `.csv`, `.asc`: parse_points());
 /// - point clouds `.pcd` (PCL's format: ascii, binary, binary_compressed) and `.las` (LiDAR), read only;
-/// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little- or big-endian) in;
-///   OFF, OBJ, PLY (ascii or binary little-endian) out, with vertex normals when known;
+/// - triangle meshes: OFF (also COFF, NOFF, CNOFF), OBJ, PLY (ascii, binary little- or big-endian), STL
+///   (binary or ASCII, corners welded into indexed vertices) in; OFF, OBJ, PLY (ascii or binary
+///   little-endian) out, with vertex normals when known, and binary STL;
 /// - sensor positions: `.viewpoint` files (`x y z`), read beside point inputs by read_input().
 ///
 /// Every reader throws vitri::ParseError(file, line, what) on a malformed file (truncated, wrong counts,
 /// non-numeric tokens, indices out of range, non-finite numbers), and ParseError with line 0 when the file
-/// cannot be opened. Binary PLY errors carry line 0 and a byte offset in the message. Readers never
-/// allocate more than the input can describe, so a corrupt count fails cleanly.
+/// cannot be opened. Binary PLY and STL errors carry line 0 and, in the message, a byte offset (STL: and
+/// the triangle, or the size expected). Readers never allocate more than the input can describe, so a
+/// corrupt count fails cleanly.
 ///
 /// The `parse_*` functions read from memory (what the fuzz targets call); `read_*` open a file and call
 /// them with the file name used in messages.
@@ -137,14 +139,35 @@ TriangleMesh parse_obj(std::string_view text, const std::string& name = "<memory
 /// nx, ny, nz, any other properties skipped) and element face (a list property named vertex_indices or
 /// vertex_index); other elements are skipped.
 TriangleMesh parse_ply(std::string_view bytes, const std::string& name = "<memory>");
-/// Reads a mesh by extension: .off, .obj, .ply (case-insensitive).
+/// STL, binary or ASCII (docs/formats.md). Binary when the size is exactly 84 + 50 x the uint32 count at
+/// byte 80 (whatever the header says: many binary files begin with "solid"); otherwise ASCII when the text
+/// begins with "solid" (`solid NAME`, `facet normal nx ny nz`, `outer loop`, 3 x `vertex x y z`, `endloop`,
+/// `endfacet` ..., `endsolid [NAME]`; keywords case-insensitive, any whitespace; several solids in a row
+/// read as one mesh). STL has no shared vertices: corners with exactly the same coordinates (as doubles;
+/// 0.0 and -0.0 equal) are welded into one vertex, in the order of first appearance, so a closed STL solid
+/// reads as a closed mesh. The facet normals are ignored (the corners' order gives the orientation); N
+/// is empty (0 x 3). Triangles whose corners coincide after welding are kept.
+/// @throws ParseError for a size that matches no binary STL in a file that is not ASCII STL (the message
+///         gives the size a binary STL of the declared count has), a file with no triangle, a non-finite
+///         coordinate (binary: line 0 and the triangle; ASCII: its line), and, in ASCII, an unexpected
+///         keyword, a facet with other than 3 vertices or a missing `endsolid` (with the 1-based line).
+TriangleMesh parse_stl(std::string_view bytes, const std::string& name = "<memory>");
+/// Reads a mesh by extension: .off, .obj, .ply, .stl (case-insensitive).
 TriangleMesh read_mesh(const std::string& path);
-/// Writes a mesh by extension (.off, .obj, .ply); N is written when it has #V rows. 17 significant
-/// digits in text formats.
+/// Writes a mesh by extension (.off, .obj, .ply, .stl); N is written when it has #V rows and the format
+/// holds vertex normals (not STL). 17 significant digits in text formats; `ply` applies to .ply only.
 void write_mesh(const std::string& path, const TriangleMesh& mesh, PlyEncoding ply = PlyEncoding::Ascii);
 void write_off(const std::string& path, const TriangleMesh& mesh);
 void write_obj(const std::string& path, const TriangleMesh& mesh);
 void write_ply(const std::string& path, const TriangleMesh& mesh, PlyEncoding encoding = PlyEncoding::Ascii);
+/// Binary little-endian STL: an 80-byte header holding "vitri" (never "solid" first), the triangle count,
+/// and per triangle its unit normal (the normalized cross product of its edges; zero for a degenerate
+/// triangle) and its corners, all float32. N is not written.
+/// @note float32 keeps about 7 significant digits: the positions read back are the float32 roundings.
+/// @throws InvalidArgument naming the file and the vertex for a corner coordinate that is not finite or
+///         beyond float32's range (|x| > FLT_MAX), and for more than 2^32 - 1 triangles; nothing is
+///         written then.
+void write_stl(const std::string& path, const TriangleMesh& mesh);
 /// The same writers on a view: the same bytes as for the TriangleMesh with the same values. An index
 /// out of range, or a mesh with more than 2^31 - 1 vertices (the formats' int indices), is an
 /// InvalidArgument naming the file and the triangle; nothing is written then.
@@ -152,6 +175,8 @@ void write_mesh(const std::string& path, const TriangleMeshView& mesh, PlyEncodi
 void write_off(const std::string& path, const TriangleMeshView& mesh);
 void write_obj(const std::string& path, const TriangleMeshView& mesh);
 void write_ply(const std::string& path, const TriangleMeshView& mesh, PlyEncoding encoding = PlyEncoding::Ascii);
+/// write_stl() on a view.
+void write_stl(const std::string& path, const TriangleMeshView& mesh);
 
 // ----- any input -----
 /// What read_input() found.
@@ -162,7 +187,7 @@ enum class InputKind {
   Points,          ///< 3-column .xyz, .pcd without normals, or a mesh file without faces and normals:
                    ///< `points` without normals (their normals must be estimated: constraints_from_points
                    ///< in vitri::rbf).
-  Mesh,            ///< .off, .obj, .ply with at least one face: `mesh`.
+  Mesh,            ///< .off, .obj, .ply with at least one face, or .stl: `mesh`.
 };
 
 /// One input file of any supported kind; only the member matching `kind` is filled.
@@ -174,7 +199,7 @@ struct Input {
 };
 
 /// Reads any supported input, detected by extension (.xyzv, the text point formats, .pcd, .las, .off,
-/// .obj, .ply). A mesh
+/// .obj, .ply, .stl). A mesh
 /// file with no face (a PLY point cloud, an OFF with 0 faces) is read as points, with normals when its
 /// vertices have them (PLY nx ny nz, NOFF, OBJ vn), and per-point sensor positions from PLY vx vy vz.
 /// When the result is points (kind Points or OrientedPoints) without a viewpoint from the file itself,

@@ -2,6 +2,7 @@
 #include "vitri/polygonize/surface_mesh.hpp"
 
 #include "vitri/core/error.hpp"
+#include "vitri/core/spatial_order.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -11,6 +12,67 @@
 #include <tuple>
 
 namespace vitri {
+
+namespace {
+
+/// Moves a[i] to a[to[i]] for every i < to.size() (`to` a permutation of [0, to.size())), in place,
+/// cycle by cycle; the entries beyond stay.
+template <class T>
+void permute_in_place(std::vector<T>& a, const std::vector<std::uint32_t>& to) {
+  std::vector<bool> placed(to.size(), false);
+  for (std::size_t i = 0; i < to.size(); ++i) {
+    if (placed[i]) continue;
+    T moving = a[i];
+    for (std::size_t j = to[i]; !placed[j]; j = to[j]) {
+      std::swap(moving, a[j]);
+      placed[j] = true;
+    }
+  }
+}
+
+}  // namespace
+
+SurfaceMesh renumbered(SurfaceMesh mesh, const std::vector<std::uint32_t>& vertex_to,
+                       const std::vector<std::uint32_t>& triangle_to) {
+  if (vertex_to.size() > mesh.vertices.size() || triangle_to.size() > mesh.triangles.size())
+    throw InvalidArgument("renumbered: more entries in a map than the mesh has elements");
+  permute_in_place(mesh.vertices, vertex_to);
+  if (mesh.normals.size() == mesh.vertices.size()) permute_in_place(mesh.normals, vertex_to);
+  for (auto& tri : mesh.triangles)
+    for (auto& c : tri)
+      if (c < vertex_to.size()) c = vertex_to[c];
+  permute_in_place(mesh.triangles, triangle_to);
+  return mesh;
+}
+
+SurfaceMesh spatially_ordered(SurfaceMesh mesh, std::vector<std::uint32_t>* new_of,
+                              std::vector<std::uint32_t>* triangle_new_of) {
+  const std::size_t nv = mesh.vertices.size(), nt = mesh.triangles.size();
+  std::vector<std::uint32_t> to(nv);
+  {
+    const std::vector<std::size_t> order = detail::spatial_order(mesh.vertices);
+    for (std::size_t k = 0; k < nv; ++k) to[order[k]] = static_cast<std::uint32_t>(k);
+  }
+  // Triangles by their smallest new corner, then their new corners (a total order on distinct
+  // triangles; equal ones keep their given order): the same order whatever the given numbering.
+  auto key = [&](const std::array<std::uint32_t, 3>& t) {
+    const std::uint32_t a = to[t[0]], b = to[t[1]], c = to[t[2]];
+    return std::make_tuple(std::min({a, b, c}), a, b, c);
+  };
+  std::vector<std::uint32_t> by(nt);
+  std::iota(by.begin(), by.end(), 0u);
+  std::sort(by.begin(), by.end(), [&](std::uint32_t a, std::uint32_t b) {
+    const auto ka = key(mesh.triangles[a]), kb = key(mesh.triangles[b]);
+    return ka != kb ? ka < kb : a < b;
+  });
+  std::vector<std::uint32_t> tri_to(nt);
+  for (std::size_t k = 0; k < nt; ++k) tri_to[by[k]] = static_cast<std::uint32_t>(k);
+  by = {};
+  mesh = renumbered(std::move(mesh), to, tri_to);
+  if (new_of) new_of->swap(to);
+  if (triangle_new_of) triangle_new_of->swap(tri_to);
+  return mesh;
+}
 
 SurfaceMesh keep_supported_components(SurfaceMesh mesh, const std::function<bool(const Point3&)>& supported,
                                       std::size_t* dropped) {

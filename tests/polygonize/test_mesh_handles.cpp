@@ -15,6 +15,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <random>
 #include <vector>
 
 using namespace vitri;
@@ -210,4 +211,57 @@ TEST_CASE("mesh_handles: triangle soups (non-manifold, repeated corners, flipped
       for (const std::uint32_t c : t) REQUIRE(c < out.vertices.size());
     CHECK(r.genus_after <= r.genus_before);
   }
+}
+
+TEST_CASE("mesh_handles: a large mesh numbered at random is searched by place and given back in its numbering",
+          "[mesh_handles]") {
+  // A torus of 400 x 200 quads (80,000 vertices: past the size at which a scattered numbering is searched
+  // by place), its vertices and triangles shuffled (neighbours ~27,000 ids apart at the median).
+  const std::uint32_t nu = 400, nw = 200;
+  const double R = 1.0, r = 0.3;  // meridian 2 pi 0.3 = 1.885
+  std::vector<std::uint32_t> id(nu * nw);
+  for (std::uint32_t i = 0; i < id.size(); ++i) id[i] = i;
+  std::mt19937 rng(11);
+  std::shuffle(id.begin(), id.end(), rng);
+  SurfaceMesh torus;
+  torus.vertices.resize(id.size());
+  torus.normals.resize(id.size());
+  for (std::uint32_t i = 0; i < nu; ++i)
+    for (std::uint32_t j = 0; j < nw; ++j) {
+      const double u = 2 * kPi * i / nu, w = 2 * kPi * j / nw;
+      torus.vertices[id[i * nw + j]] = {(R + r * std::cos(w)) * std::cos(u), (R + r * std::cos(w)) * std::sin(u),
+                                        r * std::sin(w)};
+      torus.normals[id[i * nw + j]] = {std::cos(w) * std::cos(u), std::cos(w) * std::sin(u), std::sin(w)};
+    }
+  for (std::uint32_t i = 0; i < nu; ++i)
+    for (std::uint32_t j = 0; j < nw; ++j) {
+      const std::uint32_t a = id[i * nw + j], b = id[((i + 1) % nu) * nw + j], c = id[((i + 1) % nu) * nw + (j + 1) % nw],
+                          d = id[i * nw + (j + 1) % nw];
+      torus.triangles.push_back({a, b, c});
+      torus.triangles.push_back({a, c, d});
+    }
+  std::shuffle(torus.triangles.begin(), torus.triangles.end(), rng);
+  require_closed(torus, 0, 1);
+  REQUIRE(mesh_genus(torus) == 1);
+
+  HandleOptions o;
+  o.max_loop = 2.4;
+  HandleReport rep;
+  const SurfaceMesh m = cut_short_handles(torus, o, &rep);
+  REQUIRE(rep.cut == 1);
+  CHECK(rep.genus_after == 0);
+  require_closed(m, 2, 1);
+  CHECK(mesh_genus(m) == 0);
+  // The given numbering kept: every vertex off the cut at its index and place, the copies and the two
+  // centres after them; every triangle off the cut as it was, the caps' after them.
+  std::size_t moved = 0;
+  for (std::size_t v = 0; v < torus.vertices.size(); ++v) moved += !(m.vertices[v] == torus.vertices[v]);
+  CHECK(moved >= 3);
+  CHECK(moved <= nw);  // one meridian at most (a polygon around the tube)
+  CHECK(m.vertices.size() == torus.vertices.size() + moved + 2);
+  std::size_t changed = 0;
+  for (std::size_t t = 0; t < torus.triangles.size(); ++t) changed += !(m.triangles[t] == torus.triangles[t]);
+  CHECK(changed > 0);
+  CHECK(changed <= 6 * moved);  // the left fans of the cycle's vertices
+  CHECK(m.triangles.size() == torus.triangles.size() + 2 * moved);
 }

@@ -7,7 +7,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <numeric>
+#include <random>
+#include <tuple>
 #include <limits>
 #include <array>
 #include <vector>
@@ -425,4 +430,78 @@ TEST_CASE("keep_supported_components: components whose lowest ids come last", "[
     REQUIRE(t[0] == t[1] + 1);
     REQUIRE(t[1] == t[2] + 1);
   }
+}
+
+TEST_CASE("spatially_ordered: the same triangles, oriented as given, numbered by place", "[mesh_metrics]") {
+  using vitri::Point3;
+  using vitri::SurfaceMesh;
+  // A 60 x 60 grid of squares (two triangles each) with its vertices shuffled, plus an unreferenced
+  // vertex; normals that name their vertex (its position).
+  const std::uint32_t n = 61;
+  std::vector<std::uint32_t> slot(n * n);
+  std::iota(slot.begin(), slot.end(), 0u);
+  std::mt19937 rng(7);
+  std::shuffle(slot.begin(), slot.end(), rng);
+  SurfaceMesh m;
+  m.vertices.resize(n * n + 1);
+  for (std::uint32_t i = 0; i < n; ++i)
+    for (std::uint32_t j = 0; j < n; ++j) m.vertices[slot[i * n + j]] = Point3{double(i), double(j), 0.1 * i * j};
+  m.vertices[n * n] = Point3{-5, -5, -5};
+  m.normals = m.vertices;
+  for (std::uint32_t i = 0; i + 1 < n; ++i)
+    for (std::uint32_t j = 0; j + 1 < n; ++j) {
+      const std::uint32_t a = slot[i * n + j], b = slot[(i + 1) * n + j], c = slot[(i + 1) * n + j + 1],
+                          d = slot[i * n + j + 1];
+      m.triangles.push_back({a, b, c});
+      m.triangles.push_back({c, d, a});
+    }
+  auto median_gap = [](const SurfaceMesh& s) {
+    std::vector<long> gap;
+    for (const auto& t : s.triangles) gap.push_back(std::labs(long(t[0]) - long(t[1])));
+    std::nth_element(gap.begin(), gap.begin() + long(gap.size() / 2), gap.end());
+    return gap[gap.size() / 2];
+  };
+  // Each triangle as its corners' positions, from the lowest position on (the cyclic order kept).
+  auto as_positions = [](const SurfaceMesh& s) {
+    std::vector<std::array<Point3, 3>> out;
+    auto less = [](const Point3& p, const Point3& q) { return std::tie(p.x, p.y, p.z) < std::tie(q.x, q.y, q.z); };
+    for (const auto& t : s.triangles) {
+      std::array<Point3, 3> p{s.vertices[t[0]], s.vertices[t[1]], s.vertices[t[2]]};
+      while (less(p[1], p[0]) || less(p[2], p[0])) std::rotate(p.begin(), p.begin() + 1, p.end());
+      out.push_back(p);
+    }
+    std::sort(out.begin(), out.end(), [&](const std::array<Point3, 3>& x, const std::array<Point3, 3>& y) {
+      for (int k = 0; k < 3; ++k) {
+        if (less(x[k], y[k])) return true;
+        if (less(y[k], x[k])) return false;
+      }
+      return false;
+    });
+    return out;
+  };
+  std::vector<std::uint32_t> new_of;
+  const SurfaceMesh s = vitri::spatially_ordered(m, &new_of);
+  REQUIRE(s.vertices.size() == m.vertices.size());
+  REQUIRE(s.triangles.size() == m.triangles.size());
+  REQUIRE(new_of.size() == m.vertices.size());
+  for (std::size_t v = 0; v < m.vertices.size(); ++v) {
+    REQUIRE(s.vertices[new_of[v]] == m.vertices[v]);
+    REQUIRE(s.normals[new_of[v]] == m.normals[v]);  // normals follow their vertices
+  }
+  CHECK(as_positions(s) == as_positions(m));  // the same triangles, each with its orientation
+  // Triangles by their smallest corner; neighbours near each other in the numbering.
+  for (std::size_t t = 1; t < s.triangles.size(); ++t) {
+    const auto& a = s.triangles[t - 1];
+    const auto& b = s.triangles[t];
+    CHECK(std::min({a[0], a[1], a[2]}) <= std::min({b[0], b[1], b[2]}));
+  }
+  CHECK(median_gap(m) > 500);
+  CHECK(median_gap(s) < 100);
+  // The order depends on the places only: the same mesh again, and from the unshuffled numbering.
+  const SurfaceMesh again = vitri::spatially_ordered(s);
+  CHECK(again.vertices == s.vertices);
+  CHECK(again.triangles == s.triangles);
+  // Without normals, none appear.
+  m.normals.clear();
+  CHECK(vitri::spatially_ordered(m).normals.empty());
 }

@@ -33,6 +33,24 @@ struct SurfaceMesh {
 SurfaceMesh keep_supported_components(SurfaceMesh mesh, const std::function<bool(const Point3&)>& supported,
                                       std::size_t* dropped = nullptr);
 
+/// The mesh renumbered: vertex i moves to vertex_to[i] and triangle t to triangle_to[t] (each map a
+/// permutation of [0, its size); the vertices and triangles beyond keep their places), the corners
+/// renumbered with the vertices, normals following them. In place.
+/// @throws InvalidArgument when a map has more entries than the mesh has elements.
+SurfaceMesh renumbered(SurfaceMesh mesh, const std::vector<std::uint32_t>& vertex_to,
+                       const std::vector<std::uint32_t>& triangle_to);
+
+/// The same mesh with its vertices along a Morton (Z-order) curve of their positions (ties by index) and
+/// its triangles in the order of their smallest new vertex index (ties by their corners, then in their
+/// given order), each triangle's corners in their given order (orientation kept); normals follow their
+/// vertices, unreferenced vertices stay. Permuted in place (no second copy of the arrays). A mesh as
+/// extracted numbers its vertices by the tetrahedralization's history, not by place (neighbours 19,000
+/// indices apart at the median on a 280,000-vertex scan): a search over neighbourhoods
+/// (cut_short_handles) then touches scattered memory. `new_of` and `triangle_new_of`, when given,
+/// receive each old vertex's and each old triangle's new index. O(V log V + F log F).
+SurfaceMesh spatially_ordered(SurfaceMesh mesh, std::vector<std::uint32_t>* new_of = nullptr,
+                              std::vector<std::uint32_t>* triangle_new_of = nullptr);
+
 /// Copies the mesh into Eigen arrays: V (#V x 3), F (#F x 3), N (#V x 3, or 0 x 3 without normals).
 void to_eigen(const SurfaceMesh& mesh, Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd* N = nullptr);
 

@@ -320,6 +320,8 @@ constexpr std::size_t kFitProgressConstraints = 1000;
 /// mesh vertices as points (hand.off: 7231 for 1197); 2.5 spacings give 1-1.5x as many (hand 1855,
 /// sphere926 990, 33k samples of man.off 49.6k). The run defaults are the library's (shared with Python).
 constexpr double kSpacingFactor = run_defaults::spacing_factor;
+/// The facet check's thin parts are warned of from this share of its points on them (FacetCheck).
+constexpr double kThinPartsWarning = 0.01;
 /// A scan without --precision: at most this many Delaunay vertices per input point (plus the base), about
 /// 2 mesh vertices per input point (docs/scans.md "Budget").
 constexpr std::size_t kScanVerticesPerPoint = run_defaults::scan_vertices_per_point;
@@ -741,6 +743,12 @@ std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPl
                  "than %.4g from the vertices' surface%s (docs/guide.md \"Meshes with large facets\")\n",
                  check.checked, check.triangles, 100 * check.missed_area, check.tolerance,
                  check.added.points.empty() ? "" : ": the facets sampled, fitted again");
+  if (check.thin_share >= kThinPartsWarning)
+    std::fprintf(stderr, "vitri mesh: warning: %.3g%% of the facets' points lie on parts thinner than half their "
+                 "spacing of %.4g (the thinnest %.4g): the function cannot hold the two sides of such a part "
+                 "apart, so the mesh there may have holes and handles; the points' spacing is bounded by "
+                 "their count (docs/guide.md \"Meshes with large facets\")\n",
+                 100 * check.thin_share, check.point_spacing, check.thinnest);
   if (check.added.points.empty()) return mesher;
   mesher.reset();
   // The facets' points are the seeds of the tetrahedralization: its size follows them whatever the

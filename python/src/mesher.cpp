@@ -361,6 +361,8 @@ py::dict stats_of(PyMesher& pm) {
   d["facet_samples"] = s.facet_samples;      // from_mesh: the facet check's samples read
   d["facet_triangles"] = s.facet_triangles;  // triangles the vertices' surface missed
   d["facet_points"] = s.facet_points;        // points added on the facets (0: the vertices alone)
+  d["facet_thin_share"] = s.facet_thin_share;  // share of them on parts thinner than half their spacing
+  d["facet_thinnest"] = s.facet_thinnest;      // the thinnest such part (0: none)
   d["scan_small_components"] = s.scan_small_components;  // components dropped (too small, unsupported)
   d["scan_handles_cut"] = s.scan_handles_cut;            // handles of the noise cut (handle_loop_resolutions)
   d["scan_kept_unresolved"] = s.scan_kept_unresolved;    // every one too small: the best-supported kept

@@ -3,7 +3,7 @@
 // Two points closer than the radius lie in the same or in adjacent cells, so a point needs comparing only
 // with the kept points of the 27 cells around it. Kept points of one cell are pairwise >= radius apart
 // inside a cube of side >= radius, so a cell holds at most a handful of them (a linked list through
-// `next`). Occupied cells are found in an open-addressing hash table keyed by the packed cell coordinates;
+// `next`; with normals, a handful per side). Occupied cells are found in an open-addressing hash table keyed by the packed cell coordinates;
 // visiting the points in a spatial order (the caller's) keeps those lookups in cache.
 #include "spaced_subset.hpp"
 
@@ -60,7 +60,10 @@ class CellTable {
 }  // namespace
 
 std::vector<char> spaced_subset(const std::vector<Point3>& points, const std::vector<std::size_t>& order,
-                                double radius) {
+                                double radius, const std::vector<Point3>* normals) {
+  if (normals && normals->size() != points.size())
+    throw InvalidArgument("spaced subset: " + std::to_string(normals->size()) + " normals for " +
+                          std::to_string(points.size()) + " points");
   const std::size_t n = points.size();
   if (n >= kNone) throw LimitError("spaced subset: " + std::to_string(n) + " points exceed the 2^32 - 1 indices");
   std::vector<char> kept(n, 0);
@@ -87,7 +90,7 @@ std::vector<char> spaced_subset(const std::vector<Point3>& points, const std::ve
       for (std::int64_t dy = -1; dy <= 1 && !near; ++dy)
         for (std::int64_t dx = -1; dx <= 1 && !near; ++dx)
           for (std::uint32_t q = cells.head(key(cx + dx, cy + dy, cz + dz)); q != kNone; q = next[q])
-            if (squared_norm(points[q] - p) < r2) {
+            if (squared_norm(points[q] - p) < r2 && (!normals || dot((*normals)[q], (*normals)[i]) >= -0.5)) {
               near = true;
               break;
             }

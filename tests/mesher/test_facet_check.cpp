@@ -257,3 +257,45 @@ TEST_CASE("from_mesh: a cone's tip of slivers stays on the cone (points along th
   CHECK(top > 0.97);      // the tip reaches the apex within 3% of the height
   CHECK(worst < 0.03);    // every vertex on the cone
 }
+
+TEST_CASE("mesh_facet_points and check_facets: a plate thinner than the points' spacing keeps both faces and "
+          "is reported thin", "[facets]") {
+  // The cube flattened to 1 x 1 x t: its two large faces t apart.
+  for (const double t : {0.0004, 0.05}) {
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    cube_mesh(V, F);
+    V.col(2) *= t;
+    const double step = 0.01;
+    const MeshSamples s = mesh_facet_points(V, F, step, nullptr, 4000000);
+    double top = 0, bottom = 0;
+    for (std::size_t i = 0; i < s.points.size(); ++i) {
+      const Point3& p = s.points[i];
+      if (p.x < 0.05 || p.x > 0.95 || p.y < 0.05 || p.y > 0.95) continue;  // away from the rims
+      top += s.normals[i].z > 0.9 && std::abs(p.z - t) < 1e-12;
+      bottom += s.normals[i].z < -0.9 && std::abs(p.z) < 1e-12;
+    }
+    INFO("t " << t << " top " << top << " bottom " << bottom);
+    // Both faces as many points (about 0.81 / step^2 each): the spacing pass does not thin one face
+    // by the other (before: one point in four on the lower face, interleaved with the upper's).
+    CHECK(top > 0.6 * 0.81 / (step * step));
+    CHECK(bottom > 0.9 * top);
+    CHECK(top > 0.9 * bottom);
+  }
+  // The check on the thin plate: its points lie on a part thinner than half their spacing, the thinnest
+  // about the plate's thickness.
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  cube_mesh(V, F);
+  V.col(2) *= 0.0004;
+  const Mesher thin = Mesher::from_mesh(V, F, local_options(true));
+  CHECK(thin.stats().facet_thin_share > 0.9);
+  // (Measured along each point's normal: the rims' crease points, their normals at 45 degrees, read
+  // down to 0.7 t.)
+  CHECK(thin.stats().facet_thinnest <= 0.0004 * (1 + 1e-9));
+  CHECK(thin.stats().facet_thinnest >= 0.5 * 0.0004);
+  // The cube: nothing thin (its edges' bands, where two faces meet at 90 degrees, are not opposite).
+  cube_mesh(V, F);
+  const Mesher cube = Mesher::from_mesh(V, F, local_options(true));
+  CHECK(cube.stats().facet_thin_share == 0);
+}

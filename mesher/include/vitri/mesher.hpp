@@ -243,6 +243,9 @@ struct MesherStats {
   /// triangles the vertices' interpolant passes farther than the tolerance from, and the points added on
   /// those triangles (0: the vertices alone were fitted).
   std::size_t facet_samples = 0, facet_triangles = 0, facet_points = 0;
+  /// The facet check's thin parts (FacetCheck::thin_share, thinnest): parts thinner than half the points'
+  /// spacing, whose two sides the function cannot hold apart (a warning from 1% of the points on).
+  double facet_thin_share = 0, facet_thinnest = 0;
 };
 
 /// The facet check of a closed mesh (docs/guide.md "Meshes with large facets"). A mesh's vertices and
@@ -271,6 +274,14 @@ struct FacetCheck {
   /// the others with their vertices' blended) when the missed triangles hold at least 1% of the area;
   /// else empty (a few triangles at creases: the vertices' interpolant is kept).
   MeshSamples added;
+  /// With `added`: their spacing (sqrt of the area per point: wider than `spacing` where the points' cap
+  /// widened it), and the parts of the mesh thinner than half of it, where an opposite facet's point
+  /// (normals more than 120 degrees apart) lies behind a point by less than that: the function, fitted to
+  /// points that far apart, cannot hold the two sides apart there (holes and handles in the mesh). Their
+  /// share of the points (a sample of at most 20,000) and the thinnest such part (0: none).
+  double point_spacing = 0;
+  double thin_share = 0;
+  double thinnest = 0;
 };
 FacetCheck check_facets(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, const ImplicitFunction& f,
                         double spacing, std::size_t max_points = 4000000, double min_spacing = 0);

@@ -721,7 +721,11 @@ std::unique_ptr<Mesher> fit_constraints(Input data, const MeshCommand& c, MeshPl
         std::fprintf(stderr, "no --precision: using the data's median spacing, %.4g\n", data_precision);
     }
     options.on_phase = phase_announcer(phases, built.size(), false);
-    return std::make_unique<Mesher>(built, options);
+    // Auto resolved to the global function by the count: the Mesher is told auto (it chooses the same by
+    // the same count), so that a global system it cannot solve falls back to the local function.
+    MesherOptions o = options;
+    if (function0 == FunctionKind::Auto && o.function == FunctionKind::Global) o.function = FunctionKind::Auto;
+    return std::make_unique<Mesher>(built, o);
   };
   std::unique_ptr<Mesher> mesher;
   double spacing = 0;
@@ -849,6 +853,9 @@ MeshPlan plan_mesh(const MeshCommand& c, std::vector<std::string> script, PhaseT
   const Mesher& mesher = *plan.mesher;
   phases.stop();
   if (mesher.stats().memory_thinned > 0 && !c.quiet) warn_memory_thinned(c, plan);
+  if (!mesher.stats().global_fit_failed.empty())
+    std::fprintf(stderr, "vitri mesh: warning: the global function's fit failed (%s): the local function was "
+                 "fitted instead (--function auto)\n", mesher.stats().global_fit_failed.c_str());
   if (plan.scan_input) {
     const ScanReport& sr = mesher.stats().scan;
     if (!c.quiet) {

@@ -120,7 +120,21 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
   if (options_.on_phase) options_.on_phase("fit");
   const double t0 = now_seconds();
   auto rbf = std::make_unique<Rbf>();
-  rbf->fit(constraints, options_.rbf);
+  if (options_.function == FunctionKind::Auto) {
+    // Auto chose the global function by the count alone; a system it cannot solve (a thin plate's two
+    // faces: the cubic kernel's matrix at a condition of 1e15) is no reason to give no mesh: the local
+    // function, whose patches each see a few constraints, is fitted instead (stats: global_fit_failed).
+    try {
+      rbf->fit(constraints, options_.rbf);
+    } catch (const NumericalError& e) {
+      stats_.global_fit_failed = e.what();
+      options_.function = FunctionKind::Local;
+      fit_local_beside_seeds(constraints);
+      return;
+    }
+  } else {
+    rbf->fit(constraints, options_.rbf);
+  }
   function_ = std::move(rbf);
   stats_.fit_seconds = now_seconds() - t0;
   if (options_.on_phase) options_.on_phase("tetrahedralization");

@@ -333,6 +333,7 @@ py::dict stats_of(PyMesher& pm) {
   py::dict d;
   d["constraints"] = s.constraints;
   d["function"] = local ? "local" : "global";
+  d["global_fit_failed"] = s.global_fit_failed;  // function="auto": the global fit's error, local fitted instead
   d["fit_seconds"] = s.fit_seconds;
   d["edit_seconds"] = s.edit_seconds;
   d["edit_rbf_seconds"] = s.edit_rbf_seconds;

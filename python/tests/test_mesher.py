@@ -221,3 +221,17 @@ def test_a_few_points_keep_their_best_component():
     m.refine(0.05, relative=True)
     m.mesh()
     assert m.stats()["scan_kept_unresolved"] is False
+
+
+def test_auto_function_falls_back_to_local_when_the_global_fit_fails():
+    # A thin plate's two faces (20 x 20 points each, 0.0005 apart): auto chooses the global function by
+    # the count, whose system is then unsolvable; the local one is fitted instead, and stats() says why.
+    g = np.linspace(0, 1, 20)
+    X, Y = (a.ravel() for a in np.meshgrid(g, g))
+    P = np.vstack([np.c_[X, Y, np.zeros_like(X)], np.c_[X, Y, np.full_like(X, 0.0005)]])
+    N = np.vstack([np.tile([0, 0, -1.0], (X.size, 1)), np.tile([0, 0, 1.0], (X.size, 1))])
+    with pytest.raises(vitri.NumericalError):
+        vitri.Mesher.from_oriented_points(P, N, function="global")
+    m = vitri.Mesher.from_oriented_points(P, N)
+    assert m.function == "local"
+    assert "RBF fit failed" in m.stats()["global_fit_failed"]

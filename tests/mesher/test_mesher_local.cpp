@@ -529,3 +529,33 @@ TEST_CASE("from_mesh: the mesh's winding number settles the local far field, no 
   o.polygonizer.keep_history = true;
   CHECK_FALSE(Mesher::from_mesh(bunny.V, bunny.F, o).stats().far_side);
 }
+
+TEST_CASE("Mesher: function auto falls back to the local function when the global fit fails", "[mesher]") {
+  // A thin plate's two faces as oriented points (20 x 20 each, 0.0005 apart): few enough for auto to
+  // choose the global function, whose cubic system is then unsolvable (NumericalError with the global
+  // function asked for); auto fits the local one instead and says why.
+  std::vector<Point3> p, n;
+  for (const double z : {0.0, 0.0005})
+    for (int i = 0; i < 20; ++i)
+      for (int j = 0; j < 20; ++j) {
+        p.push_back({i / 19.0, j / 19.0, z});
+        n.push_back({0, 0, z > 0 ? 1.0 : -1.0});
+      }
+  MesherOptions global;  // the CLI's and Python's constraints (run_defaults)
+  global.function = FunctionKind::Global;
+  global.constraint_build.offset_spacings = run_defaults::offset_spacings;
+  global.constraint_build.off_surface_spacing = run_defaults::off_surface_spacing;
+  CHECK_THROWS_AS(Mesher::from_oriented_points(p, n, global), NumericalError);
+  MesherOptions autof = global;
+  autof.function = FunctionKind::Auto;
+  REQUIRE(choose_function(FunctionKind::Auto, 3 * p.size(), autof.auto_local_above) == FunctionKind::Global);
+  Mesher m = Mesher::from_oriented_points(p, n, autof);
+  CHECK(m.local_function() != nullptr);
+  CHECK(m.stats().global_fit_failed.find("RBF fit failed") != std::string::npos);
+  // A plate the global function solves: no fallback.
+  for (auto& q : p)
+    if (q.z > 0) q.z = 0.05;
+  Mesher fine = Mesher::from_oriented_points(p, n, autof);
+  CHECK(fine.local_function() == nullptr);
+  CHECK(fine.stats().global_fit_failed.empty());
+}

@@ -34,6 +34,7 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <string>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -204,6 +205,9 @@ struct MesherStats {
   PolygonizerStats polygonizer;    ///< Delaunay and mesh counters, phase times of the last calls
   std::size_t constraints = 0;     ///< current number of constraints
   double fit_seconds = 0;          ///< RBF fit at construction (or last rebuild)
+  /// FunctionKind::Auto chose the global function and its fit failed (NumericalError: a system it cannot
+  /// solve, such as a thin plate's): its message; the local function was fitted instead. Empty otherwise.
+  std::string global_fit_failed;
   double edit_seconds = 0;         ///< last edit, total: RBF edit + Delaunay + re-evaluation + refinement
   double edit_rbf_seconds = 0;     ///< last edit: RBF update
   double edit_refine_seconds = 0;  ///< last edit: Delaunay update, re-evaluation, refinement, cleanup

@@ -306,6 +306,9 @@ void print_build_report(const ConstraintBuildReport& merged, const ConstraintBui
     std::fprintf(stderr, "%zu off-surface constraints left out: the points that keep theirs are at least %g x "
                  "that distance apart (see --off-surface-spacing)\n",
                  merged.spaced_out, build.off_surface_spacing);
+  if (merged.inside_other_parts > 0)
+    std::fprintf(stderr, "%zu of the mesh's points lie inside another of its parts (overlapping shells): left out, "
+                 "the union is meshed (docs/guide.md \"Meshes with large facets\")\n", merged.inside_other_parts);
 }
 
 void write_current(Mesher& mesher, const std::string& path, PlyEncoding ply) {

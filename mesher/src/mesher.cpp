@@ -411,6 +411,7 @@ Mesher Mesher::from_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F, con
   m.stats_.facet_samples = check.checked;
   m.stats_.facet_triangles = check.triangles;
   m.stats_.facet_points = check.added.points.size();
+  m.stats_.mesh_inside_other_parts = built.inside_other_parts;
   m.stats_.facet_thin_share = check.thin_share;
   m.stats_.facet_thinnest = check.thinnest;
   return m;

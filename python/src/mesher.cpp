@@ -364,6 +364,7 @@ py::dict stats_of(PyMesher& pm) {
   d["facet_points"] = s.facet_points;        // points added on the facets (0: the vertices alone)
   d["facet_thin_share"] = s.facet_thin_share;  // share of them on parts thinner than half their spacing
   d["facet_thinnest"] = s.facet_thinnest;      // the thinnest such part (0: none)
+  d["mesh_inside_other_parts"] = s.mesh_inside_other_parts;  // points inside another part: left out
   d["scan_small_components"] = s.scan_small_components;  // components dropped (too small, unsupported)
   d["scan_handles_cut"] = s.scan_handles_cut;            // handles of the noise cut (handle_loop_resolutions)
   d["scan_kept_unresolved"] = s.scan_kept_unresolved;    // every one too small: the best-supported kept

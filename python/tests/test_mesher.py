@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import vitri
-from conftest import assert_closed_manifold, euler_characteristic, sphere_constraints, sphere_points
+from conftest import assert_closed_manifold, euler_characteristic, signed_volume, sphere_constraints, sphere_points
 
 
 def test_from_constraints_levels():
@@ -235,3 +235,20 @@ def test_auto_function_falls_back_to_local_when_the_global_fit_fails():
     m = vitri.Mesher.from_oriented_points(P, N)
     assert m.function == "local"
     assert "RBF fit failed" in m.stats()["global_fit_failed"]
+
+
+def test_from_mesh_overlapping_parts_mesh_their_union():
+    # Two closed spheres overlapping (an assembly's shells, no boolean union): the points of each inside
+    # the other are left out, and the mesh is the union's surface: one closed component, genus 0, its
+    # volume the union's (two unit spheres 1 apart: 2 * 4/3 pi - 5 pi / 12 = 7.069).
+    sphere = vitri.reconstruct(sphere_points(2000)[0], precision=0.03)
+    V0 = sphere.vertices / np.linalg.norm(sphere.vertices, axis=1).max()
+    V = np.vstack([V0, V0 + [1.0, 0, 0]])
+    F = np.vstack([sphere.faces, sphere.faces + len(V0)])
+    m = vitri.Mesher.from_mesh(V, F, threads=2)
+    assert m.stats()["mesh_inside_other_parts"] > 0.1 * len(V0)
+    m.refine(0.02, relative=True)
+    Vo, Fo, _ = m.mesh()
+    assert_closed_manifold(Vo, Fo)
+    assert euler_characteristic(Vo, Fo) == 2
+    assert abs(signed_volume(Vo, Fo) - 7.069) < 0.15

@@ -515,3 +515,80 @@ TEST_CASE("constraints: off_surface_spacing never thins a thin part", "[rbf][con
   CHECK(plate_side < 2 * 400 / 4);
   CHECK(report.spaced_out == 2 * 400 - plate_side);
 }
+
+namespace {
+
+/// A UV sphere (rings x segments quads, poles fanned), outward, appended to V, F; `inward` flips it.
+void append_sphere(Eigen::MatrixXd& V, Eigen::MatrixXi& F, const Point3& c, double r, bool inward = false) {
+  const int rings = 24, segments = 48;
+  const double pi = 3.14159265358979323846;
+  const auto base = static_cast<int>(V.rows());
+  std::vector<Point3> v{{c.x, c.y, c.z + r}};
+  for (int i = 1; i < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      const double t = pi * i / rings, u = 2 * pi * j / segments;
+      v.push_back({c.x + r * std::sin(t) * std::cos(u), c.y + r * std::sin(t) * std::sin(u), c.z + r * std::cos(t)});
+    }
+  v.push_back({c.x, c.y, c.z - r});
+  const int south = static_cast<int>(v.size()) - 1;
+  auto at = [&](int i, int j) { return 1 + (i - 1) * segments + (j % segments); };
+  std::vector<std::array<int, 3>> t;
+  for (int j = 0; j < segments; ++j) t.push_back({0, at(1, j), at(1, j + 1)});
+  for (int i = 1; i + 1 < rings; ++i)
+    for (int j = 0; j < segments; ++j) {
+      t.push_back({at(i, j), at(i + 1, j), at(i + 1, j + 1)});
+      t.push_back({at(i, j), at(i + 1, j + 1), at(i, j + 1)});
+    }
+  for (int j = 0; j < segments; ++j) t.push_back({south, at(rings - 1, j + 1), at(rings - 1, j)});
+  V.conservativeResize(base + static_cast<int>(v.size()), 3);
+  for (std::size_t k = 0; k < v.size(); ++k) V.row(base + static_cast<int>(k)) << v[k].x, v[k].y, v[k].z;
+  const auto f0 = static_cast<int>(F.rows());
+  F.conservativeResize(f0 + static_cast<int>(t.size()), 3);
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    if (inward) std::swap(t[k][1], t[k][2]);
+    F.row(f0 + static_cast<int>(k)) << base + t[k][0], base + t[k][1], base + t[k][2];
+  }
+}
+
+}  // namespace
+
+TEST_CASE("inside_other_parts: the points of one shell inside another, none of a mesh without overlaps",
+          "[rbf][constraints]") {
+  Eigen::MatrixXd V(0, 3);
+  Eigen::MatrixXi F(0, 3);
+  // Two unit spheres 1 apart: each has the points beyond x = 0.5 (the first) or before it (the second)
+  // inside the other.
+  append_sphere(V, F, {0, 0, 0}, 1.0);
+  const auto first = static_cast<std::size_t>(V.rows());
+  append_sphere(V, F, {1, 0, 0}, 1.0);
+  REQUIRE(mesh_defects(V, F).closed());
+  std::vector<Point3> p;
+  for (Eigen::Index i = 0; i < V.rows(); ++i) p.push_back({V(i, 0), V(i, 1), V(i, 2)});
+  const std::vector<std::uint8_t> hidden = inside_other_parts(V, F, p, 2);
+  std::size_t wrong = 0, inside = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const Point3 other = i < first ? Point3{1, 0, 0} : Point3{0, 0, 0};
+    const double depth = 1.0 - distance(p[i], other);  // > 0: inside the other sphere
+    if (std::abs(depth) < 0.2) continue;  // near the seam (the median over 8 neighbours): either
+    inside += depth > 0;
+    wrong += (depth > 0) != (hidden[i] != 0);
+  }
+  CHECK(inside > 200);
+  CHECK(wrong == 0);
+  ConstraintBuildReport report;
+  const Constraints c = constraints_from_mesh(V, F, {}, &report);
+  CHECK(report.inside_other_parts == static_cast<std::size_t>(std::count(hidden.begin(), hidden.end(), 1)));
+  CHECK(report.inside_other_parts > inside);
+  CHECK(c.size() <= 3 * (p.size() - report.inside_other_parts));  // (less the merged poles' duplicates)
+  // No overlap: two spheres apart, and a hollow ball (an inward shell inside an outward one).
+  for (const double gap : {3.0, 0.0}) {
+    Eigen::MatrixXd W(0, 3);
+    Eigen::MatrixXi G(0, 3);
+    append_sphere(W, G, {0, 0, 0}, 1.0);
+    append_sphere(W, G, {gap, 0, 0}, gap > 0 ? 1.0 : 0.6, gap == 0);
+    std::vector<Point3> q;
+    for (Eigen::Index i = 0; i < W.rows(); ++i) q.push_back({W(i, 0), W(i, 1), W(i, 2)});
+    const std::vector<std::uint8_t> none = inside_other_parts(W, G, q, 2);
+    CHECK(std::count(none.begin(), none.end(), 1) == 0);
+  }
+}

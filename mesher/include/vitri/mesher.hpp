@@ -250,6 +250,9 @@ struct MesherStats {
   /// The facet check's thin parts (FacetCheck::thin_share, thinnest): parts thinner than half the points'
   /// spacing, whose two sides the function cannot hold apart (a warning from 1% of the points on).
   double facet_thin_share = 0, facet_thinnest = 0;
+  /// from_mesh(): the mesh's points left out for lying inside another of its parts (overlapping shells:
+  /// the union interpolated; ConstraintBuildReport::inside_other_parts).
+  std::size_t mesh_inside_other_parts = 0;
 };
 
 /// The facet check of a closed mesh (docs/guide.md "Meshes with large facets"). A mesh's vertices and

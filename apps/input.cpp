@@ -54,19 +54,20 @@ void repair_mesh(Input& in, const std::string& name, const char* command) {
                  name.c_str(), n, n == 1 ? "" : "s", n == 1 ? "s" : "");
   const MeshDefects given = defects_of(in.mesh.F);
   if (given.closed()) return;
-  Eigen::MatrixXi merged = in.mesh.F;
-  const std::size_t n = merge_coincident_vertices(in.mesh.V, merged);
-  if (n == 0) return;
-  const std::size_t flat = drop_degenerate_triangles(merged);
-  if (merged.rows() == 0) return;
-  const MeshDefects now = defects_of(merged);
+  Eigen::MatrixXi repaired = in.mesh.F;
+  const std::size_t n = merge_coincident_vertices(in.mesh.V, repaired);
+  const std::size_t flat = n ? drop_degenerate_triangles(repaired) : 0;
+  const std::size_t twice = drop_duplicate_triangles(repaired);
+  if ((n == 0 && twice == 0) || repaired.rows() == 0) return;
+  const MeshDefects now = defects_of(repaired);
   if (now.boundary_edges + now.repeated_edges >= given.boundary_edges + given.repeated_edges) return;
-  const std::string dropped = flat ? ", " + std::to_string(flat) + " triangles left without area dropped" : "";
-  std::fprintf(stderr,
-               "%s: %s: %zu vertices at the same position as another merged (a triangle soup or a mesh split "
-               "along its seams)%s%s\n",
-               command, name.c_str(), n, dropped.c_str(), now.closed() ? ": a closed mesh" : "");
-  in.mesh.F = std::move(merged);
+  std::string what;
+  if (n) what += std::to_string(n) + " vertices at the same position as another merged (a triangle soup or a mesh "
+                 "split along its seams)";
+  if (flat) what += ", " + std::to_string(flat) + " triangles left without area dropped";
+  if (twice) what += std::string(what.empty() ? "" : ", ") + std::to_string(twice) + " repeated triangles left out";
+  std::fprintf(stderr, "%s: %s: %s%s\n", command, name.c_str(), what.c_str(), now.closed() ? ": a closed mesh" : "");
+  in.mesh.F = std::move(repaired);
 }
 
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,

@@ -42,8 +42,9 @@ std::string describe_scan(const ScanFit& fit, bool given);
 /// A mesh read as its file has it, made what the commands mesh: triangles that name one vertex twice (no
 /// area: an edge or a point drawn as a triangle) left out, with a warning on stderr naming `command`, the
 /// file and the count; and, when the mesh is not closed, its vertices at exactly the same position merged
-/// (merge_coincident_vertices(): a triangle soup such as an STL solid, or a mesh split along its seams),
-/// kept when that leaves fewer boundary and repeated edges, said on stderr. A closed mesh and other
+/// (merge_coincident_vertices(): a triangle soup such as an STL solid, or a mesh split along its seams)
+/// and its repeated triangles left out (drop_duplicate_triangles()), kept when that leaves fewer boundary
+/// and repeated edges, said on stderr. A closed mesh and other
 /// inputs are left as they are. @throws InvalidArgument naming the file for what is no triangle mesh.
 void repair_mesh(Input& in, const std::string& name, const char* command);
 

@@ -487,16 +487,17 @@ Options as reconstruct() (those of point inputs do not apply).)");
                       if (PyErr_WarnEx(PyExc_RuntimeWarning, what.c_str(), 1) != 0) throw py::error_already_set();
                     }
                     // As `vitri mesh`: an open mesh's vertices at exactly the same position merged (a triangle
-                    // soup, seams split), kept when fewer edges are then open or repeated.
+                    // soup, seams split) and its repeated triangles left out, kept when fewer edges are then
+                    // open or repeated.
                     if (const MeshDefects given = mesh_defects(V, F); !given.closed()) {
-                      Eigen::MatrixXi merged = F;
-                      if (merge_coincident_vertices(V, merged) > 0) {
-                        drop_degenerate_triangles(merged);
-                        if (merged.rows() > 0) {
-                          const MeshDefects now = mesh_defects(V, merged);
-                          if (now.boundary_edges + now.repeated_edges < given.boundary_edges + given.repeated_edges)
-                            F = std::move(merged);
-                        }
+                      Eigen::MatrixXi repaired = F;
+                      const std::size_t merged = merge_coincident_vertices(V, repaired);
+                      if (merged) drop_degenerate_triangles(repaired);
+                      const std::size_t twice = drop_duplicate_triangles(repaired);
+                      if ((merged || twice) && repaired.rows() > 0) {
+                        const MeshDefects now = mesh_defects(V, repaired);
+                        if (now.boundary_edges + now.repeated_edges < given.boundary_edges + given.repeated_edges)
+                          F = std::move(repaired);
                       }
                     }
                     return build(kw, "from_mesh", [&](const MesherOptions& o) { return Mesher::from_mesh(V, F, o); });
@@ -504,7 +505,7 @@ Options as reconstruct() (those of point inputs do not apply).)");
                   py::arg("vertices"), py::arg("faces"),
                   "Normal constraints of a closed, consistently oriented triangle mesh (triangles that repeat a "
                   "vertex are left out with a RuntimeWarning; a triangle soup's or split seams' vertices at the "
-                  "same position are merged first).")
+                  "same position are merged and repeated triangles left out first).")
       .def("refine",
            [](PyMesher& s, double precision, bool relative, py::object callback) {
              Progress progress(callback);

@@ -325,6 +325,31 @@ std::size_t drop_degenerate_triangles(Eigen::MatrixXi& F) {
   return dropped;
 }
 
+std::size_t drop_duplicate_triangles(Eigen::MatrixXi& F) {
+  if (F.cols() != 3) return 0;
+  // Each triangle keyed by its corners rotated to start at the smallest (the same key for the same
+  // cyclic order, another for the other orientation).
+  std::vector<std::pair<std::array<int, 3>, Eigen::Index>> keyed(static_cast<std::size_t>(F.rows()));
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    std::array<int, 3> t{F(f, 0), F(f, 1), F(f, 2)};
+    std::rotate(t.begin(), std::min_element(t.begin(), t.end()), t.end());
+    keyed[static_cast<std::size_t>(f)] = {t, f};
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<std::uint8_t> repeat(static_cast<std::size_t>(F.rows()), 0);
+  for (std::size_t k = 1; k < keyed.size(); ++k)
+    if (keyed[k].first == keyed[k - 1].first) repeat[static_cast<std::size_t>(keyed[k].second)] = 1;
+  Eigen::Index kept = 0;
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    if (repeat[static_cast<std::size_t>(f)]) continue;
+    if (kept != f) F.row(kept) = F.row(f);
+    ++kept;
+  }
+  const auto dropped = static_cast<std::size_t>(F.rows() - kept);
+  if (dropped) F.conservativeResize(kept, 3);
+  return dropped;
+}
+
 std::size_t merge_coincident_vertices(const Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
   if (V.cols() != 3 || F.cols() != 3) throw InvalidArgument("mesh: V and F must have 3 columns");
   const auto nv = V.rows();

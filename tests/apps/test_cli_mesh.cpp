@@ -827,6 +827,26 @@ TEST_CASE("vitri mesh: a triangle soup (one vertex per corner, as STL has them) 
   CHECK(farthest_from_unit_cube(read_mesh(out)) < 0.03);
 }
 
+TEST_CASE("vitri mesh: repeated triangles are left out of a mesh that is then closed", "[cli][mesh]") {
+  // The cube with two of its faces written twice (edges used twice one way): closed once they go.
+  const std::string in = kDir + "/mesh_cube_twice.off", out = kDir + "/mesh_cube_twice.ply";
+  {
+    std::ofstream c(in);
+    c << "OFF\n8 14 0\n";
+    for (int i = 0; i < 8; ++i) c << (i & 1) << ' ' << ((i >> 1) & 1) << ' ' << ((i >> 2) & 1) << '\n';
+    for (const auto& t : kCubeTriangles) c << "3 " << t[0] << ' ' << t[1] << ' ' << t[2] << '\n';
+    c << "3 " << kCubeTriangles[3][1] << ' ' << kCubeTriangles[3][2] << ' ' << kCubeTriangles[3][0] << '\n';
+    c << "3 " << kCubeTriangles[7][0] << ' ' << kCubeTriangles[7][1] << ' ' << kCubeTriangles[7][2] << '\n';
+  }
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out + " --threads 2", o, e) == 0);
+  INFO(o << e);
+  CHECK(e.find("2 repeated triangles left out: a closed mesh") != std::string::npos);
+  CHECK(e.find("not a closed mesh") == std::string::npos);
+  check_mesh(out);
+  CHECK(farthest_from_unit_cube(read_mesh(out)) < 0.03);
+}
+
 TEST_CASE("vitri mesh: an ASCII STL solid is read as its closed mesh (corners welded by the reader)",
           "[cli][mesh]") {
   const std::string in = kDir + "/mesh_cube.stl", out = kDir + "/mesh_cube_stl.ply";

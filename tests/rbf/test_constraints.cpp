@@ -284,6 +284,24 @@ TEST_CASE("a triangle soup's coincident vertices merged: the closed tetrahedron 
   CHECK(mesh_defects(S, N).boundary_edges == 4);
 }
 
+TEST_CASE("drop_duplicate_triangles: a face written twice goes, a two-sided face stays", "[rbf][constraints]") {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  unit_tetrahedron(V, F);
+  // Face 1 again (rotated: the same cyclic order), face 3 again as written, and face 0 reversed.
+  Eigen::MatrixXi G(F.rows() + 3, 3);
+  G << F, Eigen::RowVector3i(F(1, 1), F(1, 2), F(1, 0)), F.row(3), Eigen::RowVector3i(F(0, 0), F(0, 2), F(0, 1));
+  REQUIRE(mesh_defects(V, G).repeated_edges > 0);
+  CHECK(drop_duplicate_triangles(G) == 2);
+  REQUIRE(G.rows() == 5);
+  CHECK(G.topRows(4) == F);  // the first of each kept, in order
+  CHECK(G(4, 0) == F(0, 0));  // the reversed face stays (a two-sided face is no repetition)
+  CHECK(drop_duplicate_triangles(G) == 0);
+  Eigen::MatrixXi H = F;
+  CHECK(drop_duplicate_triangles(H) == 0);
+  CHECK(H == F);
+}
+
 TEST_CASE("mesh defects counted without throwing; surface samples of an open mesh lie on its triangles",
           "[rbf][constraints]") {
   Eigen::MatrixXd V;

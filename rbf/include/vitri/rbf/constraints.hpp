@@ -154,6 +154,12 @@ struct MeshDefects {
 /// Returns how many were removed. Indices are not checked here (mesh_defects does).
 std::size_t drop_degenerate_triangles(Eigen::MatrixXi& F);
 
+/// Removes the triangles of F (#F x 3) that repeat an earlier one with the same corners in the same
+/// cyclic order (a face written twice, as some exporters and concatenations leave them), keeping the
+/// others in order. A triangle with the same corners the other way round (a two-sided face) is kept.
+/// Returns how many were removed.
+std::size_t drop_duplicate_triangles(Eigen::MatrixXi& F);
+
 /// Points every triangle corner of F (#F x 3) at the first vertex of V (#V x 3) with exactly the same
 /// coordinates (0.0 and -0.0 equal), in V's order: a triangle soup (an STL file converted, one vertex per
 /// corner) or a mesh split along its texture or normal seams becomes indexed, and a closed surface closed.

@@ -34,13 +34,7 @@ namespace {
 
 template <class T>
 T little(std::string_view b, std::size_t at) {
-  T v;
-  unsigned char raw[sizeof(T)];
-  std::memcpy(raw, b.data() + at, sizeof(T));
-  if (!io_detail::host_little_endian())
-    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(raw[i], raw[sizeof(T) - 1 - i]);
-  std::memcpy(&v, raw, sizeof(T));
-  return v;
+  return io_detail::load_little<T>(b.data() + at);
 }
 
 }  // namespace

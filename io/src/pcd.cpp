@@ -270,17 +270,7 @@ PcdHeader parse_header(LineScanner& s) {
 
 // A little-endian float or double at p.
 double load(const unsigned char* p, std::size_t size) {
-  unsigned char b[8];
-  std::memcpy(b, p, size);
-  if (!io_detail::host_little_endian()) std::reverse(b, b + size);
-  if (size == 4) {
-    float f;
-    std::memcpy(&f, b, 4);
-    return static_cast<double>(f);
-  }
-  double d;
-  std::memcpy(&d, b, 8);
-  return d;
+  return size == 4 ? static_cast<double>(io_detail::load_little<float>(p)) : io_detail::load_little<double>(p);
 }
 
 bool all_finite(const Point3& p) {

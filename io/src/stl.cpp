@@ -107,21 +107,6 @@ TriangleMesh make_mesh(std::vector<double>& v, const std::vector<int>& f) {
   return m;
 }
 
-float le_float(const char* p) {
-  unsigned char b[4];
-  std::memcpy(b, p, 4);
-  if (!io_detail::host_little_endian()) std::reverse(b, b + 4);
-  float v;
-  std::memcpy(&v, b, 4);
-  return v;
-}
-
-std::uint32_t le_u32(const char* p) {
-  unsigned char b[4];
-  std::memcpy(b, p, 4);
-  return static_cast<std::uint32_t>(b[0]) | static_cast<std::uint32_t>(b[1]) << 8 |
-         static_cast<std::uint32_t>(b[2]) << 16 | static_cast<std::uint32_t>(b[3]) << 24;
-}
 
 TriangleMesh parse_binary(std::string_view bytes, const std::string& name, std::size_t count) {
   if (count == 0) throw ParseError(name, 0, "no triangle (binary STL with a triangle count of 0)");
@@ -133,7 +118,7 @@ TriangleMesh parse_binary(std::string_view bytes, const std::string& name, std::
     for (int c = 0; c < 3; ++c) {
       double x[3];
       for (int a = 0; a < 3; ++a) {
-        x[a] = le_float(corners + 12 * c + 4 * a);
+        x[a] = io_detail::load_little<float>(corners + 12 * c + 4 * a);
         if (!std::isfinite(x[a]))
           throw ParseError(name, 0,
                            "triangle " + std::to_string(t) + ": non-finite coordinate at byte offset " +
@@ -260,7 +245,7 @@ bool starts_solid(std::string_view bytes) {
 TriangleMesh parse_stl(std::string_view bytes, const std::string& name) {
   std::string not_binary;  // why the bytes are no binary STL
   if (bytes.size() >= kHeaderBytes) {
-    const std::uint64_t count = le_u32(bytes.data() + 80);
+    const std::uint64_t count = io_detail::load_little<std::uint32_t>(bytes.data() + 80);
     const std::uint64_t expected = kHeaderBytes + kTriangleBytes * count;
     if (bytes.size() == expected) return parse_binary(bytes, name, static_cast<std::size_t>(count));
     not_binary = "the size (" + std::to_string(bytes.size()) + " bytes) does not match a binary STL of " +

@@ -12,6 +12,7 @@
 #include <cstring>
 #include <fstream>
 #include <string>
+#include <utility>
 #include <string_view>
 #include <vector>
 
@@ -131,6 +132,17 @@ inline bool host_little_endian() {
   unsigned char first = 0;
   std::memcpy(&first, &one, 1);
   return first == 1;
+}
+/// The value of type T (an arithmetic type) stored little-endian at p (unaligned: copied bytewise).
+template <class T>
+T load_little(const void* p) {
+  unsigned char raw[sizeof(T)];
+  std::memcpy(raw, p, sizeof(T));
+  if (!host_little_endian())
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(raw[i], raw[sizeof(T) - 1 - i]);
+  T v;
+  std::memcpy(&v, raw, sizeof(T));
+  return v;
 }
 /// Whether the mesh has one normal per vertex (N is #V x 3, and there are vertices).
 inline bool has_vertex_normals(const TriangleMesh& m) {

@@ -42,32 +42,24 @@ std::string describe_scan(const ScanFit& fit, bool given) {
 
 void repair_mesh(Input& in, const std::string& name, const char* command) {
   if (in.kind != InputKind::Mesh) return;
-  auto defects_of = [&](const Eigen::MatrixXi& F) {
-    try {
-      return mesh_defects(in.mesh.V, F);
-    } catch (const InvalidArgument& e) {
-      throw InvalidArgument(name + ": " + e.what());
-    }
-  };
   if (const std::size_t n = drop_degenerate_triangles(in.mesh.F))
     std::fprintf(stderr, "%s: warning: %s: %zu triangle%s that repeat%s a vertex (no area) left out\n", command,
                  name.c_str(), n, n == 1 ? "" : "s", n == 1 ? "s" : "");
-  const MeshDefects given = defects_of(in.mesh.F);
-  if (given.closed()) return;
-  Eigen::MatrixXi repaired = in.mesh.F;
-  const std::size_t n = merge_coincident_vertices(in.mesh.V, repaired);
-  const std::size_t flat = n ? drop_degenerate_triangles(repaired) : 0;
-  const std::size_t twice = drop_duplicate_triangles(repaired);
-  if ((n == 0 && twice == 0) || repaired.rows() == 0) return;
-  const MeshDefects now = defects_of(repaired);
-  if (now.boundary_edges + now.repeated_edges >= given.boundary_edges + given.repeated_edges) return;
+  MeshRepair r;
+  try {
+    r = repair_open_mesh(in.mesh.V, in.mesh.F);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(name + ": " + e.what());
+  }
+  if (!r.applied) return;
   std::string what;
-  if (n) what += std::to_string(n) + " vertices at the same position as another merged (a triangle soup or a mesh "
-                 "split along its seams)";
-  if (flat) what += ", " + std::to_string(flat) + " triangles left without area dropped";
-  if (twice) what += std::string(what.empty() ? "" : ", ") + std::to_string(twice) + " repeated triangles left out";
-  std::fprintf(stderr, "%s: %s: %s%s\n", command, name.c_str(), what.c_str(), now.closed() ? ": a closed mesh" : "");
-  in.mesh.F = std::move(repaired);
+  if (r.merged_vertices)
+    what += std::to_string(r.merged_vertices) + " vertices at the same position as another merged (a triangle "
+            "soup or a mesh split along its seams)";
+  if (r.flat_triangles) what += ", " + std::to_string(r.flat_triangles) + " triangles left without area dropped";
+  if (r.repeated_triangles)
+    what += std::string(what.empty() ? "" : ", ") + std::to_string(r.repeated_triangles) + " repeated triangles left out";
+  std::fprintf(stderr, "%s: %s: %s%s\n", command, name.c_str(), what.c_str(), r.closed ? ": a closed mesh" : "");
 }
 
 Constraints constraints_of(Input in, const std::string& name, const ConstraintBuildOptions& build,

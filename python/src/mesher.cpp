@@ -489,17 +489,7 @@ Options as reconstruct() (those of point inputs do not apply).)");
                     // As `vitri mesh`: an open mesh's vertices at exactly the same position merged (a triangle
                     // soup, seams split) and its repeated triangles left out, kept when fewer edges are then
                     // open or repeated.
-                    if (const MeshDefects given = mesh_defects(V, F); !given.closed()) {
-                      Eigen::MatrixXi repaired = F;
-                      const std::size_t merged = merge_coincident_vertices(V, repaired);
-                      if (merged) drop_degenerate_triangles(repaired);
-                      const std::size_t twice = drop_duplicate_triangles(repaired);
-                      if ((merged || twice) && repaired.rows() > 0) {
-                        const MeshDefects now = mesh_defects(V, repaired);
-                        if (now.boundary_edges + now.repeated_edges < given.boundary_edges + given.repeated_edges)
-                          F = std::move(repaired);
-                      }
-                    }
+                    repair_open_mesh(V, F);
                     return build(kw, "from_mesh", [&](const MesherOptions& o) { return Mesher::from_mesh(V, F, o); });
                   },
                   py::arg("vertices"), py::arg("faces"),

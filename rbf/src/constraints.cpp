@@ -389,6 +389,25 @@ std::size_t merge_coincident_vertices(const Eigen::MatrixXd& V, Eigen::MatrixXi&
   return merged;
 }
 
+MeshRepair repair_open_mesh(const Eigen::MatrixXd& V, Eigen::MatrixXi& F) {
+  MeshRepair r;
+  const MeshDefects given = mesh_defects(V, F);
+  r.closed = given.closed();
+  if (r.closed) return r;
+  Eigen::MatrixXi repaired = F;
+  const std::size_t merged = merge_coincident_vertices(V, repaired);
+  const std::size_t flat = merged ? drop_degenerate_triangles(repaired) : 0;
+  const std::size_t twice = drop_duplicate_triangles(repaired);
+  if ((merged == 0 && twice == 0) || repaired.rows() == 0) return r;
+  const MeshDefects now = mesh_defects(V, repaired);
+  if (now.boundary_edges + now.repeated_edges >= given.boundary_edges + given.repeated_edges) return r;
+  F = std::move(repaired);
+  r.merged_vertices = merged, r.flat_triangles = flat, r.repeated_triangles = twice;
+  r.applied = true;
+  r.closed = now.closed();
+  return r;
+}
+
 MeshDefects mesh_defects(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
   if (V.cols() != 3 || F.cols() != 3) throw InvalidArgument("mesh: V and F must have 3 columns");
   if (F.rows() == 0) throw InvalidArgument("mesh has no triangle");

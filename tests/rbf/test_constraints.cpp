@@ -276,6 +276,17 @@ TEST_CASE("a triangle soup's coincident vertices merged: the closed tetrahedron 
       CHECK(M(f, k) <= T(f, k));
     }
   CHECK(merge_coincident_vertices(S, M) == 0);  // nothing left to merge
+  // repair_open_mesh: the same merge, kept (the soup closes); a closed mesh left as it is.
+  Eigen::MatrixXi R = T;
+  const MeshRepair r = repair_open_mesh(S, R);
+  CHECK(r.applied);
+  CHECK(r.closed);
+  CHECK(r.merged_vertices == 8);
+  CHECK(R == M);
+  const MeshRepair again = repair_open_mesh(S, R);
+  CHECK_FALSE(again.applied);
+  CHECK(again.closed);
+  CHECK(R == M);
   // A corner only close to another stays its own vertex.
   Eigen::MatrixXi N = T;
   N(0, 0) = static_cast<int>(S.rows() - 1);

@@ -169,6 +169,21 @@ std::size_t drop_duplicate_triangles(Eigen::MatrixXi& F);
 /// (mesh_defects does); a non-finite coordinate is merged only with the same bits.
 std::size_t merge_coincident_vertices(const Eigen::MatrixXd& V, Eigen::MatrixXi& F);
 
+/// What repair_open_mesh() did.
+struct MeshRepair {
+  std::size_t merged_vertices = 0;     ///< referenced vertices merged into a coincident one
+  std::size_t flat_triangles = 0;      ///< triangles left without area by the merge, dropped
+  std::size_t repeated_triangles = 0;  ///< triangles written twice, dropped
+  bool applied = false;                ///< the repair was kept (fewer open or repeated edges)
+  bool closed = false;                 ///< the mesh is closed afterwards (or was already)
+};
+/// A mesh not closed as given (mesh_defects()) made what it was meant to be, when that closes more of
+/// it: its coincident vertices merged (merge_coincident_vertices(), then drop_degenerate_triangles() on
+/// what that flattened) and its repeated triangles dropped (drop_duplicate_triangles()); F is replaced
+/// only when fewer boundary and repeated edges are left. A closed mesh is left as it is.
+/// @throws as mesh_defects().
+MeshRepair repair_open_mesh(const Eigen::MatrixXd& V, Eigen::MatrixXi& F);
+
 /// The defects of a triangle mesh (V #V x 3, F #F x 3), without throwing for them.
 /// @throws InvalidArgument for what is not a triangle mesh at all: columns other than 3, no triangle, a
 ///         triangle with an out-of-range or repeated vertex index (named).

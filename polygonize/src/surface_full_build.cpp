@@ -298,7 +298,7 @@ void SurfaceTracker::number_mesh_vertices(const TrackerInput& in, MeshCorners& m
         if (owner & kZeroTag) {
           const VertexId z = owner & ~kZeroTag;
           zero_out_[z] = v;
-          positions[v] = known_snap_target(in, z);
+          positions[v] = in.tri.point(z);
           no_normal[s].push_back(v);
         } else {
           Edge& edge = edges_[owner];

@@ -31,14 +31,6 @@ bool is_flat(const Point3& n, const Point3& a, const Point3& b, const Point3& c)
   return !(squared_norm(n) > kFlatRatio * kFlatRatio * l2 * l2);
 }
 
-// z moved onto the surface by one Newton step from its value fz and gradient g (z itself when the step
-// is undefined).
-Point3 newton_target(const Point3& z, double fz, const Point3& g) {
-  const double g2 = dot(g, g);
-  if (g2 > 0.0 && std::isfinite(g2) && std::isfinite(fz)) return z - (fz / g2) * g;
-  return z;
-}
-
 }  // namespace
 
 // Re-decides, in increasing id, the anchored (or collapsed) vertices of the rebuilt tetrahedra and of
@@ -70,8 +62,8 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
     std::sort(first.begin(), first.end());
   }
   deciding = true;
-  // A large update (a full build: about one offer per on-surface constraint) takes the stars and snap
-  // targets of its first offers from a lookahead computed on the threads.
+  // A large update (a full build: about one offer per on-surface constraint) takes the stars and fans of
+  // its first offers from a lookahead computed on the threads.
   const bool ahead = in.snap_lookahead && first.size() >= kLookaheadMin;
   SnapLookahead look;
   std::size_t next = 0;
@@ -114,10 +106,9 @@ void SurfaceTracker::decide_snapping(const TrackerInput& in, Work& w) {
   }
 }
 
-// The stars, fans and snap targets of first[from, from + lookahead_chunk(threads)): they depend on the
-// triangulation, the polygons, the crossings and the function only, not on any decision, so slices of
-// the chunk run on the threads and the serial pass reads what it would have computed. The targets join
-// the cache (the evaluations the serial pass would have made: same vertices, same calls of f).
+// The stars and fans of first[from, from + lookahead_chunk(threads)): they depend on the triangulation,
+// the polygons and the crossings only, not on any decision, so slices of the chunk run on the threads
+// and the serial pass reads what it would have computed.
 void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<VertexId>& first, std::size_t from,
                                 const AnchoredCorners* at, SnapLookahead& look) {
   const std::size_t n = std::min(lookahead_chunk(resolve_thread_count(in.threads)), first.size() - from);
@@ -130,16 +121,8 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
     SnapLookahead::Slice& out = look.slices[s];
     out.stars.clear();
     out.fans.clear();
-    out.targets.clear();
     std::vector<TetId> star, stars;
     std::vector<std::size_t> ends;
-    const auto add_target = [&](VertexId z) {
-      if (in.values[z] == 0.0 || snap_known_[z]) return;  // snap_target(z) evaluates nothing
-      const Point3& p = in.tri.point(z);
-      Point3 g;
-      const double fz = in.f.value_gradient(p, g);
-      out.targets.emplace_back(z, newton_target(p, fz, g));
-    };
     for (std::size_t k = lo; k < hi; ++k) {
       const VertexId z = first[from + k];
       SnapLookahead::Span& sp = look.spans[k];
@@ -149,7 +132,6 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
         if (!in.tri.is_vertex(z) || !may_collapse(in, z)) continue;
         gather_fan_at(z, at->corners.data() + at->start[z], at->start[z + 1] - at->start[z], out.fans);
         sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
-        add_target(z);
         continue;
       }
       if ((k - lo) % kStarChunk == 0)  // the next stars walked together: their cache misses overlap
@@ -164,39 +146,8 @@ void SurfaceTracker::look_ahead(const TrackerInput& in, const std::vector<Vertex
       if (star.empty() || !may_collapse(in, z)) continue;  // the test reads nothing more
       gather_fan(z, star, out.fans);
       sp.fan_last = static_cast<std::uint32_t>(out.fans.size());
-      add_target(z);
     }
   });
-  for (const SnapLookahead::Slice& slice : look.slices) {
-    report_.evaluations += slice.targets.size();
-    for (const auto& [z, q] : slice.targets) {
-      snap_at_[z] = q;
-      snap_known_[z] = 1;
-    }
-  }
-}
-
-Point3 SurfaceTracker::snap_target(const TrackerInput& in, VertexId z) {
-  const Point3& p = in.tri.point(z);
-  const double value = in.values[z];
-  if (value == 0.0) return p;
-  if (snap_known_[z]) return snap_at_[z];
-  Point3 g;
-  const double fz = in.f.value_gradient(p, g);
-  ++report_.evaluations;
-  snap_at_[z] = newton_target(p, fz, g);
-  snap_known_[z] = 1;
-  return snap_at_[z];
-}
-
-Point3 SurfaceTracker::known_snap_target(const TrackerInput& in, VertexId z) const {
-  const Point3& p = in.tri.point(z);
-  if (in.values[z] == 0.0) return p;
-  if (snap_known_[z]) return snap_at_[z];
-  // Not reached for a collapsed z (its collapse test cached the target): the same value, uncached.
-  Point3 g;
-  const double fz = in.f.value_gradient(p, g);
-  return newton_target(p, fz, g);
 }
 
 bool SurfaceTracker::can_collapse(const TrackerInput& in, VertexId z) {
@@ -294,7 +245,7 @@ void SurfaceTracker::anchored_corners(const TrackerInput& in, AnchoredCorners& o
 
 // The collapse test of z on its fan, with the collapses decided so far (all of lower ids) applied.
 bool SurfaceTracker::fan_test(const TrackerInput& in, VertexId z, const FanTriangle* fan, std::size_t count) {
-  const Point3 zp = snap_target(in, z);
+  const Point3& zp = in.tri.point(z);  // where the crossings anchored at z go
   std::vector<std::pair<std::uint32_t, std::uint32_t>>& link = link_;  // directed (w1 -> w2)
   link.clear();
   for (std::size_t f = 0; f < count; ++f) {
@@ -305,7 +256,7 @@ bool SurfaceTracker::fan_test(const TrackerInput& in, VertexId z, const FanTrian
     for (int i = 0; i < 3; ++i) {
       const VertexId a = tri.anchor[i];
       if (a != kNoVertex && a < z && collapsed_[a]) {
-        p[i] = snap_target(in, a);
+        p[i] = in.tri.point(a);
         id[i] = kZeroTag | a;
       } else {
         p[i] = tri.x[i];

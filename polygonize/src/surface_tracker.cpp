@@ -66,8 +66,6 @@ void SurfaceTracker::update(const TrackerInput& in) {
   report_ = {};
   ++epoch_;
   assert(collapsed_.size() == in.tri.vertex_capacity() && polygon_of_.size() == in.tri.tet_capacity());
-  for (const VertexId v : touched_) snap_known_[v] = 0;
-  if (rebuild_) snap_known_.fill(0);
   Work w;
   using Clock = std::chrono::steady_clock;
   auto lap = [t = Clock::now()]() mutable {
@@ -324,13 +322,12 @@ void SurfaceTracker::place_edges(const TrackerInput& in, Work& w) {
       }
     }
   }
-  project_pushed(in, pushed);
+  normals_of_pushed(in, pushed);
 }
 
-// The pushed vertices go back onto the surface by one Newton step along the gradient (at most twice
-// snap_fraction of the edge long; else they stay on the edge), in one batch call; that gradient is their
-// normal.
-void SurfaceTracker::project_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed) {
+// The pushed vertices stay on their edge (every polygon then lies in its own tetrahedron, so no two
+// triangles of the mesh cross); their normal is f's gradient where they lie, in one batch call.
+void SurfaceTracker::normals_of_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed) {
   std::vector<Point3> at(pushed.size()), g(pushed.size());
   std::vector<double> value(pushed.size());
   for (std::size_t k = 0; k < pushed.size(); ++k) at[k] = edges_[pushed[k]].x;
@@ -339,10 +336,6 @@ void SurfaceTracker::project_pushed(const TrackerInput& in, const std::vector<st
   report_.gradient_evaluations += pushed.size();
   for (std::size_t k = 0; k < pushed.size(); ++k) {
     Edge& e = edges_[pushed[k]];
-    const double g2 = dot(g[k], g[k]);
-    const Point3 step = (g2 > 0.0 ? value[k] / g2 : 0.0) * g[k];
-    const double reach = 2.0 * in.snap_fraction * norm(in.tri.point(e.neg) - in.tri.point(e.pos));
-    if (is_finite(step) && squared_norm(step) <= reach * reach) e.x = e.x - step;
     e.gradient = g[k];
     e.has_gradient = is_finite(g[k]);
   }
@@ -373,7 +366,7 @@ std::uint32_t SurfaceTracker::out_vertex(const TrackerInput& in, std::uint32_t e
   std::uint32_t owner;
   if (a != kNoVertex && collapsed_[a]) {
     slot = &zero_out_[a];
-    p = snap_target(in, a);
+    p = in.tri.point(a);
     owner = kZeroTag | a;
   } else {
     slot = &edges_[e].out;
@@ -476,7 +469,7 @@ void SurfaceTracker::refresh_vertices(const TrackerInput& in, Work& w) {
   for (const VertexId z : touched_) {
     if (z >= zero_out_.size() || zero_out_[z] == kNone) continue;
     const std::uint32_t v = zero_out_[z];
-    const Point3 q = snap_target(in, z);
+    const Point3& q = in.tri.point(z);
     if (!(mesh_.position(v) == q)) mesh_.move_vertex(v, q, mesh_.normal(v));
     w.normals.push_back(v);
   }

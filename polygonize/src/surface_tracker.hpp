@@ -98,9 +98,7 @@ class SurfaceTracker {
         anchored_(tri, 0),
         stamp_(tri, 0),
         moved_stamp_(tri, 0),
-        decide_stamp_(tri, 0),
-        snap_at_(tri),
-        snap_known_(tri, 0) {}
+        decide_stamp_(tri, 0) {}
 
   // ---- What changed (called by the Polygonizer as it edits) -----------------------------------------
   // Tetrahedra are listed until the lists outgrow the mesh (a refinement), then the next update sweeps
@@ -183,7 +181,8 @@ class SurfaceTracker {
   bool mark_if_touched(std::uint32_t e, Work& w);
   void release_edge(std::uint32_t e);
   void place_edges(const TrackerInput& in, Work& w);
-  void project_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed);
+  /// The gradient (normal) of the crossings place_edges kept snap_fraction of their edge from their anchor.
+  void normals_of_pushed(const TrackerInput& in, const std::vector<std::uint32_t>& pushed);
   void set_anchor(std::uint32_t e, VertexId anchor);
   void split_polygons(const TrackerInput& in, Work& w);
   void decide_snapping(const TrackerInput& in, Work& w);
@@ -203,7 +202,6 @@ class SurfaceTracker {
     struct Slice {
       std::vector<TetId> stars;
       std::vector<FanTriangle> fans;
-      std::vector<std::pair<VertexId, Point3>> targets;  // snap targets evaluated by this slice
     };
     std::size_t begin = 0, end = 0;  // the offers first[begin, end) it covers
     std::vector<Span> spans;         // per covered offer
@@ -251,8 +249,6 @@ class SurfaceTracker {
   }
   MeshCorners mesh_corners(const TrackerInput& in);
   void number_mesh_vertices(const TrackerInput& in, MeshCorners& m, Work& w);
-  /// snap_target of a vertex whose target is known (f(z) = 0, or cached by its collapse test), read only.
-  Point3 known_snap_target(const TrackerInput& in, VertexId z) const;
   /// g / |g|, or the zero vector when that is undefined.
   static Point3 unit_or_zero(const Point3& g) {
     const double l = norm(g);
@@ -266,9 +262,6 @@ class SurfaceTracker {
   std::uint32_t& polygon_of(TetId t);
   // Identity of a corner for merging: the edge slot, or kZeroTag | z when collapsed onto z.
   std::uint32_t corner_identity(std::uint32_t e) const;
-  /// Where the crossings anchored at z collapse to: z itself when f(z) = 0, else z moved onto the surface
-  /// by one Newton step (cached until z's value changes).
-  Point3 snap_target(const TrackerInput& in, VertexId z);
 
   static constexpr std::uint32_t kZeroTag = 0x80000000u;
 
@@ -297,10 +290,6 @@ class SurfaceTracker {
   std::size_t num_collapsed_ = 0, num_anchored_ = 0;  // vertices collapsed / with anchored edges
   // Owner of each LiveMesh vertex: an edge slot, or kZeroTag | Delaunay vertex.
   std::vector<std::uint32_t> owner_;
-  // Per Delaunay vertex: snap_target() for f(z) != 0, cached when snap_known_[z] (until z's value or
-  // position changes; a flat array: the collapse tests read it at every lower collapsed corner).
-  VertexMap<Point3> snap_at_;
-  VertexMap<std::uint8_t> snap_known_;
   // can_collapse(z) scratch: the star of z (read again by decide_snapping when z's decision changes)
   // and the directed link edges.
   std::vector<TetId> star_;

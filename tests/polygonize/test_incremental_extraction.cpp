@@ -427,9 +427,9 @@ TEST_CASE("zero-valued and near-zero vertices: snapped, no tiny triangle", "[inc
     const SurfaceMesh m = poly.extract();
     test::require_closed(m, 2, 1);
     REQUIRE(poly.stats().zero_snapped > 0);
-    // Collapsed vertices are on the surface (f = 0 exactly, or one Newton step from a vertex within 1% of
-    // an edge of it).
-    for (const Point3& p : m.vertices) REQUIRE(std::abs(norm(p) - 5.0) <= 1e-3 * precision);
+    // Collapsed vertices lie at their Delaunay vertex: on the surface (f = 0 exactly) or within 1% of an
+    // edge (< 2 precision) from its root; so do the crossings kept off an uncollapsed anchor.
+    for (const Point3& p : m.vertices) REQUIRE(std::abs(norm(p) - 5.0) <= 0.02 * precision);
   }
 }
 
@@ -505,9 +505,10 @@ TEST_CASE("flat tetrahedra of samples with equal normals: no flat triangle", "[i
     REQUIRE(poly.refine(precision));
     const SurfaceMesh m = poly.extract();
     test::require_closed(m, 2, 1);
-    // Not only the collapsed vertices: every vertex is on the cube (roots, collapses and the vertices
-    // kept off an uncollapsed anchor, projected back).
-    for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3 * precision);
+    // Not only the collapsed vertices: every vertex is on the cube up to 1% of its Delaunay edge (< 2
+    // precision): roots, collapses at their vertex and the vertices kept on their edge off an uncollapsed
+    // anchor.
+    for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 0.02 * precision);
   }
 }
 

@@ -505,3 +505,62 @@ TEST_CASE("spatially_ordered: the same triangles, oriented as given, numbered by
   m.normals.clear();
   CHECK(vitri::spatially_ordered(m).normals.empty());
 }
+
+TEST_CASE("self_intersections: none on closed meshes, every configuration that touches found", "[mesh_metrics]") {
+  using vitri::self_intersections;
+  using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
+  // Closed meshes: triangles meet only at what they share.
+  CHECK(self_intersections(tet_V(), tet_F()).empty());
+  CHECK(self_intersections(cube_V(), tris(cube_faces())).empty());
+  {
+    Eigen::MatrixXd V;
+    Eigen::MatrixXi F;
+    torus(40, 20, 2.0, 0.5, V, F);
+    CHECK(self_intersections(V, F).empty());
+    // A second torus through the first (shifted by R along x): the tubes cross near (1, +-sqrt 3, 0).
+    Eigen::MatrixXd V2 = V;
+    V2.col(0).array() += 2.0;
+    Eigen::MatrixXd VV(2 * V.rows(), 3);
+    VV << V, V2;
+    Eigen::MatrixXi FF(2 * F.rows(), 3);
+    FF << F, (F.array() + static_cast<int>(V.rows())).matrix();
+    const Pairs p = self_intersections(VV, FF);
+    CHECK(!p.empty());
+    for (const auto& [s, t] : p) {  // every pair is one triangle of each torus
+      CHECK(s < static_cast<std::size_t>(F.rows()));
+      CHECK(t >= static_cast<std::size_t>(F.rows()));
+    }
+    CHECK(self_intersections(VV, FF, 3).size() == 3);
+  }
+  // Two triangles without a common vertex: crossing, touching at a point, coplanar overlap, apart.
+  const Eigen::MatrixXi two = tris({{0, 1, 2}, {3, 4, 5}});
+  const auto base = std::vector<std::array<double, 3>>{{0, 0, 0}, {2, 0, 0}, {0, 2, 0}};
+  const auto with = [&](std::vector<std::array<double, 3>> more) {
+    auto v = base;
+    v.insert(v.end(), more.begin(), more.end());
+    return rows(v);
+  };
+  CHECK(self_intersections(with({{0.5, 0.5, -1}, {0.5, 0.5, 1}, {3, 3, 0.5}}), two) == Pairs{{0, 1}});
+  CHECK(self_intersections(with({{0.5, 0.5, 0}, {0.5, 3, 1}, {3, 0.5, 1}}), two) == Pairs{{0, 1}});  // a corner on it
+  CHECK(self_intersections(with({{1, 0, 0}, {1, 0, 1}, {5, 5, 5}}), two) == Pairs{{0, 1}});          // on its edge
+  CHECK(self_intersections(with({{0.2, 0.2, 0}, {0.6, 0.2, 0}, {0.2, 0.6, 0}}), two) == Pairs{{0, 1}});  // inside, coplanar
+  CHECK(self_intersections(with({{-0.3, 0.7, 0}, {0.7, -0.3, 0}, {1.3, 1.3, 0}}), two) == Pairs{{0, 1}});  // coplanar, edges cross
+  CHECK(self_intersections(with({{1.5, 1.5, 0}, {3, 2, 0}, {2, 3, 0}}), two).empty());               // coplanar, apart
+  CHECK(self_intersections(with({{0.5, 0.5, 1e-9}, {1, 0.5, 1}, {0.5, 1, 1}}), two).empty());        // just above
+  // One common vertex (0): a fan around it is fine, an edge running into the other triangle is not.
+  const Eigen::MatrixXi fan = tris({{0, 1, 2}, {0, 3, 4}});
+  CHECK(self_intersections(with({{-1, 0, 1}, {-1, -1, 0}}), fan).empty());
+  CHECK(self_intersections(with({{1, 1, -1}, {1, 1, 1}}), fan) == Pairs{{0, 1}});   // its far edge pierces
+  CHECK(self_intersections(with({{1, 1, 0}, {1, 1, 1}}), fan) == Pairs{{0, 1}});    // an edge from 0 inside, coplanar
+  CHECK(self_intersections(with({{-1, -1, 0}, {-1, 0, 1}}), fan).empty());          // in the plane, outside the angle
+  CHECK(self_intersections(with({{1, 0, 0}, {1, 1, 1}}), tris({{0, 1, 2}, {0, 3, 4}})) == Pairs{{0, 1}});  // edges overlap
+  // A common edge (0, 1): a fold onto the same side is an overlap, a hinge or a flat continuation is not.
+  const Eigen::MatrixXi hinge = tris({{0, 1, 2}, {1, 0, 3}});
+  CHECK(self_intersections(with({{0.5, -1, 1}}), hinge).empty());
+  CHECK(self_intersections(with({{0.5, -1, 0}}), hinge).empty());
+  CHECK(self_intersections(with({{0.5, 1, 0}}), hinge) == Pairs{{0, 1}});
+  // A repeated triangle (either orientation); degenerate ones are left out.
+  CHECK(self_intersections(rows(base), tris({{0, 1, 2}, {2, 1, 0}})) == Pairs{{0, 1}});
+  CHECK(self_intersections(with({{1, 0, 0}}), tris({{0, 1, 3}, {0, 1, 2}})).empty());  // collinear: zero area
+  CHECK_THROWS_AS(self_intersections(rows(base), tris({{0, 1, 5}})), vitri::InvalidArgument);
+}

@@ -39,6 +39,25 @@ double max_distance(const SurfaceMesh& m, const Fn& dist, bool centroids) {
   return d;
 }
 
+/// Share of the vertices within `tol` of the true surface.
+template <class Fn>
+double share_within(const SurfaceMesh& m, const Fn& dist, double tol) {
+  std::size_t n = 0;
+  for (const Point3& p : m.vertices) n += dist(p) <= tol;
+  return m.vertices.empty() ? 1.0 : double(n) / double(m.vertices.size());
+}
+
+/// Vertices are on the surface up to the root tolerance, but those kept on their Delaunay edge
+/// snap_fraction (1%) of it from an end whose collapse was refused (the root lies nearer that end): those
+/// are within 1% of the edge (< 2 precision) of it. Most vertices are of the first kind.
+template <class Fn>
+void require_vertices_near(const SurfaceMesh& m, const Fn& dist, double precision, double root_tol) {
+  REQUIRE(max_distance(m, dist, false) <= 0.02 * precision + 1e-12);
+  const double share = share_within(m, dist, root_tol);
+  INFO("share within the root tolerance " << share);
+  REQUIRE(share >= 0.98);
+}
+
 const Box3 kCube{{-2.0, -2.0, -2.0}, {2.0, 2.0, 2.0}};
 
 // n seeds uniform in [-1.9, 1.9]^3 (fixed seed).
@@ -64,7 +83,7 @@ TEST_CASE("sphere: closed genus-0 manifold, on the surface, within the precision
   for (const TetId t : poly.transverse_tetrahedra()) REQUIRE(poly.triangulation().circumradius(t) <= precision);
   // Vertices on the surface up to the root tolerance (f is a distance here; edges are < 2 precision).
   const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
-  REQUIRE(max_distance(m, dist, false) <= 2e-4 * precision + 1e-12);
+  require_vertices_near(m, dist, precision, 2e-4 * precision + 1e-12);
   // Every triangle lies in a transverse tetrahedron of diameter <= 2 precision holding its vertices.
   REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
   // Volume converges to the ball's.
@@ -87,7 +106,7 @@ TEST_CASE("torus: closed genus-1 manifold (Euler characteristic 0)", "[polygoniz
   const SurfaceMesh m = poly.extract();
   require_closed(m, 0, 1);
   const auto dist = [&](const Point3& p) { return f.distance_to_surface(p); };
-  REQUIRE(max_distance(m, dist, false) <= 2e-4 * precision + 1e-12);
+  require_vertices_near(m, dist, precision, 2e-4 * precision + 1e-12);
   REQUIRE(max_distance(m, dist, true) <= 2.0 * precision);
 }
 
@@ -172,7 +191,7 @@ TEST_CASE("options: queue order and vertex placement", "[polygonizer]") {
     REQUIRE(poly.stats().root_evaluations == 0);
     REQUIRE(max_distance(m, dist, false) <= 0.2);
   } else {
-    REQUIRE(max_distance(m, dist, false) <= 2e-5);
+    require_vertices_near(m, dist, 0.1, 2e-5);
   }
 }
 

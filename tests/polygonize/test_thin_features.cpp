@@ -166,7 +166,8 @@ TEST_CASE("box hull: fallback points for hull tetrahedra, dropped ones counted",
   const SurfaceMesh m = poly.extract();
   const MeshMetrics mm = metrics_of(m);
   REQUIRE(mm.closed_manifold());
-  for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 1e-3);
+  // On the surface, or on a Delaunay edge within 1% of it from the root (edges < 2 precision).
+  for (const Point3& p : m.vertices) REQUIRE(std::abs(f.value(p)) <= 0.02 * precision);
 
   // Closed by the box (default): the surface is the sphere inside, then a sheet `band` inside each box
   // face where the sphere would leave; no hull tetrahedron is active, the mesh is closed, one component.
@@ -182,7 +183,9 @@ TEST_CASE("box hull: fallback points for hull tetrahedra, dropped ones counted",
   std::size_t on_sheet = 0;
   for (const Point3& p : c.vertices) {
     const double to_face = std::min({1.0 - std::abs(p.x), 1.0 - std::abs(p.y), 1.0 - std::abs(p.z)});
-    const bool on_sphere = std::abs(f.value(p)) <= 1e-3, on_band = std::abs(to_face - band) <= 1e-3;
+    // (up to 1% of a Delaunay edge, < 2 precision: see above)
+    const bool on_sphere = std::abs(f.value(p)) <= 0.02 * precision,
+               on_band = std::abs(to_face - band) <= 0.02 * precision;
     REQUIRE((on_sphere || on_band));
     on_sheet += on_band && !on_sphere;
   }

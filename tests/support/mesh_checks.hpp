@@ -103,8 +103,20 @@ inline double min_relative_area(const SurfaceMesh& m) {
 /// No triangle with an area below 1e-14 x diagonal^2 (issue 12's bound).
 inline void require_no_tiny_triangle(const SurfaceMesh& m) { REQUIRE(min_relative_area(m) >= 1e-14); }
 
+/// No two triangles meet beyond what they share (exact: self_intersections of mesh_metrics.hpp).
+inline void require_no_self_intersection(const SurfaceMesh& m) {
+  Eigen::MatrixXd V;
+  Eigen::MatrixXi F;
+  to_eigen(m, V, F);
+  const auto pairs = self_intersections(V, F, 5);
+  INFO("self-intersecting pairs (first 5): " << pairs.size());
+  for (const auto& [s, t] : pairs) UNSCOPED_INFO("triangles " << s << " and " << t);
+  REQUIRE(pairs.empty());
+}
+
 /// Closed, consistently oriented, manifold, no degenerate or duplicate element, no isolated vertex, the
-/// given Euler characteristic and component count, outward (positive volume), one normal per vertex.
+/// given Euler characteristic and component count, outward (positive volume), one normal per vertex, no
+/// self-intersection.
 inline void require_closed(const SurfaceMesh& m, long long euler, std::size_t components) {
   const MeshMetrics mm = metrics_of(m);
   INFO("V " << mm.vertices << " F " << mm.triangles << " boundary " << mm.boundary_edges
@@ -119,6 +131,7 @@ inline void require_closed(const SurfaceMesh& m, long long euler, std::size_t co
   REQUIRE(mm.signed_volume > 0.0);
   REQUIRE(m.normals.size() == m.vertices.size());
   require_no_tiny_triangle(m);
+  require_no_self_intersection(m);
 }
 
 }  // namespace vitri::test

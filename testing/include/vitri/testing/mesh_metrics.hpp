@@ -20,6 +20,8 @@
 #include <Eigen/Core>
 
 #include <cstddef>
+#include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace vitri {
@@ -115,6 +117,16 @@ struct MeshMetrics {
 /// Cost: O(#F log #F) time, O(#V + #F) memory.
 MeshMetrics compute_mesh_metrics(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
                                  const MeshMetricsOptions& options = {});
+
+/// The pairs (i, j), i < j, of triangles (rows of F) that meet beyond what they share, decided exactly
+/// (self_intersections.cpp): without a common vertex, any common point; with one common vertex, any
+/// other common point; with a common edge, an overlap (coplanar, third corners on the same side); a
+/// triangle repeated. Triangles with a repeated index or zero area are left out (MeshMetrics counts them).
+/// Sorted; at most max_pairs (the first ones). A mesh a mesher outputs must have none.
+/// @throws as compute_mesh_metrics(). Cost: a uniform grid of the triangles' boxes, about O(#F) for a
+///         mesh of even triangles.
+std::vector<std::pair<std::size_t, std::size_t>> self_intersections(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F,
+                                                                     std::size_t max_pairs = SIZE_MAX);
 
 /// The smallest angle (degrees) of every triangle, in the order of F: 0 for a zero-area triangle.
 /// For plotting histograms with other bins. Same preconditions and exceptions as compute_mesh_metrics().

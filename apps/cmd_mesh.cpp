@@ -967,6 +967,12 @@ double run_level(const MeshCommand& c, MeshPlan& plan, std::size_t k, double tot
     std::fprintf(stderr, "  quality: %zu Delaunay vertices, %zu inserted (%zu for the topology), %zu rejected\n",
                  qs.vertices, qs.insertions, qs.topology_insertions, qs.rejected);
   }
+  if (options.mode == MeshMode::Quality && mesher.stats().quality.below_floor)
+    std::fprintf(stderr, "warning: %zu triangles smaller than %g (the quality mode's floor, %g x the precision) "
+                 "are left below the quality criteria (their smallest angle may be below %g degrees): the surface has a "
+                 "crease or a cone point there (docs/quality.md)\n",
+                 mesher.stats().quality.below_floor, Mesher::kQualityFloor * level.precision * plan.diagonal,
+                 Mesher::kQualityFloor, options.quality.min_angle_degrees);
   phases.start("extraction");
   const auto t1 = Clock::now();
   const SurfaceMesh& m = mesher.surface();

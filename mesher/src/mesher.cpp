@@ -541,10 +541,12 @@ void Mesher::refine_quality() {
                   seeds.end());
     q.refine_where = quality_region_;
     q.min_topology_radius = quality_topology_radius_;
+    q.min_radius = std::max(q.min_radius, kQualityFloor * precision_);
     quality_ = std::make_unique<QualityMesher>(function(), poly_->triangulation().box(), seeds, q);
   } else {
     q.refine_where = quality_region_;
     q.min_topology_radius = quality_topology_radius_;
+    q.min_radius = std::max(q.min_radius, kQualityFloor * precision_);
     quality_->set_options(q);
   }
   quality_->refine();

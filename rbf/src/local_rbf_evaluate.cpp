@@ -99,7 +99,7 @@ constexpr std::size_t kSortedBatch = 8192;
 void LocalRbf::values(const Point3* points, std::size_t n, double* out) const {
   const std::vector<std::uint32_t> order =
       n >= kSortedBatch && n < PointIndex::kNoId ? batch_order(points, n, domain()) : std::vector<std::uint32_t>{};
-  parallel_chunks(n, impl_->threads(), 2048, [&](std::size_t b, std::size_t e) {
+  parallel_chunks(n, impl_->opt.threads, 2048, [&](std::size_t b, std::size_t e) {
     std::uint32_t leaf = local_detail::kNone;
     for (std::size_t k = b; k < e; ++k) {
       const std::size_t i = order.empty() ? k : order[k];
@@ -111,7 +111,7 @@ void LocalRbf::values(const Point3* points, std::size_t n, double* out) const {
 void LocalRbf::values_gradients(const Point3* points, std::size_t n, double* values, Point3* gradients) const {
   const std::vector<std::uint32_t> order =
       n >= kSortedBatch && n < PointIndex::kNoId ? batch_order(points, n, domain()) : std::vector<std::uint32_t>{};
-  parallel_chunks(n, impl_->threads(), 2048, [&](std::size_t b, std::size_t e) {
+  parallel_chunks(n, impl_->opt.threads, 2048, [&](std::size_t b, std::size_t e) {
     std::uint32_t leaf = local_detail::kNone;
     for (std::size_t k = b; k < e; ++k) {
       const std::size_t i = order.empty() ? k : order[k];

@@ -634,6 +634,42 @@ TEST_CASE("vitri mesh --min-angle --max-distance: quality mode, every angle >= A
   }
 }
 
+TEST_CASE("vitri mesh MESH --min-angle 30: the facet check's flat tetrahedra and sharp rims end", "[cli][mesh]") {
+  // The facet check adds a plane grid of points on hand.off's large facets (its wrist's cap): flat
+  // tetrahedra, whose circumcentres are not finite, and a sharp rim. (1) The quality mode clipped those
+  // tetrahedra's Voronoi edges to NaN and bisected the brackets forever: the defaults never ended. (2) With
+  // --max-size, angle refinement at a point of the rim never ended (balls of 1e-5 and shrinking, until
+  // the memory ran out): it stops at the floor now, with a warning. About 1 s each (Release); `timeout`
+  // turns a hang into a failure.
+  for (const std::string extra : {"", " --max-size 0.02"}) {
+    INFO("options:" << extra);
+    const std::string out = kDir + "/mesh_quality_hand.ply";
+    std::remove(out.c_str());
+    const std::string o = kDir + "/mesh_stdout.txt", e = kDir + "/mesh_stderr.txt";
+    const int rc = std::system(("timeout 600 " + std::string(VITRI_CLI) + " mesh " + std::string(VITRI_DATA_DIR) +
+                                "/hand.off -o " + out + " --min-angle 30" + extra + " > " + o + " 2> " + e)
+                                   .c_str());
+    const std::string err = slurp(e);
+    INFO(err);
+    REQUIRE(WIFEXITED(rc));
+    REQUIRE(WEXITSTATUS(rc) == 0);
+    REQUIRE(err.find("facet check:") != std::string::npos);
+    const TriangleMesh m = read_mesh(out);
+    const MeshMetrics mm = compute_mesh_metrics(m.V, m.F);
+    REQUIRE(mm.closed_manifold());
+    REQUIRE(mm.euler_characteristic == 2);
+    REQUIRE(mm.components == 1);
+    REQUIRE(self_intersections(m.V, m.F, 1).empty());
+    // Every angle >= 30 degrees but in the few triangles the warning counts (under the floor).
+    const bool floored = err.find("the quality mode's floor") != std::string::npos;
+    if (!extra.empty()) REQUIRE(floored);
+    std::size_t below = 0;
+    for (const double a : triangle_min_angles(m.V, m.F)) below += a < 30.0 - 1e-9;
+    if (!floored) REQUIRE(below == 0);
+    REQUIRE(below <= 20);
+  }
+}
+
 TEST_CASE("vitri mesh --memory: a coarser mesh with a warning under a small limit, an error below any mesh",
           "[cli][mesh][memory]") {
   // 6000 oriented points on the sphere. docs/memory.md's model (base 64 MB, 1100 bytes per point beside

@@ -352,6 +352,12 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
 /// Stateful mesher of one variational implicit surface. Not thread-safe. Movable, not copyable.
 class Mesher {
  public:
+  /// The quality mode's floor (QualityOptions::min_radius) as a fraction of the precision: facets with
+  /// smaller surface Delaunay balls are not refined for angle, size or distance. Angle refinement on a
+  /// smooth surface never goes below the seeds' spacing (about the precision, docs/quality.md); only a
+  /// crease or a cone point of f drives it there, forever.
+  static constexpr double kQualityFloor = 0.01;
+
   /// Fits the RBF to the constraints and builds the initial tetrahedralization (constraints + the 8
   /// corners of their bounding box enlarged by options.box_factor, plus the initial sampling).
   /// Constraint vertices carry their constraint value exactly (f = 0 on on-surface constraints).

@@ -148,7 +148,9 @@ void QualityMesher::Impl::clip_brackets(std::vector<Bracket>& brackets) {
     const Point3 to = a_out ? b.a : b.b;
     double s0 = 0.0, s1 = 1.0;
     if (!is_finite(to) || !clip_to_box(from, to, tri_.box(), s0, s1)) s1 = 0.0;
-    const Point3 exit = from + s1 * (to - from);
+    // (Not from + 0 x (to - from) for a flat tetrahedron's non-finite circumcentre: that is NaN, and a
+    // bracket with a NaN end was bisected forever.)
+    const Point3 exit = s1 > 0.0 ? from + s1 * (to - from) : from;
     (a_out ? b.a : b.b) = exit;
     points.push_back(exit);
     which.push_back(k);
@@ -159,8 +161,11 @@ void QualityMesher::Impl::clip_brackets(std::vector<Bracket>& brackets) {
     Bracket& b = brackets[which[m]];
     (std::isinf(b.fa) ? b.fa : b.fb) = values[m];
   }
+  // (An end that is still not finite would never converge: dropped like the facets without a crossing.)
   brackets.erase(std::remove_if(brackets.begin(), brackets.end(),
-                                [](const Bracket& b) { return negative(b.fa) == negative(b.fb); }),
+                                [](const Bracket& b) {
+                                  return negative(b.fa) == negative(b.fb) || !is_finite(b.a) || !is_finite(b.b);
+                                }),
                  brackets.end());
 }
 
@@ -379,6 +384,7 @@ bool QualityMesher::Impl::is_bad(const FacetRecord& r) const {
 void QualityMesher::Impl::push(const FacetKey& key, const FacetRecord& r, bool topology) {
   if (options_.refine_where && !options_.refine_where(r.center)) return;  // outside the refined region
   if (topology && r.radius < options_.min_topology_radius) return;         // thinner than asked for
+  if (!topology && r.radius < options_.min_radius) return;                 // below the floor (creases)
   queue_.push({r.radius, key, r.stamp, topology});
 }
 

@@ -77,6 +77,8 @@ void QualityMesher::validate(const QualityOptions& o) {
     throw InvalidArgument("QualityOptions::distance_probes must be in [0, 16], got " +
                           std::to_string(o.distance_probes));
   if (o.max_vertices < 9) throw InvalidArgument("QualityOptions::max_vertices must be >= 9");
+  if (!(o.min_radius >= 0.0) || !std::isfinite(o.min_radius))
+    throw InvalidArgument("QualityOptions::min_radius must be finite and >= 0, got " + std::to_string(o.min_radius));
 }
 
 void QualityMesher::Impl::set_options(const QualityOptions& options) {
@@ -271,8 +273,16 @@ bool QualityMesher::Impl::refine() {
       throw LimitError("QualityMesher::refine: more than QualityOptions::max_vertices = " +
                        std::to_string(options_.max_vertices) + " Delaunay vertices needed");
   }
+  // What the floor left: bad facets below min_radius (where the criteria apply at all).
+  stats_.below_floor = 0;
+  if (options_.min_radius > 0.0)
+    for (const auto& kv : facets_.records()) {
+      const FacetRecord& r = kv.second;
+      if (r.radius < options_.min_radius && is_bad(r) && (!options_.refine_where || options_.refine_where(r.center)))
+        ++stats_.below_floor;
+    }
   stats_.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return rejected == 0;
+  return rejected == 0 && stats_.below_floor == 0;
 }
 
 // ---- The public QualityMesher: forwards to its Impl ---------------------------------------------------

@@ -75,7 +75,9 @@ template <class Body>
 void parallel_chunks(std::size_t n, unsigned threads, std::size_t grain, const Body& body) {
   grain = std::max<std::size_t>(1, grain);
   const std::size_t chunks = (n + grain - 1) / grain;
-  const std::size_t workers = std::min<std::size_t>(resolve_thread_count(threads), chunks);
+  // One chunk needs no thread (and no look at the CPUs: small batches come often, e.g. the quality mode's
+  // root brackets, where the affinity system call cost more than the evaluations).
+  const std::size_t workers = chunks <= 1 ? chunks : std::min<std::size_t>(resolve_thread_count(threads), chunks);
   if (workers <= 1) {
     if (n) body(std::size_t{0}, n);
     return;

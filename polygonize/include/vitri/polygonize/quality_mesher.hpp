@@ -77,6 +77,14 @@ struct QualityOptions {
   /// than the data resolve (a fold where an open scan's surface turns back, bubbles of noise) are not
   /// chased (measured: 96% of the insertions on a single view of a sphere cap, past the budget).
   double min_topology_radius = 0.0;
+  /// A facet whose surface Delaunay ball radius is below this (absolute) is not refined for its angle,
+  /// size or distance. A floor for functions with a crease or a cone point (the sharp rim the facet check
+  /// of a mesh gives a large flat facet), where angle refinement never ends: Chew's argument needs a smooth
+  /// surface (measured: hand.off through the facet check with --max-size 0.02, one point of its wrist's
+  /// rim took 10^5 centres with balls of 7.7e-6, shrinking, until the memory ran out). The facets left
+  /// bad under it are counted (QualityStats::below_floor) and refine() then returns false. 0 (default):
+  /// no floor. The Mesher gives Mesher::kQualityFloor x the precision.
+  double min_radius = 0.0;
 };
 
 /// Counters of a QualityMesher (cumulative since construction unless stated).
@@ -87,6 +95,9 @@ struct QualityStats {
   std::size_t insertions = 0;                ///< surface Delaunay ball centres inserted by refine()
   std::size_t topology_insertions = 0;       ///< of which for a vertex whose restricted star was not a disk
   std::size_t rejected = 0;                  ///< centres that duplicated a vertex (facet left as it was)
+  /// Restricted facets that fail a criterion but are smaller than QualityOptions::min_radius (as the
+  /// last refine() left them): the only triangles whose angle may be below the bound.
+  std::size_t below_floor = 0;
   std::size_t function_evaluations = 0;      ///< calls of f (values and gradients), all phases
   std::size_t circumcenter_evaluations = 0;  ///< of which at circumcentres (signs of the Voronoi edges)
   std::size_t root_evaluations = 0;          ///< of which by the root finder on Voronoi edges

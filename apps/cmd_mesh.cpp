@@ -112,7 +112,8 @@ const char* const kUsage =
     "                       detail (strictly decreasing); with both lists, level k uses the k-th value\n"
     "                       of each, a shorter list repeating its last value.\n"
     "  --max-size S         quality mode: surface Delaunay ball radius (about the circumradius of each\n"
-    "                       triangle) at most S x the diagonal\n"
+    "                       triangle) at most S x the diagonal (default, when no --max-distance is\n"
+    "                       given either: half the level's --precision, the fast mesh's resolution)\n"
     "  --offset D           off-surface constraint distance for points/meshes, fraction of the\n"
     "                       diagonal (default: 2 x the median spacing of the points, at most 0.01)\n"
     "  --sides S            off-surface constraints per point for points/meshes: both (default; +D\n"
@@ -900,6 +901,8 @@ QualityOptions level_quality(const MeshCommand& c, const MeshPlan& plan, const M
   const MesherOptions& options = plan.options;
   QualityOptions q = options.quality;
   q.max_size = c.relative_size * plan.diagonal;
+  if (!std::isfinite(c.relative_size) && !level.max_distance)  // an angle alone: the level's resolution
+    q.max_size = run_defaults::quality_size_factor * level.precision * plan.diagonal;
   // The same budget as the refinement (a scan's follows its size): a coarser mesh with a warning.
   if (options.max_vertices) q.max_vertices = std::max<std::size_t>(9, std::min(q.max_vertices, options.max_vertices));
   if (level.max_distance) q.max_distance = *level.max_distance * plan.diagonal;

@@ -162,6 +162,8 @@ void set_level_quality(Mesher& mesher, const Options& o, std::size_t k) {
   const double diag = mesher.diagonal();
   q.max_size = o.relative_size * diag;
   if (!o.distances.empty()) q.max_distance = o.distances[std::min(k, o.distances.size() - 1)] * diag;
+  else if (!std::isfinite(o.relative_size) && !o.precisions.empty())  // an angle alone: the level's resolution
+    q.max_size = run_defaults::quality_size_factor * o.precisions[std::min(k, o.precisions.size() - 1)] * diag;
   mesher.set_quality_options(q);
 }
 

@@ -11,6 +11,8 @@
 
 #include "vitri/testing/mesh_metrics.hpp"
 
+#include "mesh_input.hpp"
+
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/core/predicates.hpp"
@@ -26,38 +28,15 @@
 namespace vitri {
 namespace {
 
+using testing_detail::check_mesh;
+using testing_detail::check_vertices;
+using testing_detail::is_degenerate;
+using testing_detail::is_flat;
+using testing_detail::row;
+
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegrees = 180.0 / kPi;
 
-Point3 row(const Eigen::MatrixXd& V, Eigen::Index i) { return {V(i, 0), V(i, 1), V(i, 2)}; }
-
-void check_vertices(const Eigen::MatrixXd& V) {
-  if (V.cols() != 3)
-    throw InvalidArgument("mesh vertices: expected 3 columns, got " + std::to_string(V.cols()));
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (!is_finite(row(V, i))) throw InvalidPoint(static_cast<std::size_t>(i), "vertex is not finite");
-}
-
-void check_mesh(const Eigen::MatrixXd& V, const Eigen::MatrixXi& F) {
-  check_vertices(V);
-  if (F.cols() != 3)
-    throw InvalidArgument("mesh triangles: expected 3 columns, got " + std::to_string(F.cols()));
-  for (Eigen::Index t = 0; t < F.rows(); ++t)
-    for (Eigen::Index k = 0; k < 3; ++k)
-      if (F(t, k) < 0 || F(t, k) >= V.rows())
-        throw InvalidArgument("triangle " + std::to_string(t) + ": vertex index " + std::to_string(F(t, k)) +
-                              " out of range [0, " + std::to_string(V.rows()) + ")");
-}
-
-bool is_degenerate(const Eigen::MatrixXi& F, Eigen::Index t) {
-  return F(t, 0) == F(t, 1) || F(t, 1) == F(t, 2) || F(t, 2) == F(t, 0);
-}
-
-/// Exact: the three points are collinear (or coincide) iff all three coordinate projections are.
-bool is_flat(const Point3& a, const Point3& b, const Point3& c) {
-  return orient2d(a, b, c, 0, 1) == Sign::Zero && orient2d(a, b, c, 1, 2) == Sign::Zero &&
-         orient2d(a, b, c, 2, 0) == Sign::Zero;
-}
 
 /// Angle (radians) between u and v, accurate also for tiny and near-straight angles.
 double angle(const Point3& u, const Point3& v) { return std::atan2(norm(cross(u, v)), dot(u, v)); }

@@ -14,6 +14,8 @@
 
 #include "vitri/testing/mesh_metrics.hpp"
 
+#include "mesh_input.hpp"
+
 #include "vitri/core/error.hpp"
 #include "vitri/core/point.hpp"
 #include "vitri/core/predicates.hpp"
@@ -130,34 +132,21 @@ bool pair_intersects(const std::array<int, 3>& f, const Tri& tf, const std::arra
   return sgn(orient2d(u, w, a, i, j)) * sgn(orient2d(u, w, b, i, j)) > 0;
 }
 
-bool flat(const Point3& a, const Point3& b, const Point3& c) {
-  return orient2d(a, b, c, 0, 1) == Sign::Zero && orient2d(a, b, c, 1, 2) == Sign::Zero &&
-         orient2d(a, b, c, 2, 0) == Sign::Zero;
-}
-
 }  // namespace
 
 std::vector<std::pair<std::size_t, std::size_t>> self_intersections(const Eigen::MatrixXd& V,
                                                                      const Eigen::MatrixXi& F,
                                                                      std::size_t max_pairs) {
-  if (V.cols() != 3) throw InvalidArgument("mesh vertices: expected 3 columns, got " + std::to_string(V.cols()));
-  if (F.cols() != 3) throw InvalidArgument("mesh triangles: expected 3 columns, got " + std::to_string(F.cols()));
-  for (Eigen::Index i = 0; i < V.rows(); ++i)
-    if (!is_finite(Point3{V(i, 0), V(i, 1), V(i, 2)}))
-      throw InvalidPoint(static_cast<std::size_t>(i), "vertex is not finite");
+  testing_detail::check_mesh(V, F);
   std::vector<std::size_t> ids;  // the proper triangles: no repeated index, not flat
   std::vector<Tri> tris;
   std::vector<std::array<int, 3>> idx;
   for (Eigen::Index t = 0; t < F.rows(); ++t) {
-    std::array<int, 3> f{F(t, 0), F(t, 1), F(t, 2)};
-    for (int k = 0; k < 3; ++k)
-      if (f[k] < 0 || f[k] >= V.rows())
-        throw InvalidArgument("triangle " + std::to_string(t) + ": vertex index " + std::to_string(f[k]) +
-                              " out of range [0, " + std::to_string(V.rows()) + ")");
-    if (f[0] == f[1] || f[1] == f[2] || f[0] == f[2]) continue;
+    if (testing_detail::is_degenerate(F, t)) continue;
+    const std::array<int, 3> f{F(t, 0), F(t, 1), F(t, 2)};
     Tri p;
     for (int k = 0; k < 3; ++k) p[k] = {V(f[k], 0), V(f[k], 1), V(f[k], 2)};
-    if (flat(p[0], p[1], p[2])) continue;
+    if (testing_detail::is_flat(p[0], p[1], p[2])) continue;
     ids.push_back(static_cast<std::size_t>(t));
     tris.push_back(p);
     idx.push_back(f);

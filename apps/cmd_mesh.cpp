@@ -976,6 +976,12 @@ double run_level(const MeshCommand& c, MeshPlan& plan, std::size_t k, double tot
                  "crease or a cone point there (docs/quality.md)\n",
                  mesher.stats().quality.below_floor, Mesher::kQualityFloor * level.precision * plan.diagonal,
                  Mesher::kQualityFloor, options.quality.min_angle_degrees);
+  if (options.mode == MeshMode::Quality && mesher.stats().quality.budget_reached)
+    std::fprintf(stderr, "warning: the quality mode stopped at %zu Delaunay vertices, its budget (the memory limit "
+                 "less the fast mesh's structure, %g bytes per vertex; a scan's size, docs/memory.md): some "
+                 "triangles are short of --min-angle, --max-size or --max-distance; give a larger --memory or looser "
+                 "bounds\n",
+                 mesher.stats().quality.vertices, kMemoryBytesPerQualityVertex);
   phases.start("extraction");
   const auto t1 = Clock::now();
   const SurfaceMesh& m = mesher.surface();

@@ -106,6 +106,7 @@ Mesher::Mesher(const Constraints& constraints, const MesherOptions& options)
                                         options_.polygonizer.keep_history, false, 1.0);
     options_.max_vertices = options_.max_vertices ? std::min(options_.max_vertices, plan.max_vertices)
                                                   : plan.max_vertices;
+    memory_vertices_ = plan.max_vertices;
     if (!options_.rbf.max_memory_bytes) options_.rbf.max_memory_bytes = options_.max_memory_bytes;
   }
   if (!(options_.box_factor > 1.0) || !std::isfinite(options_.box_factor))
@@ -278,6 +279,7 @@ ScanFit prepare_scan_fit(const std::vector<Point3>& points, const std::vector<Po
   }
   fit.memory_stride = plan.stride;
   fit.memory_thinned = points.size() - plan.points;
+  fit.memory_vertices = plan.max_vertices;
   if (plan.stride > 1) {
     if (scan.sensors.size() == points.size()) scan.sensors = every(scan.sensors, plan.stride);
     fit.prepared = prepare_scan(every(points, plan.stride), every(normals, plan.stride), scan, &fit.report);
@@ -367,6 +369,7 @@ Mesher Mesher::from_scan(ScanFit fit) {
   m.stats_.scan_constraints = fit.built;
   m.stats_.memory_stride = fit.memory_stride;
   m.stats_.memory_thinned = fit.memory_thinned;
+  m.memory_vertices_ = fit.memory_vertices;
   m.stats_.far_level = fit.far_level;
   m.stats_.far_jump = fit.far_jump;
   m.stats_.far_side = static_cast<bool>(o.local.far_side);
@@ -542,15 +545,30 @@ void Mesher::refine_quality() {
     q.refine_where = quality_region_;
     q.min_topology_radius = quality_topology_radius_;
     q.min_radius = std::max(q.min_radius, kQualityFloor * precision_);
+    q.max_vertices = quality_vertex_budget(q.max_vertices);
     quality_ = std::make_unique<QualityMesher>(function(), poly_->triangulation().box(), seeds, q);
   } else {
     q.refine_where = quality_region_;
     q.min_topology_radius = quality_topology_radius_;
     q.min_radius = std::max(q.min_radius, kQualityFloor * precision_);
+    q.max_vertices = quality_vertex_budget(q.max_vertices);
     quality_->set_options(q);
   }
   quality_->refine();
   mesh_valid_ = false;
+}
+
+// The quality mesher's vertex budget: the given one, within what the memory limit leaves beside the fast
+// mode's Delaunay structure (which stays: the levels and edits need it). Its vertices cost
+// kMemoryBytesPerQualityVertex each (its Delaunay tree, facet records and queue).
+std::size_t Mesher::quality_vertex_budget(std::size_t given) const {
+  if (!memory_vertices_) return given;
+  const double per_vertex =
+      options_.polygonizer.keep_history ? kMemoryBytesPerVertexHistory : kMemoryBytesPerVertexBatch;
+  const std::size_t held = poly_->triangulation().num_vertices();
+  const double left = held < memory_vertices_ ? static_cast<double>(memory_vertices_ - held) * per_vertex : 0.0;
+  const auto fits = static_cast<std::size_t>(left / kMemoryBytesPerQualityVertex);
+  return std::max<std::size_t>(9, std::min(given, fits));
 }
 
 void Mesher::set_quality_options(const QualityOptions& quality) {

@@ -170,8 +170,9 @@ void set_level_quality(Mesher& mesher, const Options& o, std::size_t k) {
 /// The levels of a one-call run (GIL released): refine, take the surface; the last level's mesh is moved
 /// out of the Mesher (which is dropped next), the others copied. Returns false when Python stopped it.
 /// `lenient`: the default precision; a LimitError then keeps the coarser mesh (reported in `limited`).
+/// A quality mode stopped at its vertex budget is reported in `quality_limited` (the mesh so far kept).
 bool run_levels(Mesher& mesher, const Options& o, Progress& progress, bool lenient, std::vector<SurfaceMesh>& out,
-                std::string& limited) {
+                std::string& limited, std::string& quality_limited) {
   const std::size_t levels = std::max(o.precisions.size(), o.distances.size());
   for (std::size_t k = 0; k < levels; ++k) {
     set_level_quality(mesher, o, k);
@@ -182,6 +183,10 @@ bool run_levels(Mesher& mesher, const Options& o, Progress& progress, bool lenie
       if (!lenient) throw;
       limited = e.what();
     }
+    if (mesher.stats().quality.budget_reached && quality_limited.empty())
+      quality_limited = "the quality mode stopped at " + std::to_string(mesher.stats().quality.vertices) +
+                        " Delaunay vertices, its budget (the memory limit less the fast mesh's structure; a "
+                        "scan's size): some triangles are short of min_angle, max_size or max_distance";
     progress.phase("extraction");
     const SurfaceMesh& s = mesher.surface();
     // The Mesher is not used after its last surface: its vectors are handed to numpy as they are.
@@ -220,13 +225,13 @@ py::object one_call(Options& o, bool lenient, Make&& make) {
   Progress progress(o.progress);
   o.mesher.on_phase = progress.phases();
   std::vector<SurfaceMesh> meshes;
-  std::string limited;
+  std::string limited, quality_limited;
   bool done = false;
   {
     py::gil_scoped_release release;
     try {
       std::unique_ptr<Mesher> mesher = make(progress);
-      done = run_levels(*mesher, o, progress, lenient, meshes, limited);
+      done = run_levels(*mesher, o, progress, lenient, meshes, limited, quality_limited);
       drop(std::move(mesher));
     } catch (const Interrupted&) {
     }
@@ -234,6 +239,7 @@ py::object one_call(Options& o, bool lenient, Make&& make) {
   progress.finish();
   if (!done) throw std::logic_error("vitri: a stopped call without a reason");
   warn_limited(limited, o.mesher.max_vertices);
+  if (!quality_limited.empty()) PyErr_WarnEx(PyExc_RuntimeWarning, quality_limited.c_str(), 1);
   return meshes_out(meshes, o.levels);
 }
 
@@ -372,6 +378,9 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_kept_unresolved"] = s.scan_kept_unresolved;    // every one too small: the best-supported kept
   d["memory_thinned"] = s.memory_thinned;  // input points left out to fit the memory limit
   d["uncertified"] = s.polygonizer.uncertified;  // certify: tetrahedra left uncertified (0: certified)
+  d["quality_vertices"] = s.quality.vertices;      // quality mode: its Delaunay vertices
+  d["quality_below_floor"] = s.quality.below_floor;  // quality mode: bad triangles left below its floor
+  d["quality_budget_reached"] = s.quality.budget_reached;  // quality mode: stopped at its vertex budget
   d["precision"] = precision;
   d["diagonal"] = diagonal;
   return d;

@@ -103,3 +103,43 @@ TEST_CASE("Mesher under a memory limit: a scan thinned before its seeds, the ref
   for (std::size_t i = 0; i < p.size(); ++i) c.add(p[i], 0.0);
   CHECK_THROWS_AS(Mesher(c, o), LimitError);
 }
+
+TEST_CASE("the quality mode stops at what the memory limit leaves beside the fast mesh, with the mesh so far",
+          "[mesher][memory][quality]") {
+  std::vector<Point3> p, n;
+  sphere(4000, p, n);
+  MesherOptions o;
+  o.polygonizer.keep_history = false;
+  o.scan.approximate = false;
+  o.function = FunctionKind::Local;
+  o.constraint_build.off_surface_spacing = 1.0;
+  o.mode = MeshMode::Quality;
+  o.quality.min_angle_degrees = 25;
+  o.quality.max_size = 0.03;
+  // The fast structure at precision 0.1 under a generous limit: what it holds, to size a tight one.
+  o.max_memory_bytes = std::size_t(1) << 30;
+  const double seeds = 2.0;  // from_scan's count with off_surface_spacing > 0 (one side's constraints)
+  const std::size_t generous = plan_memory(4000, o.max_memory_bytes, false, true, seeds).max_vertices;
+  Mesher wide = Mesher::from_scan(p, n, o);
+  REQUIRE(wide.refine(0.1));
+  const std::size_t fast = wide.stats().polygonizer.vertices;
+  const QualityStats full = wide.stats().quality;
+  CHECK_FALSE(full.budget_reached);
+  // A limit whose Delaunay budget leaves room for 1500 quality vertices beside the fast structure.
+  const std::size_t room = 1500;
+  const double extra = static_cast<double>(fast) + room * kMemoryBytesPerQualityVertex / kMemoryBytesPerVertexBatch -
+                       static_cast<double>(generous);
+  o.max_memory_bytes = static_cast<std::size_t>(static_cast<double>(o.max_memory_bytes) + extra * kMemoryBytesPerVertexBatch);
+  Mesher tight = Mesher::from_scan(p, n, o);
+  CHECK(tight.stats().memory_thinned == 0);
+  tight.refine(0.1);
+  const QualityStats q = tight.stats().quality;
+  INFO("fast " << fast << ", quality unbounded " << full.vertices << ", bounded " << q.vertices);
+  CHECK(q.budget_reached);
+  CHECK(q.vertices > room - 2);
+  CHECK(q.vertices < full.vertices / 2);
+  // The mesh so far: a surface of the sphere, every vertex on it.
+  const SurfaceMesh& m = tight.surface();
+  REQUIRE(m.triangles.size() > 1000);
+  for (const Point3& v : m.vertices) CHECK(std::abs(norm(v) - 1.0) < 0.02);
+}

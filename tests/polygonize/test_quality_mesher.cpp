@@ -161,8 +161,28 @@ TEST_CASE("quality: bad options and seeds are rejected with clear errors", "[qua
   REQUIRE_THROWS_AS(QualityMesher::seed_points(f, kCube, 0.0), InvalidArgument);
   QualityOptions tiny = quality(30.0, 1e-5);
   tiny.max_vertices = 200;
+  REQUIRE_THROWS_AS(QualityMesher(f, kCube, seeds, [] {
+                      QualityOptions o = quality(30.0, 0.01);
+                      o.max_vertices = 8;
+                      return o;
+                    }()),
+                    InvalidArgument);
+  // A criterion no budget meets: refine() stops past max_vertices with the mesh so far, and continues
+  // from there with a larger budget.
   QualityMesher q(f, kCube, seeds, tiny);
-  REQUIRE_THROWS_AS(q.refine(), LimitError);
+  REQUIRE_FALSE(q.refine());
+  const QualityStats s = q.stats();
+  CHECK(s.budget_reached);
+  CHECK(s.vertices > 200);
+  CHECK(s.vertices < 2000);
+  const SurfaceMesh m = q.extract();
+  REQUIRE(!m.triangles.empty());
+  for (const Point3& v : m.vertices) CHECK(std::abs(norm(v) - 1.0) < 1e-6);
+  tiny.max_vertices = 400;
+  q.set_options(tiny);
+  REQUIRE_FALSE(q.refine());
+  CHECK(q.stats().budget_reached);
+  CHECK(q.stats().vertices > 400);
 }
 
 TEST_CASE("quality: no seeds or no surface gives an empty mesh, no crash", "[quality]") {

@@ -308,6 +308,10 @@ constexpr double kMemoryBytesPerPoint = 1100.0;
 constexpr double kMemorySeedsPerPoint = 2.0;
 constexpr double kMemoryBytesPerVertexBatch = 1600.0;
 constexpr double kMemoryBytesPerVertexHistory = 2900.0;
+/// Bytes per Delaunay vertex of the quality mode's mesher (its own tree, facet records, queue), on top of
+/// the fast mode's structure: measured 1.9-2.8 KB on hand.off (4 x 10^4 - 1.6 x 10^5 vertices), about
+/// 7.8 KB where it crowds a crease (docs/memory.md); 4 KB leaves room for the latter's share.
+constexpr double kMemoryBytesPerQualityVertex = 4000.0;
 /// Base of a run (code, libraries, small tables), below any input.
 constexpr double kMemoryBaseBytes = 64e6;
 /// The room an input needs: this many Delaunay vertices per seed vertex (1: the seeds with their
@@ -343,6 +347,9 @@ struct ScanFit {
   /// Under MesherOptions::max_memory_bytes: every memory_stride-th input point kept, memory_thinned left out.
   std::size_t memory_stride = 1;
   std::size_t memory_thinned = 0;
+  /// Under MesherOptions::max_memory_bytes: the Delaunay vertices the limit holds beside the fit
+  /// (MemoryPlan::max_vertices; 0: no limit). The quality mode's budget is taken from it.
+  std::size_t memory_vertices = 0;
   /// The winding number's calibration for the local function's far patches (WindingSides: level and
   /// jump; both 0 when not set, e.g. with the global function).
   double far_level = 0, far_jump = 0;
@@ -531,6 +538,10 @@ class Mesher {
   std::unique_ptr<QualityMesher> quality_;  // quality mode, built by the first refine()
   std::function<bool(const Point3&)> quality_region_;  // a scan left open: where quality_ refines
   double quality_topology_radius_ = 0;                 // a scan left open: QualityOptions::min_topology_radius
+  // Delaunay vertices the memory limit holds beside the fit (MemoryPlan::max_vertices; 0: no limit): the
+  // quality mode's budget is what the fast structure leaves of it (quality_vertex_budget()).
+  std::size_t memory_vertices_ = 0;
+  std::size_t quality_vertex_budget(std::size_t given) const;
   /// The Delaunay vertex of each constraint, by id (kNoVertex: its position duplicates another seed's, or
   /// the id was removed). 4 bytes per id ever given out.
   std::vector<VertexId> vertex_of_;

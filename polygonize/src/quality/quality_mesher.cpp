@@ -260,6 +260,7 @@ void QualityMesher::Impl::check_topology() {
 bool QualityMesher::Impl::refine() {
   const auto t0 = std::chrono::steady_clock::now();
   std::size_t rejected = 0;
+  stats_.budget_reached = false;
   requeue_all();
   for (;;) {
     classify_pending();
@@ -269,9 +270,11 @@ bool QualityMesher::Impl::refine() {
       if (queue_.empty()) break;
     }
     rejected += insert_round();
-    if (tri_.num_vertices() > options_.max_vertices)
-      throw LimitError("QualityMesher::refine: more than QualityOptions::max_vertices = " +
-                       std::to_string(options_.max_vertices) + " Delaunay vertices needed");
+    if (tri_.num_vertices() > options_.max_vertices) {
+      classify_pending();  // the last round's facets: the mesh so far is whole
+      stats_.budget_reached = true;
+      break;
+    }
   }
   // What the floor left: bad facets below min_radius (where the criteria apply at all).
   stats_.below_floor = 0;
@@ -282,7 +285,7 @@ bool QualityMesher::Impl::refine() {
         ++stats_.below_floor;
     }
   stats_.refine_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return rejected == 0 && stats_.below_floor == 0;
+  return rejected == 0 && stats_.below_floor == 0 && !stats_.budget_reached;
 }
 
 // ---- The public QualityMesher: forwards to its Impl ---------------------------------------------------

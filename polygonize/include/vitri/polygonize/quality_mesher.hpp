@@ -63,8 +63,11 @@ struct QualityOptions {
   /// moves half the vertices by more than 1e-7 of the diagonal, an eighth by more than 1e-5). After an
   /// edit the vertices are on the surface to this tolerance. >= root_tolerance.
   double edit_tolerance = 1e-5;
-  /// refine() throws LimitError rather than create more Delaunay vertices than this (box corners and
-  /// seeds included): the guard against a criterion that cannot be met at any reasonable size.
+  /// refine() stops (returns false, stats().budget_reached) once a round of insertions has taken the
+  /// Delaunay vertices (box corners and seeds included) past this: the guard against a criterion that
+  /// cannot be met at any reasonable size, and the memory budget (Mesher sets it from
+  /// MesherOptions::max_memory_bytes, kMemoryBytesPerQualityVertex each). The mesh so far stays valid
+  /// (a restricted Delaunay surface; some facets short of the criteria). >= 9.
   std::size_t max_vertices = 5000000;
   /// Where the criteria apply: a facet is refined (for size, distance, angle or topology) only when this
   /// is true at the centre of its surface Delaunay ball; elsewhere it is left as it is. Empty (default):
@@ -98,6 +101,8 @@ struct QualityStats {
   /// Restricted facets that fail a criterion but are smaller than QualityOptions::min_radius (as the
   /// last refine() left them): the only triangles whose angle may be below the bound.
   std::size_t below_floor = 0;
+  /// The last refine() stopped at QualityOptions::max_vertices with facets still short of the criteria.
+  bool budget_reached = false;
   std::size_t function_evaluations = 0;      ///< calls of f (values and gradients), all phases
   std::size_t circumcenter_evaluations = 0;  ///< of which at circumcentres (signs of the Voronoi edges)
   std::size_t root_evaluations = 0;          ///< of which by the root finder on Voronoi edges
@@ -135,8 +140,9 @@ class QualityMesher {
   /// star is a topological disk. Calling it again after set_options() with finer bounds continues the
   /// same structure (levels of detail).
   /// @return true when everything holds; false when some facet's centre duplicated a vertex (counted in
-  ///         stats().rejected; not seen on smooth surfaces).
-  /// @throws LimitError when options().max_vertices would be exceeded.
+  ///         stats().rejected; not seen on smooth surfaces), when facets below options().min_radius
+  ///         fail a criterion (stats().below_floor), or when the vertices passed options().max_vertices
+  ///         (stats().budget_reached: refinement stopped there, the mesh is the one so far).
   bool refine();
   /// Replaces the criteria (validated as in the constructor); call refine() afterwards.
   void set_options(const QualityOptions& options);

@@ -38,7 +38,8 @@ const char* const kUsage =
     "                  [--min-angle A] [--max-distance E [--max-distance E2 ...]] [--max-size S]\n"
     "                  [--sides both|inside|outside] [--offset D] [--off-surface-spacing S]\n"
     "                  [--neighbours K] [--surface closed|open|auto] [--viewpoint X Y Z] [--handles L]\n"
-    "                  [--function global|local|auto] [--smoothing S] [--certify [--certify-floor F]]\n"
+    "                  [--function global|local|auto] [--smoothing S]\n"
+    "                  [--certify [--certify-floor F] [--certify-budget B]]\n"
     "                  [--threads N] [--memory M] [--blocks N|NxMxK|auto] [--spill DIR] [--vertices-only]\n"
     "                  [--ascii] [-q]\n"
     "\n"
@@ -152,6 +153,9 @@ const char* const kUsage =
     "                       at 0.05), the shared models do not yet (docs/benchmarks.md); an edit\n"
     "                       checks again only what it changed.\n"
     "  --certify-floor F    the size floor of --certify, a fraction of the precision (default 0.1)\n"
+    "  --certify-budget B   --certify inserts at most B x the level's Delaunay vertices (at least 25000)\n"
+    "                       points per level, then reports what is left uncertified (default 4; 0: no\n"
+    "                       budget, the floor alone: tens of minutes on a scanned or meshed model)\n"
     "  --threads N          threads of the fit, the seeds' insertion and the extraction (default 0:\n"
     "                       every CPU this process may run on, i.e. its affinity mask, so `taskset`\n"
     "                       works too). The mesh is the same file whatever N.\n"
@@ -542,6 +546,11 @@ std::string parse_mesh_args(const Args& args, MeshCommand& c) {
       if (!value(v) || !parse_double(v, fl) || !(fl > 0.0 && fl <= 1.0))
         return "--certify-floor needs a fraction of the precision in (0, 1]";
       options.polygonizer.certify_floor_fraction = fl;
+    } else if (a == "--certify-budget") {
+      double b;
+      if (!value(v) || !parse_double(v, b) || !(b >= 0.0) || !std::isfinite(b))
+        return "--certify-budget needs a factor >= 0 (0: no budget)";
+      options.polygonizer.certify_budget = b;
     } else if (a == "--memory") {
       if (!value(v) || !parse_memory_size(v, c.memory))
         return "--memory needs a size in bytes, or with a suffix K, M, G or T (e.g. 16G), got '" + v + "'";
@@ -934,9 +943,11 @@ void print_certificate(const PolygonizerStats& ps) {
     std::printf("      certified: %zu tetrahedra checked (%zu kept from before), %zu points inserted, %.1f ms\n",
                 ps.certify_checked, ps.certify_kept, ps.certify_insertions, 1e3 * ps.certify_seconds);
   else
-    std::printf("      NOT certified: %zu tetrahedra left uncertified at the size floor, the largest (radius "
+    std::printf("      NOT certified: %zu tetrahedra left uncertified %s, the largest (radius "
                 "%.3g) at (%.6g, %.6g, %.6g); %zu checked (%zu kept from before), %zu points, %.1f ms\n",
-                ps.uncertified, ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y,
+                ps.uncertified,
+                ps.certify_budget_reached ? "when the insertion budget was spent (--certify-budget)" : "at the size floor",
+                ps.uncertified_radius, ps.uncertified_at.x, ps.uncertified_at.y,
                 ps.uncertified_at.z, ps.certify_checked, ps.certify_kept, ps.certify_insertions,
                 1e3 * ps.certify_seconds);
 }

@@ -173,6 +173,13 @@ bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progr
   stats_.certify_checked = 0;
   stats_.certify_kept = 0;
   stats_.certify_insertions = 0;
+  stats_.certify_budget_reached = false;
+  // The insertion budget (0: none): a factor of the vertices the level had when its check started.
+  const double budget_base = static_cast<double>(
+      std::max<std::size_t>(tri_.num_vertices(), PolygonizerOptions::kCertifyBudgetBase));
+  const std::size_t budget = options_.certify_budget > 0
+                                 ? static_cast<std::size_t>(std::ceil(options_.certify_budget * budget_base))
+                                 : 0;
   if (!f_.has_bounds()) {  // nothing can be certified: say so, refine nothing
     stats_.uncertified = tri_.num_tetrahedra();
     stats_.uncertified_radius = 0;
@@ -192,6 +199,7 @@ bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progr
   std::vector<Box3> boxes;
   std::vector<std::array<VertexId, 4>> verts;
   std::vector<std::uint8_t> bad;
+  std::vector<std::pair<double, std::size_t>> order;
   certifying_ = true;
   struct Done {
     bool& flag;
@@ -226,14 +234,21 @@ bool Polygonizer::Impl::certify_level(double dmin, const ProgressCallback& progr
     });
     for (std::size_t i = 0; i < n; ++i)
       if (!bad[i]) certified_.mark(check[i]);  // (an id the insertions below recycle is forgotten on creation)
-    // The uncertified ones: circumcenters of those above the floor, the others are left.
+    // The uncertified ones: circumcenters of those above the floor, the others are left. In the order
+    // checked; largest first when the budget ends within the round, so that it leaves the smallest.
+    order.clear();
+    for (std::size_t i = 0; i < n; ++i)
+      if (bad[i]) order.emplace_back(-tri_.circumradius(check[i]), i);
+    if (budget && stats_.certify_insertions + order.size() > budget) std::sort(order.begin(), order.end());
     std::size_t inserted = 0;
-    for (std::size_t i = 0; i < n; ++i) {
-      if (!bad[i]) continue;
+    for (const auto& [minus_radius, i] : order) {
       const TetId t = check[i];
       // Killed by this round's insertions (its id maybe reused): its region is checked next round.
       if (!tri_.is_live(t) || tri_.tet_vertices(t) != verts[i]) continue;
-      if (tri_.circumradius(t) > floor &&
+      const bool above_floor = -minus_radius > floor;
+      const bool within_budget = budget == 0 || stats_.certify_insertions + inserted < budget;
+      if (above_floor && !within_budget) stats_.certify_budget_reached = true;
+      if (above_floor && within_budget &&
           insert_refinement_point(t, min_distance, VertexKind::Refinement, created)) {
         ++inserted;
       } else {

@@ -130,6 +130,8 @@ void check_options(const PolygonizerOptions& options) {
     throw InvalidArgument("PolygonizerOptions::max_root_iterations must be >= 1");
   if (!(options.certify_floor_fraction > 0.0 && options.certify_floor_fraction <= 1.0))
     throw InvalidArgument("PolygonizerOptions::certify_floor_fraction must be in (0, 1]");
+  if (!(options.certify_budget >= 0.0) || !std::isfinite(options.certify_budget))
+    throw InvalidArgument("PolygonizerOptions::certify_budget must be finite and >= 0");
 }
 
 }  // namespace

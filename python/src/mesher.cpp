@@ -143,6 +143,8 @@ Options parse_options(const py::kwargs& kw, const char* fn, bool one_call) {
       m.polygonizer.certify = v.cast<bool>();
     } else if (key == "certify_floor") {
       m.polygonizer.certify_floor_fraction = number(v, "certify_floor", 0.0, 1.0, true);
+    } else if (key == "certify_budget") {
+      m.polygonizer.certify_budget = number(v, "certify_budget", 0.0, 1e9, false);
     } else if (key == "progress") {
       if (!PyCallable_Check(v.ptr())) throw py::type_error("progress: expected a callable");
       o.progress = py::reinterpret_borrow<py::object>(v);
@@ -378,6 +380,7 @@ py::dict stats_of(PyMesher& pm) {
   d["scan_kept_unresolved"] = s.scan_kept_unresolved;    // every one too small: the best-supported kept
   d["memory_thinned"] = s.memory_thinned;  // input points left out to fit the memory limit
   d["uncertified"] = s.polygonizer.uncertified;  // certify: tetrahedra left uncertified (0: certified)
+  d["certify_budget_reached"] = s.polygonizer.certify_budget_reached;  // certify: stopped by its budget
   d["quality_vertices"] = s.quality.vertices;      // quality mode: its Delaunay vertices
   d["quality_below_floor"] = s.quality.below_floor;  // quality mode: bad triangles left below its floor
   d["quality_budget_reached"] = s.quality.budget_reached;  // quality mode: stopped at its vertex budget
@@ -435,7 +438,7 @@ points: (n, 3) float64/float32; normals: None or (n, 3). Options (the CLI's, by 
   handles: the noise's handles cut, cycles shorter than this many resolutions (2 pi; 0 keeps them)
   min_angle, max_distance, max_size: the quality mode;  offset, sides, off_surface_spacing, neighbours
   max_vertices: LimitError beyond it;  memory: bytes or '16G' (default: the machine's available
-    memory less a reserve, docs/memory.md);  certify, certify_floor: certified levels (docs/certificate.md)
+    memory less a reserve, docs/memory.md);  certify, certify_floor, certify_budget: certified levels (docs/certificate.md)
   progress: progress(phase, vertices, queued) -> bool | None; False cancels (vitri.Cancelled)
 Raises InvalidArgument/InvalidPoint (ValueError) for bad arrays, TypeError for a wrong dtype or an
 unknown option, KeyboardInterrupt on Ctrl-C.)");
@@ -456,7 +459,7 @@ Options as reconstruct() (those of point inputs do not apply).)");
           py::arg("points"), py::arg("values"),
           "Mesher(points, values, **options): fits the function through f(points[i]) = values[i] (f < 0 "
           "inside) and tetrahedralizes the constraints. Options: function, smoothing, threads, min_angle, "
-          "max_distance, max_size, max_vertices, memory, certify, certify_floor, progress (see reconstruct). Then refine() and mesh().")
+          "max_distance, max_size, max_vertices, memory, certify, certify_floor, certify_budget, progress (see reconstruct). Then refine() and mesh().")
       .def_static("from_oriented_points",
                   [](py::handle points, py::handle normals, const py::kwargs& kw) {
                     std::vector<Point3> p = points_arg(points, "points"), n = points_arg(normals, "normals");

@@ -672,6 +672,46 @@ TEST_CASE("vitri mesh MESH --min-angle 30: the facet check's flat tetrahedra and
   }
 }
 
+TEST_CASE("vitri mesh: --certify and the quality mode end at their budgets with a closed mesh and say so",
+          "[cli][mesh]") {
+  // (1) --certify on a meshed model (its RBF certifies only at tetrahedra far below its precision,
+  // docs/certificate.md) inserted for tens of minutes (hand.off: 5 minutes, 1.6 GB and growing); its
+  // insertion budget (here 0.2 x at least 25000 points) ends the level with the count left. (2) The
+  // quality mode's budget follows --memory: bunny.off at --max-size 0.005 needs 22,000 quality
+  // vertices; 80 MiB leaves room for about 2,400 beside the fast structure.
+  struct Run {
+    std::string flags, said;
+  };
+  for (const Run& r : {Run{"--certify --certify-budget 0.2", "when the insertion budget was spent"},
+                       Run{"--min-angle 25 --max-size 0.005 --memory 80M", "warning: the quality mode stopped at"}}) {
+    INFO("options: " << r.flags);
+    const std::string out = kDir + "/mesh_budget_bunny.ply";
+    std::remove(out.c_str());
+    const std::string o = kDir + "/mesh_stdout.txt", e = kDir + "/mesh_stderr.txt";
+    const int rc = std::system(("timeout 600 " + std::string(VITRI_CLI) + " mesh " + std::string(VITRI_DATA_DIR) +
+                                "/bunny.off -o " + out + " " + r.flags + " > " + o + " 2> " + e)
+                                   .c_str());
+    const std::string said = slurp(o) + slurp(e);
+    INFO(said);
+    REQUIRE(WIFEXITED(rc));
+    REQUIRE(WEXITSTATUS(rc) == 0);
+    REQUIRE(said.find(r.said) != std::string::npos);
+    const TriangleMesh m = read_mesh(out);
+    const MeshMetrics mm = compute_mesh_metrics(m.V, m.F);
+    REQUIRE(mm.closed_manifold());
+    REQUIRE(mm.components == 1);
+    REQUIRE(mm.euler_characteristic == 2);
+    REQUIRE(self_intersections(m.V, m.F, 1).empty());
+  }
+  const std::string e = kDir + "/mesh_stderr.txt";
+  const int rc = std::system((std::string(VITRI_CLI) + " mesh " + std::string(VITRI_DATA_DIR) + "/bunny.off -o " +
+                              kDir + "/never.ply --certify --certify-budget -1 2> " + e)
+                                 .c_str());
+  REQUIRE(WIFEXITED(rc));
+  CHECK(WEXITSTATUS(rc) == 2);
+  CHECK(slurp(e).find("--certify-budget needs a factor >= 0") != std::string::npos);
+}
+
 TEST_CASE("vitri mesh --memory: a coarser mesh with a warning under a small limit, an error below any mesh",
           "[cli][mesh][memory]") {
   // 6000 oriented points on the sphere. docs/memory.md's model (base 64 MB, 1100 bytes per point beside

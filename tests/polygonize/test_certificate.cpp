@@ -8,6 +8,7 @@
 #include "support/enclosure_checks.hpp"
 #include "support/surface_metrics.hpp"
 #include "vitri/core/bounds.hpp"
+#include "vitri/core/error.hpp"
 #include "vitri/testing/analytic.hpp"
 #include "vitri/polygonize/box_closure.hpp"
 #include "vitri/polygonize/certificate.hpp"
@@ -234,6 +235,38 @@ TEST_CASE("certificate: a small bubble", "[certificate]") {
   const LevelCounts c = check_levels(f, {2, 4}, {0.4, 0.2, 0.1});
   CHECK(c.certified >= 1);
   CHECK(c.fast_wrong >= 1);
+}
+
+TEST_CASE("certificate: the insertion budget ends a level with what is left counted", "[certificate]") {
+  // The small bubble of the case above at precision 0.4: certifying it inserts thousands of points.
+  const SphereFunction big({-0.3, 0.0, 0.02}, 0.4);
+  const SphereFunction small({0.467, 0.467, 0.467}, 0.02);
+  const UnionFunction f(big, small);
+  PolygonizerOptions o;
+  o.certify = true;
+  o.certify_floor_fraction = 0.005;
+  o.certify_budget = 0;  // no budget: the floor alone
+  Polygonizer free_run(f, kDomain, {}, {}, o);
+  REQUIRE(free_run.refine(0.4));
+  const PolygonizerStats all = free_run.stats();
+  CHECK_FALSE(all.certify_budget_reached);
+  const std::size_t base = std::max(free_run.stats().vertices - all.certify_insertions,
+                                    PolygonizerOptions::kCertifyBudgetBase);
+  REQUIRE(all.certify_insertions > 1000);
+  // A budget of 500 points: the level ends there, closed, its uncertified tetrahedra counted, the largest
+  // of them above the floor (the budget stopped it, not the size).
+  o.certify_budget = 500.0 / static_cast<double>(base);
+  Polygonizer bounded(f, kDomain, {}, {}, o);
+  REQUIRE(bounded.refine(0.4));
+  const PolygonizerStats s = bounded.stats();
+  CHECK(s.certify_budget_reached);
+  CHECK(s.certify_insertions <= 500);
+  CHECK(s.certify_insertions >= 400);
+  CHECK(s.uncertified > 0);
+  CHECK(s.uncertified_radius > o.certify_floor_fraction * 0.4);
+  CHECK(test::metrics_of(bounded.extract()).closed_manifold());
+  o.certify_budget = -1;
+  CHECK_THROWS_AS(Polygonizer(f, kDomain, {}, {}, o), InvalidArgument);
 }
 
 namespace {

@@ -153,6 +153,14 @@ struct PolygonizerOptions {
   /// Size floor of the certified mode, a fraction of the precision: uncertified tetrahedra whose
   /// circumradius is at most this are left (counted in stats().uncertified). In (0, 1].
   double certify_floor_fraction = 0.1;
+  /// Insertion budget of the certified mode, per refine(): at most this factor x max(the Delaunay
+  /// vertices when the certificate's check starts, kCertifyBudgetBase) circumcenters are inserted for
+  /// uncertified tetrahedra; what is uncertified past it is left as at the floor (counted in
+  /// stats().uncertified, stats().certify_budget_reached set). The shared models' RBF surfaces certify
+  /// only at tetrahedra about 0.001-0.003 of the diagonal across (docs/certificate.md): without a budget a
+  /// level of a scanned or meshed model inserts for tens of minutes. >= 0; 0: no budget (the floor alone).
+  double certify_budget = 4.0;
+  static constexpr std::size_t kCertifyBudgetBase = 25000;
   /// Keep the Delaunay tree's history DAG (TriangulationOptions::keep_history): point location by
   /// descent, O(log n) for single insertions and edits, at about 1250 bytes per Delaunay vertex instead
   /// of about 250 for the live mesh alone. false suits a batch run that refines and extracts without
@@ -233,6 +241,9 @@ struct PolygonizerStats {
   std::size_t uncertified = 0;
   Point3 uncertified_at{0, 0, 0};
   double uncertified_radius = 0;
+  /// The last refine() in certified mode left uncertified tetrahedra above the floor: the insertion
+  /// budget (PolygonizerOptions::certify_budget) was spent.
+  bool certify_budget_reached = false;
   double update_seconds = 0;            ///< last function_changed() call
 };
 

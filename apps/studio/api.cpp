@@ -389,9 +389,10 @@ ApiResponse Api::load(const ApiRequest& r) {
   const std::string name = param(r, "name");
   if (name.empty() || name.size() > 200) throw BadRequest("\"name\" (the uploaded file's name) is required");
   const std::string ext = file_extension(name);
-  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "pcd" && ext != "off" && ext != "obj" &&
-      ext != "ply" && ext != "stl")
-    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .pcd, .off, .obj, .ply, .stl)");
+  // (.laz is taken to be refused by the reader, which says how to decompress it.)
+  if (ext != "xyzv" && ext != "xyz" && ext != "pwn" && ext != "pcd" && ext != "las" && ext != "laz" && ext != "off" &&
+      ext != "obj" && ext != "ply" && ext != "stl")
+    throw BadRequest("cannot open '." + ext + "' files (.xyzv, .xyz, .pwn, .pcd, .las, .off, .obj, .ply, .stl)");
   if (r.body.empty()) throw BadRequest(name + ": empty file");
   // Points are read as vitri mesh reads a scan; "viewpoint=X,Y,Z" plays its --viewpoint (else the
   // file's own, a PCD VIEWPOINT).

@@ -3,6 +3,7 @@
 // unchanged and the server keeps answering. The session alone: undo/redo of random edits returns the
 // constraints exactly, and every mesh on the way is closed.
 #include "studio_fixture.hpp"
+#include "support/las_file.hpp"
 #include "support/surface_metrics.hpp"
 
 #include "vitri/core/error.hpp"
@@ -194,7 +195,7 @@ TEST_CASE("studio api: refine, precision, export, load", "[studio][api]") {
   CHECK(r.get("/api/mesh?format=json&since=5").find("full")->as_bool(""));
 }
 
-TEST_CASE("studio api: uploaded points are read as vitri mesh reads a scan (.xyz without normals, .pcd)",
+TEST_CASE("studio api: uploaded points are read as vitri mesh reads a scan (.xyz without normals, .pcd, .las)",
           "[studio][api][scan]") {
   // 800 points on the unit sphere with noise of 0.15 (about 1.5 spacings), no normals: the strict
   // orientation (constraints_from_points, what the studio used) refuses them; the scan path does not.
@@ -233,6 +234,30 @@ TEST_CASE("studio api: uploaded points are read as vitri mesh reads a scan (.xyz
     REQUIRE(e);
     const TriangleMesh tm = parse_input(e->body, "x.off").mesh;
     CHECK(tm.F.rows() > 100);
+  }
+  // The same points as a LAS file (integer coordinates, scale 0.01 0.01 0.001, offset 1000 2000 -5): read
+  // as vitri mesh reads one; a LAZ file is refused naming the way out (a 400, the model kept).
+  {
+    std::vector<std::array<std::int32_t, 3>> grid;
+    for (const Point3& p : pts)
+      grid.push_back({static_cast<std::int32_t>(std::lround((p.x - 1000) / 0.01)),
+                      static_cast<std::int32_t>(std::lround((p.y - 2000) / 0.01)),
+                      static_cast<std::int32_t>(std::lround((p.z + 5) / 0.001))});
+    std::string las = test::las_file(2, 1, 28, grid, std::vector<unsigned>(n, 2), std::vector<bool>(n, false));
+    const Json l = r.check(r.client.Post("/api/load?name=noisy.las", las, "application/octet-stream"), 200);
+    CHECK(l.find("name")->as_string("") == "noisy.las");
+    CHECK(l.find("scan")->as_string("scan").find("outliers set aside") != std::string::npos);
+    CHECK(number(l, "constraints") > 3 * 400);
+    r.post("/api/refine", R"({"all": true})");
+    const auto e = r.client.Get("/api/export?format=off");
+    REQUIRE(e);
+    const TriangleMesh tm = parse_input(e->body, "x.off").mesh;
+    CHECK(tm.F.rows() > 100);
+    las[104] = static_cast<char>(0x81);  // the LAZ bit
+    const auto z = r.client.Post("/api/load?name=noisy.laz", las, "application/octet-stream");
+    REQUIRE(z);
+    CHECK(z->status == 400);
+    CHECK(z->body.find("LAZ-compressed") != std::string::npos);
   }
   // A viewpoint with the upload ("viewpoint=X,Y,Z", as --viewpoint), and a bad one.
   const Json s = r.check(r.client.Post("/api/load?name=noisy.xyz&viewpoint=0,0,20", xyz, "application/octet-stream"), 200);

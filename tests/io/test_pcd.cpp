@@ -6,6 +6,7 @@
 #include "vitri/io/io.hpp"
 
 #include "../../io/src/text.hpp"
+#include "support/las_file.hpp"
 
 #include <lzf.h>
 #include <catch2/catch.hpp>
@@ -609,48 +610,6 @@ TEST_CASE("io regression corpus: the PCD and scanner PLY files read what they ho
   CHECK_THAT(refused("ply_binary_nan_sensor.ply"), Catch::Contains("vertex 1: non-finite sensor position"));
 }
 
-// LAS (ASPRS LiDAR) files written by hand, little-endian: header fields at their offsets, then records.
-namespace {
-
-std::string las_file(unsigned minor, unsigned format, std::size_t record,
-                     const std::vector<std::array<std::int32_t, 3>>& xyz, const std::vector<unsigned>& classes,
-                     const std::vector<bool>& withheld) {
-  std::string b(227, '\0');
-  auto put = [&](std::size_t at, const void* v, std::size_t n) {
-    const auto* c = static_cast<const unsigned char*>(v);
-    for (std::size_t i = 0; i < n; ++i) b[at + i] = static_cast<char>(c[vitri::io_detail::host_little_endian() ? i : n - 1 - i]);
-  };
-  b.replace(0, 4, "LASF");
-  b[24] = 1;
-  b[25] = static_cast<char>(minor);
-  const std::uint16_t header = 227, length = static_cast<std::uint16_t>(record);
-  const std::uint32_t offset = 227, count = static_cast<std::uint32_t>(xyz.size());
-  put(94, &header, 2);
-  put(96, &offset, 4);
-  b[104] = static_cast<char>(format);
-  put(105, &length, 2);
-  put(107, &count, 4);
-  const double scale[3] = {0.01, 0.01, 0.001}, shift[3] = {1000, 2000, -5};
-  for (int a = 0; a < 3; ++a) {
-    put(131 + 8 * a, &scale[a], 8);
-    put(155 + 8 * a, &shift[a], 8);
-  }
-  for (std::size_t i = 0; i < xyz.size(); ++i) {
-    std::string r(record, '\0');
-    const std::size_t at = b.size();
-    b += r;
-    for (int a = 0; a < 3; ++a) put(at + 4 * a, &xyz[i][a], 4);
-    if (format <= 5) {
-      b[at + 15] = static_cast<char>((classes[i] & 0x1F) | (withheld[i] ? 0x80 : 0));
-    } else {
-      b[at + 15] = static_cast<char>(withheld[i] ? 0x04 : 0);
-      b[at + 16] = static_cast<char>(classes[i]);
-    }
-  }
-  return b;
-}
-
-}  // namespace
 
 TEST_CASE("las: points scaled and offset; noise and withheld points left out; LAZ refused with the way out",
           "[io][las]") {
@@ -660,7 +619,7 @@ TEST_CASE("las: points scaled and offset; noise and withheld points left out; LA
   for (const auto& [minor, format, record] : std::vector<std::tuple<unsigned, unsigned, std::size_t>>{
            {2, 1, 28}, {0, 0, 20}, {4, 6, 30}, {4, 7, 36}}) {
     INFO("LAS 1." << minor << " format " << format);
-    const Input in = parse_input(las_file(minor, format, record, xyz, classes, held), "scan.las");
+    const Input in = parse_input(test::las_file(minor, format, record, xyz, classes, held), "scan.las");
     CHECK(in.kind == InputKind::Points);
     REQUIRE(in.points.points.size() == 1);  // 7 and 18 are noise, the third point is withheld
     CHECK(in.points.points[0] == Point3{1000 + 100 * 0.01, 2000 + 200 * 0.01, -5 + 3000 * 0.001});
@@ -668,7 +627,7 @@ TEST_CASE("las: points scaled and offset; noise and withheld points left out; LA
   }
   const std::vector<bool> none(4, false);
   const std::vector<unsigned> ground(4, 2);
-  CHECK(parse_las(las_file(2, 3, 34, xyz, ground, none), "all.las").points.size() == 4);
+  CHECK(parse_las(test::las_file(2, 3, 34, xyz, ground, none), "all.las").points.size() == 4);
   // Refused, naming the file: LAZ, a truncated file, a count beyond the bytes, a wrong signature.
   auto refused = [](const std::string& bytes, const std::string& what) {
     try {
@@ -679,10 +638,10 @@ TEST_CASE("las: points scaled and offset; noise and withheld points left out; LA
       CHECK_THAT(e.what(), Catch::StartsWith("bad.laz") && Catch::Contains(what));
     }
   };
-  std::string laz = las_file(2, 1, 28, xyz, ground, none);
+  std::string laz = test::las_file(2, 1, 28, xyz, ground, none);
   laz[104] = static_cast<char>(0x81);
   refused(laz, "LAZ-compressed");
-  const std::string whole = las_file(2, 1, 28, xyz, ground, none);
+  const std::string whole = test::las_file(2, 1, 28, xyz, ground, none);
   refused(whole.substr(0, whole.size() - 5), "declares 4 points of 28 bytes, the file holds 3");
   refused(whole.substr(0, 100), "header truncated");
   refused("LASX" + whole.substr(4), "not a LAS file");

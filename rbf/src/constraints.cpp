@@ -116,15 +116,12 @@ std::vector<double> off_surface_offsets(const std::vector<Point3>& points, const
   for (std::size_t k = 0; k < keep.size(); ++k) kept_points[k] = points[keep[k]];
   const std::vector<std::size_t> order = detail::spatial_order(kept_points);
   rbf_detail::parallel_chunks(keep.size(), opt.threads, 4096, [&](std::size_t b, std::size_t e) {
-    std::vector<PointIndex::Id> near;
     // Surface points that contradict p + d n within the ball: every one, or (thin_opposite_only) those
-    // whose normal is more than 60 degrees from n.
+    // whose normal is more than 60 degrees from n. The first found answers (a sorted list of a ball
+    // holding hundreds of points, where the offset is several spacings, was 13% of a scan's run).
     auto contradicted = [&](const Point3& q, double r, const Point3& n) {
       if (!opt.thin_opposite_only) return surface.count_ball(q, r * r, 0) > 0;
-      surface.ball(q, r * r, near);
-      for (const PointIndex::Id j : near)
-        if (dot(surface_normals[j], n) < 0.5) return true;
-      return false;
+      return surface.any_in_ball(q, r * r, [&](PointIndex::Id j) { return dot(surface_normals[j], n) < 0.5; });
     };
     for (std::size_t o = b; o < e; ++o) {
       const std::size_t k = order[o], i = keep[k];

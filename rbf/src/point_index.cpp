@@ -443,6 +443,19 @@ bool PointIndex::ball_up_to(const Point3& center, double radius2, std::size_t li
   });
 }
 
+bool PointIndex::any_in_ball(const Point3& center, double radius2, const std::function<bool(Id)>& accept) const {
+  bool found = false;
+  visit_ball_leaves(center, radius2, [&](const Entry* b, std::uint32_t count) {
+    for (std::uint32_t k = 0; k < count; ++k)
+      if (squared_distance(b[k].p, center) < radius2 && accept(b[k].id)) {
+        found = true;
+        return false;
+      }
+    return true;
+  });
+  return found;
+}
+
 void PointIndex::close_pairs(double radius2, const std::function<void(Id, Id)>& visit) const {
   if (size_ == 0) return;
   const double inf = std::numeric_limits<double>::infinity();

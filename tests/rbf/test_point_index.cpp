@@ -81,6 +81,13 @@ void check_queries(const PointIndex& index, const Brute& brute, std::mt19937& rn
         std::sort(capped.begin(), capped.end());
         REQUIRE(capped == all);
       }
+      // any_in_ball: whether a point of the ball passes the test (none, one id, every third id, all).
+      REQUIRE(index.any_in_ball(c, r2, [](Id) { return true; }) == !all.empty());
+      REQUIRE_FALSE(index.any_in_ball(c, r2, [](Id) { return false; }));
+      for (const Id probe : all) REQUIRE(index.any_in_ball(c, r2, [&](Id j) { return j == probe; }));
+      const bool third = std::any_of(all.begin(), all.end(), [](Id j) { return j % 3 == 0; });
+      REQUIRE(index.any_in_ball(c, r2, [](Id j) { return j % 3 == 0; }) == third);
+      REQUIRE_FALSE(index.any_in_ball(c, r2, [&](Id j) { return std::find(all.begin(), all.end(), j) == all.end(); }));
     }
     // Kept sorted up to 24, selected from a buffer of 2k beyond (cut at 2k, 4k... candidates: 97 and
     // 200 cut it several times, among the 40 coincident points too).

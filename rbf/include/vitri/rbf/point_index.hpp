@@ -70,6 +70,9 @@ class PointIndex {
   /// ball() when it holds at most `limit` points: their ids, in no particular order, and true; false as
   /// soon as more are found (`out` then holds some of them). O(log size() + limit) like count_ball().
   bool ball_up_to(const Point3& center, double radius2, std::size_t limit, std::vector<Id>& out) const;
+  /// Whether some point strictly inside the ball (same test as ball()) has accept(id) true. The search
+  /// stops at the first one (no list, no sort): "does any point of the ball contradict q?".
+  bool any_in_ball(const Point3& center, double radius2, const std::function<bool(Id)>& accept) const;
   /// Calls visit(i, j), i < j, once for every pair of points closer than sqrt(radius2) (squared distance
   /// < radius2) and every pair of coincident points whatever radius2, in no particular order. Meant for
   /// small radii (near-duplicate checks): pairs inside one leaf are compared directly and only points

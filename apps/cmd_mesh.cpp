@@ -995,7 +995,10 @@ double run_level(const MeshCommand& c, MeshPlan& plan, std::size_t k, double tot
                  mesher.stats().quality.vertices, kMemoryBytesPerQualityVertex);
   phases.start("extraction");
   const auto t1 = Clock::now();
-  const SurfaceMesh& m = mesher.surface();
+  // The last level of a run without edits: the refinement's structures are freed before the scan's
+  // finishing (a lower peak, docs/memory.md); nothing refines or edits afterwards.
+  const bool last = k + 1 == plan.levels.size() && plan.script.empty();
+  const SurfaceMesh& m = last ? mesher.final_surface() : mesher.surface();
   const double extract_ms = ms_since(t1);
   if (!c.quiet) print_extraction_split(mesher.stats().polygonizer, extract_ms);
   total_ms += refine_ms + extract_ms;

@@ -470,6 +470,7 @@ Mesher Mesher::restarted_copy() const {
 }
 
 void Mesher::restart() {
+  require_refinement("restart");
   build();
   precision_ = std::numeric_limits<double>::infinity();
 }
@@ -487,6 +488,7 @@ bool Mesher::inside_domain(const Point3& p) const {
 }
 
 bool Mesher::refine(double precision, const ProgressCallback& progress) {
+  require_refinement("refine");
   mesh_valid_ = false;
   std::size_t over_limit = 0;  // the vertex count that passed options_.max_vertices, 0 while within it
   const bool done = poly_->refine(precision, [&](const RefineProgress& p) {
@@ -599,6 +601,7 @@ std::function<bool(const Point3&)> Mesher::support_query() const {
 }
 
 void Mesher::sync_surface() {
+  require_refinement("sync_surface");
   const bool filter = filtering();
   const SupportFilter::Supported supported = support_query();
   if (quality_) {
@@ -627,22 +630,15 @@ MeshDelta Mesher::update_surface() {
   return filter_->view().take_delta();
 }
 
-const LiveMesh& Mesher::live_surface() const { return filter_->view(); }
+const LiveMesh& Mesher::live_surface() const {
+  require_refinement("live_surface");
+  return filter_->view();
+}
 
 const SurfaceMesh& Mesher::surface() {
+  if (released_) return mesh_;
   if (!mesh_valid_ && !deltas_wanted_ && !quality_) {
-    // Batch (no delta was ever asked for): the polygonizer's mesh, compacted, less its unsupported
-    // components (the filter's rule from scratch); the filter's view, a second live copy of the mesh kept
-    // for deltas, is not built. Its records are dropped (nobody reads them); a later update_surface()
-    // starts the filter from the whole mesh.
-    poly_->update_surface();
-    filter_behind_ = true;
-    std::size_t dropped = 0;
-    mesh_ = poly_->live_surface().to_surface_mesh();
-    if (filtering()) mesh_ = keep_supported_components(std::move(mesh_), support_query(), &dropped);
-    stats_.dropped_components = dropped;
-    finish_scan_surface();
-    mesh_valid_ = true;
+    batch_surface(false);
   } else if (!mesh_valid_) {
     sync_surface();
     if (!deltas_wanted_) filter_->view().take_delta();  // nobody reads the record: free the ids
@@ -651,6 +647,57 @@ const SurfaceMesh& Mesher::surface() {
     mesh_valid_ = true;
   }
   return mesh_;
+}
+
+// Batch (no delta was ever asked for): the polygonizer's mesh, compacted, less its unsupported components
+// (the filter's rule from scratch); the filter's view, a second live copy of the mesh kept for deltas, is
+// not built. Its records are dropped (nobody reads them); a later update_surface() starts the filter from
+// the whole mesh. `release`: the refinement's structures are freed before the scan's finishing.
+void Mesher::batch_surface(bool release) {
+  poly_->update_surface();
+  filter_behind_ = true;
+  std::size_t dropped = 0;
+  mesh_ = poly_->live_surface().to_surface_mesh();
+  if (filtering()) mesh_ = keep_supported_components(std::move(mesh_), support_query(), &dropped);
+  stats_.dropped_components = dropped;
+  if (release) release_refinement();
+  finish_scan_surface();
+  mesh_valid_ = true;
+}
+
+const Polygonizer& Mesher::polygonizer() const {
+  require_refinement("polygonizer");
+  return *poly_;
+}
+
+const SurfaceMesh& Mesher::final_surface() {
+  if (released_) return mesh_;
+  if (!mesh_valid_ && !deltas_wanted_ && !quality_) {
+    batch_surface(true);
+  } else {
+    surface();
+    release_refinement();
+  }
+  return mesh_;
+}
+
+// The Delaunay tree, the polygonizer's arrays and its incremental mesh, the support filter and the quality
+// mesher: freed, their last statistics kept for stats(). The function, the constraints and the mesh stay.
+void Mesher::release_refinement() {
+  released_polygonizer_ = poly_->stats();
+  if (quality_) released_quality_ = quality_->stats();
+  poly_.reset();
+  quality_.reset();
+  filter_.reset();
+  zero_index_ = PointIndex();
+  released_ = true;
+}
+
+void Mesher::require_refinement(const char* what) const {
+  if (released_)
+    throw InvalidArgument(std::string("Mesher::") + what +
+                          ": the refinement was released by final_surface() (only surface(), mesh(), stats() "
+                          "and the function's queries remain)");
 }
 
 void Mesher::finish_scan_surface() {
@@ -676,6 +723,7 @@ void Mesher::mesh(Eigen::MatrixXd& V, Eigen::MatrixXi& F, Eigen::MatrixXd& N) { 
 // then the re-evaluation where f changed, refinement and cleanup (after_edit).
 void Mesher::edit(const std::function<ChangedRegion()>& change_function, const Point3* moved_to,
                   const std::function<void()>& change_vertex) {
+  require_refinement("edit");
   const double t0 = now_seconds();
   const ChangedRegion region = change_function();  // validates; throws before anything changes
   const double t_rbf = now_seconds() - t0;
@@ -765,9 +813,10 @@ void Mesher::set_value(ConstraintId id, double value) {
 
 MesherStats Mesher::stats() const {
   MesherStats s = stats_;
-  s.polygonizer = poly_->stats();
+  s.polygonizer = poly_ ? poly_->stats() : released_polygonizer_;
   s.constraints = size();
   if (quality_) s.quality = quality_->stats();
+  if (released_) s.quality = released_quality_;
   return s;
 }
 

@@ -190,8 +190,9 @@ bool run_levels(Mesher& mesher, const Options& o, Progress& progress, bool lenie
                         " Delaunay vertices, its budget (the memory limit less the fast mesh's structure; a "
                         "scan's size): some triangles are short of min_angle, max_size or max_distance";
     progress.phase("extraction");
-    const SurfaceMesh& s = mesher.surface();
-    // The Mesher is not used after its last surface: its vectors are handed to numpy as they are.
+    // The last level: the refinement's structures are freed before the scan's finishing (a lower peak,
+    // Mesher::final_surface); the Mesher is not used afterwards: its vectors are handed to numpy as they are.
+    const SurfaceMesh& s = k + 1 == levels ? mesher.final_surface() : mesher.surface();
     if (k + 1 == levels) out.push_back(std::move(const_cast<SurfaceMesh&>(s)));
     else out.push_back(s);
   }

@@ -206,3 +206,11 @@ def test_memory_limit_and_certify_options(cli, tmp_path):
     cert.refine(0.3 * cert.stats()["diagonal"])
     assert cert.stats()["uncertified"] >= 0
     assert cert.stats()["delaunay_vertices"] >= plain.stats()["delaunay_vertices"]
+    # certify_budget as --certify-budget: a budget of 1e-4 x 25,000 = 3 points ends the level there, said in stats.
+    with pytest.raises(ValueError, match="certify_budget"):
+        vitri.Mesher(pts, vals, certify=True, certify_budget=-1.0)
+    tight = vitri.Mesher(pts, vals, function="global", certify=True, certify_floor=0.01, certify_budget=1e-4)
+    tight.refine(0.3 * tight.stats()["diagonal"])
+    assert tight.stats()["certify_budget_reached"]
+    assert tight.stats()["uncertified"] > 0
+    assert not cert.stats()["certify_budget_reached"]

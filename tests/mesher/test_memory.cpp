@@ -143,3 +143,41 @@ TEST_CASE("the quality mode stops at what the memory limit leaves beside the fas
   REQUIRE(m.triangles.size() > 1000);
   for (const Point3& v : m.vertices) CHECK(std::abs(norm(v) - 1.0) < 0.02);
 }
+
+TEST_CASE("final_surface: the same mesh as surface(), the refinement freed before the scan's finishing",
+          "[mesher][memory]") {
+  std::vector<Point3> p, n;
+  sphere(3000, p, n);
+  // A cap left out and the surface asked open: the finishing trims (it runs after the release).
+  std::vector<Point3> cap_p, cap_n;
+  for (std::size_t i = 0; i < p.size(); ++i)
+    if (p[i].z < 0.8) cap_p.push_back(p[i]), cap_n.push_back(n[i]);
+  MesherOptions o;
+  o.polygonizer.keep_history = false;
+  o.surface = SurfaceKind::Open;
+  Mesher kept = Mesher::from_scan(cap_p, cap_n, o);
+  Mesher freed = Mesher::from_scan(cap_p, cap_n, o);
+  REQUIRE(kept.refine(0.08));
+  REQUIRE(freed.refine(0.08));
+  const SurfaceMesh& a = kept.surface();
+  const SurfaceMesh& b = freed.final_surface();
+  CHECK(freed.stats().open);
+  REQUIRE(b.triangles.size() > 500);
+  CHECK(a.vertices == b.vertices);
+  CHECK(a.triangles == b.triangles);
+  CHECK(&freed.surface() == &b);  // the same mesh again, nothing recomputed
+  const MesherStats sa = kept.stats(), sb = freed.stats();
+  CHECK(sa.polygonizer.vertices == sb.polygonizer.vertices);
+  CHECK(sa.polygonizer.insertions == sb.polygonizer.insertions);
+  CHECK(sa.trimmed_triangles == sb.trimmed_triangles);
+  CHECK(sb.trimmed_triangles > 0);
+  // What needs the refinement is refused, naming why, and changes nothing.
+  const std::size_t constraints = freed.size();
+  CHECK_THROWS_WITH(freed.refine(0.04), Catch::Contains("released by final_surface()"));
+  CHECK_THROWS_AS(freed.add_constraint({0.0, 0.0, 0.5}, -1.0), InvalidArgument);
+  CHECK_THROWS_AS(freed.polygonizer(), InvalidArgument);
+  CHECK_THROWS_AS(freed.update_surface(), InvalidArgument);
+  CHECK_THROWS_AS(freed.restart(), InvalidArgument);
+  CHECK(freed.size() == constraints);
+  CHECK(freed.final_surface().triangles == a.triangles);
+}

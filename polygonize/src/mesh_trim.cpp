@@ -28,6 +28,7 @@
 
 #include "vitri/core/error.hpp"
 #include "vitri/core/parallel.hpp"
+#include "triangle_crossing.hpp"
 
 #include <algorithm>
 #include <array>
@@ -541,7 +542,8 @@ class Trimmer {
   /// Moves every copy of a split vertex, and the vertex itself, off the shared position toward the centre
   /// of its own fan (TrimOptions::separate_pinches), so that no two triangles without a common vertex
   /// touch. One at a time, from the current positions; the step is halved while a triangle of the fan
-  /// would turn over (its normal against the old one) and given up after four halvings.
+  /// would turn over (its normal against the old one) or cross a triangle near it (exact), and given up
+  /// after four halvings.
   void separate_pinches(SurfaceMesh& out, const std::vector<std::uint32_t>& renumber) const {
     std::vector<std::uint8_t> split(vertex_count(), 0);
     for (const std::uint32_t o : origin_) split[base(o)] = 1;
@@ -567,6 +569,50 @@ class Trimmer {
       const Point3 &a = out.vertices[t[0]], &b = out.vertices[t[1]], &c = out.vertices[t[2]];
       return cross(b - a, c - a);
     };
+    if (moved.empty()) return;
+    // The triangles near the moved vertices, in a hash grid whose finest cells are a fan's reach: a move
+    // is kept only where the fan crosses (or touches) none of them, exactly (a copy moved toward its own
+    // fan's centre can reach across a neighbouring sheet's triangles: building.ply's trimmed mesh had 2
+    // crossing pairs so).
+    double reach = 0;
+    for (std::size_t i = 0; i < moved.size(); ++i)
+      for (std::uint32_t j = start[i]; j < start[i + 1]; ++j)
+        for (const std::uint32_t w : out.triangles[fan[j]])
+          reach = std::max(reach, norm(out.vertices[w] - out.vertices[moved[i]]));
+    std::unordered_set<mesh_detail::TriangleGrid::Key> wanted;
+    for (const std::uint32_t v : moved) {  // a fan's box, padded by the longest move (at most half a reach)
+      const Point3 r{1.5 * reach, 1.5 * reach, 1.5 * reach};
+      const auto a = mesh_detail::TriangleGrid::cell_of(out.vertices[v] - r, reach);
+      const auto b = mesh_detail::TriangleGrid::cell_of(out.vertices[v] + r, reach);
+      for (std::int64_t x = a[0]; x <= b[0]; ++x)
+        for (std::int64_t y = a[1]; y <= b[1]; ++y)
+          for (std::int64_t z = a[2]; z <= b[2]; ++z) wanted.insert(mesh_detail::TriangleGrid::key(x, y, z));
+    }
+    mesh_detail::TriangleGrid grid(out, reach, std::move(wanted));
+    double drift = 0;  // the longest move made: the grid's boxes (of the positions before) are off by at most this
+    std::vector<std::uint32_t> near;
+    const auto corners = [&](std::uint32_t t) {
+      const Tri& c = out.triangles[t];
+      return std::array<Point3, 3>{out.vertices[c[0]], out.vertices[c[1]], out.vertices[c[2]]};
+    };
+    const auto fan_crosses = [&](std::size_t i) {
+      Point3 lo = out.vertices[moved[i]], hi = lo;
+      for (std::uint32_t j = start[i]; j < start[i + 1]; ++j)
+        for (const Point3& x : corners(fan[j]))
+          for (std::size_t k = 0; k < 3; ++k) lo[k] = std::min(lo[k], x[k]), hi[k] = std::max(hi[k], x[k]);
+      const Point3 pad{drift, drift, drift};
+      near.clear();
+      grid.query(lo - pad, hi + pad, near);
+      std::sort(near.begin(), near.end());
+      near.erase(std::unique(near.begin(), near.end()), near.end());
+      for (std::uint32_t j = start[i]; j < start[i + 1]; ++j) {
+        const std::uint32_t t = fan[j];
+        const auto pt = corners(t);
+        for (const std::uint32_t u : near)
+          if (u != t && mesh_detail::triangles_cross(out.triangles[t], pt, out.triangles[u], corners(u))) return true;
+      }
+      return false;
+    };
     for (std::size_t i = 0; i < moved.size(); ++i) {
       const std::uint32_t v = moved[i];
       const Point3 p = out.vertices[v];
@@ -584,8 +630,9 @@ class Trimmer {
         bool turned = false;
         for (std::uint32_t j = start[i]; j < start[i + 1] && !turned; ++j)
           turned = dot(normal(out.triangles[fan[j]]), before[j - start[i]]) <= 0.0;
-        if (!turned) {
+        if (!turned && !fan_crosses(i)) {
           ++rep_.separated_vertices;
+          drift = std::max(drift, norm(out.vertices[v] - p));
           break;
         }
         out.vertices[v] = p;

@@ -49,8 +49,8 @@ struct TrimOptions {
   /// position toward the centre of its own fan (the mean of the fan's other corners), so that the parts no
   /// longer touch: the result is a 2-manifold in space too, not only in its indices (no two triangles
   /// without a common vertex share a point). The step is halved, up to four times, while a triangle of
-  /// the fan would turn over; after that the copy stays where it was. In [0, 0.5]; 0 leaves the copies
-  /// on the shared position.
+  /// the fan would turn over or cross (or touch) a triangle near it (exact predicates); after that the
+  /// copy stays where it was. In [0, 0.5]; 0 leaves the copies on the shared position.
   double separate_pinches = 0.05;
   /// The field s beyond the vertices, when known (e.g. the distance to the data minus its reach, which
   /// is not linear along a long edge: an edge spanning a gap in the data passes far from it between two

@@ -301,6 +301,7 @@ std::string Api::stats_json(const std::string& extra) {
          // The certified mode (docs/certificate.md): tetrahedra the last refinement left uncertified.
          ",\"certify\":" + (session_.mesher().options().polygonizer.certify ? "true" : "false") +
          ",\"uncertified\":" + std::to_string(s.polygonizer.uncertified) +
+         ",\"certify_budget_reached\":" + (s.polygonizer.certify_budget_reached ? "true" : "false") +
          ",\"rebuilds\":" + std::to_string(s.rebuilds) +
          ",\"undo\":" + std::to_string(session_.undo_depth()) +
          ",\"redo\":" + std::to_string(session_.redo_depth()) +

@@ -594,6 +594,7 @@ TEST_CASE("studio api: the certified mode's status follows every refinement", "[
     const PolygonizerStats ps = session.mesher().stats().polygonizer;
     CHECK(s.find("certify")->as_bool("") == certify);
     CHECK(number(s, "uncertified") == static_cast<double>(ps.uncertified));
+    CHECK(s.find("certify_budget_reached")->as_bool("certify_budget_reached") == ps.certify_budget_reached);
     // The certificate ran over the level (checked now or kept from before) exactly when asked for.
     CHECK((ps.certify_checked + ps.certify_kept > 0) == certify);
   };

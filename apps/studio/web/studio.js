@@ -270,7 +270,8 @@ class Studio {
       s.triangles + ' triangles, ' + s.vertices + ' vertices\n' +
       s.constraints + ' constraints, ' + s.delaunay_vertices + ' Delaunay vertices' +
       (s.certify ? '\n' + (s.uncertified === 0 ? 'topology certified'
-                                                : 'NOT certified: ' + s.uncertified + ' tetrahedra') : '');
+                                                : 'NOT certified: ' + s.uncertified + ' tetrahedra' +
+                                                  (s.certify_budget_reached ? ' (insertion budget spent)' : '')) : '');
     this.updateSelection();
   }
 

@@ -1394,11 +1394,13 @@ double neighbours_wanted(double rho) { return 16.0 * (rho / 0.06) * (rho / 0.06)
 /// `reach` the distance to each examined point's farthest examined neighbour. With `only`, the points
 /// it does not mark are not examined (their shift 0, their reach left as it was). `nb` gives the local
 /// spacings; when it also holds the current neighbours of `p` (`nb_current`) and at least the 95 nearest
-/// others, its rows are the 96 nearest (the point itself first, skipped) with no query.
+/// others, its rows are the 96 nearest (the point itself first, skipped) with no query. `layers`, when
+/// given (sized p.size()), is set to 1 for every point moved where its region's noise is below a quarter
+/// of the gap (two layers, as opposed to a move within noise), and left as it was elsewhere.
 std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>& n, const std::vector<double>& noise,
                          const PointIndex& index, const Neighbours& nb, bool nb_current, unsigned threads,
                          std::vector<double>& shift, std::vector<double>& reach,
-                         const std::vector<std::uint8_t>* only = nullptr) {
+                         const std::vector<std::uint8_t>* only = nullptr, std::vector<std::uint8_t>* layers = nullptr) {
   shift.assign(p.size(), 0.0);
   reach.resize(p.size(), 0.0);
   // The overlap of two layers is denser than either: its local spacing is up to half a layer's, so the
@@ -1468,6 +1470,7 @@ std::size_t merge_layers(const std::vector<Point3>& p, const std::vector<Point3>
     double sum = 0;
     for (const Point3& q : keep) sum += q.x;
     shift[i] = sum / static_cast<double>(m);
+    if (layers) (*layers)[i] = noise[i] < 0.25 * gap;
   };
   // The cylinder's points among the nearest 96 (a ball would hold thousands where a sparse point borders
   // a dense region: room scans): about 3.9 h in an overlap of two layers, 5.5 h on one.
@@ -1964,6 +1967,8 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
   // moved and those with a moved point (before or after its move) within the reach of their examined
   // neighbours; every other point would see exactly its first-pass neighbours and stay (the same result
   // as examining all, at a fraction of the queries: on a clean scan almost nothing moves).
+  // `layered`: the points merge_layers moved between two layers (not as noise), for the projection below.
+  std::vector<std::uint8_t> layered(p.size(), 0);
   if (options.approximate) {
     std::vector<double> shift, reach, total(p.size(), 0.0);
     std::vector<std::uint8_t> again;
@@ -1971,7 +1976,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       if (pass > 0) index = PointIndex(p, threads);
       // (pass 0: nb holds the neighbours of these positions; pass 1: the points moved since)
       if (merge_layers(p, n, region_noise, index, nb, pass == 0, threads, shift, reach,
-                       pass > 0 ? &again : nullptr) == 0)
+                       pass > 0 ? &again : nullptr, &layered) == 0)
         break;
       std::vector<Point3> ends;  // the moved points' positions before and after
       for (std::size_t i = 0; i < p.size(); ++i)
@@ -2016,6 +2021,25 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
     std::vector<double> nearest(p.size());
     for (std::size_t i = 0; i < p.size(); ++i) nearest[i] = nb.d(i, 0);
     const double scale = median(nearest);  // the spacing
+    // The overlaps of misregistered views: points merged between two layers (`layered`; not moves
+    // within noise) most of whose neighbours were merged so too (`core`; a real scan's few merges, at
+    // steps and creases, have fewer: under 40% of their neighbours on the shipped scans but 3 points of
+    // lidar_cars, over 60% for most of an overlap's), and the points beside them (`near_layers`). Each
+    // point's middle between the layers depends on its own cylinder's points, and a 16-point fit, in one
+    // layer or the other, keeps that scatter (pits all over the overlap): there the fits see the
+    // kMaxNeighbours nearest (below) whatever their residual.
+    std::vector<std::uint8_t> core(p.size(), 0), near_layers(p.size(), 0);
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      if (!layered[i]) continue;
+      std::size_t count = 0;
+      for (std::size_t c = 0; c < nb.k; ++c) count += layered[nb.at(i, c)];
+      core[i] = 2 * count >= nb.k;
+    }
+    for (std::size_t i = 0; i < p.size(); ++i) {
+      bool any = core[i] != 0;
+      for (std::size_t c = 0; c < nb.k && !any; ++c) any = core[nb.at(i, c)] != 0;
+      near_layers[i] = any;
+    }
     // Passes: a second where the noise exceeds 0.1 spacings, four above 0.5 (three until session 41: the
     // fourth halved the handles of pig with noise of 2 spacings, -94 -> -50), the noise being the
     // larger of the scan's median and the point's region's (a noisy region gets more passes than the
@@ -2035,6 +2059,13 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
       std::vector<std::uint8_t> flagged(p.size(), 0);
       std::size_t rows = 0, kw = 0;
       for (std::size_t i = 0; i < p.size(); ++i) {
+        if (near_layers[i]) {  // an overlap's merged layers: the widest fits, kept whatever their residual
+          flagged[i] = 1;
+          wide_row[i] = rows++;
+          wide_use[i] = clamp_k(kMaxNeighbours);
+          kw = std::max(kw, wide_use[i]);
+          continue;
+        }
         const double rho = region_noise[i] / std::max(nb.d(i, nb.k - 1), 1e-300);
         const double want = neighbours_wanted(rho);
         if (!(want >= 1.5 * static_cast<double>(nb.k))) continue;
@@ -2071,7 +2102,7 @@ ScanPoints prepare_scan(const std::vector<Point3>& input, const std::vector<Poin
             // Noise keeps its scale when the neighbourhood widens; shape (an edge, a corner, clutter)
             // fits worse the wider it is seen: there the point keeps its k.
             const LocalFit own = fit_neighbourhood(p, nb, i, &n);
-            if (fit[i].noise > kWideningGrowth * own.noise) {
+            if (!near_layers[i] && fit[i].noise > kWideningGrowth * own.noise) {
               wide_row[i] = kNoRow;
               fit[i] = own;
             }

@@ -515,16 +515,16 @@ struct CutPlan {
 };
 
 void plan_cut(const SurfaceMesh& mesh, const Topology& g, const std::vector<std::uint32_t>& cycle,
-              const std::vector<std::vector<std::uint32_t>>& left, const Point3& shift, CutPlan& plan) {
+              const std::vector<std::vector<std::uint32_t>>& left, const std::vector<Point3>& shift, CutPlan& plan) {
   const std::size_t n = cycle.size();
   plan = CutPlan{};
   plan.first_new = static_cast<std::uint32_t>(mesh.vertices.size());
   std::vector<std::uint32_t> copy(n);
   for (std::size_t i = 0; i < n; ++i) {
     copy[i] = plan.first_new + static_cast<std::uint32_t>(i);
-    plan.new_points.push_back(mesh.vertices[cycle[i]] + shift);
+    plan.new_points.push_back(mesh.vertices[cycle[i]] + shift[i]);
     plan.copied_from.push_back(cycle[i]);
-    plan.moved.push_back({cycle[i], mesh.vertices[cycle[i]] - shift});
+    plan.moved.push_back({cycle[i], mesh.vertices[cycle[i]] - shift[i]});
   }
   for (std::size_t i = 0; i < n; ++i)
     for (std::uint32_t j = g.vt_start[cycle[i]]; j < g.vt_start[cycle[i] + 1]; ++j) {
@@ -820,19 +820,31 @@ SurfaceMesh cut_short_handles(SurfaceMesh mesh, const HandleOptions& options, Ha
       if (axis_len > 0) axis = axis / axis_len;
       // The shift stays well inside the triangles around the cycle: at most a third of its shortest
       // edge leaving the cycle (a large cycle among small triangles would otherwise fold them).
-      double room = radius;
+      std::vector<double> room_at(n, radius);  // each cycle vertex's own
       for (std::size_t i = 0; i < n; ++i)
         for (std::uint32_t j = g.ve_start[c.cycle[i]]; j < g.ve_start[c.cycle[i] + 1]; ++j) {
           const std::uint32_t e = g.ve[j];
-          if (e != cycle_edges[i] && e != cycle_edges[(i + n - 1) % n]) room = std::min(room, g.edge_len[e] / 3);
+          if (e != cycle_edges[i] && e != cycle_edges[(i + n - 1) % n]) room_at[i] = std::min(room_at[i], g.edge_len[e] / 3);
         }
+      const double room = *std::min_element(room_at.begin(), room_at.end());
       // The side whose triangles lie further along the axis goes that way, the other the other way.
       const double way = dot(side_l, axis) >= dot(side_r, axis) ? 1.0 : -1.0;
       CutPlan plan;
       bool clean = false;
-      for (const double factor : {kCapShift, 0.4 * kCapShift, 2 * kCapShift, 0.1 * kCapShift, 4 * kCapShift}) {
+      // Tried in turn: shifts of kCapShift, 0.4, 2, 0.1 and 4 x that of the radius, each at most the
+      // cycle's room (its shortest edge leaving it); then 1, 0.4 and 0.1 x kCapShift, each vertex within
+      // its own room (a tiny edge at one vertex, left by the extraction's collapses, held the whole cycle
+      // to a shift of a few hundredths of its radius, and the two fans of a twisted cycle crossed).
+      constexpr double kFactors[] = {kCapShift, 0.4 * kCapShift, 2 * kCapShift, 0.1 * kCapShift, 4 * kCapShift,
+                                     kCapShift, 0.4 * kCapShift, 0.1 * kCapShift};
+      constexpr int kSharedRoom = 5;  // the first five: one room for the whole cycle
+      std::vector<Point3> shift(n);
+      for (int attempt = 0; attempt < 8; ++attempt) {
         if (!(axis_len > 0)) break;
-        plan_cut(mesh, g, c.cycle, left, (way * std::min(factor * radius, room)) * axis, plan);
+        const double factor = kFactors[attempt];
+        for (std::size_t i = 0; i < n; ++i)
+          shift[i] = (way * std::min(factor * radius, attempt < kSharedRoom ? room : room_at[i])) * axis;
+        plan_cut(mesh, g, c.cycle, left, shift, plan);
         if (!grid) {
           // Cells within max_loop of a candidate's cycle: where a cut, and a triangle it could cross, may be.
           std::unordered_set<TriangleGrid::Key> wanted;

@@ -165,6 +165,18 @@ std::vector<Point3> write_noisy_sphere(const std::string& path, std::size_t n, d
   return p;
 }
 
+/// `vitri mesh IN -o OUT` with the defaults gives one closed 2-manifold of Euler characteristic 2 (genus 0).
+void mesh_is_one_sphere(const std::string& in, const std::string& out, std::uint64_t seed) {
+  std::string o, e;
+  REQUIRE(run(in + " -o " + out, o, e) == 0);
+  INFO("seed " << seed << "\n" << o << e);
+  const Shape s = shape_of(out);
+  CHECK(s.components == 1);
+  CHECK(s.boundary_edges == 0);
+  CHECK(s.nonmanifold_edges == 0);
+  CHECK(s.euler == 2);
+}
+
 }  // namespace
 
 TEST_CASE("vitri mesh, scan defaults: a noisy sphere with outliers gives one closed sphere within the noise",
@@ -243,14 +255,7 @@ TEST_CASE("vitri mesh, scan defaults: noisy spheres keep the sphere's topology (
   for (std::uint64_t seed : {11u, 12u, 13u, 14u}) {
     const std::string in = kDir + "/scan_sphere_seed.xyz", out = kDir + "/scan_sphere_seed.ply";
     write_noisy_sphere(in, 6000, spacing, 0, seed);
-    std::string o, e;
-    REQUIRE(run(in + " -o " + out, o, e) == 0);
-    INFO("seed " << seed << "\n" << o << e);
-    const Shape s = shape_of(out);
-    CHECK(s.components == 1);
-    CHECK(s.boundary_edges == 0);
-    CHECK(s.nonmanifold_edges == 0);
-    CHECK(s.euler == 2);
+    mesh_is_one_sphere(in, out, seed);
   }
 }
 
@@ -602,14 +607,7 @@ TEST_CASE("vitri mesh, scan defaults: the noise's handles with a tiny edge besid
     const std::string name = "scan_bunny_noise2_" + std::to_string(seed);
     const std::string in = kDir + "/" + name + ".xyz", out = kDir + "/" + name + ".ply";
     write_xyz(in, p);
-    std::string o, e;
-    REQUIRE(run(in + " -o " + out, o, e) == 0);
-    INFO("seed " << seed << "\n" << o << e);
-    const Shape s = shape_of(out);
-    CHECK(s.components == 1);
-    CHECK(s.boundary_edges == 0);
-    CHECK(s.nonmanifold_edges == 0);
-    CHECK(s.euler == 2);  // the bunny's genus 0
+    mesh_is_one_sphere(in, out, seed);  // the bunny's genus 0
   }
 }
 
